@@ -1,0 +1,1 @@
+//! Finite elements, sparse assembly and the procedural chassis body.

@@ -1,0 +1,1 @@
+//! Engine multibody model, mounts, coupled system and outputs.
