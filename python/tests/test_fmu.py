@@ -1,0 +1,110 @@
+"""The packaged FMU as other tools see it: fmpy (validation, simulate_fmu) and DNV's libcosim."""
+
+import json
+import pathlib
+import subprocess
+import tempfile
+import zipfile
+
+import numpy as np
+import pytest
+from fmpy import read_model_description, simulate_fmu
+from fmpy.validation import validate_fmu
+
+ROOT = pathlib.Path(__file__).resolve().parents[2]
+G = 9.80665
+
+FMI2_FUNCTIONS = {
+    "fmi2GetTypesPlatform", "fmi2GetVersion", "fmi2SetDebugLogging", "fmi2Instantiate",
+    "fmi2FreeInstance", "fmi2SetupExperiment", "fmi2EnterInitializationMode",
+    "fmi2ExitInitializationMode", "fmi2Terminate", "fmi2Reset", "fmi2GetReal", "fmi2GetInteger",
+    "fmi2GetBoolean", "fmi2GetString", "fmi2SetReal", "fmi2SetInteger", "fmi2SetBoolean",
+    "fmi2SetString", "fmi2GetFMUstate", "fmi2SetFMUstate", "fmi2FreeFMUstate",
+    "fmi2SerializedFMUstateSize", "fmi2SerializeFMUstate", "fmi2DeSerializeFMUstate",
+    "fmi2GetDirectionalDerivative", "fmi2SetRealInputDerivatives", "fmi2GetRealOutputDerivatives",
+    "fmi2DoStep", "fmi2CancelStep", "fmi2GetStatus", "fmi2GetRealStatus", "fmi2GetIntegerStatus",
+    "fmi2GetBooleanStatus", "fmi2GetStringStatus",
+}
+
+MOUNT_FORCES = [f"mount[{i}].F[{j}]" for i in range(1, 5) for j in range(1, 4)]
+
+
+def test_fmpy_validation_reports_no_problems(fmu_path):
+    assert validate_fmu(str(fmu_path)) == []
+
+
+def test_library_exports_exactly_the_fmi2_functions(fmu_path):
+    with tempfile.TemporaryDirectory() as tmp, zipfile.ZipFile(fmu_path) as z:
+        so = z.extract("binaries/linux64/EngineMountChassis.so", tmp)
+        out = subprocess.run(["nm", "-D", "--defined-only", so], capture_output=True, text=True, check=True)
+    exported = {line.split()[-1] for line in out.stdout.splitlines() if line.strip()}
+    assert exported == FMI2_FUNCTIONS
+
+
+def test_package_layout(fmu_path):
+    with zipfile.ZipFile(fmu_path) as z:
+        names = set(z.namelist())
+    assert {"modelDescription.xml", "binaries/linux64/EngineMountChassis.so",
+            "documentation/index.html", "resources/engine.json"} <= names
+    md = read_model_description(str(fmu_path))
+    assert md.coSimulation.canGetAndSetFMUstate and md.coSimulation.canSerializeFMUstate
+    assert md.coSimulation.canInterpolateInputs
+    rpm = next(v for v in md.modelVariables if v.name == "rpm")
+    assert rpm.declaredType is None and rpm.unit == "rpm"
+    unit = next(u for u in md.unitDefinitions if u.name == "rpm")
+    assert unit.baseUnit.rad == 1 and unit.baseUnit.s == -1
+    assert unit.baseUnit.factor == pytest.approx(np.pi / 30)
+
+
+def powertrain_mass() -> float:
+    from engine_config import total_mass  # noqa: E402  (helper next to this file)
+    return total_mass(json.loads((ROOT / "resources" / "engine.json").read_text()))
+
+
+def test_simulate_rpm_ramp_ground_scene(fmu_path):
+    signals = np.array([(0.0, 800.0), (2.0, 2500.0)], dtype=[("time", np.float64), ("rpm", np.float64)])
+    result = simulate_fmu(str(fmu_path), stop_time=2.0, output_interval=1e-3, input=signals,
+                          output=MOUNT_FORCES + ["crankAngle", "powertrain.r[3]"])
+    assert len(result) == 2001
+    for name in result.dtype.names:
+        assert np.all(np.isfinite(result[name])), name
+    vertical = sum(result[f"mount[{i}].F[3]"][0] for i in range(1, 5))
+    # static equilibrium at t = 0: the mounts carry the powertrain's weight (force on the ground side)
+    assert vertical == pytest.approx(-powertrain_mass() * G, rel=1e-3)
+    # the engine really runs: crank angle integrates the ramp
+    omega = np.interp(result["time"], signals["time"], signals["rpm"]) * np.pi / 30
+    expected = np.trapezoid(omega, result["time"])
+    assert result["crankAngle"][-1] == pytest.approx(expected, rel=1e-3)
+    # and the mount forces vibrate
+    assert np.std(result["mount[1].F[3]"][500:]) > 1.0
+
+
+def test_libcosim_gets_the_same_outputs_as_fmpy(fmu_path):
+    from libcosimpy.CosimEnums import CosimVariableType
+    from libcosimpy.CosimExecution import CosimExecution
+    from libcosimpy.CosimObserver import CosimObserver
+    from libcosimpy.CosimSlave import CosimLocalSlave
+
+    md = read_model_description(str(fmu_path))
+    vr = {v.name: v.valueReference for v in md.modelVariables}
+    names = MOUNT_FORCES + ["crankAngle"]
+    steps, h = 100, 1e-3
+
+    execution = CosimExecution.from_step_size(step_size=int(h * 1e9))
+    slave = CosimLocalSlave(fmu_path=str(fmu_path), instance_name="engine")
+    index = execution.add_local_slave(local_slave=slave)
+    observer = CosimObserver.create_last_value()
+    execution.add_observer(observer=observer)
+    execution.real_initial_value(slave_index=index, variable_reference=vr["rpm"], value=1500.0)
+    cosim = []
+    for _ in range(steps):
+        assert execution.step()
+        cosim.append(observer.last_real_values(slave_index=index, variable_references=[vr[n] for n in names]))
+    cosim = np.array(cosim)
+
+    result = simulate_fmu(str(fmu_path), stop_time=steps * h, output_interval=h,
+                          start_values={"rpm": 1500.0}, output=names)
+    fmpy_values = np.array([[row[n] for n in names] for row in result[1:]])
+    scale = np.max(np.abs(fmpy_values))
+    np.testing.assert_allclose(cosim, fmpy_values, rtol=0, atol=1e-9 * scale)
+    assert CosimVariableType.REAL is not None

@@ -1,0 +1,138 @@
+//! Inputs as continuous signals between communication points.
+
+/// A real input that changes linearly from its reference time on: the value set at a
+/// communication point plus the first derivative from `fmi2SetRealInputDerivatives`.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Signal {
+    pub value: f64,
+    pub derivative: f64,
+    pub reference_time: f64,
+}
+
+impl Signal {
+    pub fn constant(value: f64) -> Signal {
+        Signal { value, derivative: 0.0, reference_time: 0.0 }
+    }
+
+    pub fn at(&self, t: f64) -> f64 {
+        self.value + self.derivative * (t - self.reference_time)
+    }
+
+    /// Whether `next`, valid from `t` on, continues this signal without a jump at `t`.
+    pub fn continues_into(&self, next: &Signal, t: f64) -> bool {
+        let before = self.at(t);
+        let after = next.at(t);
+        (before - after).abs() <= 1e-12 * before.abs().max(after.abs()).max(1.0)
+    }
+}
+
+/// All inputs of the model, in SI units.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Inputs {
+    /// Crank speed in rad/s.
+    pub crank_speed: Signal,
+    /// Drivetrain reaction torque on the housing about the crank axis, N m.
+    pub load_torque: Signal,
+    /// Scale on each mount's force-deflection curve (> 0).
+    pub stiffness_scale: [Signal; 4],
+    /// Scale on each mount's damping (>= 0).
+    pub damping_scale: [Signal; 4],
+}
+
+impl Inputs {
+    /// Physical admissibility of the input values (finite values are checked by the caller).
+    pub fn validate(&self) -> Result<(), String> {
+        if self.crank_speed.value < 0.0 {
+            return Err(format!(
+                "engine speed {} rpm is negative",
+                self.crank_speed.value / super::RPM_TO_RAD_PER_S
+            ));
+        }
+        for (i, s) in self.stiffness_scale.iter().enumerate() {
+            if !(s.value > 0.0) {
+                return Err(format!(
+                    "mount[{}].stiffnessScale = {} must be > 0 (remove a mount in the configuration instead)",
+                    i + 1,
+                    s.value
+                ));
+            }
+        }
+        for (i, s) in self.damping_scale.iter().enumerate() {
+            if !(s.value >= 0.0) {
+                return Err(format!("mount[{}].dampingScale = {} must be >= 0", i + 1, s.value));
+            }
+        }
+        Ok(())
+    }
+
+    /// Whether `next` continues every signal without a jump at time `t`.
+    pub fn continue_into(&self, next: &Inputs, t: f64) -> bool {
+        let pairs = [(&self.crank_speed, &next.crank_speed), (&self.load_torque, &next.load_torque)];
+        pairs.iter().all(|(a, b)| a.continues_into(b, t))
+            && self.stiffness_scale.iter().zip(&next.stiffness_scale).all(|(a, b)| a.continues_into(b, t))
+            && self.damping_scale.iter().zip(&next.damping_scale).all(|(a, b)| a.continues_into(b, t))
+    }
+
+    /// The signals as a flat vector (for the serialized state), and back.
+    pub fn to_vec(&self) -> Vec<f64> {
+        let mut v = Vec::with_capacity(30);
+        let mut push = |s: &Signal| v.extend_from_slice(&[s.value, s.derivative, s.reference_time]);
+        push(&self.crank_speed);
+        push(&self.load_torque);
+        self.stiffness_scale.iter().for_each(&mut push);
+        self.damping_scale.iter().for_each(&mut push);
+        v
+    }
+
+    pub const FLAT_LEN: usize = 30;
+
+    pub fn from_slice(v: &[f64]) -> Result<Inputs, String> {
+        if v.len() != Self::FLAT_LEN {
+            return Err(format!("input state has {} numbers, expected {}", v.len(), Self::FLAT_LEN));
+        }
+        let s = |k: usize| Signal { value: v[3 * k], derivative: v[3 * k + 1], reference_time: v[3 * k + 2] };
+        Ok(Inputs {
+            crank_speed: s(0),
+            load_torque: s(1),
+            stiffness_scale: [s(2), s(3), s(4), s(5)],
+            damping_scale: [s(6), s(7), s(8), s(9)],
+        })
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn inputs() -> Inputs {
+        Inputs {
+            crank_speed: Signal { value: 100.0, derivative: 10.0, reference_time: 1.0 },
+            load_torque: Signal::constant(0.0),
+            stiffness_scale: [Signal::constant(1.0); 4],
+            damping_scale: [Signal::constant(1.0); 4],
+        }
+    }
+
+    #[test]
+    fn a_ramp_continued_at_its_end_is_not_a_jump() {
+        let a = inputs();
+        let mut b = a;
+        b.crank_speed = Signal { value: 110.0, derivative: 10.0, reference_time: 2.0 };
+        assert!(a.continue_into(&b, 2.0));
+        b.crank_speed.value = 120.0;
+        assert!(!a.continue_into(&b, 2.0));
+    }
+
+    #[test]
+    fn flat_round_trip_and_validation() {
+        let a = inputs();
+        assert_eq!(Inputs::from_slice(&a.to_vec()).unwrap(), a);
+        assert!(Inputs::from_slice(&[0.0; 3]).is_err());
+        let mut bad = a;
+        bad.stiffness_scale[2].value = -1.0;
+        assert!(bad.validate().unwrap_err().contains("mount[3].stiffnessScale"));
+        bad = a;
+        bad.damping_scale[0].value = -0.5;
+        assert!(bad.validate().is_err());
+    }
+}

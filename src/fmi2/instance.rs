@@ -1,0 +1,608 @@
+//! One FMU instance: variable values, the state machine and the co-simulation stepping.
+//!
+//! Everything here is safe Rust; [`super::abi`] turns C arguments into these calls. Every
+//! rejected call leaves the instance exactly as it was: values are validated as a whole before
+//! any is applied.
+
+use std::path::PathBuf;
+
+use super::logger::{Level, Logger};
+use super::state::{self, Mask, Phase};
+use super::variables::{
+    boolean, integer, real, string, Causality, Variability, Variable, BOOLEANS, INTEGERS, REALS,
+    STRINGS,
+};
+use crate::cosim::{self, Simulation};
+
+/// Result of an FMI call, mapped to `fmi2Status` by the ABI layer.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Status {
+    Ok,
+    Warning,
+    Discard,
+    Error,
+    Fatal,
+}
+
+/// All variable values, indexed by value reference.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Values {
+    pub reals: Vec<f64>,
+    pub integers: Vec<i32>,
+    pub booleans: Vec<bool>,
+    pub strings: Vec<String>,
+}
+
+impl Values {
+    pub fn start() -> Values {
+        Values {
+            reals: REALS.iter().map(|v| v.start).collect(),
+            integers: INTEGERS.iter().map(|v| v.start).collect(),
+            booleans: BOOLEANS.iter().map(|v| v.start).collect(),
+            strings: STRINGS.iter().map(|v| v.start.to_owned()).collect(),
+        }
+    }
+}
+
+/// Everything an FMU state (`fmi2GetFMUstate`) captures.
+#[derive(Clone)]
+pub struct Core {
+    pub phase: Phase,
+    pub values: Values,
+    /// First time derivatives of the Real inputs (`fmi2SetRealInputDerivatives`), by value reference.
+    pub input_derivatives: Vec<f64>,
+    pub start_time: f64,
+    pub stop_time: Option<f64>,
+    pub time: f64,
+    pub terminated: bool,
+    pub simulation: Option<Simulation>,
+}
+
+impl Core {
+    fn fresh() -> Core {
+        Core {
+            phase: Phase::Instantiated,
+            values: Values::start(),
+            input_derivatives: vec![0.0; REALS.len()],
+            start_time: 0.0,
+            stop_time: None,
+            time: 0.0,
+            terminated: false,
+            simulation: None,
+        }
+    }
+}
+
+/// One instance of the FMU.
+pub struct Instance {
+    pub name: String,
+    pub logger: Logger,
+    pub resource_dir: Option<PathBuf>,
+    pub core: Core,
+}
+
+/// Relative tolerance on communication points: masters compute them as `t0 + n h`.
+const TIME_JITTER: f64 = 1e-9;
+
+fn same_time(a: f64, b: f64) -> bool {
+    (a - b).abs() <= TIME_JITTER * a.abs().max(b.abs()).max(1.0)
+}
+
+impl Instance {
+    pub fn new(name: &str, logger: Logger, resource_dir: Option<PathBuf>) -> Instance {
+        Instance { name: name.to_owned(), logger, resource_dir, core: Core::fresh() }
+    }
+
+    pub fn phase(&self) -> Phase {
+        self.core.phase
+    }
+
+    pub fn error(&self, message: &str) -> Status {
+        self.logger.log(Level::Error, "logStatusError", message);
+        Status::Error
+    }
+
+    pub fn event(&self, message: &str) {
+        self.logger.log(Level::Info, "logEvents", message);
+    }
+
+    /// Checks the state mask; on refusal logs why and returns the status to give.
+    pub fn allowed(&self, function: &str, mask: Mask) -> Result<(), Status> {
+        self.logger.log(Level::Info, "logCalls", function);
+        if self.core.phase == Phase::Fatal {
+            self.logger.log(
+                Level::Fatal,
+                "logStatusError",
+                &format!("{function}: the instance is in a fatal state; only fmi2FreeInstance is allowed"),
+            );
+            return Err(Status::Fatal);
+        }
+        if mask.allows(self.core.phase) {
+            Ok(())
+        } else {
+            Err(self.error(&format!(
+                "{function} is not allowed in phase {:?}",
+                self.core.phase
+            )))
+        }
+    }
+
+    /// `fmi2Reset`: back to the freshly instantiated state with start values.
+    pub fn reset(&mut self) -> Status {
+        self.core = Core::fresh();
+        Status::Ok
+    }
+
+    pub fn setup_experiment(&mut self, start: f64, stop: Option<f64>) -> Status {
+        if !start.is_finite() {
+            return self.error(&format!("fmi2SetupExperiment: start time {start} is not finite"));
+        }
+        if let Some(stop) = stop {
+            if !stop.is_finite() || stop < start {
+                return self.error(&format!(
+                    "fmi2SetupExperiment: stop time {stop} must be finite and >= start time {start}"
+                ));
+            }
+        }
+        self.core.start_time = start;
+        self.core.stop_time = stop;
+        self.core.time = start;
+        Status::Ok
+    }
+
+    pub fn enter_initialization(&mut self) -> Status {
+        self.core.phase = Phase::InitializationMode;
+        Status::Ok
+    }
+
+    pub fn exit_initialization(&mut self) -> Status {
+        if let Err(status) = self.ensure_simulation() {
+            return status;
+        }
+        self.core.phase = Phase::StepComplete;
+        Status::Ok
+    }
+
+    pub fn terminate(&mut self) -> Status {
+        self.core.phase = Phase::Terminated;
+        Status::Ok
+    }
+
+    /// Builds the model from the parameters and finds its static equilibrium, once per
+    /// initialisation (parameters set afterwards in initialisation mode rebuild it).
+    fn ensure_simulation(&mut self) -> Result<(), Status> {
+        if self.core.simulation.is_some() {
+            return Ok(());
+        }
+        let mut simulation = self.build_simulation().map_err(|m| self.error(&m))?;
+        for line in simulation.describe() {
+            self.event(&line);
+        }
+        let outputs = simulation.outputs().map_err(|m| self.error(&m))?;
+        self.write_outputs(&outputs, &simulation.counters());
+        self.core.simulation = Some(simulation);
+        Ok(())
+    }
+
+    /// A simulation built from the current parameters and inputs, at its static equilibrium.
+    pub fn build_simulation(&self) -> Result<Simulation, String> {
+        let settings = self.settings()?;
+        let inputs = self.inputs_at_time();
+        self.event(&format!(
+            "building scene {} at t = {} s (config: {})",
+            settings.scene,
+            self.core.time,
+            settings
+                .config_file
+                .as_ref()
+                .map(|p| p.display().to_string())
+                .unwrap_or_else(|| "built-in defaults".to_owned())
+        ));
+        Simulation::new(&settings, self.core.time, &inputs).map_err(|m| format!("model set-up failed: {m}"))
+    }
+
+    /// The model settings the parameters describe.
+    fn settings(&self) -> Result<cosim::Settings, String> {
+        let v = &self.core.values;
+        let config_file = {
+            let given = v.strings[string::CONFIG_FILE as usize].trim();
+            if !given.is_empty() {
+                let p = PathBuf::from(given);
+                Some(if p.is_relative() {
+                    self.resource_dir.as_ref().map(|r| r.join(&p)).unwrap_or(p)
+                } else {
+                    p
+                })
+            } else {
+                self.resource_dir
+                    .as_ref()
+                    .map(|r| r.join(cosim::DEFAULT_CONFIG_NAME))
+                    .filter(|p| p.is_file())
+            }
+        };
+        Ok(cosim::Settings {
+            scene: v.integers[integer::SCENE as usize],
+            config_file,
+            effects: cosim::EffectSwitches {
+                gas_forces: v.booleans[boolean::EFFECT_GAS_FORCES as usize],
+                mass_forces: v.booleans[boolean::EFFECT_MASS_FORCES as usize],
+                balance_shaft: v.booleans[boolean::EFFECT_BALANCE_SHAFT as usize],
+                gyroscopic: v.booleans[boolean::EFFECT_GYROSCOPIC as usize],
+                ring_carrier: v.booleans[boolean::EFFECT_RING_CARRIER as usize],
+                mount_nonlinearity: v.booleans[boolean::EFFECT_MOUNT_NONLINEARITY as usize],
+            },
+            fade_in_time: v.reals[real::FADE_IN_TIME as usize],
+            crank_start_angle: v.reals[real::CRANK_START_ANGLE as usize],
+            rel_tol: v.reals[real::SOLVER_REL_TOL as usize],
+            abs_tol: v.reals[real::SOLVER_ABS_TOL as usize],
+            max_order: v.integers[integer::SOLVER_MAX_ORDER as usize],
+            stability_limit_detection: v.booleans[boolean::SOLVER_STABILITY_LIMIT_DETECTION as usize],
+        })
+    }
+
+    /// The inputs as signals referenced to the current time.
+    fn inputs_at_time(&self) -> cosim::Inputs {
+        inputs_from(&self.core.values.reals, &self.core.input_derivatives, self.core.time)
+    }
+
+    fn write_outputs(&mut self, o: &cosim::Outputs, c: &cosim::Counters) {
+        let r = &mut self.core.values.reals;
+        for (i, mount) in o.mount_force.iter().enumerate() {
+            for (j, f) in mount.iter().enumerate() {
+                r[real::MOUNT_F[i][j] as usize] = *f;
+            }
+        }
+        r[real::CRANK_ANGLE as usize] = o.crank_angle;
+        for k in 0..3 {
+            r[real::POWERTRAIN_R[k] as usize] = o.powertrain_displacement[k];
+            r[real::POWERTRAIN_PHI[k] as usize] = o.powertrain_rotation[k];
+            r[real::POWERTRAIN_A[k] as usize] = o.powertrain_acceleration[k];
+        }
+        let n = &mut self.core.values.integers;
+        let clamp = |x: u64| x.min(i32::MAX as u64) as i32;
+        n[integer::SOLVER_STEPS as usize] = clamp(c.steps);
+        n[integer::SOLVER_RHS_EVALUATIONS as usize] = clamp(c.rhs_evaluations);
+        n[integer::SOLVER_JACOBIAN_EVALUATIONS as usize] = clamp(c.jacobian_evaluations);
+        n[integer::SOLVER_FACTORIZATIONS as usize] = clamp(c.factorizations);
+    }
+
+    // ----- get -------------------------------------------------------------------------------
+
+    /// Outputs asked for in initialisation mode are the static equilibrium's.
+    fn prepare_get(&mut self, function: &str, vrs: &[u32], outputs_of: impl Fn(u32) -> bool) -> Result<(), Status> {
+        self.allowed(function, state::GET_VALUES)?;
+        if self.core.phase == Phase::InitializationMode && vrs.iter().any(|vr| outputs_of(*vr)) {
+            self.ensure_simulation()?;
+        }
+        Ok(())
+    }
+
+    pub fn get_real(&mut self, vrs: &[u32], out: &mut [f64]) -> Status {
+        let is_output = |vr: u32| REALS.get(vr as usize).is_some_and(|v| v.causality == Causality::Output);
+        if let Err(s) = self.prepare_get("fmi2GetReal", vrs, is_output) {
+            return s;
+        }
+        self.get_values(vrs, out, &self.core.values.reals, REALS, "fmi2GetReal", |x| *x)
+    }
+
+    pub fn get_integer(&mut self, vrs: &[u32], out: &mut [i32]) -> Status {
+        let is_output =
+            |vr: u32| INTEGERS.get(vr as usize).is_some_and(|v| v.causality == Causality::Output);
+        if let Err(s) = self.prepare_get("fmi2GetInteger", vrs, is_output) {
+            return s;
+        }
+        self.get_values(vrs, out, &self.core.values.integers, INTEGERS, "fmi2GetInteger", |x| *x)
+    }
+
+    pub fn get_boolean(&mut self, vrs: &[u32], out: &mut [bool]) -> Status {
+        if let Err(s) = self.prepare_get("fmi2GetBoolean", vrs, |_| false) {
+            return s;
+        }
+        self.get_values(vrs, out, &self.core.values.booleans, BOOLEANS, "fmi2GetBoolean", |x| *x)
+    }
+
+    pub fn get_string(&mut self, vrs: &[u32], out: &mut Vec<String>) -> Status {
+        if let Err(s) = self.prepare_get("fmi2GetString", vrs, |_| false) {
+            return s;
+        }
+        let mut tmp = vec![String::new(); vrs.len()];
+        let status =
+            self.get_values(vrs, &mut tmp, &self.core.values.strings, STRINGS, "fmi2GetString", |x| x.clone());
+        *out = tmp;
+        status
+    }
+
+    fn get_values<T, S: 'static, F: Fn(&T) -> O, O>(
+        &self,
+        vrs: &[u32],
+        out: &mut [O],
+        values: &[T],
+        table: &[Variable<S>],
+        function: &str,
+        convert: F,
+    ) -> Status {
+        if let Some(bad) = vrs.iter().find(|vr| (**vr as usize) >= table.len()) {
+            return self.error(&format!("{function}: unknown value reference {bad}"));
+        }
+        for (slot, vr) in out.iter_mut().zip(vrs) {
+            *slot = convert(&values[*vr as usize]);
+        }
+        Status::Ok
+    }
+
+    // ----- set -------------------------------------------------------------------------------
+
+    /// Whether a variable may be set now (FMI 2.0 §3.2.3 for co-simulation).
+    fn settable<T>(&self, v: &Variable<T>) -> Result<(), String> {
+        let phase = self.core.phase;
+        let ok = match v.causality {
+            Causality::Input => true,
+            Causality::Parameter => match v.variability {
+                Variability::Tunable => true,
+                _ => matches!(phase, Phase::Instantiated | Phase::InitializationMode),
+            },
+            _ => false,
+        };
+        if ok {
+            Ok(())
+        } else {
+            Err(format!(
+                "variable {} ({:?}, {:?}) cannot be set in phase {phase:?}",
+                v.name, v.causality, v.variability
+            ))
+        }
+    }
+
+    /// Applies validated values and tells the simulation what changed.
+    fn after_set(&mut self, structural: bool) {
+        if self.core.phase != Phase::StepComplete && structural {
+            // Parameters or initial inputs changed before the model started: rebuild lazily.
+            self.core.simulation = None;
+        }
+    }
+
+    pub fn set_real(&mut self, vrs: &[u32], values: &[f64]) -> Status {
+        if let Err(s) = self.allowed("fmi2SetReal", state::SET_VALUES) {
+            return s;
+        }
+        let mut candidate = self.core.values.reals.clone();
+        for (vr, value) in vrs.iter().zip(values) {
+            let Some(v) = REALS.get(*vr as usize) else {
+                return self.error(&format!("fmi2SetReal: unknown value reference {vr}"));
+            };
+            if let Err(m) = self.settable(v) {
+                return self.error(&format!("fmi2SetReal: {m}"));
+            }
+            if !value.is_finite() {
+                return self.error(&format!("fmi2SetReal: {} = {value} is not finite", v.name));
+            }
+            if v.min.is_some_and(|m| *value < m) || v.max.is_some_and(|m| *value > m) {
+                return self.error(&format!(
+                    "fmi2SetReal: {} = {value} is outside [{}, {}]",
+                    v.name,
+                    v.min.unwrap_or(f64::NEG_INFINITY),
+                    v.max.unwrap_or(f64::INFINITY)
+                ));
+            }
+            candidate[*vr as usize] = *value;
+        }
+        let inputs = inputs_from(&candidate, &self.core.input_derivatives, self.core.time);
+        if let Err(m) = inputs.validate() {
+            return self.error(&format!("fmi2SetReal: {m}"));
+        }
+        // A new input value starts a new linear segment: its derivative is reset until the
+        // master sets it again with fmi2SetRealInputDerivatives.
+        for vr in vrs {
+            if REALS[*vr as usize].causality == Causality::Input {
+                self.core.input_derivatives[*vr as usize] = 0.0;
+            }
+        }
+        self.core.values.reals = candidate;
+        self.after_set(true);
+        Status::Ok
+    }
+
+    pub fn set_integer(&mut self, vrs: &[u32], values: &[i32]) -> Status {
+        if let Err(s) = self.allowed("fmi2SetInteger", state::SET_VALUES) {
+            return s;
+        }
+        let mut candidate = self.core.values.integers.clone();
+        for (vr, value) in vrs.iter().zip(values) {
+            let Some(v) = INTEGERS.get(*vr as usize) else {
+                return self.error(&format!("fmi2SetInteger: unknown value reference {vr}"));
+            };
+            if let Err(m) = self.settable(v) {
+                return self.error(&format!("fmi2SetInteger: {m}"));
+            }
+            if v.min.is_some_and(|m| *value < m) || v.max.is_some_and(|m| *value > m) {
+                return self.error(&format!(
+                    "fmi2SetInteger: {} = {value} is outside [{}, {}]",
+                    v.name,
+                    v.min.unwrap_or(i32::MIN),
+                    v.max.unwrap_or(i32::MAX)
+                ));
+            }
+            candidate[*vr as usize] = *value;
+        }
+        self.core.values.integers = candidate;
+        self.after_set(true);
+        Status::Ok
+    }
+
+    pub fn set_boolean(&mut self, vrs: &[u32], values: &[bool]) -> Status {
+        if let Err(s) = self.allowed("fmi2SetBoolean", state::SET_VALUES) {
+            return s;
+        }
+        let mut candidate = self.core.values.booleans.clone();
+        for (vr, value) in vrs.iter().zip(values) {
+            let Some(v) = BOOLEANS.get(*vr as usize) else {
+                return self.error(&format!("fmi2SetBoolean: unknown value reference {vr}"));
+            };
+            if let Err(m) = self.settable(v) {
+                return self.error(&format!("fmi2SetBoolean: {m}"));
+            }
+            candidate[*vr as usize] = *value;
+        }
+        self.core.values.booleans = candidate;
+        self.after_set(true);
+        Status::Ok
+    }
+
+    pub fn set_string(&mut self, vrs: &[u32], values: &[String]) -> Status {
+        if let Err(s) = self.allowed("fmi2SetString", state::SET_VALUES) {
+            return s;
+        }
+        let mut candidate = self.core.values.strings.clone();
+        for (vr, value) in vrs.iter().zip(values) {
+            let Some(v) = STRINGS.get(*vr as usize) else {
+                return self.error(&format!("fmi2SetString: unknown value reference {vr}"));
+            };
+            if let Err(m) = self.settable(v) {
+                return self.error(&format!("fmi2SetString: {m}"));
+            }
+            candidate[*vr as usize] = value.clone();
+        }
+        self.core.values.strings = candidate;
+        self.after_set(true);
+        Status::Ok
+    }
+
+    pub fn set_real_input_derivatives(&mut self, vrs: &[u32], orders: &[i32], values: &[f64]) -> Status {
+        if let Err(s) = self.allowed("fmi2SetRealInputDerivatives", state::SET_INPUT_DERIVATIVES) {
+            return s;
+        }
+        let mut candidate = self.core.input_derivatives.clone();
+        for ((vr, order), value) in vrs.iter().zip(orders).zip(values) {
+            let Some(v) = REALS.get(*vr as usize) else {
+                return self.error(&format!("fmi2SetRealInputDerivatives: unknown value reference {vr}"));
+            };
+            if v.causality != Causality::Input {
+                return self.error(&format!("fmi2SetRealInputDerivatives: {} is not an input", v.name));
+            }
+            if *order != 1 {
+                return self.error(&format!(
+                    "fmi2SetRealInputDerivatives: derivative order {order} of {} is not supported (only 1)",
+                    v.name
+                ));
+            }
+            if !value.is_finite() {
+                return self.error(&format!("fmi2SetRealInputDerivatives: d{}/dt = {value} is not finite", v.name));
+            }
+            candidate[*vr as usize] = *value;
+        }
+        self.core.input_derivatives = candidate;
+        Status::Ok
+    }
+
+    // ----- stepping --------------------------------------------------------------------------
+
+    pub fn do_step(&mut self, current: f64, step: f64) -> Status {
+        if let Err(s) = self.allowed("fmi2DoStep", state::DO_STEP) {
+            return s;
+        }
+        if !current.is_finite() || !step.is_finite() || step <= 0.0 {
+            return self.error(&format!(
+                "fmi2DoStep: communication point {current} and step size {step} must be finite, step > 0"
+            ));
+        }
+        if !same_time(current, self.core.time) {
+            return self.error(&format!(
+                "fmi2DoStep: communication point {current} s does not match the FMU time {} s \
+                 (use fmi2SetFMUstate to go back in time)",
+                self.core.time
+            ));
+        }
+        let target = current + step;
+        if let Some(stop) = self.core.stop_time {
+            if target > stop && !same_time(target, stop) {
+                return self.error(&format!("fmi2DoStep: step to {target} s passes the stop time {stop} s"));
+            }
+        }
+        let inputs = self.inputs_at_time();
+        let Some(simulation) = self.core.simulation.as_mut() else {
+            return self.error("fmi2DoStep: the model was not initialised");
+        };
+        match simulation.set_inputs(&inputs) {
+            Ok(true) => self.event(&format!(
+                "input discontinuity at t = {} s: integrator restarted at order 1",
+                self.core.time
+            )),
+            Ok(false) => {}
+            Err(m) => return self.error(&format!("fmi2DoStep: {m}")),
+        }
+        let Some(simulation) = self.core.simulation.as_mut() else {
+            return Status::Error;
+        };
+        match simulation.advance_to(target) {
+            Ok(()) => {
+                let outputs = simulation.outputs();
+                let counters = simulation.counters();
+                match outputs {
+                    Ok(o) => {
+                        self.write_outputs(&o, &counters);
+                        self.core.time = target;
+                        self.logger.log(
+                            Level::Info,
+                            "logSolver",
+                            &format!(
+                                "t = {target} s: {} steps, {} RHS, {} Jacobians, {} factorisations",
+                                counters.steps,
+                                counters.rhs_evaluations,
+                                counters.jacobian_evaluations,
+                                counters.factorizations
+                            ),
+                        );
+                        Status::Ok
+                    }
+                    Err(m) => {
+                        self.core.phase = Phase::Error;
+                        self.error(&format!("fmi2DoStep: output evaluation failed: {m}"))
+                    }
+                }
+            }
+            Err(failure) => {
+                // The integrator kept its last successful step; report it and stop the run.
+                if let Ok(o) = simulation.outputs() {
+                    let counters = simulation.counters();
+                    self.write_outputs(&o, &counters);
+                }
+                let reached = failure.reached;
+                self.core.time = reached;
+                self.core.phase = Phase::StepFailed;
+                self.core.terminated = true;
+                self.logger.log(
+                    Level::Error,
+                    "logStatusError",
+                    &format!(
+                        "fmi2DoStep from {current} s to {target} s failed at {reached} s: {}",
+                        failure.message
+                    ),
+                );
+                Status::Discard
+            }
+        }
+    }
+
+    pub fn last_successful_time(&self) -> f64 {
+        self.core.time
+    }
+}
+
+/// Input signals from the Real values and their derivatives, referenced to `time`.
+fn inputs_from(reals: &[f64], derivatives: &[f64], time: f64) -> cosim::Inputs {
+    let signal = |vr: u32| cosim::Signal {
+        value: reals[vr as usize],
+        derivative: derivatives[vr as usize],
+        reference_time: time,
+    };
+    cosim::Inputs {
+        crank_speed: cosim::Signal {
+            value: reals[real::RPM as usize] * cosim::RPM_TO_RAD_PER_S,
+            derivative: derivatives[real::RPM as usize] * cosim::RPM_TO_RAD_PER_S,
+            reference_time: time,
+        },
+        load_torque: signal(real::LOAD_TORQUE),
+        stiffness_scale: real::MOUNT_STIFFNESS_SCALE.map(signal),
+        damping_scale: real::MOUNT_DAMPING_SCALE.map(signal),
+    }
+}

@@ -1,0 +1,120 @@
+//! Logging through the simulation environment's printf-style callback.
+
+use fmi_sys::fmi2::{
+    fmi2CallbackLogger, fmi2ComponentEnvironment, fmi2Status, fmi2Status_fmi2Error,
+    fmi2Status_fmi2Fatal, fmi2Status_fmi2Warning,
+};
+use std::ffi::CString;
+
+use super::variables::LOG_CATEGORIES;
+
+/// How serious a message is; maps to the status passed to the callback.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Level {
+    Info,
+    Warning,
+    Error,
+    Fatal,
+}
+
+/// The environment's logger and which categories it asked for.
+pub struct Logger {
+    callback: fmi2CallbackLogger,
+    environment: fmi2ComponentEnvironment,
+    instance_name: CString,
+    enabled: Vec<bool>,
+    debug_logging: bool,
+}
+
+impl Logger {
+    pub fn new(
+        callback: fmi2CallbackLogger,
+        environment: fmi2ComponentEnvironment,
+        instance_name: &str,
+        debug_logging: bool,
+    ) -> Logger {
+        Logger {
+            callback,
+            environment,
+            instance_name: sanitized(instance_name),
+            enabled: vec![true; LOG_CATEGORIES.len()],
+            debug_logging,
+        }
+    }
+
+    /// `fmi2SetDebugLogging`: with no categories, all are switched; unknown names are an error.
+    pub fn set_debug_logging(&mut self, on: bool, categories: &[String]) -> Result<(), String> {
+        if categories.is_empty() {
+            self.debug_logging = on;
+            self.enabled.iter_mut().for_each(|e| *e = true);
+            return Ok(());
+        }
+        let mut indices = Vec::with_capacity(categories.len());
+        for c in categories {
+            match LOG_CATEGORIES.iter().position(|k| k == c) {
+                Some(i) => indices.push(i),
+                None => {
+                    return Err(format!(
+                        "unknown log category \"{c}\"; known: {}",
+                        LOG_CATEGORIES.join(", ")
+                    ))
+                }
+            }
+        }
+        if on {
+            self.debug_logging = true;
+            self.enabled.iter_mut().for_each(|e| *e = false);
+        }
+        for i in indices {
+            self.enabled[i] = on;
+        }
+        Ok(())
+    }
+
+    fn category_enabled(&self, category: &str) -> bool {
+        LOG_CATEGORIES
+            .iter()
+            .position(|k| *k == category)
+            .map(|i| self.enabled[i])
+            .unwrap_or(true)
+    }
+
+    /// Errors and warnings always reach the environment; other categories only when debug
+    /// logging is on for them.
+    pub fn log(&self, level: Level, category: &str, message: &str) {
+        let always = matches!(level, Level::Error | Level::Fatal | Level::Warning);
+        if !always && !(self.debug_logging && self.category_enabled(category)) {
+            return;
+        }
+        let Some(callback) = self.callback else {
+            return;
+        };
+        let status: fmi2Status = match level {
+            Level::Info => 0,
+            Level::Warning => fmi2Status_fmi2Warning,
+            Level::Error => fmi2Status_fmi2Error,
+            Level::Fatal => fmi2Status_fmi2Fatal,
+        };
+        let category = sanitized(category);
+        let message = sanitized(message);
+        // SAFETY: the callback was supplied by the environment in fmi2Instantiate and stays valid
+        // for the instance's lifetime (FMI 2.0 §2.1.5). The format is the literal "%s" and the
+        // single vararg is a NUL-terminated string that outlives the call, so the printf-style
+        // callee reads exactly one valid C string.
+        unsafe {
+            callback(
+                self.environment,
+                self.instance_name.as_ptr(),
+                status,
+                category.as_ptr(),
+                c"%s".as_ptr(),
+                message.as_ptr(),
+            );
+        }
+    }
+}
+
+/// A C string without interior NUL bytes (they would truncate the message).
+fn sanitized(text: &str) -> CString {
+    CString::new(text.replace('\0', "\u{2400}")).unwrap_or_default()
+}
