@@ -318,22 +318,7 @@ impl GroundScene {
         }
         let phi = y[self.crank_index()];
         if mode.running {
-            if let Some(gas) = &self.gas {
-                let fade = self.excitation(t);
-                let body = &kin[0];
-                let ex = body.rotation * Vector3::x();
-                for &(yo, throw, firing) in &gas.cylinders {
-                    let psi = phi - throw;
-                    let p = gas.curve.pressure(phi - firing);
-                    let f_gas = (p - gas.crankcase_pressure) * gas.area * fade;
-                    let n = side_force(f_gas, psi, gas.radius / gas.conrod);
-                    let (s, _, _) = slider_crank(psi, gas.radius, gas.conrod);
-                    let pin = body.point(&(gas.crank_centre + Vector3::new(0.0, yo, s)));
-                    let bearing = body.point(&(gas.crank_centre + Vector3::new(0.0, yo, 0.0)));
-                    dynamics[0].add_point_force(body, &pin, &(-n * ex));
-                    dynamics[0].add_point_force(body, &bearing, &(n * ex));
-                }
-            }
+            self.add_gas_forces(&kin[0], phi, self.excitation(t), &mut dynamics[0]);
         }
         if nb == 2 {
             for rc in &self.ring_carriers {
@@ -380,6 +365,37 @@ impl GroundScene {
             mounts,
             crank_rate,
         }
+    }
+
+    /// Piston side-force pairs (paper §4.2) on the monoblock `body`: `−F_N` at each piston pin,
+    /// `+F_N` at the main bearing on the same cylinder axis, `F_N = p A tan β`, scaled by `scale`.
+    pub(crate) fn add_gas_forces(
+        &self,
+        body: &BodyKinematics,
+        phi: f64,
+        scale: f64,
+        out: &mut BodyDynamics,
+    ) {
+        let Some(gas) = &self.gas else { return };
+        let ex = body.rotation * Vector3::x();
+        for &(yo, throw, firing) in &gas.cylinders {
+            let psi = phi - throw;
+            let p = gas.curve.pressure(phi - firing);
+            let f_gas = (p - gas.crankcase_pressure) * gas.area * scale;
+            let n = side_force(f_gas, psi, gas.radius / gas.conrod);
+            let (s, _, _) = slider_crank(psi, gas.radius, gas.conrod);
+            let pin = body.point(&(gas.crank_centre + Vector3::new(0.0, yo, s)));
+            let bearing = body.point(&(gas.crank_centre + Vector3::new(0.0, yo, 0.0)));
+            out.add_point_force(body, &pin, &(-n * ex));
+            out.add_point_force(body, &bearing, &(n * ex));
+        }
+    }
+
+    /// Cylinder pressure of cylinder `i` at crank angle `phi` (Pa), if gas forces are on.
+    pub fn cylinder_pressure(&self, i: usize, phi: f64) -> Option<f64> {
+        let gas = self.gas.as_ref()?;
+        let &(_, _, firing) = gas.cylinders.get(i)?;
+        Some(gas.curve.pressure(phi - firing))
     }
 
     /// One evaluation of the equations of motion of the running engine at `(t, y)`.
