@@ -754,8 +754,8 @@ impl Bdf {
         }
         s.etamax = 1.0;
         if s.opts.stability_limit_detection {
-            let nst = s.nst;
-            s.stability.record_error_test_failure(nst, q_failed, h_failed);
+            let (nst, t) = (s.nst, s.tn);
+            s.stability.record_error_test_failure(nst, t, q_failed, h_failed);
         }
         if *nef <= MXNEF1 {
             let mut eta = 1.0 / ((BIAS2 * dsm).powf(1.0 / (s.q + 1) as f64) + ADDON);
@@ -827,8 +827,8 @@ impl Bdf {
             hi[0].copy_from_slice(&s.acor);
             s.saved_tq5 = s.tq[5];
         }
-        let nst = s.nst;
-        s.stability.on_step_accepted(nst);
+        let (nst, t) = (s.nst, s.tn);
+        s.stability.on_step_accepted(nst, t);
     }
 
     /// Chooses the next step size and order (cvPrepareNextStep, cvChooseEta, cvSetEta).

@@ -166,6 +166,11 @@ impl BdfSnapshot {
             }
         }
         w.u64(g.triggers);
+        w.f(g.h_trigger);
+        w.u64(g.hold_start);
+        w.f(g.t_hold_start);
+        w.u64(g.lockout_until);
+        w.u64(g.lockout_len);
         w.bool(s.fixed);
         let len = w.0.len();
         w.0[2] = len as f64;
@@ -297,6 +302,11 @@ impl BdfSnapshot {
             }
         };
         let triggers = r.u64()?;
+        let h_trigger = r.f()?;
+        let hold_start = r.u64()?;
+        let t_hold_start = r.f()?;
+        let lockout_until = r.u64()?;
+        let lockout_len = r.u64()?;
         let fixed = r.bool()?;
         if r.pos != data.len() {
             return Err(bad(format!("{} trailing values", data.len() - r.pos)));
@@ -335,7 +345,18 @@ impl BdfSnapshot {
             pending_h0,
             tstop,
             h_unclipped,
-            stability: StabilityGuard { failures, hold_until, hold_len, last_release, triggers },
+            stability: StabilityGuard {
+                failures,
+                hold_until,
+                hold_len,
+                last_release,
+                triggers,
+                h_trigger,
+                hold_start,
+                t_hold_start,
+                lockout_until,
+                lockout_len,
+            },
             fixed,
         };
         Ok(Self { state })
