@@ -23,8 +23,15 @@ fn run(rtol: f64, stability: bool, mass_matrix: bool) -> Run {
     assert_eq!(bdf.t(), 1.0);
     let exact = p.exact(&y0, 1.0);
     let scale = exact.iter().fold(0.0_f64, |m, v| m.max(v.abs()));
-    let err = bdf.y().iter().zip(&exact).fold(0.0_f64, |m, (a, b)| m.max((a - b).abs()));
-    Run { rel_error: err / scale, stats: bdf.stats().clone() }
+    let err = bdf
+        .y()
+        .iter()
+        .zip(&exact)
+        .fold(0.0_f64, |m, (a, b)| m.max((a - b).abs()));
+    Run {
+        rel_error: err / scale,
+        stats: bdf.stats().clone(),
+    }
 }
 
 #[test]
@@ -33,7 +40,11 @@ fn chain_has_the_specified_modes() {
     let f = p.frequencies_hz();
     assert_eq!(f.len(), 20);
     assert!(f[0] > 3.5 && f[0] < 4.5, "lowest mode {}", f[0]);
-    assert!(f[18] > 95.0 && f[18] < 101.0, "highest chain mode {}", f[18]);
+    assert!(
+        f[18] > 95.0 && f[18] < 101.0,
+        "highest chain mode {}",
+        f[18]
+    );
     assert!(f[19] > 1900.0 && f[19] < 2100.0, "stiff mode {}", f[19]);
 }
 
@@ -42,11 +53,22 @@ fn chain_error_is_at_the_tolerance_scale() {
     for stability in [false, true] {
         let loose = run(1e-4, stability, false);
         let tight = run(1e-7, stability, false);
-        eprintln!("stability {stability}: rel err {:.2e} @1e-4, {:.2e} @1e-7", loose.rel_error, tight.rel_error);
+        eprintln!(
+            "stability {stability}: rel err {:.2e} @1e-4, {:.2e} @1e-7",
+            loose.rel_error, tight.rel_error
+        );
         // Global error of a lightly damped oscillator accumulates over ~1e3..2e4 steps, so the
         // bound is a modest multiple of rtol.
-        assert!(loose.rel_error < 2e-2, "rtol 1e-4: relative error {}", loose.rel_error);
-        assert!(tight.rel_error < 1e-4, "rtol 1e-7: relative error {}", tight.rel_error);
+        assert!(
+            loose.rel_error < 2e-2,
+            "rtol 1e-4: relative error {}",
+            loose.rel_error
+        );
+        assert!(
+            tight.rel_error < 1e-4,
+            "rtol 1e-7: relative error {}",
+            tight.rel_error
+        );
         assert!(tight.rel_error < loose.rel_error);
     }
 }
@@ -55,7 +77,10 @@ fn chain_error_is_at_the_tolerance_scale() {
 fn mass_matrix_form_gives_the_same_solution() {
     let plain = run(1e-6, false, false);
     let with_mass = run(1e-6, false, true);
-    eprintln!("plain {:.2e}, with mass matrix {:.2e}", plain.rel_error, with_mass.rel_error);
+    eprintln!(
+        "plain {:.2e}, with mass matrix {:.2e}",
+        plain.rel_error, with_mass.rel_error
+    );
     assert!(with_mass.rel_error < 1e-3);
 }
 

@@ -12,7 +12,11 @@ fn bits(v: &[f64]) -> Vec<u64> {
 fn restore_reproduces_the_run_bit_for_bit() {
     let mut p = SpringChain::standard(true);
     let y0 = vec![0.0; 40];
-    let opts = BdfOptions { rtol: 1e-5, atol: engine_mount_chassis::ode::Tolerance::Scalar(1e-8), ..Default::default() };
+    let opts = BdfOptions {
+        rtol: 1e-5,
+        atol: engine_mount_chassis::ode::Tolerance::Scalar(1e-8),
+        ..Default::default()
+    };
     let mut bdf = Bdf::new(&mut p, 0.0, &y0, opts).unwrap();
     bdf.advance_to(&mut p, 0.1).unwrap();
     let snap = bdf.snapshot();
@@ -33,7 +37,9 @@ fn restore_reproduces_the_run_bit_for_bit() {
 
     // Through bytes into a fresh integrator.
     let mut other = Bdf::new(&mut p, 0.0, &y0, BdfOptions::default()).unwrap();
-    other.restore(&BdfSnapshot::from_bytes(&flat).unwrap()).unwrap();
+    other
+        .restore(&BdfSnapshot::from_bytes(&flat).unwrap())
+        .unwrap();
     for k in 1..=20 {
         other.advance_to(&mut p, 0.1 + 0.01 * k as f64).unwrap();
     }
@@ -49,16 +55,31 @@ fn serialisation_rejects_foreign_and_damaged_buffers() {
     bdf.advance_to(&mut p, 0.01).unwrap();
     let v = bdf.snapshot().to_f64_vec();
     assert_eq!(BdfSnapshot::from_f64_slice(&v).unwrap(), bdf.snapshot());
-    assert!(matches!(BdfSnapshot::from_f64_slice(&v[..v.len() - 1]), Err(BdfError::BadSnapshot(_))));
+    assert!(matches!(
+        BdfSnapshot::from_f64_slice(&v[..v.len() - 1]),
+        Err(BdfError::BadSnapshot(_))
+    ));
     let mut wrong = v.clone();
     wrong[0] = 1.0;
-    assert!(matches!(BdfSnapshot::from_f64_slice(&wrong), Err(BdfError::BadSnapshot(_))));
+    assert!(matches!(
+        BdfSnapshot::from_f64_slice(&wrong),
+        Err(BdfError::BadSnapshot(_))
+    ));
     let mut wrong_version = v.clone();
     wrong_version[1] = 99.0;
-    assert!(matches!(BdfSnapshot::from_f64_slice(&wrong_version), Err(BdfError::BadSnapshot(_))));
-    assert!(matches!(BdfSnapshot::from_bytes(&[0u8; 7]), Err(BdfError::BadSnapshot(_))));
+    assert!(matches!(
+        BdfSnapshot::from_f64_slice(&wrong_version),
+        Err(BdfError::BadSnapshot(_))
+    ));
+    assert!(matches!(
+        BdfSnapshot::from_bytes(&[0u8; 7]),
+        Err(BdfError::BadSnapshot(_))
+    ));
     // A snapshot of another dimension is refused by restore.
     let mut small = engine_mount_chassis::ode::test_problems::VanDerPol { mu: 1.0 };
     let mut other = Bdf::new(&mut small, 0.0, &[2.0, 0.0], BdfOptions::default()).unwrap();
-    assert!(matches!(other.restore(&bdf.snapshot()), Err(BdfError::BadSnapshot(_))));
+    assert!(matches!(
+        other.restore(&bdf.snapshot()),
+        Err(BdfError::BadSnapshot(_))
+    ));
 }

@@ -143,7 +143,12 @@ fn problem_error(e: ProblemError) -> String {
 
 impl Bdf {
     /// Creates an integrator at `(t0, y0)`; evaluates `f(t0, y0)` (and `M`) once.
-    pub fn new<P: OdeProblem>(problem: &mut P, t0: f64, y0: &[f64], opts: BdfOptions) -> Result<Self, BdfError> {
+    pub fn new<P: OdeProblem>(
+        problem: &mut P,
+        t0: f64,
+        y0: &[f64],
+        opts: BdfOptions,
+    ) -> Result<Self, BdfError> {
         let n = problem.dim();
         if y0.len() != n {
             return Err(BdfError::InvalidInput {
@@ -152,10 +157,16 @@ impl Bdf {
             });
         }
         if !t0.is_finite() {
-            return Err(BdfError::InvalidInput { field: "t0", message: format!("must be finite, got {t0}") });
+            return Err(BdfError::InvalidInput {
+                field: "t0",
+                message: format!("must be finite, got {t0}"),
+            });
         }
         if let Some(i) = y0.iter().position(|v| !v.is_finite()) {
-            return Err(BdfError::InvalidInput { field: "y0", message: format!("entry {i} is {}", y0[i]) });
+            return Err(BdfError::InvalidInput {
+                field: "y0",
+                message: format!("entry {i} is {}", y0[i]),
+            });
         }
         opts.validate(n)?;
         let pattern = match problem.jacobian_pattern() {
@@ -201,8 +212,17 @@ impl Bdf {
             nscon: 0,
             zn: Nordsieck::new(n, max_order),
             acor: vec![0.0; n],
-            lin: LinearSystem { saved_j: Mat::zeros(n, n), lu: DenseLu::new(n), nstlj: 0, jcur: false },
-            stats: BdfStats { order: 0, order_next: 1, ..Default::default() },
+            lin: LinearSystem {
+                saved_j: Mat::zeros(n, n),
+                lu: DenseLu::new(n),
+                nstlj: 0,
+                jcur: false,
+            },
+            stats: BdfStats {
+                order: 0,
+                order_next: 1,
+                ..Default::default()
+            },
             pending_h0: true,
             tstop: t0,
             h_unclipped: None,
@@ -220,12 +240,21 @@ impl Bdf {
             jac_f: vec![0.0; n],
             mass: Mat::zeros(if has_mass { n } else { 0 }, if has_mass { n } else { 0 }),
         };
-        let mut bdf = Self { s: state, w: work, pattern, has_mass, constant_mass: None };
+        let mut bdf = Self {
+            s: state,
+            w: work,
+            pattern,
+            has_mass,
+            constant_mass: None,
+        };
         if has_mass && problem.mass_is_constant() {
             let mut m = Mat::zeros(n, n);
             problem
                 .mass(t0, y0, m.as_mut())
-                .map_err(|e| BdfError::ProblemFailed { t: t0, message: format!("mass matrix: {}", problem_error(e)) })?;
+                .map_err(|e| BdfError::ProblemFailed {
+                    t: t0,
+                    message: format!("mass matrix: {}", problem_error(e)),
+                })?;
             if m.col_iter().any(|c| c.iter().any(|v| !v.is_finite())) {
                 return Err(BdfError::NonFiniteRhs { t: t0 });
             }
@@ -270,7 +299,9 @@ impl Bdf {
             self.s.saved_tq5 = 0.0;
         } else if opts.max_order < self.s.zn.zn.len() - 1 {
             while self.s.q > opts.max_order {
-                self.s.zn.decrease_order(self.s.q, self.s.hscale, &self.s.tau);
+                self.s
+                    .zn
+                    .decrease_order(self.s.q, self.s.hscale, &self.s.tau);
                 self.s.q -= 1;
                 self.s.qwait = self.s.q + 1;
             }
@@ -283,24 +314,43 @@ impl Bdf {
     }
 
     /// Changes only the tolerances.
-    pub fn set_tolerances(&mut self, rtol: f64, atol: super::options::Tolerance) -> Result<(), BdfError> {
-        let opts = BdfOptions { rtol, atol, ..self.s.opts.clone() };
+    pub fn set_tolerances(
+        &mut self,
+        rtol: f64,
+        atol: super::options::Tolerance,
+    ) -> Result<(), BdfError> {
+        let opts = BdfOptions {
+            rtol,
+            atol,
+            ..self.s.opts.clone()
+        };
         self.set_options(opts)
     }
 
     /// Restarts at order 1 at the current time (after a discontinuity), optionally from a new
     /// state. The step size is chosen afresh at the next `advance_to`.
-    pub fn restart<P: OdeProblem>(&mut self, problem: &mut P, y: Option<&[f64]>) -> Result<(), BdfError> {
+    pub fn restart<P: OdeProblem>(
+        &mut self,
+        problem: &mut P,
+        y: Option<&[f64]>,
+    ) -> Result<(), BdfError> {
         let y0: Vec<f64> = match y {
             Some(y) => {
                 if y.len() != self.s.n {
                     return Err(BdfError::InvalidInput {
                         field: "y",
-                        message: format!("has {} entries, the problem has {} states", y.len(), self.s.n),
+                        message: format!(
+                            "has {} entries, the problem has {} states",
+                            y.len(),
+                            self.s.n
+                        ),
                     });
                 }
                 if let Some(i) = y.iter().position(|v| !v.is_finite()) {
-                    return Err(BdfError::InvalidInput { field: "y", message: format!("entry {i} is {}", y[i]) });
+                    return Err(BdfError::InvalidInput {
+                        field: "y",
+                        message: format!("entry {i} is {}", y[i]),
+                    });
                 }
                 y.to_vec()
             }
@@ -323,6 +373,7 @@ impl Bdf {
         s.h_unclipped = None;
         s.lin.nstlj = 0;
         s.stability = StabilityGuard::default();
+        s.stats.order_next = 1;
         s.acor.iter_mut().for_each(|v| *v = 0.0);
         for col in s.zn.zn.iter_mut().skip(2) {
             col.iter_mut().for_each(|v| *v = 0.0);
@@ -335,22 +386,34 @@ impl Bdf {
     }
 
     /// Sets `zn[0] = y0`, `zn[1] = y'(t) = M^{-1} f` and marks the first step size as pending.
-    fn load_initial_derivative<P: OdeProblem>(&mut self, problem: &mut P, y0: &[f64]) -> Result<(), BdfError> {
+    fn load_initial_derivative<P: OdeProblem>(
+        &mut self,
+        problem: &mut P,
+        y0: &[f64],
+    ) -> Result<(), BdfError> {
         let t = self.s.tn;
         let mut yp = vec![0.0; self.s.n];
         eval_rhs(problem, &mut self.s.stats, t, y0, &mut yp).map_err(|e| match e {
             ProblemError::NonFinite => BdfError::NonFiniteRhs { t },
-            other => BdfError::ProblemFailed { t, message: problem_error(other) },
+            other => BdfError::ProblemFailed {
+                t,
+                message: problem_error(other),
+            },
         })?;
         if self.has_mass {
             let n = self.s.n;
             let mut lu = DenseLu::new(n);
-            eval_mass(problem, self.constant_mass.as_ref(), t, y0, lu.matrix_mut())
-                .map_err(|e| BdfError::ProblemFailed { t, message: format!("mass matrix: {}", problem_error(e)) })?;
+            eval_mass(problem, self.constant_mass.as_ref(), t, y0, lu.matrix_mut()).map_err(
+                |e| BdfError::ProblemFailed {
+                    t,
+                    message: format!("mass matrix: {}", problem_error(e)),
+                },
+            )?;
             if !lu.factor() {
                 return Err(BdfError::ProblemFailed {
                     t,
-                    message: "the mass matrix is singular; the integrator needs an invertible M".to_string(),
+                    message: "the mass matrix is singular; the integrator needs an invertible M"
+                        .to_string(),
                 });
             }
             lu.solve_in_place(&mut yp);
@@ -365,14 +428,25 @@ impl Bdf {
 
     /// Integrates up to exactly `t_stop`, keeping the history for the next call. Returns at once
     /// if `t_stop` equals the current time to within rounding.
-    pub fn advance_to<P: OdeProblem>(&mut self, problem: &mut P, t_stop: f64) -> Result<(), BdfError> {
+    pub fn advance_to<P: OdeProblem>(
+        &mut self,
+        problem: &mut P,
+        t_stop: f64,
+    ) -> Result<(), BdfError> {
         if !t_stop.is_finite() {
-            return Err(BdfError::InvalidInput { field: "t_stop", message: format!("must be finite, got {t_stop}") });
+            return Err(BdfError::InvalidInput {
+                field: "t_stop",
+                message: format!("must be finite, got {t_stop}"),
+            });
         }
         if problem.dim() != self.s.n {
             return Err(BdfError::InvalidInput {
                 field: "problem",
-                message: format!("has {} states, the integrator was built for {}", problem.dim(), self.s.n),
+                message: format!(
+                    "has {} states, the integrator was built for {}",
+                    problem.dim(),
+                    self.s.n
+                ),
             });
         }
         let tn = self.s.tn;
@@ -383,7 +457,9 @@ impl Bdf {
         if t_stop < tn {
             return Err(BdfError::InvalidInput {
                 field: "t_stop",
-                message: format!("{t_stop} is behind the current time {tn}; the integrator only moves forward"),
+                message: format!(
+                    "{t_stop} is behind the current time {tn}; the integrator only moves forward"
+                ),
             });
         }
         self.s.tstop = t_stop;
@@ -393,12 +469,18 @@ impl Bdf {
         let mut steps = 0usize;
         loop {
             if steps >= self.s.opts.max_steps_per_call {
-                return Err(BdfError::TooManySteps { t: self.s.tn, steps });
+                return Err(BdfError::TooManySteps {
+                    t: self.s.tn,
+                    steps,
+                });
             }
             self.set_error_weights()?;
             let tolsf = f64::EPSILON * wrms_norm(&self.s.zn.zn[0], &self.w.ewt);
             if tolsf > 1.0 {
-                return Err(BdfError::TooMuchAccuracy { t: self.s.tn, factor: 2.0 * tolsf });
+                return Err(BdfError::TooMuchAccuracy {
+                    t: self.s.tn,
+                    factor: 2.0 * tolsf,
+                });
             }
             if steps > 0 || self.s.nst > 0 {
                 self.clip_to_stop_time();
@@ -434,8 +516,11 @@ impl Bdf {
         let rtol = self.s.opts.rtol;
         for (i, (w, y)) in self.w.ewt.iter_mut().zip(&self.s.zn.zn[0]).enumerate() {
             let tol = rtol * y.abs() + self.s.opts.atol.get(i);
-            if !(tol > 0.0) || !tol.is_finite() {
-                return Err(BdfError::BadErrorWeight { t: self.s.tn, index: i });
+            if tol.partial_cmp(&0.0) != Some(std::cmp::Ordering::Greater) || !tol.is_finite() {
+                return Err(BdfError::BadErrorWeight {
+                    t: self.s.tn,
+                    index: i,
+                });
             }
             *w = 1.0 / tol;
         }
@@ -468,7 +553,11 @@ impl Bdf {
     }
 
     /// CVODE's cvHin: geometric mean of bounds refined by an estimate of `y''`.
-    fn estimate_initial_step<P: OdeProblem>(&mut self, problem: &mut P, tout: f64) -> Result<f64, BdfError> {
+    fn estimate_initial_step<P: OdeProblem>(
+        &mut self,
+        problem: &mut P,
+        tout: f64,
+    ) -> Result<f64, BdfError> {
         let t0 = self.s.tn;
         let tdist = (tout - t0).abs();
         let tround = f64::EPSILON * t0.abs().max(tout.abs());
@@ -478,7 +567,14 @@ impl Bdf {
         for i in 0..self.s.n {
             let y = self.s.zn.zn[0][i];
             let yp = self.s.zn.zn[1][i];
-            let denom = 0.1 * y.abs() + self.s.opts.atol.get(i).max(self.s.opts.rtol * y.abs()).max(f64::MIN_POSITIVE);
+            let denom = 0.1 * y.abs()
+                + self
+                    .s
+                    .opts
+                    .atol
+                    .get(i)
+                    .max(self.s.opts.rtol * y.abs())
+                    .max(f64::MIN_POSITIVE);
             hub_inv = hub_inv.max(yp.abs() / denom);
         }
         let mut hub = 0.1 * tdist;
@@ -502,7 +598,9 @@ impl Bdf {
                         hg_ok = true;
                         break;
                     }
-                    Err(ProblemError::Fatal(m)) => return Err(BdfError::ProblemFailed { t: t0, message: m }),
+                    Err(ProblemError::Fatal(m)) => {
+                        return Err(BdfError::ProblemFailed { t: t0, message: m })
+                    }
                     Err(_) => hg *= 0.2,
                 }
             }
@@ -518,7 +616,11 @@ impl Bdf {
                 hnew = hg;
                 break;
             }
-            hnew = if yddnrm * hub * hub > 2.0 { (2.0 / yddnrm).sqrt() } else { (hg * hub).sqrt() };
+            hnew = if yddnrm * hub * hub > 2.0 {
+                (2.0 / yddnrm).sqrt()
+            } else {
+                (hg * hub).sqrt()
+            };
             let hrat = hnew / hg;
             if hrat > 0.5 && hrat < 2.0 {
                 hnew_ok = true;
@@ -546,7 +648,9 @@ impl Bdf {
             let mut lu = DenseLu::new(n);
             eval_mass(problem, self.constant_mass.as_ref(), t, &y, lu.matrix_mut())?;
             if !lu.factor() {
-                return Err(ProblemError::Recoverable("singular mass matrix".to_string()));
+                return Err(ProblemError::Recoverable(
+                    "singular mass matrix".to_string(),
+                ));
             }
             lu.solve_in_place(&mut f);
         }
@@ -566,13 +670,20 @@ impl Bdf {
             });
         }
         if derivative > 5 {
-            return Err(BdfError::InvalidInput { field: "derivative", message: format!("must be <= 5, got {derivative}") });
+            return Err(BdfError::InvalidInput {
+                field: "derivative",
+                message: format!("must be <= 5, got {derivative}"),
+            });
         }
         let tfuzz = 100.0 * f64::EPSILON * (s.tn.abs() + s.hu.abs());
         let t_lo = s.tn - s.hu - tfuzz;
         let t_hi = s.tn + tfuzz;
         if !(t >= t_lo && t <= t_hi) {
-            return Err(BdfError::BadInterpolationTime { t, t_lo: s.tn - s.hu, t_hi: s.tn });
+            return Err(BdfError::BadInterpolationTime {
+                t,
+                t_lo: s.tn - s.hu,
+                t_hi: s.tn,
+            });
         }
         if s.pending_h0 {
             // No step yet: zn[1] holds y' itself.
@@ -624,7 +735,11 @@ impl Bdf {
         self.complete_step();
         if !self.s.fixed {
             self.prepare_next_step(dsm);
-            self.s.etamax = if self.s.nst <= SMALL_NST { ETAMX2 } else { ETAMX3 };
+            self.s.etamax = if self.s.nst <= SMALL_NST {
+                ETAMX2
+            } else {
+                ETAMX3
+            };
         } else {
             self.s.hprime = self.s.h;
             self.s.qprime = self.s.q;
@@ -671,7 +786,9 @@ impl Bdf {
     fn predict(&mut self) {
         let s = &mut self.s;
         let t_new = s.tn + s.h;
-        s.tn = if (t_new - s.tstop).abs() <= 4.0 * f64::EPSILON * s.tstop.abs().max(s.h.abs()) || t_new > s.tstop {
+        s.tn = if (t_new - s.tstop).abs() <= 4.0 * f64::EPSILON * s.tstop.abs().max(s.h.abs())
+            || t_new > s.tstop
+        {
             s.tstop
         } else {
             t_new
@@ -700,7 +817,12 @@ impl Bdf {
     }
 
     /// Nonlinear solver failure: shrink the step or give up (cvHandleNFlag).
-    fn handle_nls_failure(&mut self, outcome: NlsOutcome, saved_t: f64, ncf: &mut usize) -> Result<(), BdfError> {
+    fn handle_nls_failure(
+        &mut self,
+        outcome: NlsOutcome,
+        saved_t: f64,
+        ncf: &mut usize,
+    ) -> Result<(), BdfError> {
         self.s.stats.conv_fails += 1;
         self.restore_history(saved_t);
         let t = self.s.tn;
@@ -714,15 +836,29 @@ impl Bdf {
         if at_hmin || *ncf >= self.s.opts.max_conv_fails || self.s.fixed {
             return Err(match outcome {
                 NlsOutcome::RhsRecoverable(ProblemError::NonFinite) => BdfError::NonFiniteRhs { t },
-                NlsOutcome::RhsRecoverable(e) => BdfError::RepeatedProblemError { t, message: problem_error(e) },
+                NlsOutcome::RhsRecoverable(e) => BdfError::RepeatedProblemError {
+                    t,
+                    message: problem_error(e),
+                },
                 _ if at_hmin => BdfError::StepSizeUnderflow { t, h },
-                _ => BdfError::TooManyConvergenceFailures { t, h, failures: *ncf },
+                _ => BdfError::TooManyConvergenceFailures {
+                    t,
+                    h,
+                    failures: *ncf,
+                },
             });
         }
         self.s.eta = ETACF.max(self.s.opts.h_min / h.abs());
         self.rescale();
-        self.check_step_size()?;
-        Ok(())
+        // When the step has shrunk to nothing because the problem keeps failing, name the cause.
+        self.check_step_size().map_err(|e| match outcome {
+            NlsOutcome::RhsRecoverable(ProblemError::NonFinite) => BdfError::NonFiniteRhs { t },
+            NlsOutcome::RhsRecoverable(p) => BdfError::RepeatedProblemError {
+                t,
+                message: problem_error(p),
+            },
+            _ => e,
+        })
     }
 
     /// The step must still move time forward.
@@ -750,12 +886,17 @@ impl Bdf {
         self.restore_history(saved_t);
         let s = &mut self.s;
         if s.h.abs() <= s.opts.h_min * ONEPSM || *nef >= s.opts.max_err_test_fails {
-            return Err(BdfError::TooManyErrorTestFailures { t: s.tn, h: s.h, failures: *nef });
+            return Err(BdfError::TooManyErrorTestFailures {
+                t: s.tn,
+                h: s.h,
+                failures: *nef,
+            });
         }
         s.etamax = 1.0;
         if s.opts.stability_limit_detection {
             let (nst, t) = (s.nst, s.tn);
-            s.stability.record_error_test_failure(nst, t, q_failed, h_failed);
+            s.stability
+                .record_error_test_failure(nst, t, q_failed, h_failed);
         }
         if *nef <= MXNEF1 {
             let mut eta = 1.0 / ((BIAS2 * dsm).powf(1.0 / (s.q + 1) as f64) + ADDON);
@@ -787,14 +928,24 @@ impl Bdf {
         let mut f = vec![0.0; s.n];
         eval_rhs(problem, &mut self.s.stats, t, &y, &mut f).map_err(|e| match e {
             ProblemError::NonFinite => BdfError::NonFiniteRhs { t },
-            other => BdfError::ProblemFailed { t, message: problem_error(other) },
+            other => BdfError::ProblemFailed {
+                t,
+                message: problem_error(other),
+            },
         })?;
         if self.has_mass {
             let mut lu = DenseLu::new(self.s.n);
-            eval_mass(problem, self.constant_mass.as_ref(), t, &y, lu.matrix_mut())
-                .map_err(|e| BdfError::ProblemFailed { t, message: format!("mass matrix: {}", problem_error(e)) })?;
+            eval_mass(problem, self.constant_mass.as_ref(), t, &y, lu.matrix_mut()).map_err(
+                |e| BdfError::ProblemFailed {
+                    t,
+                    message: format!("mass matrix: {}", problem_error(e)),
+                },
+            )?;
             if !lu.factor() {
-                return Err(BdfError::ProblemFailed { t, message: "the mass matrix is singular".to_string() });
+                return Err(BdfError::ProblemFailed {
+                    t,
+                    message: "the mass matrix is singular".to_string(),
+                });
             }
             lu.solve_in_place(&mut f);
         }
@@ -834,7 +985,11 @@ impl Bdf {
     /// Chooses the next step size and order (cvPrepareNextStep, cvChooseEta, cvSetEta).
     fn prepare_next_step(&mut self, dsm: f64) {
         let qmax = self.s.zn.zn.len() - 1;
-        let landed = if self.s.tn == self.s.tstop { self.s.h_unclipped.take() } else { None };
+        let landed = if self.s.tn == self.s.tstop {
+            self.s.h_unclipped.take()
+        } else {
+            None
+        };
         let s = &mut self.s;
         if s.etamax == 1.0 {
             s.qwait = s.qwait.max(2);

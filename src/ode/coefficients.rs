@@ -84,7 +84,11 @@ pub fn bdf_coefficients(
 
 /// Polynomial coefficients for raising the order from `q` to `q + 1` (cvIncreaseBDF) and the
 /// factor `A1` applied to the saved correction.
-pub fn increase_order_coefficients(q: usize, hscale: f64, tau: &[f64; L_MAX + 1]) -> ([f64; L_MAX + 1], f64) {
+pub fn increase_order_coefficients(
+    q: usize,
+    hscale: f64,
+    tau: &[f64; L_MAX + 1],
+) -> ([f64; L_MAX + 1], f64) {
     let mut l = [0.0; L_MAX + 1];
     l[2] = 1.0;
     let mut alpha1 = 1.0;
@@ -110,7 +114,11 @@ pub fn increase_order_coefficients(q: usize, hscale: f64, tau: &[f64; L_MAX + 1]
 }
 
 /// Polynomial coefficients for lowering the order from `q` to `q - 1` (cvDecreaseBDF).
-pub fn decrease_order_coefficients(q: usize, hscale: f64, tau: &[f64; L_MAX + 1]) -> [f64; L_MAX + 1] {
+pub fn decrease_order_coefficients(
+    q: usize,
+    hscale: f64,
+    tau: &[f64; L_MAX + 1],
+) -> [f64; L_MAX + 1] {
     let mut l = [0.0; L_MAX + 1];
     l[2] = 1.0;
     let mut hsum = 0.0;
@@ -143,7 +151,12 @@ mod tests {
                 }
             }
             for k in 0..=q {
-                assert!((c.l[k] - poly[k]).abs() < 1e-13, "q={q} k={k}: {} vs {}", c.l[k], poly[k]);
+                assert!(
+                    (c.l[k] - poly[k]).abs() < 1e-13,
+                    "q={q} k={k}: {} vs {}",
+                    c.l[k],
+                    poly[k]
+                );
             }
             let harmonic: f64 = (1..=q).map(|j| 1.0 / j as f64).sum();
             assert!((c.l[1] - harmonic).abs() < 1e-14);

@@ -7,9 +7,15 @@ use std::fmt;
 #[derive(Debug, Clone, PartialEq)]
 pub enum BdfError {
     /// An option is out of range.
-    InvalidOption { field: &'static str, message: String },
+    InvalidOption {
+        field: &'static str,
+        message: String,
+    },
     /// An argument of a call is invalid (wrong length, non-finite, out of range).
-    InvalidInput { field: &'static str, message: String },
+    InvalidInput {
+        field: &'static str,
+        message: String,
+    },
     /// The step size became too small to change `t` (or fell below `h_min`).
     StepSizeUnderflow { t: f64, h: f64 },
     /// The local error test failed too often on one step.
@@ -37,29 +43,53 @@ pub enum BdfError {
 impl fmt::Display for BdfError {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
         match self {
-            Self::InvalidOption { field, message } => write!(f, "invalid option `{field}`: {message}"),
-            Self::InvalidInput { field, message } => write!(f, "invalid argument `{field}`: {message}"),
-            Self::StepSizeUnderflow { t, h } => write!(f, "step size underflow at t = {t} (h = {h})"),
+            Self::InvalidOption { field, message } => {
+                write!(f, "invalid option `{field}`: {message}")
+            }
+            Self::InvalidInput { field, message } => {
+                write!(f, "invalid argument `{field}`: {message}")
+            }
+            Self::StepSizeUnderflow { t, h } => {
+                write!(f, "step size underflow at t = {t} (h = {h})")
+            }
             Self::TooManyErrorTestFailures { t, h, failures } => {
-                write!(f, "{failures} error-test failures in one step at t = {t} (h = {h})")
+                write!(
+                    f,
+                    "{failures} error-test failures in one step at t = {t} (h = {h})"
+                )
             }
             Self::TooManyConvergenceFailures { t, h, failures } => {
-                write!(f, "{failures} Newton convergence failures in one step at t = {t} (h = {h})")
+                write!(
+                    f,
+                    "{failures} Newton convergence failures in one step at t = {t} (h = {h})"
+                )
             }
             Self::NonFiniteRhs { t } => write!(f, "right-hand side is not finite near t = {t}"),
             Self::RepeatedProblemError { t, message } => {
-                write!(f, "problem evaluation failed repeatedly near t = {t}: {message}")
+                write!(
+                    f,
+                    "problem evaluation failed repeatedly near t = {t}: {message}"
+                )
             }
             Self::ProblemFailed { t, message } => write!(f, "problem failed at t = {t}: {message}"),
-            Self::TooManySteps { t, steps } => write!(f, "{steps} steps taken before reaching the stop time (at t = {t})"),
+            Self::TooManySteps { t, steps } => write!(
+                f,
+                "{steps} steps taken before reaching the stop time (at t = {t})"
+            ),
             Self::TooMuchAccuracy { t, factor } => {
                 write!(f, "tolerances too small at t = {t}; increase them by a factor of at least {factor}")
             }
             Self::BadErrorWeight { t, index } => {
-                write!(f, "error weight of component {index} is not positive/finite at t = {t}")
+                write!(
+                    f,
+                    "error weight of component {index} is not positive/finite at t = {t}"
+                )
             }
             Self::BadInterpolationTime { t, t_lo, t_hi } => {
-                write!(f, "interpolation time {t} is outside the last step [{t_lo}, {t_hi}]")
+                write!(
+                    f,
+                    "interpolation time {t} is outside the last step [{t_lo}, {t_hi}]"
+                )
             }
             Self::BadSnapshot(m) => write!(f, "snapshot rejected: {m}"),
         }

@@ -40,7 +40,11 @@ impl JacobianPattern {
             row_idx.extend_from_slice(&sorted);
             col_ptr.push(row_idx.len());
         }
-        Ok(Self { n, col_ptr, row_idx })
+        Ok(Self {
+            n,
+            col_ptr,
+            row_idx,
+        })
     }
 
     /// Dimension of the (square) Jacobian.
@@ -60,7 +64,9 @@ impl JacobianPattern {
         let mut row_owner: Vec<Vec<bool>> = Vec::new();
         for j in 0..self.n {
             let rows = self.rows(j);
-            let slot = row_owner.iter().position(|used| rows.iter().all(|&i| !used[i]));
+            let slot = row_owner
+                .iter()
+                .position(|used| rows.iter().all(|&i| !used[i]));
             let g = match slot {
                 Some(g) => g,
                 None => {
@@ -100,7 +106,11 @@ pub fn finite_difference_jacobian<P: OdeProblem + ?Sized>(
     let n = at.y.len();
     let srur = f64::EPSILON.sqrt();
     let fnorm = super::nordsieck::wrms_norm(at.fy, at.ewt);
-    let min_inc = if fnorm != 0.0 { 1000.0 * at.h.abs() * f64::EPSILON * n as f64 * fnorm } else { 1.0 };
+    let min_inc = if fnorm != 0.0 {
+        1000.0 * at.h.abs() * f64::EPSILON * n as f64 * fnorm
+    } else {
+        1.0
+    };
     let increment = |j: usize| (srur * at.y[j].abs()).max(min_inc / at.ewt[j]);
     work_y.copy_from_slice(at.y);
     let mut evals = 0;
@@ -171,7 +181,12 @@ mod tests {
             }
             Ok(())
         }
-        fn jacobian(&mut self, _t: f64, _y: &[f64], _j: MatMut<'_, f64>) -> Result<bool, ProblemError> {
+        fn jacobian(
+            &mut self,
+            _t: f64,
+            _y: &[f64],
+            _j: MatMut<'_, f64>,
+        ) -> Result<bool, ProblemError> {
             Ok(false)
         }
     }
@@ -200,16 +215,30 @@ mod tests {
         let mut fy = vec![0.0; n];
         p.rhs(0.0, &y, &mut fy).unwrap();
         let ewt = vec![1e6; n];
-        let at = DifferenceQuotient { t: 0.0, h: 1e-3, y: &y, fy: &fy, ewt: &ewt };
-        let cols: Vec<Vec<usize>> = (0..n).map(|j| (j.saturating_sub(1)..(j + 2).min(n)).collect()).collect();
+        let at = DifferenceQuotient {
+            t: 0.0,
+            h: 1e-3,
+            y: &y,
+            fy: &fy,
+            ewt: &ewt,
+        };
+        let cols: Vec<Vec<usize>> = (0..n)
+            .map(|j| (j.saturating_sub(1)..(j + 2).min(n)).collect())
+            .collect();
         let pattern = JacobianPattern::from_columns(n, &cols).unwrap();
         let groups = pattern.column_groups();
-        assert_eq!(groups.len(), 3, "a tridiagonal pattern needs exactly three colours");
+        assert_eq!(
+            groups.len(),
+            3,
+            "a tridiagonal pattern needs exactly three colours"
+        );
         let reference = exact(&y);
         let (mut wy, mut wf) = (vec![0.0; n], vec![0.0; n]);
         for grouping in [None, Some((&pattern, groups.as_slice()))] {
             let mut jac = Mat::zeros(n, n);
-            let evals = finite_difference_jacobian(&mut p, &at, grouping, &mut jac, &mut wy, &mut wf).unwrap();
+            let evals =
+                finite_difference_jacobian(&mut p, &at, grouping, &mut jac, &mut wy, &mut wf)
+                    .unwrap();
             assert_eq!(evals, if grouping.is_some() { 3 } else { n as u64 });
             for i in 0..n {
                 for j in 0..n {

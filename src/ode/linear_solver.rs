@@ -16,7 +16,12 @@ pub struct DenseLu {
 
 impl DenseLu {
     pub fn new(n: usize) -> Self {
-        Self { lu: Mat::zeros(n, n), perm: (0..n).collect(), perm_inv: (0..n).collect(), factored: false }
+        Self {
+            lu: Mat::zeros(n, n),
+            perm: (0..n).collect(),
+            perm_inv: (0..n).collect(),
+            factored: false,
+        }
     }
 
     /// Storage to be filled with the matrix before [`Self::factor`].
@@ -30,7 +35,12 @@ impl DenseLu {
     pub fn factor(&mut self) -> bool {
         let n = self.lu.nrows();
         let par = Par::Seq;
-        let mut mem = MemBuffer::new(factor::lu_in_place_scratch::<usize, f64>(n, n, par, Default::default()));
+        let mut mem = MemBuffer::new(factor::lu_in_place_scratch::<usize, f64>(
+            n,
+            n,
+            par,
+            Default::default(),
+        ));
         factor::lu_in_place(
             self.lu.as_mut(),
             &mut self.perm,
@@ -57,7 +67,14 @@ impl DenseLu {
         let mut mem = MemBuffer::new(solve::solve_in_place_scratch::<usize, f64>(n, 1, par));
         let perm = PermRef::new_checked(&self.perm, &self.perm_inv, n);
         let rhs = MatMut::from_column_major_slice_mut(b, n, 1);
-        solve::solve_in_place(self.lu.as_ref(), self.lu.as_ref(), perm, rhs, par, MemStack::new(&mut mem));
+        solve::solve_in_place(
+            self.lu.as_ref(),
+            self.lu.as_ref(),
+            perm,
+            rhs,
+            par,
+            MemStack::new(&mut mem),
+        );
     }
 
     /// The raw parts for serialisation: the factor storage, the permutation and the flag.
@@ -66,8 +83,18 @@ impl DenseLu {
     }
 
     /// Rebuilds from raw parts (validated by the caller: square storage, permutation of 0..n).
-    pub fn from_parts(lu: Mat<f64>, perm: Vec<usize>, perm_inv: Vec<usize>, factored: bool) -> Self {
-        Self { lu, perm, perm_inv, factored }
+    pub fn from_parts(
+        lu: Mat<f64>,
+        perm: Vec<usize>,
+        perm_inv: Vec<usize>,
+        factored: bool,
+    ) -> Self {
+        Self {
+            lu,
+            perm,
+            perm_inv,
+            factored,
+        }
     }
 }
 
@@ -87,7 +114,9 @@ mod tests {
             }
         }
         assert!(lu.factor());
-        let mut b: Vec<f64> = (0..3).map(|i| (0..3).map(|j| a[i][j] * x_true[j]).sum()).collect();
+        let mut b: Vec<f64> = (0..3)
+            .map(|i| (0..3).map(|j| a[i][j] * x_true[j]).sum())
+            .collect();
         lu.solve_in_place(&mut b);
         for i in 0..3 {
             assert!((b[i] - x_true[i]).abs() < 1e-14);

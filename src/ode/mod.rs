@@ -3,12 +3,20 @@
 //! The integrator knows nothing about the model: it integrates any [`OdeProblem`] in linearly
 //! implicit form `M(t, y) y' = f(t, y)`. See [`Bdf`] for the driver API.
 
+// Index loops mirror CVODE's formulas, which address several arrays by one index.
+#[allow(clippy::needless_range_loop)]
 mod bdf;
+// Index loops mirror CVODE's formulas, which address several arrays by one index.
+#[allow(clippy::needless_range_loop)]
 mod coefficients;
 mod error;
 mod jacobian;
+// Index loops mirror CVODE's formulas, which address several arrays by one index.
+#[allow(clippy::needless_range_loop)]
 mod linear_solver;
 mod newton;
+// Index loops mirror CVODE's formulas, which address several arrays by one index.
+#[allow(clippy::needless_range_loop)]
 mod nordsieck;
 mod options;
 mod problem;
@@ -18,6 +26,7 @@ mod stats;
 pub mod test_problems;
 
 #[cfg(test)]
+#[allow(clippy::needless_range_loop)]
 mod tests;
 
 pub use bdf::Bdf;

@@ -83,9 +83,16 @@ fn recoverable(e: ProblemError) -> NlsOutcome {
 impl Bdf {
     /// Solves the corrector equation for the current step attempt; on success `acor` holds the
     /// correction and `acnrm` its WRMS norm.
-    pub(super) fn nonlinear_solve<P: OdeProblem>(&mut self, problem: &mut P, flag: StepFlag) -> NlsOutcome {
-        let mut convfail =
-            if matches!(flag, StepFlag::FirstCall | StepFlag::PrevErrFail) { ConvFail::None } else { ConvFail::Other };
+    pub(super) fn nonlinear_solve<P: OdeProblem>(
+        &mut self,
+        problem: &mut P,
+        flag: StepFlag,
+    ) -> NlsOutcome {
+        let mut convfail = if matches!(flag, StepFlag::FirstCall | StepFlag::PrevErrFail) {
+            ConvFail::None
+        } else {
+            ConvFail::Other
+        };
         let s = &self.s;
         let mut call_setup = flag != StepFlag::FirstCall
             || s.nst == 0
@@ -146,7 +153,11 @@ impl Bdf {
             }
             let dcon = del * self.s.crate_.min(1.0) / self.s.tq[4];
             if dcon <= 1.0 {
-                self.s.acnrm = if m == 0 { del } else { wrms_norm(&self.s.acor, &self.w.ewt) };
+                self.s.acnrm = if m == 0 {
+                    del
+                } else {
+                    wrms_norm(&self.s.acor, &self.w.ewt)
+                };
                 // The state at the accepted iterate.
                 for ((y, z), a) in self.w.y.iter_mut().zip(&self.s.zn.zn[0]).zip(&self.s.acor) {
                     *y = z + a;
@@ -182,7 +193,13 @@ impl Bdf {
             for ((t, z), a) in w.tempv.iter_mut().zip(&s.zn.zn[1]).zip(&s.acor) {
                 *t = rl1 * z + a;
             }
-            eval_mass(problem, self.constant_mass.as_ref(), s.tn, &w.y, &mut w.mass)?;
+            eval_mass(
+                problem,
+                self.constant_mass.as_ref(),
+                s.tn,
+                &w.y,
+                &mut w.mass,
+            )?;
             for (d, f) in w.delta.iter_mut().zip(&w.ftemp) {
                 *d = -gamma * f;
             }
@@ -193,7 +210,13 @@ impl Bdf {
                 }
             }
         } else {
-            for (((d, z), a), f) in w.delta.iter_mut().zip(&s.zn.zn[1]).zip(&s.acor).zip(&w.ftemp) {
+            for (((d, z), a), f) in w
+                .delta
+                .iter_mut()
+                .zip(&s.zn.zn[1])
+                .zip(&s.acor)
+                .zip(&w.ftemp)
+            {
                 *d = rl1 * z + a - gamma * f;
             }
         }
@@ -202,7 +225,11 @@ impl Bdf {
 
     /// Builds and factorises `M - gamma J`, re-evaluating `J` when it is judged stale (cvLsSetup).
     /// Returns whether the Jacobian is fresh.
-    fn setup<P: OdeProblem>(&mut self, problem: &mut P, convfail: ConvFail) -> Result<bool, NlsOutcome> {
+    fn setup<P: OdeProblem>(
+        &mut self,
+        problem: &mut P,
+        convfail: ConvFail,
+    ) -> Result<bool, NlsOutcome> {
         let s = &mut self.s;
         let w = &mut self.w;
         let dgamma = (s.gamma / s.gammap - 1.0).abs();
@@ -215,17 +242,35 @@ impl Bdf {
             s.stats.jac_evals += 1;
             s.lin.nstlj = s.nst;
             s.lin.saved_j.fill(0.0);
-            let analytic = problem.jacobian(s.tn, &w.y, s.lin.saved_j.as_mut()).map_err(recoverable)?;
+            let analytic = problem
+                .jacobian(s.tn, &w.y, s.lin.saved_j.as_mut())
+                .map_err(recoverable)?;
             if analytic {
-                if s.lin.saved_j.col_iter().any(|c| c.iter().any(|v| !v.is_finite())) {
+                if s.lin
+                    .saved_j
+                    .col_iter()
+                    .any(|c| c.iter().any(|v| !v.is_finite()))
+                {
                     return Err(NlsOutcome::RhsRecoverable(ProblemError::NonFinite));
                 }
             } else {
-                let at = DifferenceQuotient { t: s.tn, h: s.h, y: &w.y, fy: &w.ftemp, ewt: &w.ewt };
+                let at = DifferenceQuotient {
+                    t: s.tn,
+                    h: s.h,
+                    y: &w.y,
+                    fy: &w.ftemp,
+                    ewt: &w.ewt,
+                };
                 let groups = self.pattern.as_ref().map(|(p, g)| (p, g.as_slice()));
-                let evals =
-                    finite_difference_jacobian(problem, &at, groups, &mut s.lin.saved_j, &mut w.jac_y, &mut w.jac_f)
-                        .map_err(recoverable)?;
+                let evals = finite_difference_jacobian(
+                    problem,
+                    &at,
+                    groups,
+                    &mut s.lin.saved_j,
+                    &mut w.jac_y,
+                    &mut w.jac_f,
+                )
+                .map_err(recoverable)?;
                 s.stats.rhs_evals += evals;
                 s.stats.rhs_evals_jac += evals;
             }
@@ -233,7 +278,14 @@ impl Bdf {
         let gamma = s.gamma;
         let n = s.n;
         if self.has_mass {
-            eval_mass(problem, self.constant_mass.as_ref(), s.tn, &w.y, &mut w.mass).map_err(recoverable)?;
+            eval_mass(
+                problem,
+                self.constant_mass.as_ref(),
+                s.tn,
+                &w.y,
+                &mut w.mass,
+            )
+            .map_err(recoverable)?;
         }
         {
             let a = s.lin.lu.matrix_mut();

@@ -13,7 +13,9 @@ pub struct Nordsieck {
 
 impl Nordsieck {
     pub fn new(n: usize, max_order: usize) -> Self {
-        Self { zn: vec![vec![0.0; n]; max_order + 1] }
+        Self {
+            zn: vec![vec![0.0; n]; max_order + 1],
+        }
     }
 
     /// Predictor: multiplies the history by the Pascal matrix (Taylor expansion to t + h).
@@ -62,7 +64,13 @@ impl Nordsieck {
     }
 
     /// Raises the order from `q` to `q + 1` using the correction saved in `zn[saved_index]`.
-    pub fn increase_order(&mut self, q: usize, hscale: f64, tau: &[f64; L_MAX + 1], saved_index: usize) {
+    pub fn increase_order(
+        &mut self,
+        q: usize,
+        hscale: f64,
+        tau: &[f64; L_MAX + 1],
+        saved_index: usize,
+    ) {
         let (l, a1) = increase_order_coefficients(q, hscale, tau);
         let new_col = q + 1;
         if saved_index != new_col {

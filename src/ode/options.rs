@@ -67,7 +67,8 @@ impl Default for BdfOptions {
 impl BdfOptions {
     /// Checks every field against the problem dimension `n`.
     pub fn validate(&self, n: usize) -> Result<(), BdfError> {
-        let bad = |field: &'static str, message: String| Err(BdfError::InvalidOption { field, message });
+        let bad =
+            |field: &'static str, message: String| Err(BdfError::InvalidOption { field, message });
         if !(self.rtol.is_finite() && self.rtol > 0.0) {
             return bad("rtol", format!("must be finite and > 0, got {}", self.rtol));
         }
@@ -79,15 +80,28 @@ impl BdfOptions {
             }
             Tolerance::Vector(v) => {
                 if v.len() != n {
-                    return bad("atol", format!("has {} entries, the problem has {n} states", v.len()));
+                    return bad(
+                        "atol",
+                        format!("has {} entries, the problem has {n} states", v.len()),
+                    );
                 }
-                if let Some((i, a)) = v.iter().enumerate().find(|(_, a)| !(a.is_finite() && **a >= 0.0)) {
-                    return bad("atol", format!("entry {i} must be finite and >= 0, got {a}"));
+                if let Some((i, a)) = v
+                    .iter()
+                    .enumerate()
+                    .find(|(_, a)| !(a.is_finite() && **a >= 0.0))
+                {
+                    return bad(
+                        "atol",
+                        format!("entry {i} must be finite and >= 0, got {a}"),
+                    );
                 }
             }
         }
         if !(1..=5).contains(&self.max_order) {
-            return bad("max_order", format!("must be in 1..=5, got {}", self.max_order));
+            return bad(
+                "max_order",
+                format!("must be in 1..=5, got {}", self.max_order),
+            );
         }
         if let Some(h) = self.h_init {
             if !(h.is_finite() && h > 0.0) {
@@ -95,10 +109,16 @@ impl BdfOptions {
             }
         }
         if !(self.h_min.is_finite() && self.h_min >= 0.0) {
-            return bad("h_min", format!("must be finite and >= 0, got {}", self.h_min));
+            return bad(
+                "h_min",
+                format!("must be finite and >= 0, got {}", self.h_min),
+            );
         }
-        if !(self.h_max > 0.0) || self.h_max < self.h_min {
-            return bad("h_max", format!("must be > 0 and >= h_min, got {}", self.h_max));
+        if self.h_max.is_nan() || self.h_max <= 0.0 || self.h_max < self.h_min {
+            return bad(
+                "h_max",
+                format!("must be > 0 and >= h_min, got {}", self.h_max),
+            );
         }
         if self.max_steps_per_call == 0 {
             return bad("max_steps_per_call", "must be >= 1".to_string());

@@ -26,7 +26,9 @@ pub struct BdfSnapshot {
 impl Bdf {
     /// Captures the complete integrator state.
     pub fn snapshot(&self) -> BdfSnapshot {
-        BdfSnapshot { state: self.s.clone() }
+        BdfSnapshot {
+            state: self.s.clone(),
+        }
     }
 
     /// Returns to a captured state. The snapshot must come from an integrator of the same
@@ -95,7 +97,16 @@ impl BdfSnapshot {
         w.slice(&s.tau);
         w.slice(&s.tq);
         w.slice(&s.l);
-        for v in [s.rl1, s.gamma, s.gammap, s.gamrat, s.crate_, s.delp, s.acnrm, s.saved_tq5] {
+        for v in [
+            s.rl1,
+            s.gamma,
+            s.gammap,
+            s.gamrat,
+            s.crate_,
+            s.delp,
+            s.acnrm,
+            s.saved_tq5,
+        ] {
             w.f(v);
         }
         w.u64(s.nst);
@@ -181,32 +192,44 @@ impl BdfSnapshot {
     pub fn from_f64_slice(data: &[f64]) -> Result<Self, BdfError> {
         let bad = |m: String| BdfError::BadSnapshot(m);
         if data.len() < 5 {
-            return Err(bad(format!("{} values is too short for a BDF snapshot", data.len())));
+            return Err(bad(format!(
+                "{} values is too short for a BDF snapshot",
+                data.len()
+            )));
         }
         if data[0] != MAGIC {
             return Err(bad("not a BDF snapshot (wrong magic number)".to_string()));
         }
         if data[1] != VERSION {
-            return Err(bad(format!("version {} is not supported (expected {VERSION})", data[1])));
+            return Err(bad(format!(
+                "version {} is not supported (expected {VERSION})",
+                data[1]
+            )));
         }
         if data[2] != data.len() as f64 {
-            return Err(bad(format!("declared length {} but {} values were given", data[2], data.len())));
+            return Err(bad(format!(
+                "declared length {} but {} values were given",
+                data[2],
+                data.len()
+            )));
         }
         let mut r = Reader { data, pos: 3 };
         let n = r.usize("n")?;
         let ncols = r.usize("history length")?;
         if n == 0 || n > 1 << 24 || !(2..=6).contains(&ncols) {
-            return Err(bad(format!("implausible sizes n = {n}, history columns = {ncols}")));
+            return Err(bad(format!(
+                "implausible sizes n = {n}, history columns = {ncols}"
+            )));
         }
         let rtol = r.f()?;
         let atol = match r.f()? {
-            t if t == 0.0 => Tolerance::Scalar(r.f()?),
-            t if t == 1.0 => Tolerance::Vector(r.vec(n)?),
+            0.0 => Tolerance::Scalar(r.f()?),
+            1.0 => Tolerance::Vector(r.vec(n)?),
             t => return Err(bad(format!("unknown tolerance tag {t}"))),
         };
         let max_order = r.usize("max_order")?;
         let h_init = match (r.f()?, r.f()?) {
-            (t, h) if t == 1.0 => Some(h),
+            (1.0, h) => Some(h),
             _ => None,
         };
         let opts = BdfOptions {
@@ -223,20 +246,33 @@ impl BdfSnapshot {
         };
         opts.validate(n)?;
         if ncols != max_order + 1 {
-            return Err(bad(format!("history has {ncols} columns for max_order {max_order}")));
+            return Err(bad(format!(
+                "history has {ncols} columns for max_order {max_order}"
+            )));
         }
-        let (tn, h, hprime, hscale, eta, etamax, hu) = (r.f()?, r.f()?, r.f()?, r.f()?, r.f()?, r.f()?, r.f()?);
+        let (tn, h, hprime, hscale, eta, etamax, hu) =
+            (r.f()?, r.f()?, r.f()?, r.f()?, r.f()?, r.f()?, r.f()?);
         let q = r.usize("q")?;
         let qprime = r.usize("qprime")?;
         let qwait = r.usize("qwait")?;
         if !(1..=max_order).contains(&q) || !(1..=max_order).contains(&qprime) {
-            return Err(bad(format!("order {q} (next {qprime}) outside 1..={max_order}")));
+            return Err(bad(format!(
+                "order {q} (next {qprime}) outside 1..={max_order}"
+            )));
         }
         let tau = r.array::<{ L_MAX + 1 }>()?;
         let tq = r.array::<6>()?;
         let l = r.array::<{ L_MAX + 1 }>()?;
-        let (rl1, gamma, gammap, gamrat, crate_, delp, acnrm, saved_tq5) =
-            (r.f()?, r.f()?, r.f()?, r.f()?, r.f()?, r.f()?, r.f()?, r.f()?);
+        let (rl1, gamma, gammap, gamrat, crate_, delp, acnrm, saved_tq5) = (
+            r.f()?,
+            r.f()?,
+            r.f()?,
+            r.f()?,
+            r.f()?,
+            r.f()?,
+            r.f()?,
+            r.f()?,
+        );
         let (nst, nstlp, nscon) = (r.u64()?, r.u64()?, r.u64()?);
         let mut zn = Nordsieck::new(n, max_order);
         for col in zn.zn.iter_mut() {
@@ -254,7 +290,9 @@ impl BdfSnapshot {
             perm_inv.push(r.usize("permutation")?);
         }
         if (0..n).any(|i| perm[i] >= n || perm_inv[i] >= n || perm_inv[perm[i]] != i) {
-            return Err(bad("the LU row permutation is not a permutation".to_string()));
+            return Err(bad(
+                "the LU row permutation is not a permutation".to_string()
+            ));
         }
         let factored = r.bool()?;
         let nstlj = r.u64()?;
@@ -281,7 +319,7 @@ impl BdfSnapshot {
         let pending_h0 = r.bool()?;
         let tstop = r.f()?;
         let h_unclipped = match (r.f()?, r.f()?) {
-            (t, h) if t == 1.0 => Some(h),
+            (1.0, h) => Some(h),
             _ => None,
         };
         let nfail = r.usize("stability failures")?;
@@ -295,7 +333,7 @@ impl BdfSnapshot {
         let hold_until = r.u64()?;
         let hold_len = r.u64()?;
         let last_release = match r.f()? {
-            t if t == 1.0 => Some(r.u64()?),
+            1.0 => Some(r.u64()?),
             _ => {
                 r.f()?;
                 None
@@ -340,7 +378,12 @@ impl BdfSnapshot {
             nscon,
             zn,
             acor,
-            lin: LinearSystem { saved_j, lu: DenseLu::from_parts(lu, perm, perm_inv, factored), nstlj, jcur },
+            lin: LinearSystem {
+                saved_j,
+                lu: DenseLu::from_parts(lu, perm, perm_inv, factored),
+                nstlj,
+                jcur,
+            },
             stats,
             pending_h0,
             tstop,
@@ -364,13 +407,19 @@ impl BdfSnapshot {
 
     /// Serialisation as little-endian bytes of [`Self::to_f64_vec`].
     pub fn to_bytes(&self) -> Vec<u8> {
-        self.to_f64_vec().iter().flat_map(|v| v.to_le_bytes()).collect()
+        self.to_f64_vec()
+            .iter()
+            .flat_map(|v| v.to_le_bytes())
+            .collect()
     }
 
     /// Inverse of [`Self::to_bytes`].
     pub fn from_bytes(bytes: &[u8]) -> Result<Self, BdfError> {
         if bytes.len() % 8 != 0 {
-            return Err(BdfError::BadSnapshot(format!("{} bytes is not a whole number of f64 values", bytes.len())));
+            return Err(BdfError::BadSnapshot(format!(
+                "{} bytes is not a whole number of f64 values",
+                bytes.len()
+            )));
         }
         let data: Vec<f64> = bytes
             .chunks_exact(8)
@@ -424,23 +473,33 @@ impl Reader<'_> {
         if v >= 0.0 && v.fract() == 0.0 && v < 9.0e15 {
             Ok(v as u64)
         } else {
-            Err(BdfError::BadSnapshot(format!("value {v} at {} is not a count", self.pos - 1)))
+            Err(BdfError::BadSnapshot(format!(
+                "value {v} at {} is not a count",
+                self.pos - 1
+            )))
         }
     }
     fn usize(&mut self, what: &str) -> Result<usize, BdfError> {
-        let v = self.u64().map_err(|_| BdfError::BadSnapshot(format!("`{what}` is not a non-negative integer")))?;
-        usize::try_from(v).map_err(|_| BdfError::BadSnapshot(format!("`{what}` = {v} is too large")))
+        let v = self.u64().map_err(|_| {
+            BdfError::BadSnapshot(format!("`{what}` is not a non-negative integer"))
+        })?;
+        usize::try_from(v)
+            .map_err(|_| BdfError::BadSnapshot(format!("`{what}` = {v} is too large")))
     }
     fn bool(&mut self) -> Result<bool, BdfError> {
         match self.f()? {
-            v if v == 0.0 => Ok(false),
-            v if v == 1.0 => Ok(true),
-            v => Err(BdfError::BadSnapshot(format!("flag value {v} at {} is not 0 or 1", self.pos - 1))),
+            0.0 => Ok(false),
+            1.0 => Ok(true),
+            v => Err(BdfError::BadSnapshot(format!(
+                "flag value {v} at {} is not 0 or 1",
+                self.pos - 1
+            ))),
         }
     }
     fn vec(&mut self, n: usize) -> Result<Vec<f64>, BdfError> {
         let end = self.pos.checked_add(n).filter(|&e| e <= self.data.len());
-        let end = end.ok_or_else(|| BdfError::BadSnapshot(format!("truncated at value {}", self.pos)))?;
+        let end =
+            end.ok_or_else(|| BdfError::BadSnapshot(format!("truncated at value {}", self.pos)))?;
         let v = self.data[self.pos..end].to_vec();
         self.pos = end;
         Ok(v)

@@ -18,7 +18,12 @@ pub struct LinearOscillator {
 
 impl Default for LinearOscillator {
     fn default() -> Self {
-        Self { a: -0.5, b: 2.0, c: -3.0, y0: [1.0, 0.5, 2.0] }
+        Self {
+            a: -0.5,
+            b: 2.0,
+            c: -3.0,
+            y0: [1.0, 0.5, 2.0],
+        }
     }
 }
 
@@ -37,7 +42,11 @@ impl LinearOscillator {
         let (zr, zi) = (self.y0[0], self.y0[1]);
         // z0 * lambda^k * exp(i b t) * exp(a t)
         let (wr, wi) = (zr * pr - zi * pi, zr * pi + zi * pr);
-        [wr * cr - wi * ci, wr * ci + wi * cr, self.y0[2] * self.c.powi(k as i32) * (self.c * t).exp()]
+        [
+            wr * cr - wi * ci,
+            wr * ci + wi * cr,
+            self.y0[2] * self.c.powi(k as i32) * (self.c * t).exp(),
+        ]
     }
 }
 
@@ -51,7 +60,12 @@ impl OdeProblem for LinearOscillator {
         f[2] = self.c * y[2];
         Ok(())
     }
-    fn jacobian(&mut self, _t: f64, _y: &[f64], mut j: MatMut<'_, f64>) -> Result<bool, ProblemError> {
+    fn jacobian(
+        &mut self,
+        _t: f64,
+        _y: &[f64],
+        mut j: MatMut<'_, f64>,
+    ) -> Result<bool, ProblemError> {
         j[(0, 0)] = self.a;
         j[(0, 1)] = -self.b;
         j[(1, 0)] = self.b;
@@ -71,7 +85,11 @@ pub struct Robertson {
 impl Robertson {
     pub const Y0: [f64; 3] = [1.0, 0.0, 0.0];
     /// Reference solution at t = 40 (Hairer & Wanner; IVP test-set literature).
-    pub const Y_AT_40: [f64; 3] = [0.715_827_068_719_377_2, 9.185_534_764_557_338e-6, 0.284_163_745_745_862_0];
+    pub const Y_AT_40: [f64; 3] = [
+        0.715_827_068_719_377,
+        9.185_534_764_557_338e-6,
+        0.284_163_745_745_862,
+    ];
 }
 
 impl OdeProblem for Robertson {
@@ -84,7 +102,12 @@ impl OdeProblem for Robertson {
         f[1] = -f[0] - f[2];
         Ok(())
     }
-    fn jacobian(&mut self, _t: f64, y: &[f64], mut j: MatMut<'_, f64>) -> Result<bool, ProblemError> {
+    fn jacobian(
+        &mut self,
+        _t: f64,
+        y: &[f64],
+        mut j: MatMut<'_, f64>,
+    ) -> Result<bool, ProblemError> {
         if !self.analytic_jacobian {
             return Ok(false);
         }
@@ -116,7 +139,12 @@ impl OdeProblem for VanDerPol {
         f[1] = self.mu * (1.0 - y[0] * y[0]) * y[1] - y[0];
         Ok(())
     }
-    fn jacobian(&mut self, _t: f64, y: &[f64], mut j: MatMut<'_, f64>) -> Result<bool, ProblemError> {
+    fn jacobian(
+        &mut self,
+        _t: f64,
+        y: &[f64],
+        mut j: MatMut<'_, f64>,
+    ) -> Result<bool, ProblemError> {
         j[(0, 0)] = 0.0;
         j[(0, 1)] = 1.0;
         j[(1, 0)] = -2.0 * self.mu * y[0] * y[1] - 1.0;
@@ -179,7 +207,42 @@ impl SpringChain {
         kk[(chain, chain)] += k_small;
         kk[(attach, chain)] -= k_small;
         kk[(chain, attach)] -= k_small;
-        Self::from_matrices(mass, kk, 0.01, attach, 100.0, 2.0 * PI * 25.0, use_mass_matrix)
+        Self::from_matrices(
+            mass,
+            kk,
+            0.01,
+            attach,
+            100.0,
+            2.0 * PI * 25.0,
+            use_mass_matrix,
+        )
+    }
+
+    /// The 19-mass chain of [`Self::standard`] without the stiff mode (modes 4–100 Hz only),
+    /// forced at its free end: a smooth, non-stiff-stalling problem.
+    pub fn without_stiff_mode() -> Self {
+        let chain = 19;
+        let top = (((2 * chain - 1) as f64) * PI / (2.0 * (2 * chain + 1) as f64)).sin();
+        let sqrt_km = 2.0 * PI * 100.0 / (2.0 * top);
+        let k = sqrt_km * sqrt_km;
+        let mut kk = Mat::<f64>::zeros(chain, chain);
+        for i in 0..chain {
+            kk[(i, i)] += k;
+            if i > 0 {
+                kk[(i - 1, i - 1)] += k;
+                kk[(i - 1, i)] -= k;
+                kk[(i, i - 1)] -= k;
+            }
+        }
+        Self::from_matrices(
+            vec![1.0; chain],
+            kk,
+            0.01,
+            chain - 1,
+            100.0,
+            2.0 * PI * 25.0,
+            false,
+        )
     }
 
     /// Builds the chain from diagonal masses and a stiffness matrix.
@@ -207,9 +270,27 @@ impl SpringChain {
         };
         // C = M Phi diag(2 zeta omega) Phi^T M
         let damping = Mat::from_fn(n, n, |i, j| {
-            (0..n).map(|r| mass[i] * modes[(i, r)] * 2.0 * zeta * omega[r] * modes[(j, r)] * mass[j]).sum()
+            (0..n)
+                .map(|r| mass[i] * modes[(i, r)] * 2.0 * zeta * omega[r] * modes[(j, r)] * mass[j])
+                .sum()
         });
-        Self { mass, stiffness, damping, modes, omega, zeta, force_dof, force_amplitude, force_omega, use_mass_matrix }
+        Self {
+            mass,
+            stiffness,
+            damping,
+            modes,
+            omega,
+            zeta,
+            force_dof,
+            force_amplitude,
+            force_omega,
+            use_mass_matrix,
+        }
+    }
+
+    /// Number of states (twice the degrees of freedom).
+    pub fn dim2(&self) -> usize {
+        2 * self.mass.len()
     }
 
     pub fn dofs(&self) -> usize {
@@ -250,7 +331,8 @@ impl SpringChain {
             let e = (-z * om * t).exp();
             let (cs, sn) = ((wd * t).cos(), (wd * t).sin());
             let q = a * (w * t).sin() + b * (w * t).cos() + e * (c1 * cs + c2 * sn);
-            let qd = a * w * (w * t).cos() - b * w * (w * t).sin() + e * ((-z * om) * (c1 * cs + c2 * sn) + wd * (-c1 * sn + c2 * cs));
+            let qd = a * w * (w * t).cos() - b * w * (w * t).sin()
+                + e * ((-z * om) * (c1 * cs + c2 * sn) + wd * (-c1 * sn + c2 * cs));
             for i in 0..n {
                 y[i] += phi(i) * q;
                 y[n + i] += phi(i) * qd;
@@ -300,11 +382,20 @@ impl OdeProblem for SpringChain {
         }
         Ok(())
     }
-    fn jacobian(&mut self, _t: f64, _y: &[f64], mut j: MatMut<'_, f64>) -> Result<bool, ProblemError> {
+    fn jacobian(
+        &mut self,
+        _t: f64,
+        _y: &[f64],
+        mut j: MatMut<'_, f64>,
+    ) -> Result<bool, ProblemError> {
         let n = self.dofs();
         for i in 0..n {
             j[(i, n + i)] = 1.0;
-            let scale = if self.use_mass_matrix { 1.0 } else { 1.0 / self.mass[i] };
+            let scale = if self.use_mass_matrix {
+                1.0
+            } else {
+                1.0 / self.mass[i]
+            };
             for c in 0..n {
                 j[(n + i, c)] = -self.stiffness[(i, c)] * scale;
                 j[(n + i, n + c)] = -self.damping[(i, c)] * scale;

@@ -9,7 +9,12 @@ fn global_error(order: usize, steps: usize) -> f64 {
     let mut p = LinearOscillator::default();
     let t_end = 2.0;
     let h = t_end / steps as f64;
-    let opts = BdfOptions { rtol: 1e-13, atol: Tolerance::Scalar(1e-13), max_order: 5, ..Default::default() };
+    let opts = BdfOptions {
+        rtol: 1e-13,
+        atol: Tolerance::Scalar(1e-13),
+        max_order: 5,
+        ..Default::default()
+    };
     let y0 = p.y0;
     let mut bdf = Bdf::new(&mut p, 0.0, &y0, opts).expect("valid setup");
     {
@@ -34,10 +39,15 @@ fn global_error(order: usize, steps: usize) -> f64 {
         s.hscale = h;
         s.tau = [h; 7];
     }
-    bdf.advance_to(&mut p, t_end).expect("fixed-step run succeeds");
+    bdf.advance_to(&mut p, t_end)
+        .expect("fixed-step run succeeds");
     assert_eq!(bdf.t(), t_end);
     let exact = p.exact_derivative(t_end, 0);
-    bdf.y().iter().zip(exact).map(|(a, b)| (a - b).abs()).fold(0.0, f64::max)
+    bdf.y()
+        .iter()
+        .zip(exact)
+        .map(|(a, b)| (a - b).abs())
+        .fold(0.0, f64::max)
 }
 
 #[test]
@@ -50,9 +60,16 @@ fn fixed_order_fixed_step_converges_at_rate_k() {
         let ys: Vec<f64> = errors.iter().map(|e| e.ln()).collect();
         let mx = xs.iter().sum::<f64>() / xs.len() as f64;
         let my = ys.iter().sum::<f64>() / ys.len() as f64;
-        let slope = xs.iter().zip(&ys).map(|(x, y)| (x - mx) * (y - my)).sum::<f64>()
+        let slope = xs
+            .iter()
+            .zip(&ys)
+            .map(|(x, y)| (x - mx) * (y - my))
+            .sum::<f64>()
             / xs.iter().map(|x| (x - mx) * (x - mx)).sum::<f64>();
         eprintln!("order {order}: errors {errors:?}, slope {slope:.3}");
-        assert!((slope - order as f64).abs() <= 0.3, "order {order}: slope {slope}, errors {errors:?}");
+        assert!(
+            (slope - order as f64).abs() <= 0.3,
+            "order {order}: slope {slope}, errors {errors:?}"
+        );
     }
 }
