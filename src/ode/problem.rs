@@ -2,6 +2,8 @@
 
 use faer::MatMut;
 
+use super::jacobian::JacobianPattern;
+
 /// Why a problem could not evaluate its equations at the requested point.
 #[derive(Debug, Clone, PartialEq)]
 pub enum ProblemError {
@@ -39,5 +41,16 @@ pub trait OdeProblem {
     /// to let the integrator form it by finite differences.
     fn jacobian(&mut self, _t: f64, _y: &[f64], _j: MatMut<'_, f64>) -> Result<bool, ProblemError> {
         Ok(false)
+    }
+
+    /// Optional structure of `df/dy`: which rows each column may touch. When given, the
+    /// finite-difference Jacobian perturbs structurally independent columns together.
+    fn jacobian_pattern(&self) -> Option<JacobianPattern> {
+        None
+    }
+
+    /// Whether `M` is constant in `t` and `y`; then it is evaluated once and cached.
+    fn mass_is_constant(&self) -> bool {
+        false
     }
 }

@@ -1,0 +1,185 @@
+//! Builds the bodies of the engine model (parts, reference points) from a configuration.
+
+use nalgebra::{Matrix3, Vector3};
+
+use super::config::{BalanceShaftConfig, CrankDriveConfig, EngineConfig, RigidBodyConfig};
+use super::parts::{Part, PartMotion};
+
+/// One free rigid body (6 coordinates) with the parts it carries.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Body {
+    pub name: String,
+    /// Reference point in the vehicle frame (reference configuration).
+    pub reference: Vector3<f64>,
+    pub parts: Vec<Part>,
+}
+
+pub(crate) fn v3(a: &[f64; 3]) -> Vector3<f64> {
+    Vector3::new(a[0], a[1], a[2])
+}
+
+pub(crate) fn m3(a: &[[f64; 3]; 3]) -> Matrix3<f64> {
+    Matrix3::from_fn(|r, c| a[r][c])
+}
+
+fn spin_inertia(j: f64) -> Matrix3<f64> {
+    Matrix3::new(0.0, 0.0, 0.0, 0.0, j, 0.0, 0.0, 0.0, 0.0)
+}
+
+/// A rigid body's own structure as a part of a body with reference point `reference`.
+pub fn structure_part(name: &str, body: &RigidBodyConfig, reference: &Vector3<f64>) -> Part {
+    Part {
+        name: name.to_string(),
+        mass: body.mass,
+        inertia: m3(&body.inertia),
+        motion: PartMotion::Fixed {
+            offset: v3(&body.centre_of_mass) - reference,
+        },
+        spin_ratio: 0.0,
+    }
+}
+
+/// Crank drive parts (pistons, crank points, crank rotor), relative to `reference`.
+pub fn crank_drive_parts(c: &CrankDriveConfig, reference: &Vector3<f64>) -> Vec<Part> {
+    let centre = v3(&c.crank_centre) - reference;
+    let mut parts = Vec::new();
+    for (i, cyl) in c.cylinders.iter().enumerate() {
+        let throw = cyl.throw_deg.to_radians();
+        parts.push(Part {
+            name: format!("piston {}", i + 1),
+            mass: c.oscillating_mass,
+            inertia: Matrix3::zeros(),
+            motion: PartMotion::Piston {
+                crank_centre: centre,
+                y: cyl.y_offset,
+                throw,
+                radius: c.crank_radius,
+                conrod: c.conrod_length,
+            },
+            spin_ratio: 0.0,
+        });
+        if c.rotating_mass > 0.0 {
+            parts.push(Part {
+                name: format!("crank pin {}", i + 1),
+                mass: c.rotating_mass,
+                inertia: Matrix3::zeros(),
+                motion: PartMotion::Orbit {
+                    centre,
+                    y: cyl.y_offset,
+                    radius: c.crank_radius,
+                    ratio: 1.0,
+                    phase: -throw,
+                },
+                spin_ratio: 1.0,
+            });
+        }
+        if c.counterweight_mass > 0.0 {
+            parts.push(Part {
+                name: format!("counterweight {}", i + 1),
+                mass: c.counterweight_mass,
+                inertia: Matrix3::zeros(),
+                motion: PartMotion::Orbit {
+                    centre,
+                    y: cyl.y_offset,
+                    radius: c.counterweight_radius,
+                    ratio: 1.0,
+                    phase: std::f64::consts::PI - throw,
+                },
+                spin_ratio: 1.0,
+            });
+        }
+    }
+    parts.push(Part {
+        name: "crankshaft".into(),
+        mass: c.crank_mass,
+        inertia: spin_inertia(c.crank_axial_inertia),
+        motion: PartMotion::Fixed { offset: centre },
+        spin_ratio: 1.0,
+    });
+    parts
+}
+
+/// Balance shaft and extra crank counterweight parts, relative to `reference`.
+pub fn balance_parts(
+    b: &BalanceShaftConfig,
+    c: &CrankDriveConfig,
+    reference: &Vector3<f64>,
+) -> Vec<Part> {
+    let axis = v3(&b.axis_point) - reference;
+    let crank = v3(&c.crank_centre) - reference;
+    let pi = std::f64::consts::PI;
+    let mut parts = vec![Part {
+        name: "balance shaft".into(),
+        mass: b.shaft_mass,
+        inertia: spin_inertia(b.shaft_axial_inertia),
+        motion: PartMotion::Fixed { offset: axis },
+        spin_ratio: -1.0,
+    }];
+    let wp = b.weight_phase_deg.to_radians();
+    let cp = b.extra_counterweight_phase_deg.to_radians();
+    for (sign, extra) in [(1.0, 0.0), (-1.0, pi)] {
+        parts.push(Part {
+            name: format!("balance weight {}", if sign > 0.0 { "+y" } else { "-y" }),
+            mass: b.weight_mass,
+            inertia: Matrix3::zeros(),
+            motion: PartMotion::Orbit {
+                centre: axis,
+                y: sign * 0.5 * b.weight_spacing,
+                radius: b.weight_eccentricity,
+                ratio: -1.0,
+                phase: wp + extra,
+            },
+            spin_ratio: -1.0,
+        });
+        parts.push(Part {
+            name: format!(
+                "extra counterweight {}",
+                if sign > 0.0 { "+y" } else { "-y" }
+            ),
+            mass: b.extra_counterweight_mass,
+            inertia: Matrix3::zeros(),
+            motion: PartMotion::Orbit {
+                centre: crank,
+                y: sign * 0.5 * b.extra_counterweight_spacing,
+                radius: b.extra_counterweight_radius,
+                ratio: 1.0,
+                phase: cp + extra,
+            },
+            spin_ratio: 1.0,
+        });
+    }
+    parts
+}
+
+/// The free bodies of the model: `[monoblock, housing]` with elastic ring carriers, otherwise one
+/// rigid `powertrain`. The monoblock (or powertrain) is always body 0 and carries the crank drive.
+pub fn build_bodies(cfg: &EngineConfig) -> Vec<Body> {
+    let mb_ref = v3(&cfg.monoblock.centre_of_mass);
+    let mut mb_parts = vec![structure_part("monoblock", &cfg.monoblock, &mb_ref)];
+    mb_parts.extend(crank_drive_parts(&cfg.crank_drive, &mb_ref));
+    if cfg.effects.balance_shaft {
+        mb_parts.extend(balance_parts(&cfg.balance_shaft, &cfg.crank_drive, &mb_ref));
+    }
+    if cfg.effects.ring_carrier_elasticity {
+        let h_ref = v3(&cfg.housing.centre_of_mass);
+        vec![
+            Body {
+                name: "monoblock".into(),
+                reference: mb_ref,
+                parts: mb_parts,
+            },
+            Body {
+                name: "housing".into(),
+                reference: h_ref,
+                parts: vec![structure_part("housing", &cfg.housing, &h_ref)],
+            },
+        ]
+    } else {
+        mb_parts.push(structure_part("housing", &cfg.housing, &mb_ref));
+        vec![Body {
+            name: "powertrain".into(),
+            reference: mb_ref,
+            parts: mb_parts,
+        }]
+    }
+}

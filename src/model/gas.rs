@@ -1,0 +1,366 @@
+//! Cylinder gas pressure over the 720° cycle (paper §4.2, DESIGN §4.1).
+//!
+//! Single-zone model: between inlet valve closing and exhaust valve opening the first law
+//! `dp/dθ = (κ−1)/V · dQ/dθ − κ p/V · dV/dθ` with a (multi-stage) Wiebe heat release
+//! `x = 1 − exp(−6.908 ((θ − θ_soc)/Δθ)^(m+1))` and a polytropic exponent that moves linearly from
+//! compression to expansion value. It is integrated once per operating point (idle, full load) on
+//! a 0.25° grid; outside the closed part the pressure blends smoothly back to the charge pressure.
+//! The load parameter interpolates linearly between the idle and full-load curves. Evaluation uses
+//! cubic Hermite interpolation, so the pressure is C¹ in the crank angle.
+
+use serde::{Deserialize, Serialize};
+
+/// One Wiebe combustion stage.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct WiebeStage {
+    /// Fraction of the cycle's heat released by this stage.
+    pub fraction: f64,
+    /// Start of combustion (deg after firing TDC).
+    pub start_deg: f64,
+    /// Combustion duration (deg).
+    pub duration_deg: f64,
+    /// Wiebe shape exponent m.
+    pub shape: f64,
+}
+
+/// Charge and heat release at one load point.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct CombustionPoint {
+    /// Cylinder pressure at inlet valve closing (Pa).
+    pub pressure_ivc: f64,
+    /// Heat released per cylinder and cycle (J).
+    pub heat: f64,
+    pub stages: Vec<WiebeStage>,
+}
+
+/// Single-zone Wiebe model parameters.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(default)]
+pub struct WiebeModel {
+    pub compression_ratio: f64,
+    pub kappa_compression: f64,
+    pub kappa_expansion: f64,
+    /// Inlet valve closing (deg after firing TDC, negative).
+    pub ivc_deg: f64,
+    /// Exhaust valve opening (deg after firing TDC).
+    pub evo_deg: f64,
+    /// Crank angle over which the pressure blows down to the charge pressure after EVO (deg).
+    pub blowdown_deg: f64,
+    pub idle: CombustionPoint,
+    pub full_load: CombustionPoint,
+}
+
+impl Default for WiebeModel {
+    fn default() -> Self {
+        Self {
+            compression_ratio: 18.5,
+            kappa_compression: 1.36,
+            kappa_expansion: 1.30,
+            ivc_deg: -150.0,
+            evo_deg: 130.0,
+            blowdown_deg: 60.0,
+            idle: CombustionPoint {
+                pressure_ivc: 1.0e5,
+                heat: 220.0,
+                stages: vec![WiebeStage {
+                    fraction: 1.0,
+                    start_deg: -6.0,
+                    duration_deg: 30.0,
+                    shape: 2.0,
+                }],
+            },
+            full_load: CombustionPoint {
+                pressure_ivc: 2.0e5,
+                heat: 1500.0,
+                stages: vec![
+                    WiebeStage {
+                        fraction: 0.08,
+                        start_deg: -6.0,
+                        duration_deg: 8.0,
+                        shape: 2.0,
+                    },
+                    WiebeStage {
+                        fraction: 0.92,
+                        start_deg: -4.0,
+                        duration_deg: 60.0,
+                        shape: 0.9,
+                    },
+                ],
+            },
+        }
+    }
+}
+
+/// User-supplied pressure over the cycle (absolute Pa at deg after firing TDC, covering 720°).
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct PressureTable {
+    pub angle_deg: Vec<f64>,
+    pub pressure: Vec<f64>,
+}
+
+/// Source of the cylinder pressure.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(tag = "kind", rename_all = "snake_case")]
+pub enum GasModel {
+    Wiebe(WiebeModel),
+    Table(PressureTable),
+}
+
+impl Default for GasModel {
+    fn default() -> Self {
+        GasModel::Wiebe(WiebeModel::default())
+    }
+}
+
+/// Cylinder geometry needed by the pressure model.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct CylinderGeometry {
+    pub bore: f64,
+    pub crank_radius: f64,
+    pub conrod: f64,
+}
+
+impl CylinderGeometry {
+    pub fn piston_area(&self) -> f64 {
+        std::f64::consts::PI * 0.25 * self.bore * self.bore
+    }
+
+    /// Cylinder volume at crank angle `theta` (rad after TDC) for a compression ratio.
+    fn volume(&self, theta: f64, compression_ratio: f64) -> (f64, f64) {
+        let (r, l) = (self.crank_radius, self.conrod);
+        let a = self.piston_area();
+        let displacement = a * 2.0 * r;
+        let clearance = displacement / (compression_ratio - 1.0);
+        let (s, s1, _) = super::parts::slider_crank(theta, r, l);
+        (clearance + a * (r + l - s), -a * s1)
+    }
+}
+
+const GRID_DEG: f64 = 0.25;
+
+/// Tabulated cylinder pressure over one cycle, ready for fast C¹ evaluation.
+#[derive(Debug, Clone, PartialEq)]
+pub struct PressureCurve {
+    /// Pressure at angles −360° + k·0.25° (k = 0..2880), periodic.
+    values: Vec<f64>,
+    slopes: Vec<f64>,
+}
+
+impl PressureCurve {
+    /// Absolute pressure at cycle angle `theta` (rad after firing TDC, any value; period 4π).
+    pub fn pressure(&self, theta: f64) -> f64 {
+        let n = self.values.len();
+        let deg = theta.to_degrees();
+        let u = (deg + 360.0).rem_euclid(720.0) / GRID_DEG;
+        let i = (u.floor() as usize).min(n - 1);
+        let t = u - i as f64;
+        let j = (i + 1) % n;
+        let (p0, p1, m0, m1) = (
+            self.values[i],
+            self.values[j],
+            self.slopes[i],
+            self.slopes[j],
+        );
+        let t2 = t * t;
+        let t3 = t2 * t;
+        (2.0 * t3 - 3.0 * t2 + 1.0) * p0
+            + (t3 - 2.0 * t2 + t) * m0
+            + (-2.0 * t3 + 3.0 * t2) * p1
+            + (t3 - t2) * m1
+    }
+
+    /// Peak pressure over the cycle (Pa).
+    pub fn peak(&self) -> f64 {
+        self.values.iter().cloned().fold(f64::MIN, f64::max)
+    }
+
+    fn from_samples(values: Vec<f64>) -> Self {
+        let n = values.len();
+        // Centred differences (per grid step) keep the periodic Hermite interpolant C¹.
+        let slopes = (0..n)
+            .map(|i| 0.5 * (values[(i + 1) % n] - values[(i + n - 1) % n]))
+            .collect();
+        Self { values, slopes }
+    }
+
+    /// Linear blend `(1−w) a + w b`.
+    pub fn blend(a: &Self, b: &Self, w: f64) -> Self {
+        let values = a
+            .values
+            .iter()
+            .zip(&b.values)
+            .map(|(x, y)| (1.0 - w) * x + w * y)
+            .collect();
+        Self::from_samples(values)
+    }
+
+    /// Single-zone Wiebe pressure for one load point.
+    pub fn wiebe(model: &WiebeModel, point: &CombustionPoint, geometry: &CylinderGeometry) -> Self {
+        let n = (720.0 / GRID_DEG).round() as usize;
+        let step = GRID_DEG.to_radians();
+        let ivc = model.ivc_deg.to_radians();
+        let evo = model.evo_deg.to_radians();
+        let blow = model.blowdown_deg.to_radians().max(step);
+        let heat_rate = |theta: f64| -> f64 {
+            point
+                .stages
+                .iter()
+                .map(|s| {
+                    let soc = s.start_deg.to_radians();
+                    let dur = s.duration_deg.to_radians();
+                    let z = (theta - soc) / dur;
+                    if z <= 0.0 {
+                        return 0.0;
+                    }
+                    let m1 = s.shape + 1.0;
+                    point.heat * s.fraction * 6.908 * m1 / dur
+                        * z.powf(s.shape)
+                        * (-6.908 * z.powf(m1)).exp()
+                })
+                .sum()
+        };
+        let kappa = |theta: f64| {
+            let w = ((theta - ivc) / (evo - ivc)).clamp(0.0, 1.0);
+            model.kappa_compression + w * (model.kappa_expansion - model.kappa_compression)
+        };
+        let dpdt = |theta: f64, p: f64| {
+            let (v, dv) = geometry.volume(theta, model.compression_ratio);
+            let k = kappa(theta);
+            (k - 1.0) / v * heat_rate(theta) - k * p / v * dv
+        };
+        // RK4 on a 4× finer step from IVC to EVO.
+        let sub = 4;
+        let h = step / sub as f64;
+        let closed_steps = ((evo - ivc) / step).ceil() as usize;
+        let mut closed = Vec::with_capacity(closed_steps + 1);
+        let mut p = point.pressure_ivc;
+        let mut theta = ivc;
+        closed.push(p);
+        for _ in 0..closed_steps {
+            for _ in 0..sub {
+                let k1 = dpdt(theta, p);
+                let k2 = dpdt(theta + 0.5 * h, p + 0.5 * h * k1);
+                let k3 = dpdt(theta + 0.5 * h, p + 0.5 * h * k2);
+                let k4 = dpdt(theta + h, p + h * k3);
+                p += h / 6.0 * (k1 + 2.0 * k2 + 2.0 * k3 + k4);
+                theta += h;
+            }
+            closed.push(p);
+        }
+        let p_evo = closed[closed.len() - 1];
+        let charge = point.pressure_ivc;
+        let values = (0..n)
+            .map(|k| {
+                let th = (-360.0 + k as f64 * GRID_DEG).to_radians();
+                if th >= ivc && th <= ivc + closed_steps as f64 * step {
+                    let u = (th - ivc) / step;
+                    let i = (u.floor() as usize).min(closed.len() - 2);
+                    let t = u - i as f64;
+                    if th <= evo {
+                        return closed[i] + t * (closed[i + 1] - closed[i]);
+                    }
+                }
+                // Smooth (cosine) blow-down from EVO, charge pressure during gas exchange.
+                let since = if th > evo {
+                    th - evo
+                } else {
+                    th + 4.0 * std::f64::consts::PI - evo
+                };
+                if since < blow {
+                    let w = 0.5 * (1.0 + (std::f64::consts::PI * since / blow).cos());
+                    charge + w * (p_evo - charge)
+                } else {
+                    charge
+                }
+            })
+            .collect();
+        Self::from_samples(values)
+    }
+
+    /// Resamples a user table (periodic linear interpolation, then C¹ Hermite on the grid).
+    pub fn from_table(table: &PressureTable) -> Self {
+        let n = (720.0 / GRID_DEG).round() as usize;
+        let pts: Vec<(f64, f64)> = table
+            .angle_deg
+            .iter()
+            .zip(&table.pressure)
+            .map(|(a, p)| ((a + 360.0).rem_euclid(720.0), *p))
+            .collect();
+        let mut sorted = pts;
+        sorted.sort_by(|a, b| a.0.total_cmp(&b.0));
+        let values = (0..n)
+            .map(|k| {
+                let x = k as f64 * GRID_DEG;
+                let m = sorted.len();
+                let idx = sorted.iter().position(|(a, _)| *a > x).unwrap_or(m);
+                let (a0, p0) = if idx == 0 {
+                    (sorted[m - 1].0 - 720.0, sorted[m - 1].1)
+                } else {
+                    sorted[idx - 1]
+                };
+                let (a1, p1) = if idx == m {
+                    (sorted[0].0 + 720.0, sorted[0].1)
+                } else {
+                    sorted[idx]
+                };
+                if a1 - a0 <= 0.0 {
+                    p0
+                } else {
+                    p0 + (x - a0) / (a1 - a0) * (p1 - p0)
+                }
+            })
+            .collect();
+        Self::from_samples(values)
+    }
+}
+
+/// Piston side force `F_N = F_gas tan β` with `sin β = λ sin ψ` (ψ = crank angle after TDC).
+/// Positive: the piston presses against the cylinder wall in the +x direction of the block.
+pub fn side_force(gas_force: f64, psi: f64, lambda: f64) -> f64 {
+    let sb = lambda * psi.sin();
+    gas_force * sb / (1.0 - sb * sb).sqrt()
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn geometry() -> CylinderGeometry {
+        CylinderGeometry {
+            bore: 0.085,
+            crank_radius: 0.047,
+            conrod: 0.047 / 0.3,
+        }
+    }
+
+    #[test]
+    fn motored_cycle_follows_the_polytropic_law() {
+        // No heat release, constant exponent: p V^κ = const between IVC and EVO (independent truth).
+        let mut model = WiebeModel {
+            kappa_expansion: 1.36,
+            ..Default::default()
+        };
+        model.idle.heat = 0.0;
+        let curve = PressureCurve::wiebe(&model, &model.idle, &geometry());
+        let g = geometry();
+        let (v_ivc, _) = g.volume((-150f64).to_radians(), model.compression_ratio);
+        for deg in [-120.0, -60.0, -10.0, 0.0, 30.0, 100.0] {
+            let (v, _) = g.volume(f64::to_radians(deg), model.compression_ratio);
+            let expect = 1.0e5 * (v_ivc / v).powf(1.36);
+            let got = curve.pressure(f64::to_radians(deg));
+            assert!(
+                (got / expect - 1.0).abs() < 1e-4,
+                "{deg}: {got} vs {expect}"
+            );
+        }
+    }
+
+    #[test]
+    fn peak_pressures_are_in_the_design_ranges() {
+        let model = WiebeModel::default();
+        let idle = PressureCurve::wiebe(&model, &model.idle, &geometry()).peak();
+        let full = PressureCurve::wiebe(&model, &model.full_load, &geometry()).peak();
+        assert!((45e5..70e5).contains(&idle), "idle peak {idle}");
+        assert!((120e5..165e5).contains(&full), "full-load peak {full}");
+    }
+}

@@ -1,0 +1,135 @@
+//! Dense LU factorisation with partial pivoting through faer, with reusable storage.
+
+use faer::dyn_stack::{MemBuffer, MemStack};
+use faer::linalg::lu::partial_pivoting::{factor, solve};
+use faer::perm::PermRef;
+use faer::{Mat, MatMut, Par};
+
+/// A factorised square matrix `P A = L U`, stored in place.
+#[derive(Debug, Clone, PartialEq)]
+pub struct DenseLu {
+    lu: Mat<f64>,
+    perm: Vec<usize>,
+    perm_inv: Vec<usize>,
+    factored: bool,
+}
+
+impl DenseLu {
+    pub fn new(n: usize) -> Self {
+        Self {
+            lu: Mat::zeros(n, n),
+            perm: (0..n).collect(),
+            perm_inv: (0..n).collect(),
+            factored: false,
+        }
+    }
+
+    /// Storage to be filled with the matrix before [`Self::factor`].
+    pub fn matrix_mut(&mut self) -> &mut Mat<f64> {
+        self.factored = false;
+        &mut self.lu
+    }
+
+    /// Factorises the matrix written through [`Self::matrix_mut`]. Returns `false` when a pivot
+    /// is zero or not finite (the matrix is singular to working precision).
+    pub fn factor(&mut self) -> bool {
+        let n = self.lu.nrows();
+        let par = Par::Seq;
+        let mut mem = MemBuffer::new(factor::lu_in_place_scratch::<usize, f64>(
+            n,
+            n,
+            par,
+            Default::default(),
+        ));
+        factor::lu_in_place(
+            self.lu.as_mut(),
+            &mut self.perm,
+            &mut self.perm_inv,
+            par,
+            MemStack::new(&mut mem),
+            Default::default(),
+        );
+        self.factored = (0..n).all(|i| {
+            let d = self.lu[(i, i)];
+            d != 0.0 && d.is_finite()
+        });
+        self.factored
+    }
+
+    pub fn is_factored(&self) -> bool {
+        self.factored
+    }
+
+    /// Solves `A x = b` in place. Must follow a successful [`Self::factor`].
+    pub fn solve_in_place(&self, b: &mut [f64]) {
+        let n = self.lu.nrows();
+        let par = Par::Seq;
+        let mut mem = MemBuffer::new(solve::solve_in_place_scratch::<usize, f64>(n, 1, par));
+        let perm = PermRef::new_checked(&self.perm, &self.perm_inv, n);
+        let rhs = MatMut::from_column_major_slice_mut(b, n, 1);
+        solve::solve_in_place(
+            self.lu.as_ref(),
+            self.lu.as_ref(),
+            perm,
+            rhs,
+            par,
+            MemStack::new(&mut mem),
+        );
+    }
+
+    /// The raw parts for serialisation: the factor storage, the permutation and the flag.
+    pub fn parts(&self) -> (&Mat<f64>, &[usize], &[usize], bool) {
+        (&self.lu, &self.perm, &self.perm_inv, self.factored)
+    }
+
+    /// Rebuilds from raw parts (validated by the caller: square storage, permutation of 0..n).
+    pub fn from_parts(
+        lu: Mat<f64>,
+        perm: Vec<usize>,
+        perm_inv: Vec<usize>,
+        factored: bool,
+    ) -> Self {
+        Self {
+            lu,
+            perm,
+            perm_inv,
+            factored,
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn solves_a_pivoting_system() {
+        // Needs a row swap: the (0,0) entry is zero.
+        let a = [[0.0, 2.0, 1.0], [1.0, 1.0, 0.0], [3.0, 0.0, 1.0]];
+        let x_true = [1.0, -2.0, 0.5];
+        let mut lu = DenseLu::new(3);
+        for i in 0..3 {
+            for j in 0..3 {
+                lu.matrix_mut()[(i, j)] = a[i][j];
+            }
+        }
+        assert!(lu.factor());
+        let mut b: Vec<f64> = (0..3)
+            .map(|i| (0..3).map(|j| a[i][j] * x_true[j]).sum())
+            .collect();
+        lu.solve_in_place(&mut b);
+        for i in 0..3 {
+            assert!((b[i] - x_true[i]).abs() < 1e-14);
+        }
+    }
+
+    #[test]
+    fn reports_singular_matrix() {
+        let mut lu = DenseLu::new(2);
+        lu.matrix_mut()[(0, 0)] = 1.0;
+        lu.matrix_mut()[(0, 1)] = 2.0;
+        lu.matrix_mut()[(1, 0)] = 2.0;
+        lu.matrix_mut()[(1, 1)] = 4.0;
+        assert!(!lu.factor());
+    }
+}

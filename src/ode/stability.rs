@@ -1,0 +1,150 @@
+//! Stability-limit detection for lightly damped oscillatory modes.
+//!
+//! BDF3–5 are unstable in a band of `h * omega` near the imaginary axis. When a lightly damped
+//! stiff mode falls in that band the error test keeps failing at order >= 3 while the step size
+//! cannot grow; CVODE's own order selection then oscillates between rejected high-order steps
+//! and recovery. The guard notices repeated failures at q >= 3 with a non-growing step inside a
+//! short window and caps the order at 2 (A-stable) for a while; if the pattern recurs soon
+//! after the cap is lifted, the hold doubles.
+
+/// Failures at order >= 3 needed inside the window to trigger the cap.
+const TRIGGER_FAILURES: usize = 3;
+/// Window length in accepted steps.
+const WINDOW_STEPS: u64 = 25;
+/// First hold length in accepted steps.
+const INITIAL_HOLD: u64 = 50;
+/// Longest hold.
+const MAX_HOLD: u64 = 3200;
+/// Order allowed while the cap holds.
+const CAPPED_ORDER: usize = 2;
+/// Steps after the end of a hold at which the guard checks that the hold paid off.
+const PROBE_STEPS: u64 = 30;
+/// The hold paid off when the mean step since it began is at least this multiple of the failing
+/// step size.
+const PAYOFF_GROWTH: f64 = 0.3;
+/// First lock-out after a cap that did not pay off (accepted steps); doubles on each repeat.
+const INITIAL_LOCKOUT: u64 = 500;
+
+/// State of the detector; part of the integrator snapshot.
+#[derive(Debug, Clone, PartialEq)]
+pub struct StabilityGuard {
+    /// (step count, step size) of recent error-test failures at q >= 3.
+    pub(crate) failures: Vec<(u64, f64)>,
+    pub(crate) hold_until: u64,
+    pub(crate) hold_len: u64,
+    pub(crate) last_release: Option<u64>,
+    pub(crate) triggers: u64,
+    /// Largest failing step size when the current hold started.
+    pub(crate) h_trigger: f64,
+    /// Step count at which the current hold started.
+    pub(crate) hold_start: u64,
+    /// Time at which the current hold started.
+    pub(crate) t_hold_start: f64,
+    /// No new hold before this step count (a hold did not pay off recently).
+    pub(crate) lockout_until: u64,
+    pub(crate) lockout_len: u64,
+}
+
+impl Default for StabilityGuard {
+    fn default() -> Self {
+        Self {
+            failures: Vec::new(),
+            hold_until: 0,
+            hold_len: INITIAL_HOLD,
+            last_release: None,
+            triggers: 0,
+            h_trigger: 0.0,
+            hold_start: 0,
+            t_hold_start: 0.0,
+            lockout_until: 0,
+            lockout_len: INITIAL_LOCKOUT,
+        }
+    }
+}
+
+impl StabilityGuard {
+    /// Records an error-test failure of a step attempted at order `q` with size `h` from time
+    /// `t` when `nst` steps had been accepted.
+    pub fn record_error_test_failure(&mut self, nst: u64, t: f64, q: usize, h: f64) {
+        if q < 3 || nst < self.hold_until || nst < self.lockout_until {
+            return;
+        }
+        self.failures.retain(|(n, _)| n + WINDOW_STEPS >= nst);
+        self.failures.push((nst, h));
+        if self.failures.len() < TRIGGER_FAILURES {
+            return;
+        }
+        let h_first = self.failures[0].1;
+        let non_growing = h <= h_first * 1.5;
+        if !non_growing {
+            return;
+        }
+        if let Some(released) = self.last_release {
+            if nst < released + 2 * self.hold_len {
+                self.hold_len = (self.hold_len * 2).min(MAX_HOLD);
+            }
+        }
+        self.hold_until = nst + self.hold_len;
+        self.hold_start = nst;
+        self.t_hold_start = t;
+        self.h_trigger = self.failures.iter().map(|f| f.1).fold(0.0, f64::max);
+        self.failures.clear();
+        self.triggers += 1;
+    }
+
+    /// Notes an accepted step ending at `t`: detects the end of a hold and, a little later,
+    /// whether it paid off. A hold that did not (the mean step stayed below the failing step, so
+    /// accuracy rather than stability limits the step) locks the guard out for a while.
+    pub fn on_step_accepted(&mut self, nst: u64, t: f64) {
+        if self.hold_until != 0 && nst == self.hold_until {
+            self.last_release = Some(nst);
+        }
+        if self.hold_until != 0 && nst == self.hold_until + PROBE_STEPS && nst > self.hold_start {
+            let mean_h = (t - self.t_hold_start) / (nst - self.hold_start) as f64;
+            if mean_h < PAYOFF_GROWTH * self.h_trigger {
+                self.lockout_until = nst + self.lockout_len;
+                self.lockout_len = self.lockout_len.saturating_mul(2);
+                self.hold_len = INITIAL_HOLD;
+                self.last_release = None;
+            }
+        }
+    }
+
+    /// Highest order allowed for the step after `nst` accepted steps.
+    pub fn order_cap(&self, nst: u64, max_order: usize) -> usize {
+        if nst < self.hold_until {
+            CAPPED_ORDER.min(max_order)
+        } else {
+            max_order
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn caps_after_repeated_failures_and_releases_later() {
+        let mut g = StabilityGuard::default();
+        g.record_error_test_failure(10, 0.0, 4, 1e-3);
+        g.record_error_test_failure(12, 0.0, 4, 1e-3);
+        assert_eq!(g.order_cap(13, 5), 5);
+        g.record_error_test_failure(14, 0.0, 3, 0.9e-3);
+        assert_eq!(g.order_cap(15, 5), 2);
+        assert_eq!(g.order_cap(14 + INITIAL_HOLD, 5), 5);
+    }
+
+    #[test]
+    fn ignores_low_order_and_spread_out_failures() {
+        let mut g = StabilityGuard::default();
+        for k in 0..10 {
+            g.record_error_test_failure(k, 0.0, 2, 1e-3);
+        }
+        assert_eq!(g.order_cap(11, 5), 5);
+        for k in 0..5 {
+            g.record_error_test_failure(100 * k, 0.0, 5, 1e-3);
+        }
+        assert_eq!(g.order_cap(501, 5), 5);
+    }
+}

@@ -1,0 +1,406 @@
+//! Problems with known solutions, shipped with the solver for tests and benchmarks.
+
+use std::f64::consts::PI;
+
+use faer::{Mat, MatMut, Side};
+
+use super::problem::{OdeProblem, ProblemError};
+
+/// `y' = A y` with `A` in real Jordan form: a decaying oscillation `lambda = a ± i b` in
+/// (y0, y1) and a decay `c` in y2. Every derivative is known in closed form.
+#[derive(Debug, Clone)]
+pub struct LinearOscillator {
+    pub a: f64,
+    pub b: f64,
+    pub c: f64,
+    pub y0: [f64; 3],
+}
+
+impl Default for LinearOscillator {
+    fn default() -> Self {
+        Self {
+            a: -0.5,
+            b: 2.0,
+            c: -3.0,
+            y0: [1.0, 0.5, 2.0],
+        }
+    }
+}
+
+impl LinearOscillator {
+    /// The `k`-th time derivative of the exact solution at `t`.
+    pub fn exact_derivative(&self, t: f64, k: usize) -> [f64; 3] {
+        // (y0 + i y1)(t) = z0 exp(lambda t), d^k/dt^k multiplies by lambda^k.
+        let (mut pr, mut pi) = (1.0, 0.0);
+        for _ in 0..k {
+            let (r, i) = (pr * self.a - pi * self.b, pr * self.b + pi * self.a);
+            pr = r;
+            pi = i;
+        }
+        let e = (self.a * t).exp();
+        let (cr, ci) = (e * (self.b * t).cos(), e * (self.b * t).sin());
+        let (zr, zi) = (self.y0[0], self.y0[1]);
+        // z0 * lambda^k * exp(i b t) * exp(a t)
+        let (wr, wi) = (zr * pr - zi * pi, zr * pi + zi * pr);
+        [
+            wr * cr - wi * ci,
+            wr * ci + wi * cr,
+            self.y0[2] * self.c.powi(k as i32) * (self.c * t).exp(),
+        ]
+    }
+}
+
+impl OdeProblem for LinearOscillator {
+    fn dim(&self) -> usize {
+        3
+    }
+    fn rhs(&mut self, _t: f64, y: &[f64], f: &mut [f64]) -> Result<(), ProblemError> {
+        f[0] = self.a * y[0] - self.b * y[1];
+        f[1] = self.b * y[0] + self.a * y[1];
+        f[2] = self.c * y[2];
+        Ok(())
+    }
+    fn jacobian(
+        &mut self,
+        _t: f64,
+        _y: &[f64],
+        mut j: MatMut<'_, f64>,
+    ) -> Result<bool, ProblemError> {
+        j[(0, 0)] = self.a;
+        j[(0, 1)] = -self.b;
+        j[(1, 0)] = self.b;
+        j[(1, 1)] = self.a;
+        j[(2, 2)] = self.c;
+        Ok(true)
+    }
+}
+
+/// Robertson's chemical kinetics (stiff, nonlinear). `analytic_jacobian = false` makes the
+/// integrator use finite differences.
+#[derive(Debug, Clone)]
+pub struct Robertson {
+    pub analytic_jacobian: bool,
+}
+
+impl Robertson {
+    pub const Y0: [f64; 3] = [1.0, 0.0, 0.0];
+    /// Reference solution at t = 40 (Hairer & Wanner; IVP test-set literature).
+    pub const Y_AT_40: [f64; 3] = [
+        0.715_827_068_719_377,
+        9.185_534_764_557_338e-6,
+        0.284_163_745_745_862,
+    ];
+}
+
+impl OdeProblem for Robertson {
+    fn dim(&self) -> usize {
+        3
+    }
+    fn rhs(&mut self, _t: f64, y: &[f64], f: &mut [f64]) -> Result<(), ProblemError> {
+        f[0] = -0.04 * y[0] + 1e4 * y[1] * y[2];
+        f[2] = 3e7 * y[1] * y[1];
+        f[1] = -f[0] - f[2];
+        Ok(())
+    }
+    fn jacobian(
+        &mut self,
+        _t: f64,
+        y: &[f64],
+        mut j: MatMut<'_, f64>,
+    ) -> Result<bool, ProblemError> {
+        if !self.analytic_jacobian {
+            return Ok(false);
+        }
+        j[(0, 0)] = -0.04;
+        j[(0, 1)] = 1e4 * y[2];
+        j[(0, 2)] = 1e4 * y[1];
+        j[(2, 0)] = 0.0;
+        j[(2, 1)] = 6e7 * y[1];
+        j[(2, 2)] = 0.0;
+        j[(1, 0)] = 0.04;
+        j[(1, 1)] = -1e4 * y[2] - 6e7 * y[1];
+        j[(1, 2)] = -1e4 * y[1];
+        Ok(true)
+    }
+}
+
+/// Van der Pol oscillator `y0' = y1, y1' = mu (1 - y0^2) y1 - y0`.
+#[derive(Debug, Clone)]
+pub struct VanDerPol {
+    pub mu: f64,
+}
+
+impl OdeProblem for VanDerPol {
+    fn dim(&self) -> usize {
+        2
+    }
+    fn rhs(&mut self, _t: f64, y: &[f64], f: &mut [f64]) -> Result<(), ProblemError> {
+        f[0] = y[1];
+        f[1] = self.mu * (1.0 - y[0] * y[0]) * y[1] - y[0];
+        Ok(())
+    }
+    fn jacobian(
+        &mut self,
+        _t: f64,
+        y: &[f64],
+        mut j: MatMut<'_, f64>,
+    ) -> Result<bool, ProblemError> {
+        j[(0, 0)] = 0.0;
+        j[(0, 1)] = 1.0;
+        j[(1, 0)] = -2.0 * self.mu * y[0] * y[1] - 1.0;
+        j[(1, 1)] = self.mu * (1.0 - y[0] * y[0]);
+        Ok(true)
+    }
+}
+
+/// Linear spring–mass chain with modal damping and harmonic forcing; exact solution by modal
+/// superposition.
+///
+/// 19 equal masses in a fixed–free chain (modes about 4–100 Hz) and one light mass on a stiff
+/// spring (about 2 kHz) hung from the middle mass: 20 degrees of freedom, 40 states
+/// `y = [x; v]`. Damping is 1 % in every mode, built as `C = M Phi diag(2 zeta omega) Phi^T M`.
+/// A force `F0 sin(2 pi 25 t)` acts on the middle mass, where the stiff mode is attached, so the
+/// 2 kHz mode is excited (the case in which BDF3–5 stall without stability-limit detection).
+#[derive(Debug, Clone)]
+pub struct SpringChain {
+    pub mass: Vec<f64>,
+    pub stiffness: Mat<f64>,
+    pub damping: Mat<f64>,
+    /// Mass-normalised mode shapes (columns).
+    pub modes: Mat<f64>,
+    /// Undamped natural circular frequencies (rad/s), ascending.
+    pub omega: Vec<f64>,
+    pub zeta: f64,
+    pub force_dof: usize,
+    pub force_amplitude: f64,
+    pub force_omega: f64,
+    /// Formulate as `diag(I, M) y' = f` instead of `y' = M^{-1} f`.
+    pub use_mass_matrix: bool,
+}
+
+impl SpringChain {
+    /// The standard 20-DOF chain described on the type.
+    pub fn standard(use_mass_matrix: bool) -> Self {
+        let chain = 19;
+        let n = chain + 1;
+        let m = 1.0;
+        // Top chain mode 100 Hz: omega_r = 2 sqrt(k/m) sin((2r-1) pi / (2 (2N+1))).
+        let top = (((2 * chain - 1) as f64) * PI / (2.0 * (2 * chain + 1) as f64)).sin();
+        let sqrt_km = 2.0 * PI * 100.0 / (2.0 * top);
+        let k = m * sqrt_km * sqrt_km;
+        let m_small = 0.01;
+        let k_small = m_small * (2.0 * PI * 2000.0_f64).powi(2);
+        let attach = chain / 2;
+        let mut mass = vec![m; n];
+        mass[chain] = m_small;
+        let mut kk = Mat::<f64>::zeros(n, n);
+        for i in 0..chain {
+            // Spring to the previous mass (or to the ground for i = 0).
+            kk[(i, i)] += k;
+            if i > 0 {
+                kk[(i - 1, i - 1)] += k;
+                kk[(i - 1, i)] -= k;
+                kk[(i, i - 1)] -= k;
+            }
+        }
+        kk[(attach, attach)] += k_small;
+        kk[(chain, chain)] += k_small;
+        kk[(attach, chain)] -= k_small;
+        kk[(chain, attach)] -= k_small;
+        Self::from_matrices(
+            mass,
+            kk,
+            0.01,
+            attach,
+            100.0,
+            2.0 * PI * 25.0,
+            use_mass_matrix,
+        )
+    }
+
+    /// The 19-mass chain of [`Self::standard`] without the stiff mode (modes 4–100 Hz only),
+    /// forced at its free end: a smooth, non-stiff-stalling problem.
+    pub fn without_stiff_mode() -> Self {
+        let chain = 19;
+        let top = (((2 * chain - 1) as f64) * PI / (2.0 * (2 * chain + 1) as f64)).sin();
+        let sqrt_km = 2.0 * PI * 100.0 / (2.0 * top);
+        let k = sqrt_km * sqrt_km;
+        let mut kk = Mat::<f64>::zeros(chain, chain);
+        for i in 0..chain {
+            kk[(i, i)] += k;
+            if i > 0 {
+                kk[(i - 1, i - 1)] += k;
+                kk[(i - 1, i)] -= k;
+                kk[(i, i - 1)] -= k;
+            }
+        }
+        Self::from_matrices(
+            vec![1.0; chain],
+            kk,
+            0.01,
+            chain - 1,
+            100.0,
+            2.0 * PI * 25.0,
+            false,
+        )
+    }
+
+    /// Builds the chain from diagonal masses and a stiffness matrix.
+    pub fn from_matrices(
+        mass: Vec<f64>,
+        stiffness: Mat<f64>,
+        zeta: f64,
+        force_dof: usize,
+        force_amplitude: f64,
+        force_omega: f64,
+        use_mass_matrix: bool,
+    ) -> Self {
+        let n = mass.len();
+        // K~ = M^{-1/2} K M^{-1/2}, symmetric; its eigenvectors give the modes.
+        let ktilde = Mat::from_fn(n, n, |i, j| stiffness[(i, j)] / (mass[i] * mass[j]).sqrt());
+        let (omega, modes) = match ktilde.self_adjoint_eigen(Side::Lower) {
+            Ok(evd) => {
+                let s = evd.S();
+                let u = evd.U();
+                let omega: Vec<f64> = (0..n).map(|r| s[r].max(0.0).sqrt()).collect();
+                let modes = Mat::from_fn(n, n, |i, r| u[(i, r)] / mass[i].sqrt());
+                (omega, modes)
+            }
+            Err(_) => (vec![0.0; n], Mat::zeros(n, n)),
+        };
+        // C = M Phi diag(2 zeta omega) Phi^T M
+        let damping = Mat::from_fn(n, n, |i, j| {
+            (0..n)
+                .map(|r| mass[i] * modes[(i, r)] * 2.0 * zeta * omega[r] * modes[(j, r)] * mass[j])
+                .sum()
+        });
+        Self {
+            mass,
+            stiffness,
+            damping,
+            modes,
+            omega,
+            zeta,
+            force_dof,
+            force_amplitude,
+            force_omega,
+            use_mass_matrix,
+        }
+    }
+
+    /// Number of states (twice the degrees of freedom).
+    pub fn dim2(&self) -> usize {
+        2 * self.mass.len()
+    }
+
+    pub fn dofs(&self) -> usize {
+        self.mass.len()
+    }
+
+    /// Natural frequencies in Hz.
+    pub fn frequencies_hz(&self) -> Vec<f64> {
+        self.omega.iter().map(|w| w / (2.0 * PI)).collect()
+    }
+
+    fn force(&self, t: f64, i: usize) -> f64 {
+        if i == self.force_dof {
+            self.force_amplitude * (self.force_omega * t).sin()
+        } else {
+            0.0
+        }
+    }
+
+    /// Exact state `[x; v]` at `t` from the initial state `y0` (modal superposition).
+    pub fn exact(&self, y0: &[f64], t: f64) -> Vec<f64> {
+        let n = self.dofs();
+        let w = self.force_omega;
+        let mut y = vec![0.0; 2 * n];
+        for r in 0..n {
+            let phi = |i: usize| self.modes[(i, r)];
+            let q0: f64 = (0..n).map(|i| phi(i) * self.mass[i] * y0[i]).sum();
+            let qd0: f64 = (0..n).map(|i| phi(i) * self.mass[i] * y0[n + i]).sum();
+            let p = phi(self.force_dof) * self.force_amplitude;
+            let om = self.omega[r];
+            let z = self.zeta;
+            let d = (om * om - w * w).powi(2) + (2.0 * z * om * w).powi(2);
+            let a = p * (om * om - w * w) / d;
+            let b = -p * 2.0 * z * om * w / d;
+            let wd = om * (1.0 - z * z).sqrt();
+            let c1 = q0 - b;
+            let c2 = (qd0 + z * om * c1 - a * w) / wd;
+            let e = (-z * om * t).exp();
+            let (cs, sn) = ((wd * t).cos(), (wd * t).sin());
+            let q = a * (w * t).sin() + b * (w * t).cos() + e * (c1 * cs + c2 * sn);
+            let qd = a * w * (w * t).cos() - b * w * (w * t).sin()
+                + e * ((-z * om) * (c1 * cs + c2 * sn) + wd * (-c1 * sn + c2 * cs));
+            for i in 0..n {
+                y[i] += phi(i) * q;
+                y[n + i] += phi(i) * qd;
+            }
+        }
+        y
+    }
+}
+
+impl OdeProblem for SpringChain {
+    fn dim(&self) -> usize {
+        2 * self.dofs()
+    }
+    fn rhs(&mut self, t: f64, y: &[f64], f: &mut [f64]) -> Result<(), ProblemError> {
+        let n = self.dofs();
+        let (x, v) = y.split_at(n);
+        let (fx, fv) = f.split_at_mut(n);
+        fx.copy_from_slice(v);
+        for (i, out) in fv.iter_mut().enumerate() {
+            *out = self.force(t, i);
+        }
+        for j in 0..n {
+            let kc = self.stiffness.col_as_slice(j);
+            let cc = self.damping.col_as_slice(j);
+            for i in 0..n {
+                fv[i] -= kc[i] * x[j] + cc[i] * v[j];
+            }
+        }
+        if !self.use_mass_matrix {
+            for (o, m) in fv.iter_mut().zip(&self.mass) {
+                *o /= m;
+            }
+        }
+        Ok(())
+    }
+    fn has_mass_matrix(&self) -> bool {
+        self.use_mass_matrix
+    }
+    fn mass_is_constant(&self) -> bool {
+        true
+    }
+    fn mass(&mut self, _t: f64, _y: &[f64], mut m: MatMut<'_, f64>) -> Result<(), ProblemError> {
+        let n = self.dofs();
+        for i in 0..n {
+            m[(i, i)] = 1.0;
+            m[(n + i, n + i)] = self.mass[i];
+        }
+        Ok(())
+    }
+    fn jacobian(
+        &mut self,
+        _t: f64,
+        _y: &[f64],
+        mut j: MatMut<'_, f64>,
+    ) -> Result<bool, ProblemError> {
+        let n = self.dofs();
+        for i in 0..n {
+            j[(i, n + i)] = 1.0;
+            let scale = if self.use_mass_matrix {
+                1.0
+            } else {
+                1.0 / self.mass[i]
+            };
+            for c in 0..n {
+                j[(n + i, c)] = -self.stiffness[(i, c)] * scale;
+                j[(n + i, n + c)] = -self.damping[(i, c)] * scale;
+            }
+        }
+        Ok(true)
+    }
+}

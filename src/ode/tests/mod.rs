@@ -1,0 +1,3 @@
+//! Convergence and behaviour tests that need the integrator internals.
+
+mod order;

@@ -1,0 +1,153 @@
+//! Static equilibrium (fact 6) and configuration handling of the engine model.
+
+use engine_mount_chassis::model::{EngineConfig, GroundScene, POWERTRAIN_MASS};
+
+fn vertical_sum(scene: &GroundScene, y: &[f64]) -> f64 {
+    let out = scene.outputs(0.0, y).expect("outputs");
+    out.mount_forces.iter().map(|f| f[2]).sum()
+}
+
+#[test]
+fn default_config_is_valid_and_statics_carry_the_weight() {
+    let cfg = EngineConfig::default();
+    cfg.validate().expect("default config valid");
+    let mut scene = GroundScene::new(cfg.clone()).expect("scene");
+    let y = scene.static_equilibrium(0.0).expect("equilibrium");
+    let weight = POWERTRAIN_MASS * cfg.gravity;
+    // Force on the ground side: the powertrain pushes the ground down.
+    let sum = -vertical_sum(&scene, &y);
+    assert!(
+        (sum / weight - 1.0).abs() < 1e-3,
+        "sum {sum} vs weight {weight}"
+    );
+}
+
+#[test]
+fn weight_is_carried_without_preload_and_with_load_torque_and_three_mounts() {
+    // Fact 6 where the answer is not built into the preloads: no preload at all (the weight
+    // deflects the progressive mounts by several mm), a 150 N m load torque, one mount removed.
+    let mut cfg = EngineConfig::default();
+    for m in &mut cfg.mounts {
+        m.preload = [0.0; 3];
+    }
+    cfg.mounts[1].active = false;
+    let weight = POWERTRAIN_MASS * cfg.gravity;
+    let mut scene = GroundScene::new(cfg).expect("scene");
+    scene.set_load_torque(0.0, 150.0, 0.0).expect("torque");
+    let y = scene.static_equilibrium(0.0).expect("equilibrium");
+    let out = scene.outputs(0.0, &y).expect("outputs");
+    let sum: f64 = -out.mount_forces.iter().map(|f| f[2]).sum::<f64>();
+    assert!(
+        (sum / weight - 1.0).abs() < 1e-3,
+        "sum {sum} vs weight {weight}"
+    );
+    // The moment about y of the mount forces (ground side) balances the load torque.
+    let cg = engine_mount_chassis::model::POWERTRAIN_CG;
+    let my: f64 = scene
+        .config()
+        .mounts
+        .iter()
+        .zip(&out.mount_forces)
+        .map(|(m, f)| {
+            let r = [m.bracket[0] - cg[0], m.bracket[2] - cg[2]];
+            r[1] * f[0] - r[0] * f[2]
+        })
+        .sum();
+    assert!((my - 150.0).abs() < 0.5, "mount moment about y {my}");
+    assert_eq!(out.mount_forces[1], [0.0; 3]);
+    // The static accelerations vanish.
+    for a in out
+        .housing
+        .acceleration
+        .iter()
+        .chain(&out.monoblock.acceleration)
+    {
+        assert!(a.abs() < 1e-6, "{a}");
+    }
+}
+
+#[test]
+fn too_soft_mounts_give_a_clear_error() {
+    let mut scene = GroundScene::new(EngineConfig::default()).expect("scene");
+    for i in 0..4 {
+        scene.set_mount_scales(i, 0.02, 1.0).expect("scale");
+    }
+    let mut cfg = scene.config().clone();
+    for m in &mut cfg.mounts {
+        m.preload = [0.0; 3];
+    }
+    let mut soft = GroundScene::new(cfg).expect("scene");
+    for i in 0..4 {
+        soft.set_mount_scales(i, 0.02, 1.0).expect("scale");
+    }
+    let e = soft.static_equilibrium(0.0).expect_err("too soft");
+    assert!(e.to_string().contains("too soft"), "{e}");
+}
+
+#[test]
+fn invalid_values_are_rejected_naming_field_and_value() {
+    type Mutation = Box<dyn Fn(&mut EngineConfig)>;
+    let cases: Vec<(Mutation, &str)> = vec![
+        (Box::new(|c| c.monoblock.mass = -3.0), "monoblock.mass = -3"),
+        (
+            Box::new(|c| c.housing.inertia[0][0] = -1.0),
+            "housing.inertia",
+        ),
+        (Box::new(|c| c.crank_drive.conrod_length = 0.04), "lambda"),
+        (
+            Box::new(|c| c.mounts[2].curves[1].knots[3].stiffness = 0.0),
+            "mounts[2].curves[1].knots[3].stiffness = 0",
+        ),
+        (Box::new(|c| c.gas.load = 1.5), "gas.load = 1.5"),
+        (
+            Box::new(|c| c.crank_drive.cylinders[1].firing_tdc_deg = 100.0),
+            "crank_drive.cylinders[1].firing_tdc_deg = 100",
+        ),
+        (Box::new(|c| c.mounts.truncate(2)), "2 active mounts"),
+        (
+            Box::new(|c| c.crank_drive.oscillating_mass = f64::NAN),
+            "crank_drive.oscillating_mass = NaN",
+        ),
+    ];
+    for (mutate, expect) in cases {
+        let mut c = EngineConfig::default();
+        mutate(&mut c);
+        let e = c.validate().expect_err(expect).to_string();
+        assert!(
+            e.contains(expect),
+            "message {e:?} should contain {expect:?}"
+        );
+        assert!(GroundScene::new(c).is_err());
+    }
+}
+
+#[test]
+fn json_round_trip_and_partial_json_takes_defaults() {
+    let d = EngineConfig::default();
+    let back = EngineConfig::from_json(&d.to_json()).expect("round trip");
+    assert_eq!(back, d);
+    let partial =
+        EngineConfig::from_json(r#"{"gravity": 9.80665, "effects": {"gas_forces": false}}"#)
+            .expect("partial");
+    assert_eq!(partial.gravity, 9.80665);
+    assert!(!partial.effects.gas_forces);
+    assert!(partial.effects.mass_forces);
+    assert_eq!(partial.mounts, d.mounts);
+    let e = EngineConfig::from_json(r#"{"gravity": "x"}"#).expect_err("bad json");
+    assert!(e.to_string().contains("json"));
+}
+
+#[test]
+fn resource_file_equals_the_defaults() {
+    let text = std::fs::read_to_string(concat!(
+        env!("CARGO_MANIFEST_DIR"),
+        "/resources/engine.json"
+    ))
+    .expect("resources/engine.json");
+    let cfg = EngineConfig::from_json(&text).expect("resource parses");
+    assert_eq!(
+        cfg,
+        EngineConfig::default(),
+        "regenerate with `cargo run --release --example engine_default_config`"
+    );
+}
