@@ -90,18 +90,31 @@ fn main() {
     let (scalars, families) = expand(&table);
     validate(&table, &scalars);
 
-    write(&out.join("modelDescription.xml"), &model_description(&table, &scalars, &guid));
-    write(&out.join("variables.rs"), &rust_table(&table, &scalars, &families, &guid));
-    write(&out.join("index.html"), &documentation(&table, &scalars, &guid));
+    write(
+        &out.join("modelDescription.xml"),
+        &model_description(&table, &scalars, &guid),
+    );
+    write(
+        &out.join("variables.rs"),
+        &rust_table(&table, &scalars, &families, &guid),
+    );
+    write(
+        &out.join("index.html"),
+        &documentation(&table, &scalars, &guid),
+    );
 
     let mut map = String::from("{\n  global:\n");
     for f in FMI2_FUNCTIONS {
         let _ = writeln!(map, "    {f};");
     }
-    map.push_str("  local: *;\n};\n");
+    // fmi-sys (fmi2 feature) defines a #[no_mangle] `callback_log` that rustc would export too.
+    map.push_str("  local:\n    callback_log;\n    *;\n};\n");
     let map_path = out.join("exports.map");
     write(&map_path, &map);
-    println!("cargo:rustc-cdylib-link-arg=-Wl,--version-script={}", map_path.display());
+    println!(
+        "cargo:rustc-cdylib-link-arg=-Wl,--version-script={}",
+        map_path.display()
+    );
 }
 
 fn env(key: &str) -> String {
@@ -131,7 +144,9 @@ fn opt_str(v: &Value, key: &str) -> Option<String> {
 /// A content-derived GUID: two FNV-1a 64-bit hashes with different offsets, formatted as a UUID.
 fn guid_of(text: &str) -> String {
     let fnv = |offset: u64| {
-        text.bytes().fold(offset, |h, b| (h ^ u64::from(b)).wrapping_mul(0x100000001b3))
+        text.bytes().fold(offset, |h, b| {
+            (h ^ u64::from(b)).wrapping_mul(0x100000001b3)
+        })
     };
     let a = fnv(0xcbf29ce484222325);
     let b = fnv(0x84222325cbf29ce4);
@@ -164,15 +179,22 @@ fn expand(table: &Value) -> (Vec<Scalar>, Vec<Family>) {
             .and_then(Value::as_array)
             .map(|d| d.iter().map(|x| x.as_u64().unwrap_or(0) as usize).collect())
             .unwrap_or_default();
-        if dims.iter().any(|d| *d == 0) || dims.len() > 2 {
+        if dims.contains(&0) || dims.len() > 2 {
             fail(&format!("bad dims in {}", str_field(e, "name")));
         }
         let first_vr = next_vr[ty];
-        families.push(Family { rust: str_field(e, "rust").to_owned(), ty, dims: dims.clone(), first_vr });
+        families.push(Family {
+            rust: str_field(e, "rust").to_owned(),
+            ty,
+            dims: dims.clone(),
+            first_vr,
+        });
         let indices: Vec<Vec<usize>> = match dims.as_slice() {
             [] => vec![vec![]],
             [n] => (1..=*n).map(|i| vec![i]).collect(),
-            [n, m] => (1..=*n).flat_map(|i| (1..=*m).map(move |j| vec![i, j])).collect(),
+            [n, m] => (1..=*n)
+                .flat_map(|i| (1..=*m).map(move |j| vec![i, j]))
+                .collect(),
             _ => unreachable!(),
         };
         for idx in indices {
@@ -223,7 +245,10 @@ fn validate(table: &Value, scalars: &[Scalar]) {
             fail(&format!("{} ({}) needs a start value", s.name, s.causality));
         }
         if s.causality == "output" && s.start.is_some() {
-            fail(&format!("output {} is calculated and must not have a start value", s.name));
+            fail(&format!(
+                "output {} is calculated and must not have a start value",
+                s.name
+            ));
         }
         if let Some(u) = &s.unit {
             if !units.contains(&u.as_str()) {
@@ -269,8 +294,17 @@ fn model_description(table: &Value, scalars: &[Scalar], guid: &str) -> String {
         r#"  <CoSimulation modelIdentifier="{id}" needsExecutionTool="false" canHandleVariableCommunicationStepSize="true" canInterpolateInputs="true" maxOutputDerivativeOrder="0" canRunAsynchronuously="false" canBeInstantiatedOnlyOncePerProcess="false" canNotUseMemoryManagementFunctions="true" canGetAndSetFMUstate="true" canSerializeFMUstate="true" providesDirectionalDerivative="false"/>"#
     );
     x.push_str("  <UnitDefinitions>\n");
-    for u in table.get("units").and_then(Value::as_array).into_iter().flatten() {
-        let _ = writeln!(x, r#"    <Unit name="{}">"#, xml_escape(str_field(u, "name")));
+    for u in table
+        .get("units")
+        .and_then(Value::as_array)
+        .into_iter()
+        .flatten()
+    {
+        let _ = writeln!(
+            x,
+            r#"    <Unit name="{}">"#,
+            xml_escape(str_field(u, "name"))
+        );
         let mut base = String::from("      <BaseUnit");
         if let Some(obj) = u.get("base").and_then(Value::as_object) {
             for (k, v) in obj {
@@ -282,7 +316,12 @@ fn model_description(table: &Value, scalars: &[Scalar], guid: &str) -> String {
         }
         base.push_str("/>\n");
         x.push_str(&base);
-        for d in u.get("display").and_then(Value::as_array).into_iter().flatten() {
+        for d in u
+            .get("display")
+            .and_then(Value::as_array)
+            .into_iter()
+            .flatten()
+        {
             let factor = d.get("factor").and_then(Value::as_f64).unwrap_or(1.0);
             let _ = writeln!(
                 x,
@@ -294,7 +333,12 @@ fn model_description(table: &Value, scalars: &[Scalar], guid: &str) -> String {
     }
     x.push_str("  </UnitDefinitions>\n");
     x.push_str("  <LogCategories>\n");
-    for c in table.get("logCategories").and_then(Value::as_array).into_iter().flatten() {
+    for c in table
+        .get("logCategories")
+        .and_then(Value::as_array)
+        .into_iter()
+        .flatten()
+    {
         let _ = writeln!(
             x,
             r#"    <Category name="{}" description="{}"/>"#,
@@ -390,7 +434,9 @@ fn rust_variability(v: &str) -> &'static str {
 }
 
 fn rust_table(table: &Value, scalars: &[Scalar], families: &[Family], guid: &str) -> String {
-    let mut r = String::from("// Generated by build.rs from modelDescription/variables.json. Do not edit.\n\n");
+    let mut r = String::from(
+        "// Generated by build.rs from modelDescription/variables.json. Do not edit.\n\n",
+    );
     let _ = writeln!(
         r,
         "/// `modelIdentifier`: the FMU's binary name.\npub const MODEL_IDENTIFIER: &str = {:?};",
@@ -408,7 +454,11 @@ fn rust_table(table: &Value, scalars: &[Scalar], families: &[Family], guid: &str
     );
     for ty in TYPES {
         let module = ty.to_lowercase();
-        let _ = writeln!(r, "\n/// Value references of the {ty} variables (indices into [`{}S`]).", ty.to_uppercase());
+        let _ = writeln!(
+            r,
+            "\n/// Value references of the {ty} variables (indices into [`{}S`]).",
+            ty.to_uppercase()
+        );
         let _ = writeln!(r, "pub mod {module} {{");
         for f in families.iter().filter(|f| f.ty == ty) {
             match f.dims.as_slice() {
@@ -420,8 +470,9 @@ fn rust_table(table: &Value, scalars: &[Scalar], families: &[Family], guid: &str
                     let _ = writeln!(r, "    pub const {}: [u32; {n}] = {vrs:?};", f.rust);
                 }
                 [n, m] => {
-                    let rows: Vec<Vec<usize>> =
-                        (0..*n).map(|i| (0..*m).map(|j| f.first_vr + i * m + j).collect()).collect();
+                    let rows: Vec<Vec<usize>> = (0..*n)
+                        .map(|i| (0..*m).map(|j| f.first_vr + i * m + j).collect())
+                        .collect();
                     let _ = writeln!(r, "    pub const {}: [[u32; {m}]; {n}] = {rows:?};", f.rust);
                 }
                 _ => unreachable!(),
@@ -435,7 +486,11 @@ fn rust_table(table: &Value, scalars: &[Scalar], families: &[Family], guid: &str
             _ => "&'static str",
         };
         let _ = writeln!(r, "\n/// The {ty} variables, indexed by value reference.");
-        let _ = writeln!(r, "pub static {}S: &[Variable<{rust_ty}>] = &[", ty.to_uppercase());
+        let _ = writeln!(
+            r,
+            "pub static {}S: &[Variable<{rust_ty}>] = &[",
+            ty.to_uppercase()
+        );
         for s in scalars.iter().filter(|s| s.ty == ty) {
             let start = match (&s.start, ty) {
                 (None, "Real") => "0.0".to_owned(),
@@ -476,7 +531,11 @@ fn documentation(table: &Value, scalars: &[Scalar], guid: &str) -> String {
         h,
         "<!DOCTYPE html>\n<html lang=\"en\"><head><meta charset=\"utf-8\"><title>{name}</title>\n<style>body{{font-family:sans-serif;max-width:70em;margin:2em auto}}table{{border-collapse:collapse}}td,th{{border:1px solid #bbb;padding:3px 6px;text-align:left}}</style></head><body>"
     );
-    let _ = writeln!(h, "<h1>{name}</h1>\n<p>{}</p>", xml_escape(str_field(table, "description")));
+    let _ = writeln!(
+        h,
+        "<h1>{name}</h1>\n<p>{}</p>",
+        xml_escape(str_field(table, "description"))
+    );
     let _ = writeln!(h, "<p>FMI 2.0 co-simulation, GUID <code>{guid}</code>.</p>");
     h.push_str(
         "<h2>Scenes</h2>\n<ul><li><b>1</b>: engine on rigid ground: monoblock and housing (with gearbox) as rigid bodies \

@@ -8,6 +8,8 @@ bash scripts/setup.sh
 
 cargo fmt --all -- --check
 cargo clippy --release --all-targets -- -D warnings
+# The ABI tests dlopen the cdylib, which `cargo test` does not build.
+cargo build --release
 cargo test --release
 
 if [ -d python/tests ] && ls python/tests/test_*.py >/dev/null 2>&1; then

@@ -6,7 +6,11 @@
 //! - [`ode`]: the Gear/BDF integrator, generic over [`ode::OdeProblem`]; knows nothing of engines.
 //! - [`fe`]: finite elements, assembly and the procedural chassis.
 //! - [`model`]: engine multibody model, mounts, coupled system, outputs.
+//! - [`cosim`]: a scene with its integrator and inputs, stepped between communication points.
+//! - [`fmi2`]: the FMI 2.0 co-simulation C ABI (the only `unsafe` code).
 
+pub mod cosim;
 pub mod fe;
+pub mod fmi2;
 pub mod model;
 pub mod ode;

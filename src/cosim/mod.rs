@@ -9,7 +9,7 @@
 mod scene;
 mod signals;
 
-pub use scene::{GroundScene, Scene};
+pub use scene::{Scene, FMU_MOUNTS};
 pub use signals::{Inputs, Signal};
 
 use std::path::PathBuf;
@@ -114,10 +114,13 @@ pub struct StepFailure {
 /// A scene with its integrator, ready to step.
 #[derive(Clone)]
 pub struct Simulation {
-    scene: GroundScene,
+    scene: Scene,
     integrator: Bdf,
     inputs: Inputs,
-    options: BdfOptions,
+    /// Where and under which inputs the static equilibrium was found: with the settings, this
+    /// rebuilds the scene exactly (fade-in start, mount operating points).
+    initial_time: f64,
+    initial_inputs: Inputs,
 }
 
 impl Simulation {
@@ -125,9 +128,6 @@ impl Simulation {
     /// integrator there.
     pub fn new(settings: &Settings, t0: f64, inputs: &Inputs) -> Result<Simulation, String> {
         inputs.validate()?;
-        if settings.scene != 1 {
-            return Err(format!("scene {} is not available (1 = engine on rigid ground)", settings.scene));
-        }
         let options = BdfOptions {
             rtol: settings.rel_tol,
             atol: Tolerance::Scalar(settings.abs_tol),
@@ -135,11 +135,17 @@ impl Simulation {
             stability_limit_detection: settings.stability_limit_detection,
             ..BdfOptions::default()
         };
-        let mut scene = GroundScene::new(settings)?;
-        scene.set_inputs(inputs);
+        let mut scene = Scene::build(settings)?;
+        scene.set_inputs(inputs)?;
         let y0 = scene.initial_state(t0)?;
-        let integrator = Bdf::new(&mut scene, t0, &y0, options.clone()).map_err(|e| e.to_string())?;
-        Ok(Simulation { scene, integrator, inputs: *inputs, options })
+        let integrator = Bdf::new(&mut scene, t0, &y0, options).map_err(|e| e.to_string())?;
+        Ok(Simulation {
+            scene,
+            integrator,
+            inputs: *inputs,
+            initial_time: t0,
+            initial_inputs: *inputs,
+        })
     }
 
     /// Lines for the log describing the scene.
@@ -157,20 +163,24 @@ impl Simulation {
         inputs.validate()?;
         let t = self.integrator.t();
         let jumped = !self.inputs.continue_into(inputs, t);
+        self.scene.set_inputs(inputs)?;
         self.inputs = *inputs;
-        self.scene.set_inputs(inputs);
         if jumped {
-            self.integrator.restart(&mut self.scene, None).map_err(|e| e.to_string())?;
+            self.integrator
+                .restart(&mut self.scene, None)
+                .map_err(|e| e.to_string())?;
         }
         Ok(jumped)
     }
 
     /// Integrates to exactly `t`, keeping the history for the next call.
     pub fn advance_to(&mut self, t: f64) -> Result<(), StepFailure> {
-        self.integrator.advance_to(&mut self.scene, t).map_err(|e| StepFailure {
-            message: e.to_string(),
-            reached: self.integrator.t(),
-        })
+        self.integrator
+            .advance_to(&mut self.scene, t)
+            .map_err(|e| StepFailure {
+                message: e.to_string(),
+                reached: self.integrator.t(),
+            })
     }
 
     /// Outputs at the current time, with accelerations from one evaluation of the equations of
@@ -191,25 +201,66 @@ impl Simulation {
         }
     }
 
-    /// What changes over time, as numbers: the inputs and the integrator state. The scene
-    /// itself is rebuilt from the settings.
+    /// Everything that is not in the settings, as numbers: where the simulation started, the
+    /// inputs, and the integrator state. [`Simulation::restore`] rebuilds from it.
     pub fn dynamic_state(&self) -> Vec<f64> {
-        let mut v = self.inputs.to_vec();
-        v.extend(self.integrator.snapshot().to_vec());
+        let mut v = vec![self.initial_time];
+        v.extend(self.initial_inputs.to_vec());
+        v.extend(self.inputs.to_vec());
+        v.extend(self.integrator.snapshot().to_f64_vec());
         v
     }
 
-    pub fn restore_dynamic_state(&mut self, data: &[f64]) -> Result<(), String> {
-        if data.len() < Inputs::FLAT_LEN {
+    /// Rebuilds a simulation from its settings and [`Simulation::dynamic_state`]; continuing it
+    /// reproduces the original run bit for bit.
+    pub fn restore(settings: &Settings, data: &[f64]) -> Result<Simulation, String> {
+        let n = Inputs::FLAT_LEN;
+        if data.len() < 1 + 2 * n {
             return Err("simulation state is truncated".into());
         }
-        let (inputs, integrator) = data.split_at(Inputs::FLAT_LEN);
-        let inputs = Inputs::from_slice(inputs)?;
-        let snapshot = BdfSnapshot::from_slice(integrator).map_err(|e| e.to_string())?;
-        self.integrator.restore(&snapshot).map_err(|e| e.to_string())?;
-        self.inputs = inputs;
-        self.scene.set_inputs(&inputs);
-        let _ = &self.options;
-        Ok(())
+        let initial_time = data[0];
+        let initial_inputs = Inputs::from_slice(&data[1..1 + n])?;
+        let inputs = Inputs::from_slice(&data[1 + n..1 + 2 * n])?;
+        let snapshot =
+            BdfSnapshot::from_f64_slice(&data[1 + 2 * n..]).map_err(|e| e.to_string())?;
+        let mut sim = Simulation::new(settings, initial_time, &initial_inputs)?;
+        sim.integrator
+            .restore(&snapshot)
+            .map_err(|e| e.to_string())?;
+        sim.scene.set_inputs(&inputs)?;
+        sim.inputs = inputs;
+        Ok(sim)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn inputs(rpm: f64) -> Inputs {
+        Inputs {
+            crank_speed: Signal::constant(rpm * RPM_TO_RAD_PER_S),
+            load_torque: Signal::constant(0.0),
+            stiffness_scale: [Signal::constant(1.0); 4],
+            damping_scale: [Signal::constant(1.0); 4],
+        }
+    }
+
+    #[test]
+    fn restored_dynamic_state_continues_bit_for_bit() {
+        let settings = Settings::default();
+        let mut a = Simulation::new(&settings, 0.0, &inputs(1200.0)).unwrap();
+        for k in 1..=20 {
+            a.advance_to(k as f64 * 1e-3).unwrap();
+        }
+        let saved = a.dynamic_state();
+        let mut b = Simulation::restore(&settings, &saved).unwrap();
+        assert_eq!(b.dynamic_state(), saved);
+        for k in 21..=40 {
+            let t = k as f64 * 1e-3;
+            a.advance_to(t).unwrap();
+            b.advance_to(t).unwrap();
+            assert_eq!(a.outputs().unwrap(), b.outputs().unwrap(), "t = {t}");
+        }
     }
 }

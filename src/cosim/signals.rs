@@ -11,7 +11,11 @@ pub struct Signal {
 
 impl Signal {
     pub fn constant(value: f64) -> Signal {
-        Signal { value, derivative: 0.0, reference_time: 0.0 }
+        Signal {
+            value,
+            derivative: 0.0,
+            reference_time: 0.0,
+        }
     }
 
     pub fn at(&self, t: f64) -> f64 {
@@ -49,7 +53,7 @@ impl Inputs {
             ));
         }
         for (i, s) in self.stiffness_scale.iter().enumerate() {
-            if !(s.value > 0.0) {
+            if s.value.is_nan() || s.value <= 0.0 {
                 return Err(format!(
                     "mount[{}].stiffnessScale = {} must be > 0 (remove a mount in the configuration instead)",
                     i + 1,
@@ -57,9 +61,25 @@ impl Inputs {
                 ));
             }
         }
+        for (name, signals) in [
+            ("stiffnessScale", &self.stiffness_scale),
+            ("dampingScale", &self.damping_scale),
+        ] {
+            if let Some(i) = signals.iter().position(|s| s.derivative != 0.0) {
+                return Err(format!(
+                    "mount[{}].{name} has a time derivative; mount scales are held constant over a \
+                     communication step (set a new value at the next communication point)",
+                    i + 1
+                ));
+            }
+        }
         for (i, s) in self.damping_scale.iter().enumerate() {
-            if !(s.value >= 0.0) {
-                return Err(format!("mount[{}].dampingScale = {} must be >= 0", i + 1, s.value));
+            if s.value.is_nan() || s.value < 0.0 {
+                return Err(format!(
+                    "mount[{}].dampingScale = {} must be >= 0",
+                    i + 1,
+                    s.value
+                ));
             }
         }
         Ok(())
@@ -67,10 +87,21 @@ impl Inputs {
 
     /// Whether `next` continues every signal without a jump at time `t`.
     pub fn continue_into(&self, next: &Inputs, t: f64) -> bool {
-        let pairs = [(&self.crank_speed, &next.crank_speed), (&self.load_torque, &next.load_torque)];
+        let pairs = [
+            (&self.crank_speed, &next.crank_speed),
+            (&self.load_torque, &next.load_torque),
+        ];
         pairs.iter().all(|(a, b)| a.continues_into(b, t))
-            && self.stiffness_scale.iter().zip(&next.stiffness_scale).all(|(a, b)| a.continues_into(b, t))
-            && self.damping_scale.iter().zip(&next.damping_scale).all(|(a, b)| a.continues_into(b, t))
+            && self
+                .stiffness_scale
+                .iter()
+                .zip(&next.stiffness_scale)
+                .all(|(a, b)| a.continues_into(b, t))
+            && self
+                .damping_scale
+                .iter()
+                .zip(&next.damping_scale)
+                .all(|(a, b)| a.continues_into(b, t))
     }
 
     /// The signals as a flat vector (for the serialized state), and back.
@@ -88,9 +119,17 @@ impl Inputs {
 
     pub fn from_slice(v: &[f64]) -> Result<Inputs, String> {
         if v.len() != Self::FLAT_LEN {
-            return Err(format!("input state has {} numbers, expected {}", v.len(), Self::FLAT_LEN));
+            return Err(format!(
+                "input state has {} numbers, expected {}",
+                v.len(),
+                Self::FLAT_LEN
+            ));
         }
-        let s = |k: usize| Signal { value: v[3 * k], derivative: v[3 * k + 1], reference_time: v[3 * k + 2] };
+        let s = |k: usize| Signal {
+            value: v[3 * k],
+            derivative: v[3 * k + 1],
+            reference_time: v[3 * k + 2],
+        };
         Ok(Inputs {
             crank_speed: s(0),
             load_torque: s(1),
@@ -106,7 +145,11 @@ mod tests {
 
     fn inputs() -> Inputs {
         Inputs {
-            crank_speed: Signal { value: 100.0, derivative: 10.0, reference_time: 1.0 },
+            crank_speed: Signal {
+                value: 100.0,
+                derivative: 10.0,
+                reference_time: 1.0,
+            },
             load_torque: Signal::constant(0.0),
             stiffness_scale: [Signal::constant(1.0); 4],
             damping_scale: [Signal::constant(1.0); 4],
@@ -117,7 +160,11 @@ mod tests {
     fn a_ramp_continued_at_its_end_is_not_a_jump() {
         let a = inputs();
         let mut b = a;
-        b.crank_speed = Signal { value: 110.0, derivative: 10.0, reference_time: 2.0 };
+        b.crank_speed = Signal {
+            value: 110.0,
+            derivative: 10.0,
+            reference_time: 2.0,
+        };
         assert!(a.continue_into(&b, 2.0));
         b.crank_speed.value = 120.0;
         assert!(!a.continue_into(&b, 2.0));
@@ -130,7 +177,10 @@ mod tests {
         assert!(Inputs::from_slice(&[0.0; 3]).is_err());
         let mut bad = a;
         bad.stiffness_scale[2].value = -1.0;
-        assert!(bad.validate().unwrap_err().contains("mount[3].stiffnessScale"));
+        assert!(bad
+            .validate()
+            .unwrap_err()
+            .contains("mount[3].stiffnessScale"));
         bad = a;
         bad.damping_scale[0].value = -0.5;
         assert!(bad.validate().is_err());

@@ -16,7 +16,6 @@ use super::snapshot;
 use super::state::{self, Phase};
 use super::uri::resource_path;
 use super::variables::GUID;
-use crate::cosim::Simulation;
 
 /// Marks a live instance allocated by `fmi2Instantiate`; cleared when freed, so a stale or
 /// foreign pointer is recognised with high probability instead of being used.
@@ -117,7 +116,10 @@ unsafe fn text(ptr: fmi2String) -> Option<String> {
         return None;
     }
     // SAFETY: non-null and NUL-terminated by the caller's contract.
-    unsafe { CStr::from_ptr(ptr) }.to_str().ok().map(str::to_owned)
+    unsafe { CStr::from_ptr(ptr) }
+        .to_str()
+        .ok()
+        .map(str::to_owned)
 }
 
 fn null_argument(inst: &Instance, function: &str) -> Status {
@@ -163,7 +165,11 @@ pub extern "C" fn fmi2Instantiate(
         let name = unsafe { text(instanceName) }.unwrap_or_default();
         let logger = Logger::new(callback, environment, &name, loggingOn != 0);
         if instanceName.is_null() || name.is_empty() {
-            logger.log(Level::Error, "logStatusError", "fmi2Instantiate: instanceName is missing");
+            logger.log(
+                Level::Error,
+                "logStatusError",
+                "fmi2Instantiate: instanceName is missing",
+            );
             return std::ptr::null_mut();
         }
         if fmuType != fmi2Type_fmi2CoSimulation {
@@ -342,7 +348,8 @@ macro_rules! get_values {
             with_handle(c, |h| {
                 let inst = &mut h.instance;
                 // SAFETY: FMI passes arrays of nvr value references and nvr values.
-                let (Some(vrs), Some(out)) = (unsafe { slice(vr, nvr) }, unsafe { slice_mut(value, nvr) })
+                let (Some(vrs), Some(out)) =
+                    (unsafe { slice(vr, nvr) }, unsafe { slice_mut(value, nvr) })
                 else {
                     return null_argument(inst, stringify!($fn_name));
                 };
@@ -360,15 +367,36 @@ macro_rules! get_values {
     };
 }
 
-get_values!(fmi2GetReal, fmi2Real, fmi2GetRealTYPE, get_real, 0.0f64, |x: f64| x);
-get_values!(fmi2GetInteger, fmi2Integer, fmi2GetIntegerTYPE, get_integer, 0i32, |x: i32| x);
-get_values!(fmi2GetBoolean, fmi2Boolean, fmi2GetBooleanTYPE, get_boolean, false, |x: bool| {
-    if x {
-        fmi2True as fmi2Boolean
-    } else {
-        fmi2False as fmi2Boolean
+get_values!(
+    fmi2GetReal,
+    fmi2Real,
+    fmi2GetRealTYPE,
+    get_real,
+    0.0f64,
+    |x: f64| x
+);
+get_values!(
+    fmi2GetInteger,
+    fmi2Integer,
+    fmi2GetIntegerTYPE,
+    get_integer,
+    0i32,
+    |x: i32| x
+);
+get_values!(
+    fmi2GetBoolean,
+    fmi2Boolean,
+    fmi2GetBooleanTYPE,
+    get_boolean,
+    false,
+    |x: bool| {
+        if x {
+            fmi2True as fmi2Boolean
+        } else {
+            fmi2False as fmi2Boolean
+        }
     }
-});
+);
 
 #[no_mangle]
 pub extern "C" fn fmi2GetString(
@@ -379,7 +407,8 @@ pub extern "C" fn fmi2GetString(
 ) -> fmi2Status {
     with_handle(c, |h| {
         // SAFETY: FMI passes arrays of nvr value references and nvr string slots.
-        let (Some(vrs), Some(out)) = (unsafe { slice(vr, nvr) }, unsafe { slice_mut(value, nvr) }) else {
+        let (Some(vrs), Some(out)) = (unsafe { slice(vr, nvr) }, unsafe { slice_mut(value, nvr) })
+        else {
             return null_argument(&h.instance, "fmi2GetString");
         };
         let mut strings = Vec::new();
@@ -387,7 +416,10 @@ pub extern "C" fn fmi2GetString(
         if s != Status::Ok {
             return s;
         }
-        h.returned_strings = strings.iter().map(|t| CString::new(t.replace('\0', "")).unwrap_or_default()).collect();
+        h.returned_strings = strings
+            .iter()
+            .map(|t| CString::new(t.replace('\0', "")).unwrap_or_default())
+            .collect();
         for (o, t) in out.iter_mut().zip(&h.returned_strings) {
             *o = t.as_ptr();
         }
@@ -406,7 +438,8 @@ pub extern "C" fn fmi2SetReal(
     with_handle(c, |h| {
         let inst = &mut h.instance;
         // SAFETY: FMI passes arrays of nvr value references and nvr values.
-        let (Some(vrs), Some(vals)) = (unsafe { slice(vr, nvr) }, unsafe { slice(value, nvr) }) else {
+        let (Some(vrs), Some(vals)) = (unsafe { slice(vr, nvr) }, unsafe { slice(value, nvr) })
+        else {
             return null_argument(inst, "fmi2SetReal");
         };
         inst.set_real(vrs, vals)
@@ -424,7 +457,8 @@ pub extern "C" fn fmi2SetInteger(
     with_handle(c, |h| {
         let inst = &mut h.instance;
         // SAFETY: FMI passes arrays of nvr value references and nvr values.
-        let (Some(vrs), Some(vals)) = (unsafe { slice(vr, nvr) }, unsafe { slice(value, nvr) }) else {
+        let (Some(vrs), Some(vals)) = (unsafe { slice(vr, nvr) }, unsafe { slice(value, nvr) })
+        else {
             return null_argument(inst, "fmi2SetInteger");
         };
         inst.set_integer(vrs, vals)
@@ -442,7 +476,8 @@ pub extern "C" fn fmi2SetBoolean(
     with_handle(c, |h| {
         let inst = &mut h.instance;
         // SAFETY: FMI passes arrays of nvr value references and nvr values.
-        let (Some(vrs), Some(vals)) = (unsafe { slice(vr, nvr) }, unsafe { slice(value, nvr) }) else {
+        let (Some(vrs), Some(vals)) = (unsafe { slice(vr, nvr) }, unsafe { slice(value, nvr) })
+        else {
             return null_argument(inst, "fmi2SetBoolean");
         };
         let vals: Vec<bool> = vals.iter().map(|b| *b != 0).collect();
@@ -461,7 +496,8 @@ pub extern "C" fn fmi2SetString(
     with_handle(c, |h| {
         let inst = &mut h.instance;
         // SAFETY: FMI passes arrays of nvr value references and nvr C strings.
-        let (Some(vrs), Some(vals)) = (unsafe { slice(vr, nvr) }, unsafe { slice(value, nvr) }) else {
+        let (Some(vrs), Some(vals)) = (unsafe { slice(vr, nvr) }, unsafe { slice(value, nvr) })
+        else {
             return null_argument(inst, "fmi2SetString");
         };
         // SAFETY: each entry is a NUL-terminated string or null.
@@ -475,14 +511,6 @@ pub extern "C" fn fmi2SetString(
 const _: fmi2SetStringTYPE = Some(fmi2SetString);
 
 // ----- FMU state -------------------------------------------------------------------------------
-
-/// Rebuilds the simulation a deserialized state needs from that state's own parameters.
-fn rebuild_for(inst: &Instance, core: &Core) -> Result<Simulation, String> {
-    let mut probe = Instance::new(&inst.name, Logger::new(None, std::ptr::null_mut(), &inst.name, false), inst.resource_dir.clone());
-    probe.core = core.clone();
-    probe.core.simulation = None;
-    probe.build_simulation()
-}
 
 #[no_mangle]
 pub extern "C" fn fmi2GetFMUstate(c: fmi2Component, FMUstate: *mut fmi2FMUstate) -> fmi2Status {
@@ -505,7 +533,10 @@ pub extern "C" fn fmi2GetFMUstate(c: fmi2Component, FMUstate: *mut fmi2FMUstate)
             }
             existing.core = inst.core.clone();
         } else {
-            *slot = Box::into_raw(Box::new(StateHandle { live: LIVE, core: inst.core.clone() })) as fmi2FMUstate;
+            *slot = Box::into_raw(Box::new(StateHandle {
+                live: LIVE,
+                core: inst.core.clone(),
+            })) as fmi2FMUstate;
         }
         Status::Ok
     })
@@ -641,7 +672,9 @@ pub extern "C" fn fmi2DeSerializeFMUstate(
         if FMUstate.is_null() {
             return null_argument(inst, "fmi2DeSerializeFMUstate");
         }
-        let core = match snapshot::deserialize(bytes, |core| rebuild_for(inst, core)) {
+        let core = match snapshot::deserialize(bytes, |core, dynamic| {
+            inst.restore_simulation(core, dynamic)
+        }) {
             Ok(core) => core,
             Err(m) => return inst.error(&format!("fmi2DeSerializeFMUstate: {m}")),
         };
@@ -655,7 +688,9 @@ pub extern "C" fn fmi2DeSerializeFMUstate(
                 unsafe { (*existing).core = core };
                 return Status::Ok;
             }
-            return inst.error("fmi2DeSerializeFMUstate: the given FMU state slot holds a foreign pointer");
+            return inst.error(
+                "fmi2DeSerializeFMUstate: the given FMU state slot holds a foreign pointer",
+            );
         }
         *slot = Box::into_raw(Box::new(StateHandle { live: LIVE, core })) as fmi2FMUstate;
         Status::Ok
@@ -674,7 +709,9 @@ pub extern "C" fn fmi2GetDirectionalDerivative(
     _dvUnknown: *mut fmi2Real,
 ) -> fmi2Status {
     with_handle(c, |h| {
-        h.instance.error("fmi2GetDirectionalDerivative: not provided (providesDirectionalDerivative=false)")
+        h.instance.error(
+            "fmi2GetDirectionalDerivative: not provided (providesDirectionalDerivative=false)",
+        )
     })
 }
 const _: fmi2GetDirectionalDerivativeTYPE = Some(fmi2GetDirectionalDerivative);
@@ -692,9 +729,11 @@ pub extern "C" fn fmi2SetRealInputDerivatives(
     with_handle(c, |h| {
         let inst = &mut h.instance;
         // SAFETY: FMI passes three arrays of nvr elements.
-        let (Some(vrs), Some(orders), Some(vals)) =
-            (unsafe { slice(vr, nvr) }, unsafe { slice(order, nvr) }, unsafe { slice(value, nvr) })
-        else {
+        let (Some(vrs), Some(orders), Some(vals)) = (
+            unsafe { slice(vr, nvr) },
+            unsafe { slice(order, nvr) },
+            unsafe { slice(value, nvr) },
+        ) else {
             return null_argument(inst, "fmi2SetRealInputDerivatives");
         };
         inst.set_real_input_derivatives(vrs, orders, vals)
@@ -712,7 +751,10 @@ pub extern "C" fn fmi2GetRealOutputDerivatives(
 ) -> fmi2Status {
     with_handle(c, |h| {
         let inst = &mut h.instance;
-        if let Err(s) = inst.allowed("fmi2GetRealOutputDerivatives", state::GET_OUTPUT_DERIVATIVES) {
+        if let Err(s) = inst.allowed(
+            "fmi2GetRealOutputDerivatives",
+            state::GET_OUTPUT_DERIVATIVES,
+        ) {
             return s;
         }
         inst.error("fmi2GetRealOutputDerivatives: not provided (maxOutputDerivativeOrder=0)")
@@ -727,33 +769,47 @@ pub extern "C" fn fmi2DoStep(
     communicationStepSize: fmi2Real,
     _noSetFMUStatePriorToCurrentPoint: fmi2Boolean,
 ) -> fmi2Status {
-    with_handle(c, |h| h.instance.do_step(currentCommunicationPoint, communicationStepSize))
+    with_handle(c, |h| {
+        h.instance
+            .do_step(currentCommunicationPoint, communicationStepSize)
+    })
 }
 const _: fmi2DoStepTYPE = Some(fmi2DoStep);
 
 #[no_mangle]
 pub extern "C" fn fmi2CancelStep(c: fmi2Component) -> fmi2Status {
     with_handle(c, |h| {
-        h.instance
-            .error("fmi2CancelStep: no step is in progress (fmi2DoStep always completes synchronously)")
+        h.instance.error(
+            "fmi2CancelStep: no step is in progress (fmi2DoStep always completes synchronously)",
+        )
     })
 }
 const _: fmi2CancelStepTYPE = Some(fmi2CancelStep);
 
 #[no_mangle]
-pub extern "C" fn fmi2GetStatus(c: fmi2Component, _s: fmi2StatusKind, _value: *mut fmi2Status) -> fmi2Status {
+pub extern "C" fn fmi2GetStatus(
+    c: fmi2Component,
+    _s: fmi2StatusKind,
+    _value: *mut fmi2Status,
+) -> fmi2Status {
     with_handle(c, |h| {
         let inst = &mut h.instance;
         if let Err(s) = inst.allowed("fmi2GetStatus", state::GET_STATUS) {
             return s;
         }
-        inst.error("fmi2GetStatus: no asynchronous step status exists (canRunAsynchronuously=false)")
+        inst.error(
+            "fmi2GetStatus: no asynchronous step status exists (canRunAsynchronuously=false)",
+        )
     })
 }
 const _: fmi2GetStatusTYPE = Some(fmi2GetStatus);
 
 #[no_mangle]
-pub extern "C" fn fmi2GetRealStatus(c: fmi2Component, s: fmi2StatusKind, value: *mut fmi2Real) -> fmi2Status {
+pub extern "C" fn fmi2GetRealStatus(
+    c: fmi2Component,
+    s: fmi2StatusKind,
+    value: *mut fmi2Real,
+) -> fmi2Status {
     with_handle(c, |h| {
         let inst = &mut h.instance;
         if let Err(st) = inst.allowed("fmi2GetRealStatus", state::GET_STATUS) {
@@ -763,7 +819,9 @@ pub extern "C" fn fmi2GetRealStatus(c: fmi2Component, s: fmi2StatusKind, value: 
             return null_argument(inst, "fmi2GetRealStatus");
         }
         if s != fmi2StatusKind_fmi2LastSuccessfulTime {
-            return inst.error(&format!("fmi2GetRealStatus: status kind {s} has no Real value"));
+            return inst.error(&format!(
+                "fmi2GetRealStatus: status kind {s} has no Real value"
+            ));
         }
         // SAFETY: value is a non-null writable fmi2Real.
         unsafe { *value = inst.last_successful_time() };
@@ -783,7 +841,9 @@ pub extern "C" fn fmi2GetIntegerStatus(
         if let Err(st) = inst.allowed("fmi2GetIntegerStatus", state::GET_STATUS) {
             return st;
         }
-        inst.error(&format!("fmi2GetIntegerStatus: status kind {s} has no Integer value"))
+        inst.error(&format!(
+            "fmi2GetIntegerStatus: status kind {s} has no Integer value"
+        ))
     })
 }
 const _: fmi2GetIntegerStatusTYPE = Some(fmi2GetIntegerStatus);
@@ -803,9 +863,15 @@ pub extern "C" fn fmi2GetBooleanStatus(
             return null_argument(inst, "fmi2GetBooleanStatus");
         }
         if s != fmi2StatusKind_fmi2Terminated {
-            return inst.error(&format!("fmi2GetBooleanStatus: status kind {s} has no Boolean value"));
+            return inst.error(&format!(
+                "fmi2GetBooleanStatus: status kind {s} has no Boolean value"
+            ));
         }
-        let terminated = if inst.core.terminated { fmi2True } else { fmi2False };
+        let terminated = if inst.core.terminated {
+            fmi2True
+        } else {
+            fmi2False
+        };
         // SAFETY: value is a non-null writable fmi2Boolean.
         unsafe { *value = terminated as fmi2Boolean };
         Status::Ok
@@ -824,7 +890,9 @@ pub extern "C" fn fmi2GetStringStatus(
         if let Err(st) = inst.allowed("fmi2GetStringStatus", state::GET_STATUS) {
             return st;
         }
-        inst.error(&format!("fmi2GetStringStatus: status kind {s} has no String value"))
+        inst.error(&format!(
+            "fmi2GetStringStatus: status kind {s} has no String value"
+        ))
     })
 }
 const _: fmi2GetStringStatusTYPE = Some(fmi2GetStringStatus);

@@ -83,7 +83,8 @@ impl Logger {
     /// logging is on for them.
     pub fn log(&self, level: Level, category: &str, message: &str) {
         let always = matches!(level, Level::Error | Level::Fatal | Level::Warning);
-        if !always && !(self.debug_logging && self.category_enabled(category)) {
+        let wanted = self.debug_logging && self.category_enabled(category);
+        if !(always || wanted) {
             return;
         }
         let Some(callback) = self.callback else {

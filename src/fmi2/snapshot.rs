@@ -46,22 +46,30 @@ pub fn serialize(core: &Core) -> Vec<u8> {
     w.0
 }
 
-/// Rebuilds a state from bytes; `rebuild` constructs the simulation from the stored values.
+/// Rebuilds a state from bytes; `rebuild` constructs the simulation from the stored values and
+/// the simulation's dynamic state.
 pub fn deserialize(
     bytes: &[u8],
-    rebuild: impl FnOnce(&Core) -> Result<Simulation, String>,
+    rebuild: impl FnOnce(&Core, &[f64]) -> Result<Simulation, String>,
 ) -> Result<Core, String> {
-    let mut r = Reader { data: bytes, pos: 0 };
+    let mut r = Reader {
+        data: bytes,
+        pos: 0,
+    };
     if r.take(MAGIC.len())? != MAGIC {
         return Err("not an FMU state of this model (bad magic)".into());
     }
     let version = r.u32()?;
     if version != FORMAT_VERSION {
-        return Err(format!("FMU state format version {version}, expected {FORMAT_VERSION}"));
+        return Err(format!(
+            "FMU state format version {version}, expected {FORMAT_VERSION}"
+        ));
     }
     let guid = r.str()?;
     if guid != GUID {
-        return Err(format!("FMU state belongs to GUID {guid}, this FMU is {GUID}"));
+        return Err(format!(
+            "FMU state belongs to GUID {guid}, this FMU is {GUID}"
+        ));
     }
     let phase = Phase::from_code(r.u8()?).ok_or("unknown phase code")?;
     let start_time = r.f64()?;
@@ -70,7 +78,9 @@ pub fn deserialize(
     let time = r.f64()?;
     let terminated = r.u8()? != 0;
     let reals = r.counted(REALS.len(), "Real values", |r| r.f64())?;
-    let integers = r.counted(INTEGERS.len(), "Integer values", |r| r.u32().map(|x| x as i32))?;
+    let integers = r.counted(INTEGERS.len(), "Integer values", |r| {
+        r.u32().map(|x| x as i32)
+    })?;
     let booleans = r.counted(BOOLEANS.len(), "Boolean values", |r| r.u8().map(|x| x != 0))?;
     let strings = r.counted(STRINGS.len(), "String values", |r| r.str())?;
     let input_derivatives = r.counted(REALS.len(), "input derivatives", |r| r.f64())?;
@@ -85,11 +95,19 @@ pub fn deserialize(
         Vec::new()
     };
     if r.remaining() != 0 {
-        return Err(format!("{} trailing bytes after the FMU state", r.remaining()));
+        return Err(format!(
+            "{} trailing bytes after the FMU state",
+            r.remaining()
+        ));
     }
     let mut core = Core {
         phase,
-        values: Values { reals, integers, booleans, strings },
+        values: Values {
+            reals,
+            integers,
+            booleans,
+            strings,
+        },
         input_derivatives,
         start_time,
         stop_time: has_stop.then_some(stop),
@@ -98,9 +116,7 @@ pub fn deserialize(
         simulation: None,
     };
     if has_simulation {
-        let mut sim = rebuild(&core)?;
-        sim.restore_dynamic_state(&dynamic)?;
-        core.simulation = Some(sim);
+        core.simulation = Some(rebuild(&core, &dynamic)?);
     }
     Ok(core)
 }
@@ -137,7 +153,10 @@ impl Reader<'_> {
     }
     fn take(&mut self, n: usize) -> Result<&[u8], String> {
         if n > self.remaining() {
-            return Err(format!("truncated FMU state: needs {n} more bytes at offset {}", self.pos));
+            return Err(format!(
+                "truncated FMU state: needs {n} more bytes at offset {}",
+                self.pos
+            ));
         }
         let s = &self.data[self.pos..self.pos + n];
         self.pos += n;

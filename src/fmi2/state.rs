@@ -25,9 +25,17 @@ impl Phase {
 
     pub fn from_code(code: u8) -> Option<Phase> {
         use Phase::*;
-        [Instantiated, InitializationMode, StepComplete, StepFailed, Terminated, Error, Fatal]
-            .into_iter()
-            .find(|p| p.code() == code)
+        [
+            Instantiated,
+            InitializationMode,
+            StepComplete,
+            StepFailed,
+            Terminated,
+            Error,
+            Fatal,
+        ]
+        .into_iter()
+        .find(|p| p.code() == code)
     }
 }
 
@@ -66,8 +74,13 @@ pub const SETUP_EXPERIMENT: Mask = Mask::of(&[Instantiated]);
 pub const ENTER_INITIALIZATION: Mask = Mask::of(&[Instantiated]);
 pub const EXIT_INITIALIZATION: Mask = Mask::of(&[InitializationMode]);
 pub const TERMINATE: Mask = Mask::of(&[StepComplete, StepFailed, Error]);
-pub const GET_VALUES: Mask =
-    Mask::of(&[InitializationMode, StepComplete, StepFailed, Terminated, Error]);
+pub const GET_VALUES: Mask = Mask::of(&[
+    InitializationMode,
+    StepComplete,
+    StepFailed,
+    Terminated,
+    Error,
+]);
 pub const SET_VALUES: Mask = Mask::of(&[Instantiated, InitializationMode, StepComplete]);
 pub const SET_INPUT_DERIVATIVES: Mask = Mask::of(&[Instantiated, InitializationMode, StepComplete]);
 pub const GET_OUTPUT_DERIVATIVES: Mask = Mask::of(&[StepComplete, StepFailed, Terminated, Error]);

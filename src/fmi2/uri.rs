@@ -12,17 +12,23 @@ pub fn resource_path(uri: &str) -> Result<PathBuf, String> {
         let slash = after.find('/').unwrap_or(after.len());
         let host = &after[..slash];
         if !(host.is_empty() || host.eq_ignore_ascii_case("localhost")) {
-            return Err(format!("resource location \"{uri}\" names a remote host \"{host}\""));
+            return Err(format!(
+                "resource location \"{uri}\" names a remote host \"{host}\""
+            ));
         }
         &after[slash..]
     } else {
         rest
     };
     if !path.starts_with('/') {
-        return Err(format!("resource location \"{uri}\" is not an absolute path"));
+        return Err(format!(
+            "resource location \"{uri}\" is not an absolute path"
+        ));
     }
-    let bytes = percent_decode(path).ok_or_else(|| format!("resource location \"{uri}\" has a bad %-escape"))?;
-    let text = String::from_utf8(bytes).map_err(|_| format!("resource location \"{uri}\" is not UTF-8"))?;
+    let bytes = percent_decode(path)
+        .ok_or_else(|| format!("resource location \"{uri}\" has a bad %-escape"))?;
+    let text = String::from_utf8(bytes)
+        .map_err(|_| format!("resource location \"{uri}\" is not UTF-8"))?;
     Ok(PathBuf::from(text))
 }
 
@@ -51,10 +57,19 @@ mod tests {
     #[test]
     fn accepts_the_forms_tools_use() {
         let want = PathBuf::from("/tmp/my fmu/resources");
-        assert_eq!(resource_path("file:///tmp/my%20fmu/resources").unwrap(), want);
+        assert_eq!(
+            resource_path("file:///tmp/my%20fmu/resources").unwrap(),
+            want
+        );
         assert_eq!(resource_path("file:/tmp/my%20fmu/resources").unwrap(), want);
-        assert_eq!(resource_path("file://localhost/tmp/my%20fmu/resources").unwrap(), want);
-        assert_eq!(resource_path("file:///tmp/%C3%A4/r").unwrap(), PathBuf::from("/tmp/ä/r"));
+        assert_eq!(
+            resource_path("file://localhost/tmp/my%20fmu/resources").unwrap(),
+            want
+        );
+        assert_eq!(
+            resource_path("file:///tmp/%C3%A4/r").unwrap(),
+            PathBuf::from("/tmp/ä/r")
+        );
     }
 
     #[test]

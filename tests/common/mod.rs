@@ -3,6 +3,7 @@
 //! Log messages are captured through fmi-sys' printf-style logger, keyed by instance name.
 
 #![allow(dead_code)]
+#![allow(non_snake_case)] // fields carry the FMI function names
 
 use std::collections::HashMap;
 use std::ffi::{c_char, CStr, CString};
@@ -27,7 +28,9 @@ impl log::Log for Capture {
     }
     fn log(&self, record: &log::Record) {
         if let Ok(mut m) = self.0.lock() {
-            m.entry(record.target().to_owned()).or_default().push(format!("{}", record.args()));
+            m.entry(record.target().to_owned())
+                .or_default()
+                .push(format!("{}", record.args()));
         }
     }
     fn flush(&self) {}
@@ -44,10 +47,54 @@ fn capture() -> &'static Capture {
 }
 
 /// Path of the cdylib next to the test executable (target/<profile>/).
+///
+/// `cargo test` builds the library only as an rlib, so the cdylib comes from `cargo build`
+/// (scripts/test.sh runs it first). A library older than any source file would test stale code:
+/// refuse it with instructions instead.
 pub fn library_path() -> PathBuf {
     let exe = std::env::current_exe().expect("test executable path");
     let dir = exe.parent().and_then(|d| d.parent()).expect("target dir");
-    dir.join("libengine_mount_chassis.so")
+    let lib = dir.join("libengine_mount_chassis.so");
+    let built = std::fs::metadata(&lib)
+        .and_then(|m| m.modified())
+        .unwrap_or_else(|_| {
+            panic!(
+                "{} is missing: run `cargo build --release` first",
+                lib.display()
+            )
+        });
+    let root = PathBuf::from(env!("CARGO_MANIFEST_DIR"));
+    let newest = newest_mtime(&root.join("src"))
+        .into_iter()
+        .chain(newest_mtime(&root.join("modelDescription")))
+        .chain(
+            std::fs::metadata(root.join("build.rs"))
+                .and_then(|m| m.modified())
+                .ok(),
+        )
+        .max();
+    if let Some(newest) = newest {
+        assert!(
+            built >= newest,
+            "{} is older than the sources: run `cargo build --release` first",
+            lib.display()
+        );
+    }
+    lib
+}
+
+fn newest_mtime(dir: &std::path::Path) -> Option<std::time::SystemTime> {
+    let mut newest = None;
+    for entry in std::fs::read_dir(dir).ok()?.flatten() {
+        let path = entry.path();
+        let t = if path.is_dir() {
+            newest_mtime(&path)
+        } else {
+            entry.metadata().and_then(|m| m.modified()).ok()
+        };
+        newest = newest.max(t);
+    }
+    newest
 }
 
 pub fn resources_uri() -> String {
@@ -125,13 +172,19 @@ impl Fmu {
         capture();
         let path = library_path();
         // SAFETY: loading our own cdylib runs no foreign initialisers beyond Rust's std.
-        let lib = unsafe { Library::new(&path) }.unwrap_or_else(|e| panic!("load {}: {e}", path.display()));
+        let lib = unsafe { Library::new(&path) }
+            .unwrap_or_else(|e| panic!("load {}: {e}", path.display()));
         let f = Functions::load(&lib);
         Fmu { _lib: lib, f }
     }
 
     /// Instantiates with explicit GUID and resource URI; `None` when the FMU returns NULL.
-    pub fn instantiate_with(&self, name: &str, guid: &str, resources: Option<&str>) -> Option<Slave<'_>> {
+    pub fn instantiate_with(
+        &self,
+        name: &str,
+        guid: &str,
+        resources: Option<&str>,
+    ) -> Option<Slave<'_>> {
         let name_c = CString::new(name).unwrap();
         let guid_c = CString::new(guid).unwrap();
         let res_c = resources.map(|r| CString::new(r).unwrap());
@@ -158,16 +211,26 @@ impl Fmu {
         if c.is_null() {
             return None;
         }
-        Some(Slave { fmu: self, c, name: name.to_owned(), _callbacks: callbacks })
+        Some(Slave {
+            fmu: self,
+            c,
+            name: name.to_owned(),
+            _callbacks: callbacks,
+        })
     }
 
     pub fn instantiate(&self, name: &str) -> Slave<'_> {
-        self.instantiate_with(name, GUID, Some(&resources_uri())).expect("instantiate")
+        self.instantiate_with(name, GUID, Some(&resources_uri()))
+            .expect("instantiate")
     }
 }
 
 pub fn logs(name: &str) -> Vec<String> {
-    capture().0.lock().map(|m| m.get(name).cloned().unwrap_or_default()).unwrap_or_default()
+    capture()
+        .0
+        .lock()
+        .map(|m| m.get(name).cloned().unwrap_or_default())
+        .unwrap_or_default()
 }
 
 pub fn clear_logs(name: &str) {
@@ -198,7 +261,14 @@ impl Slave<'_> {
     pub fn setup(&self, start: f64, stop: Option<f64>) -> fmi2Status {
         // SAFETY: c is a live instance.
         unsafe {
-            (self.f().fmi2SetupExperiment)(self.c, 0, 0.0, start, stop.is_some() as i32, stop.unwrap_or(0.0))
+            (self.f().fmi2SetupExperiment)(
+                self.c,
+                0,
+                0.0,
+                start,
+                stop.is_some() as i32,
+                stop.unwrap_or(0.0),
+            )
         }
     }
     pub fn enter_init(&self) -> fmi2Status {
@@ -250,7 +320,8 @@ impl Slave<'_> {
     pub fn get_real(&self, vrs: &[u32]) -> (fmi2Status, Vec<f64>) {
         let mut out = vec![f64::NAN; vrs.len()];
         // SAFETY: arrays of equal length nvr.
-        let s = unsafe { (self.f().fmi2GetReal)(self.c, vrs.as_ptr(), vrs.len(), out.as_mut_ptr()) };
+        let s =
+            unsafe { (self.f().fmi2GetReal)(self.c, vrs.as_ptr(), vrs.len(), out.as_mut_ptr()) };
         (s, out)
     }
     pub fn reals(&self, vrs: &[u32]) -> Vec<f64> {
@@ -261,22 +332,31 @@ impl Slave<'_> {
     pub fn get_integer(&self, vrs: &[u32]) -> (fmi2Status, Vec<i32>) {
         let mut out = vec![0; vrs.len()];
         // SAFETY: arrays of equal length nvr.
-        let s = unsafe { (self.f().fmi2GetInteger)(self.c, vrs.as_ptr(), vrs.len(), out.as_mut_ptr()) };
+        let s =
+            unsafe { (self.f().fmi2GetInteger)(self.c, vrs.as_ptr(), vrs.len(), out.as_mut_ptr()) };
         (s, out)
     }
     pub fn get_boolean(&self, vrs: &[u32]) -> (fmi2Status, Vec<bool>) {
         let mut out = vec![0; vrs.len()];
         // SAFETY: arrays of equal length nvr.
-        let s = unsafe { (self.f().fmi2GetBoolean)(self.c, vrs.as_ptr(), vrs.len(), out.as_mut_ptr()) };
+        let s =
+            unsafe { (self.f().fmi2GetBoolean)(self.c, vrs.as_ptr(), vrs.len(), out.as_mut_ptr()) };
         (s, out.iter().map(|b| *b != 0).collect())
     }
     pub fn get_string(&self, vrs: &[u32]) -> (fmi2Status, Vec<String>) {
         let mut out = vec![std::ptr::null(); vrs.len()];
         // SAFETY: arrays of equal length nvr; returned strings are valid until the next call.
-        let s = unsafe { (self.f().fmi2GetString)(self.c, vrs.as_ptr(), vrs.len(), out.as_mut_ptr()) };
+        let s =
+            unsafe { (self.f().fmi2GetString)(self.c, vrs.as_ptr(), vrs.len(), out.as_mut_ptr()) };
         let strings = out
             .iter()
-            .map(|p| if p.is_null() { String::new() } else { unsafe { CStr::from_ptr(*p) }.to_string_lossy().into_owned() })
+            .map(|p| {
+                if p.is_null() {
+                    String::new()
+                } else {
+                    unsafe { CStr::from_ptr(*p) }.to_string_lossy().into_owned()
+                }
+            })
             .collect();
         (s, strings)
     }
@@ -284,7 +364,13 @@ impl Slave<'_> {
         let orders = vec![1; vrs.len()];
         // SAFETY: arrays of equal length nvr.
         unsafe {
-            (self.f().fmi2SetRealInputDerivatives)(self.c, vrs.as_ptr(), vrs.len(), orders.as_ptr(), values.as_ptr())
+            (self.f().fmi2SetRealInputDerivatives)(
+                self.c,
+                vrs.as_ptr(),
+                vrs.len(),
+                orders.as_ptr(),
+                values.as_ptr(),
+            )
         }
     }
     pub fn get_state(&self) -> fmi2FMUstate {
@@ -305,17 +391,30 @@ impl Slave<'_> {
     pub fn serialize(&self, s: fmi2FMUstate) -> Vec<u8> {
         let mut size = 0usize;
         // SAFETY: valid state and size slot.
-        assert_eq!(unsafe { (self.f().fmi2SerializedFMUstateSize)(self.c, s, &mut size) }, OK);
+        assert_eq!(
+            unsafe { (self.f().fmi2SerializedFMUstateSize)(self.c, s, &mut size) },
+            OK
+        );
         let mut buf = vec![0u8; size];
         // SAFETY: buffer of `size` bytes.
-        assert_eq!(unsafe { (self.f().fmi2SerializeFMUstate)(self.c, s, buf.as_mut_ptr() as *mut c_char, size) }, OK);
+        assert_eq!(
+            unsafe {
+                (self.f().fmi2SerializeFMUstate)(self.c, s, buf.as_mut_ptr() as *mut c_char, size)
+            },
+            OK
+        );
         buf
     }
     pub fn deserialize(&self, bytes: &[u8]) -> (fmi2Status, fmi2FMUstate) {
         let mut s: fmi2FMUstate = std::ptr::null_mut();
         // SAFETY: buffer of bytes.len() bytes and a writable slot.
         let st = unsafe {
-            (self.f().fmi2DeSerializeFMUstate)(self.c, bytes.as_ptr() as *const c_char, bytes.len(), &mut s)
+            (self.f().fmi2DeSerializeFMUstate)(
+                self.c,
+                bytes.as_ptr() as *const c_char,
+                bytes.len(),
+                &mut s,
+            )
         };
         (st, s)
     }
