@@ -438,3 +438,57 @@ fn stop_time_is_respected_with_jitter() {
     assert_eq!(s.do_step(t, 0.01), ERROR);
     assert_logged(&s, "stop time");
 }
+
+#[test]
+fn unsupported_functions_answer_with_an_error_not_a_crash() {
+    let fmu = Fmu::load();
+    let s = fmu.instantiate("unsupported");
+    s.initialize();
+    assert_eq!(s.do_step(0.0, 1e-3), OK);
+    let vr = [real::MOUNT_F[0][2]];
+    let order = [1];
+    let mut value = [0.0];
+    let mut status = 0;
+    let mut int_value = 0;
+    let mut text: *const std::ffi::c_char = std::ptr::null();
+    // SAFETY: valid arrays of length 1 and writable out-parameters.
+    unsafe {
+        assert_eq!(
+            (s.f().fmi2GetRealOutputDerivatives)(
+                s.c,
+                vr.as_ptr(),
+                1,
+                order.as_ptr(),
+                value.as_mut_ptr()
+            ),
+            ERROR
+        );
+        assert_eq!((s.f().fmi2GetStatus)(s.c, 0, &mut status), ERROR);
+        assert_eq!((s.f().fmi2GetIntegerStatus)(s.c, 0, &mut int_value), ERROR);
+        assert_eq!((s.f().fmi2GetStringStatus)(s.c, 1, &mut text), ERROR);
+    }
+    assert_logged(&s, "maxOutputDerivativeOrder=0");
+    assert_logged(&s, "canRunAsynchronuously=false");
+    // the instance is still usable
+    assert_eq!(s.do_step(1e-3, 1e-3), OK);
+}
+
+#[test]
+fn model_exchange_is_refused() {
+    let fmu = Fmu::load();
+    let name = c"model-exchange";
+    let guid = std::ffi::CString::new(GUID).unwrap();
+    // SAFETY: valid C strings; null callbacks are allowed by this FMU (no logging).
+    let c = unsafe {
+        (fmu.f.fmi2Instantiate)(
+            name.as_ptr(),
+            fmi_sys::fmi2::fmi2Type_fmi2ModelExchange,
+            guid.as_ptr(),
+            std::ptr::null(),
+            std::ptr::null(),
+            0,
+            0,
+        )
+    };
+    assert!(c.is_null());
+}
