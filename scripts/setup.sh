@@ -25,9 +25,10 @@ stamp="$venv/.requirements.sha256"
 if [ ! -x "$venv/bin/python" ]; then
   python3 -m venv "$venv"
 fi
-want=$(sha256sum "$req" | cut -d' ' -f1)
+want=$(cat "$req" "$root/python/pyproject.toml" | sha256sum | cut -d' ' -f1)
 if [ ! -f "$stamp" ] || [ "$(cat "$stamp")" != "$want" ]; then
-  echo "setup: installing Python requirements"
+  echo "setup: installing Python requirements and the emc tool"
   "$venv/bin/pip" install -q --disable-pip-version-check -r "$req"
+  "$venv/bin/pip" install -q --disable-pip-version-check --no-deps -e "$root/python"
   echo "$want" >"$stamp"
 fi

@@ -1,0 +1,147 @@
+"""The ``emc`` command: speed sweeps and run-ups with the packaged FMU, tables and plots.
+
+Examples:
+    emc sweep --fmu dist/EngineMountChassis.fmu --rpm 800 2500 --count 18 --out out/sweep
+    emc sweep ... --set effects.balanceShaft=false --case no-balance-shaft
+    emc sweep ... --scheduler tcp://10.0.0.5:8786        # a running Dask cluster
+    emc runup --fmu dist/EngineMountChassis.fmu --rpm 800 2500 --duration 10 --out out/runup
+"""
+
+from __future__ import annotations
+
+import argparse
+import pathlib
+import re
+import sys
+import time
+
+import numpy as np
+import pandas as pd
+
+from . import plots
+from .runner import OperatingPoint, Runner
+from .spectra import amplitude_spectrum
+from .sweep import run_sweep, save, speed_points
+
+
+def parse_value(text: str):
+    lowered = text.lower()
+    if lowered in ("true", "false"):
+        return lowered == "true"
+    try:
+        return int(text)
+    except ValueError:
+        pass
+    try:
+        return float(text)
+    except ValueError:
+        return text
+
+
+def parse_settings(items: list[str]) -> tuple:
+    out = []
+    for item in items or []:
+        if "=" not in item:
+            raise SystemExit(f"--set expects name=value, got {item!r}")
+        name, value = item.split("=", 1)
+        out.append((name.strip(), parse_value(value.strip())))
+    return tuple(out)
+
+
+def safe_name(signal: str) -> str:
+    return re.sub(r"[^A-Za-z0-9_.-]+", "_", re.sub(r"\[(\d+)\]", r"\1", signal)).strip("_")
+
+
+def cmd_sweep(args) -> int:
+    out = pathlib.Path(args.out)
+    out.mkdir(parents=True, exist_ok=True)
+    points = speed_points(args.rpm[0], args.rpm[1], args.count, revolutions=args.revolutions,
+                          settle_revolutions=args.settle, steps_per_revolution=args.steps_per_rev,
+                          load_torque=args.load_torque, parameters=parse_settings(args.set))
+    started = time.perf_counter()
+    orders, spectra = run_sweep(args.fmu, points, signals=args.signal or None, case=args.case,
+                                parallel=not args.serial, scheduler=args.scheduler,
+                                workers=args.workers, progress=not args.quiet)
+    elapsed = time.perf_counter() - started
+    suffix = ".parquet" if args.parquet else ".csv"
+    save(orders, str(out / f"orders{suffix}"))
+    save(spectra, str(out / f"spectra{suffix}"))
+    for signal in args.plot or sorted(orders.signal.unique())[:1]:
+        plots.waterfall(spectra, signal, str(out / f"waterfall_{safe_name(signal)}.png"))
+        plots.order_cuts(orders, signal, str(out / f"order_cuts_{safe_name(signal)}.png"))
+    print(f"{len(points)} points in {elapsed:.1f} s -> {out}")
+    return 0
+
+
+def cmd_runup(args) -> int:
+    out = pathlib.Path(args.out)
+    out.mkdir(parents=True, exist_ok=True)
+    with Runner(args.fmu) as runner:
+        signals = args.signal or ["mount[1].F[3]"]
+        result = runner.run_up(args.rpm[0], args.rpm[1], args.duration, signals, step=args.step,
+                               start_values=dict(parse_settings(args.set)))
+    table = pd.DataFrame(result["samples"], columns=signals)
+    table.insert(0, "rpm", result["rpm"])
+    table.insert(0, "time", np.arange(1, len(table) + 1) * result["dt"])
+    save(table, str(out / ("runup.parquet" if args.parquet else "runup.csv")))
+    # Run-up waterfall from consecutive windows of ~0.25 s (quasi-stationary at slow rates).
+    n = max(16, int(round(args.window / result["dt"])))
+    rows = []
+    for signal in signals:
+        x = table[signal].to_numpy()
+        for start in range(0, len(x) - n + 1, n):
+            f, a = amplitude_spectrum(x[start:start + n], result["dt"])
+            rpm = float(np.mean(result["rpm"][start:start + n]))
+            keep = f <= 6.5 * rpm / 60
+            rows += [{"case": "runup", "rpm": rpm, "signal": signal, "frequency": fi, "amplitude": ai}
+                     for fi, ai in zip(f[keep], a[keep])]
+    spectra = pd.DataFrame(rows)
+    for signal in signals:
+        plots.waterfall(spectra, signal, str(out / f"runup_waterfall_{safe_name(signal)}.png"),
+                        title=f"{signal}: run-up {args.rpm[0]:g}→{args.rpm[1]:g} rpm in {args.duration:g} s")
+    print(f"run-up -> {out}")
+    return 0
+
+
+def main(argv: list[str] | None = None) -> int:
+    parser = argparse.ArgumentParser(prog="emc", description=__doc__,
+                                     formatter_class=argparse.RawDescriptionHelpFormatter)
+    sub = parser.add_subparsers(dest="command", required=True)
+
+    def common(p):
+        p.add_argument("--fmu", default="dist/EngineMountChassis.fmu")
+        p.add_argument("--rpm", nargs=2, type=float, default=[800.0, 2500.0], metavar=("FROM", "TO"))
+        p.add_argument("--signal", action="append", help="output to analyse (repeatable)")
+        p.add_argument("--set", action="append", metavar="NAME=VALUE",
+                       help="FMU start value, e.g. effects.balanceShaft=false (repeatable)")
+        p.add_argument("--out", required=True)
+        p.add_argument("--parquet", action="store_true", help="write Parquet instead of CSV")
+
+    s = sub.add_parser("sweep", help="constant-speed points: fade-in, settle, stationary window")
+    common(s)
+    s.add_argument("--count", type=int, default=18)
+    s.add_argument("--revolutions", type=int, default=40, help="stationary window (even)")
+    s.add_argument("--settle", type=int, default=20, help="revolutions before the window")
+    s.add_argument("--steps-per-rev", type=int, default=72)
+    s.add_argument("--load-torque", type=float, default=0.0)
+    s.add_argument("--case", default="")
+    s.add_argument("--plot", action="append", help="signal to plot (default: the first)")
+    s.add_argument("--serial", action="store_true", help="no Dask")
+    s.add_argument("--workers", type=int, default=2)
+    s.add_argument("--scheduler", help="address of a running Dask scheduler")
+    s.add_argument("--quiet", action="store_true")
+    s.set_defaults(func=cmd_sweep)
+
+    r = sub.add_parser("runup", help="slow linear run-up with continuous speed input")
+    common(r)
+    r.add_argument("--duration", type=float, default=10.0)
+    r.add_argument("--step", type=float, default=2e-4)
+    r.add_argument("--window", type=float, default=0.25, help="analysis window (s)")
+    r.set_defaults(func=cmd_runup)
+
+    args = parser.parse_args(argv)
+    return args.func(args)
+
+
+if __name__ == "__main__":
+    sys.exit(main())

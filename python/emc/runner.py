@@ -1,0 +1,132 @@
+"""Drives the packaged FMU with fmpy's low-level API, one instance reused via ``reset()``."""
+
+from __future__ import annotations
+
+import dataclasses
+import math
+import shutil
+import tempfile
+from typing import Iterable
+
+import numpy as np
+from fmpy import extract, read_model_description
+from fmpy.fmi2 import FMU2Slave
+
+
+@dataclasses.dataclass(frozen=True)
+class OperatingPoint:
+    """One constant-speed run: fade-in and settling, then a stationary window."""
+
+    rpm: float
+    load_torque: float = 0.0
+    revolutions: int = 40          # stationary window (even: half orders fall on bins)
+    settle_revolutions: int = 20   # after the start, before the window
+    steps_per_revolution: int = 72  # communication steps (5 degrees of crank angle)
+    parameters: tuple = ()          # extra (name, value) start values: effects, solver, scene …
+
+    def __post_init__(self):
+        if self.rpm <= 0 or not math.isfinite(self.rpm):
+            raise ValueError(f"rpm must be positive, got {self.rpm}")
+        if self.revolutions < 2 or self.revolutions % 2:
+            raise ValueError(f"revolutions must be even and >= 2 (half orders), got {self.revolutions}")
+
+
+class Runner:
+    """One FMU instance; ``run_point`` resets it, so results never depend on earlier points."""
+
+    def __init__(self, fmu_path: str, instance_name: str = "emc"):
+        self.md = read_model_description(fmu_path)
+        self.unzipdir = extract(fmu_path)
+        self.vr = {v.name: v.valueReference for v in self.md.modelVariables}
+        self.kind = {v.name: v.type for v in self.md.modelVariables}
+        self.slave = FMU2Slave(
+            guid=self.md.guid,
+            unzipDirectory=self.unzipdir,
+            modelIdentifier=self.md.coSimulation.modelIdentifier,
+            instanceName=instance_name,
+        )
+        self.slave.instantiate()
+        self.fresh = True
+
+    def close(self):
+        self.slave.terminate()
+        self.slave.freeInstance()
+        shutil.rmtree(self.unzipdir, ignore_errors=True)
+
+    def __enter__(self):
+        return self
+
+    def __exit__(self, *exc):
+        self.close()
+
+    def outputs(self, names: Iterable[str] | None = None) -> list[str]:
+        if names:
+            return list(names)
+        return [v.name for v in self.md.modelVariables if v.causality == "output" and v.type == "Real"]
+
+    def _set(self, name: str, value):
+        kind = self.kind[name]
+        vr = [self.vr[name]]
+        if kind == "Real":
+            self.slave.setReal(vr, [float(value)])
+        elif kind == "Integer":
+            self.slave.setInteger(vr, [int(value)])
+        elif kind == "Boolean":
+            self.slave.setBoolean(vr, [bool(value)])
+        else:
+            self.slave.setString(vr, [str(value)])
+
+    def _start(self, start_values: dict):
+        if not self.fresh:
+            self.slave.reset()
+        self.fresh = False
+        self.slave.setupExperiment(startTime=0.0)
+        for name, value in start_values.items():
+            self._set(name, value)
+        self.slave.enterInitializationMode()
+        self.slave.exitInitializationMode()
+
+    def run_point(self, point: OperatingPoint, signals: list[str]) -> dict:
+        """Runs one point; returns the stationary window of ``signals`` sampled per step."""
+        start = {"rpm": point.rpm, "loadTorque": point.load_torque, **dict(point.parameters)}
+        self._start(start)
+        t_rev = 60.0 / point.rpm
+        h = t_rev / point.steps_per_revolution
+        n_settle = point.settle_revolutions * point.steps_per_revolution
+        n_window = point.revolutions * point.steps_per_revolution
+        vrs = [self.vr[s] for s in signals]
+        samples = np.empty((n_window, len(vrs)))
+        t = 0.0
+        for k in range(n_settle + n_window):
+            self.slave.doStep(currentCommunicationPoint=t, communicationStepSize=h)
+            t = (k + 1) * h
+            if k >= n_settle:
+                samples[k - n_settle] = self.slave.getReal(vrs)
+        if not np.all(np.isfinite(samples)):
+            raise RuntimeError(f"non-finite outputs at {point.rpm} rpm")
+        return {"point": point, "dt": h, "signals": signals, "samples": samples}
+
+    def run_up(self, rpm_from: float, rpm_to: float, duration: float, signals: list[str],
+               step: float = 2e-4, start_values: dict | None = None) -> dict:
+        """A slow linear run-up, the speed given continuously by input derivatives."""
+        self._start({"rpm": rpm_from, **(start_values or {})})
+        rate = (rpm_to - rpm_from) / duration
+        n = int(round(duration / step))
+        vrs = [self.vr[s] for s in signals]
+        samples = np.empty((n, len(vrs)))
+        rpm = np.empty(n)
+        t = 0.0
+        for k in range(n):
+            self.slave.setReal([self.vr["rpm"]], [rpm_from + rate * t])
+            self.slave.setRealInputDerivatives([self.vr["rpm"]], [1], [rate])
+            self.slave.doStep(currentCommunicationPoint=t, communicationStepSize=step)
+            t = (k + 1) * step
+            samples[k] = self.slave.getReal(vrs)
+            rpm[k] = rpm_from + rate * t
+        return {"dt": step, "rpm": rpm, "signals": signals, "samples": samples}
+
+
+def temporary_copy(path: str) -> str:
+    """A private copy of the FMU (each Dask worker extracts its own)."""
+    tmp = tempfile.mkdtemp(prefix="emc-")
+    return shutil.copy(path, tmp)

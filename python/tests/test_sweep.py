@@ -1,0 +1,45 @@
+"""The sweep tool: exact order analysis, and Dask sweeps equal to serial ones."""
+
+import numpy as np
+import pandas as pd
+
+from emc.runner import OperatingPoint
+from emc.spectra import amplitude_spectrum, order_amplitudes
+from emc.sweep import run_sweep, speed_points
+
+
+def test_order_amplitudes_of_a_synthetic_signal_are_exact():
+    rpm, revolutions, steps = 1500.0, 8, 72
+    t = np.arange(revolutions * steps) * (60 / rpm) / steps
+    f1 = rpm / 60
+    x = 3.0 + 2.0 * np.sin(2 * np.pi * 1.5 * f1 * t + 0.3) + 0.5 * np.cos(2 * np.pi * 2.0 * f1 * t)
+    amplitudes = order_amplitudes(x, revolutions, [0.5, 1.0, 1.5, 2.0, 3.0])
+    assert abs(amplitudes[1.5] - 2.0) < 1e-12
+    assert abs(amplitudes[2.0] - 0.5) < 1e-12
+    assert max(amplitudes[o] for o in (0.5, 1.0, 3.0)) < 1e-12
+    f, a = amplitude_spectrum(x, t[1] - t[0])
+    assert abs(f[np.argmax(a)] - 1.5 * f1) < 1e-9
+
+
+def test_operating_points_reject_windows_without_half_orders():
+    for bad in ({"rpm": 1000.0, "revolutions": 5}, {"rpm": -1.0}):
+        try:
+            OperatingPoint(**bad)
+        except ValueError:
+            continue
+        raise AssertionError(f"{bad} accepted")
+
+
+def test_dask_sweep_equals_serial_sweep(fmu_path):
+    points = speed_points(900, 2100, 3, revolutions=4, settle_revolutions=4)
+    signals = ["mount[1].F[3]", "mount[3].F[1]"]
+    serial = run_sweep(str(fmu_path), points, signals, parallel=False, progress=False)
+    parallel = run_sweep(str(fmu_path), points, signals, parallel=True, workers=2, progress=False)
+    for a, b in zip(serial, parallel):
+        pd.testing.assert_frame_equal(a, b, check_exact=True)
+    orders = serial[0]
+    assert set(orders.rpm) == {900.0, 1500.0, 2100.0}
+    # the 1.5 order of the gas torque dominates the vertical mount force
+    main = orders[(orders.signal == "mount[1].F[3]") & (orders.order == 1.5)].amplitude
+    other = orders[(orders.signal == "mount[1].F[3]") & (orders.order.isin([2.5, 3.5]))].amplitude
+    assert main.min() > 10 * other.max()
