@@ -1,1 +1,12 @@
 //! Finite elements, sparse assembly and the procedural chassis body.
+//!
+//! Frame: ISO 8855 vehicle axes (x forward, y left, z up), origin at the front-axle centre on the
+//! ground. SI units throughout. Six DOFs per node: ux, uy, uz, rx, ry, rz in global axes.
+
+pub mod beam;
+pub mod dof;
+pub mod error;
+pub mod mesh;
+pub mod shell;
+
+pub use error::FeError;
