@@ -106,6 +106,7 @@ fn simply_supported_plate_frequency(thickness: f64, n: usize) -> (f64, f64) {
                 nodes: [id(i, j), id(i + 1, j), id(i + 1, j + 1), id(i, j + 1)],
                 material: STEEL,
                 thickness,
+                bending_thickness: thickness,
                 extra_mass_per_area: 0.0,
             });
         }
@@ -165,7 +166,7 @@ fn membrane_patch_test_reproduces_a_linear_displacement_field_exactly() {
         mesh.add_node(Vector3::new(x, y, 0.0));
     }
     for nodes in [[0, 1, 5, 4], [1, 2, 6, 5], [2, 3, 7, 6], [3, 0, 4, 7], [4, 5, 6, 7]] {
-        mesh.shells.push(Shell { nodes, material: STEEL, thickness: 0.001, extra_mass_per_area: 0.0 });
+        mesh.shells.push(Shell { nodes, material: STEEL, thickness: 0.001, bending_thickness: 0.001, extra_mass_per_area: 0.0 });
     }
     let asm = assemble(&mesh).unwrap();
     let n = asm.dofs.n_free();
@@ -229,6 +230,7 @@ fn grid(mesh: &mut Mesh, origin: Vector3<f64>, du: Vector3<f64>, dv: Vector3<f64
                 nodes: [ids[i][j], ids[i + 1][j], ids[i + 1][j + 1], ids[i][j + 1]],
                 material: STEEL,
                 thickness: 0.002,
+                bending_thickness: 0.002,
                 extra_mass_per_area: 0.0,
             });
         }

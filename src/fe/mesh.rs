@@ -87,8 +87,11 @@ pub struct Shell {
     pub nodes: [usize; 4],
     /// Material.
     pub material: Material,
-    /// Thickness [m].
+    /// Thickness [m] (membrane stiffness and mass).
     pub thickness: f64,
+    /// Effective thickness for plate bending and transverse shear [m]: equal to `thickness` for a
+    /// plain sheet, larger for a beaded or stiffened panel in a phenomenological model.
+    pub bending_thickness: f64,
     /// Non-structural mass per area [kg/m²] (trim carried by the panel).
     pub extra_mass_per_area: f64,
 }

@@ -5,11 +5,14 @@
 
 pub mod assembly;
 pub mod beam;
+pub mod chassis;
+pub mod chassis_config;
 pub mod dof;
 pub mod eigen;
 pub mod error;
 pub mod mass;
 pub mod mesh;
+pub mod modal;
 pub mod shell;
 pub mod spring;
 

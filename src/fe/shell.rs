@@ -106,6 +106,7 @@ fn validate(index: usize, shell: &Shell) -> Result<(), FeError> {
     let m = &shell.material;
     let name = |f: &str| format!("shell {index}: {f}");
     require_positive(&name("thickness"), shell.thickness)?;
+    require_positive(&name("bending_thickness"), shell.bending_thickness)?;
     require_positive(&name("youngs_modulus"), m.youngs_modulus)?;
     require_non_negative(&name("density"), m.density)?;
     require_non_negative(&name("extra_mass_per_area"), shell.extra_mass_per_area)?;
@@ -154,11 +155,12 @@ pub fn stiffness(index: usize, shell: &Shell, p: &[Vector3<f64>; 4]) -> Result<M
     let xy = &geo.local_xy;
     let mat = &shell.material;
     let (e, nu, t) = (mat.youngs_modulus, mat.poisson_ratio, shell.thickness);
+    let tb = shell.bending_thickness;
     let g = mat.shear_modulus();
     let iso = Matrix3::new(1.0, nu, 0.0, nu, 1.0, 0.0, 0.0, 0.0, (1.0 - nu) / 2.0);
     let dm = iso * (e * t / (1.0 - nu * nu));
-    let db = iso * (e * t.powi(3) / (12.0 * (1.0 - nu * nu)));
-    let ds = SHEAR_CORRECTION * g * t;
+    let db = iso * (e * tb.powi(3) / (12.0 * (1.0 - nu * nu)));
+    let ds = SHEAR_CORRECTION * g * tb;
     let gamma = DRILLING_FACTOR * g * t;
 
     let tie_xi = [
@@ -219,14 +221,13 @@ pub fn stiffness(index: usize, shell: &Shell, p: &[Vector3<f64>; 4]) -> Result<M
 }
 
 /// Global lumped mass matrix of shell `index`: each corner carries the row sum of the consistent
-/// translational mass (∫ N_i ρ t dA) and the same share of the rotary inertia ρ t³/12 about all
-/// three axes (isotropic, so it stays diagonal in global axes).
+/// translational mass (∫ N_i ρ t dA) and the same share of the rotary inertia (mass per area
+/// × t_b²/12) about all three axes (isotropic, so it stays diagonal in global axes).
 pub fn lumped_mass(index: usize, shell: &Shell, p: &[Vector3<f64>; 4]) -> Result<Mat24, FeError> {
     validate(index, shell)?;
     let geo = geometry(index, p)?;
-    let t = shell.thickness;
-    let areal = shell.material.density * t + shell.extra_mass_per_area;
-    let rotary = shell.material.density * t.powi(3) / 12.0 + areal * t * t / 12.0;
+    let areal = shell.material.density * shell.thickness + shell.extra_mass_per_area;
+    let rotary = areal * shell.bending_thickness.powi(2) / 12.0;
     let gp = 1.0 / 3.0_f64.sqrt();
     let mut share = [0.0; 4];
     for &(xi, eta) in &[(-gp, -gp), (gp, -gp), (gp, gp), (-gp, gp)] {
@@ -252,7 +253,7 @@ mod tests {
     use crate::fe::mesh::Material;
 
     fn plate() -> Shell {
-        Shell { nodes: [0, 1, 2, 3], material: Material::STEEL, thickness: 0.002, extra_mass_per_area: 0.0 }
+        Shell { nodes: [0, 1, 2, 3], material: Material::STEEL, thickness: 0.002, bending_thickness: 0.002, extra_mass_per_area: 0.0 }
     }
 
     fn corners() -> [Vector3<f64>; 4] {
