@@ -316,6 +316,11 @@ impl<'a> Builder<'a> {
             self.line(region::ROOF, p(x, -w, g.roof_z), p(x, w, g.roof_z), &s.roof_bow, "roof_bow", body, roof_trim, None)?;
         }
         self.line("shelf", p(g.shelf_x, -w, g.shelf_z), p(g.shelf_x, w, g.shelf_z), &s.shelf_beam, "shelf_beam", body, 0.0, None)?;
+        if cfg.options.stiffening_bar {
+            let x = cfg.options.stiffening_bar_x;
+            self.existing(p(x, g.girder_y, g.girder_z), "stiffening bar end (options.stiffening_bar_x)")?;
+            self.line(region::FRONT_END, p(x, -g.girder_y, g.girder_z), p(x, g.girder_y, g.girder_z), &s.stiffening_bar, "stiffening_bar", body, 0.0, None)?;
+        }
         let body_nodes: Vec<usize> = (0..self.mesh.nodes.len()).collect();
         self.regions.insert(region::BODY.into(), body_nodes);
 

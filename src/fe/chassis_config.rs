@@ -288,8 +288,8 @@ impl Default for Steering {
             // Tuned by `examples/fe_tune.rs`.
             column_section: SectionSpec::Explicit {
                 area: 2.5e-4,
-                iy: 1.76e-8,
-                iz: 2.28e-8,
+                iy: 1.755e-8,
+                iz: 2.294e-8,
                 j: 8.0e-8,
             },
             bracket_section: SectionSpec::Box { b: 0.05, h: 0.05, t: 0.002 },
@@ -446,7 +446,7 @@ impl Default for ChassisConfig {
             material: Material::STEEL,
             glass: Material { youngs_modulus: 70.0e9, poisson_ratio: 0.22, density: 2500.0 },
             // Tuned by `examples/fe_tune.rs` (with trim.floor and the steering column section).
-            body_stiffness_scale: 0.8828,
+            body_stiffness_scale: 0.8827,
             geometry: Geometry::default(),
             thickness: Thicknesses::default(),
             sections: Sections::default(),
