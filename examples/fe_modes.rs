@@ -1,13 +1,23 @@
-//! Modal analysis of the chassis body: `cargo run --release --example fe_modes [config.json]`.
+//! Modal analysis of the chassis body with mode descriptions:
+//! `cargo run --release --example fe_modes [config.json] [--export DIR]`.
+//! With `--export DIR`, K and M (Matrix Market), the node table and the DOF table are written to
+//! DIR for checking with another tool.
 
 use engine_mount_chassis::fe::assembly::{assemble, translational_mass};
 use engine_mount_chassis::fe::chassis::Chassis;
 use engine_mount_chassis::fe::chassis_config::ChassisConfig;
 use engine_mount_chassis::fe::eigen::lowest_modes;
+use engine_mount_chassis::fe::export::write_all;
 use engine_mount_chassis::fe::modal::describe;
 
 fn main() -> Result<(), Box<dyn std::error::Error>> {
-    let config = match std::env::args().nth(1) {
+    let args: Vec<String> = std::env::args().skip(1).collect();
+    let export = args
+        .iter()
+        .position(|a| a == "--export")
+        .map(|i| args.get(i + 1).cloned());
+    let config_path = args.iter().take_while(|a| *a != "--export").next();
+    let config = match config_path {
         Some(path) => ChassisConfig::from_json(&std::fs::read_to_string(path)?)?,
         None => ChassisConfig::default(),
     };
@@ -22,9 +32,17 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         asm.dofs.n_free(),
         translational_mass(&asm, 2)
     );
+    match export {
+        Some(Some(dir)) => {
+            write_all(std::path::Path::new(&dir), mesh, &asm)?;
+            println!("wrote K.mtx, M.mtx, nodes.csv, dofs.csv to {dir}");
+        }
+        Some(None) => return Err("--export needs a directory".into()),
+        None => {}
+    }
     let modes = lowest_modes(&asm.k, &asm.m, 30, -1.0)?;
     for d in describe(mesh, &asm, &modes)? {
-        println!("{}  elastic {:4.2}", d.summary(), d.elastic);
+        println!("{}", d.summary());
     }
     Ok(())
 }

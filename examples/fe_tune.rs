@@ -10,27 +10,12 @@ use engine_mount_chassis::fe::assembly::{assemble, translational_mass};
 use engine_mount_chassis::fe::chassis::Chassis;
 use engine_mount_chassis::fe::chassis_config::{ChassisConfig, SectionSpec};
 use engine_mount_chassis::fe::eigen::lowest_modes;
-use engine_mount_chassis::fe::modal::{describe, ModeDescription, ModeKind};
+use engine_mount_chassis::fe::modal::{describe, steering_wheel_pair, ModeKind};
 
 const TORSION: f64 = 43.0;
 const WHEEL_VERTICAL: f64 = 31.5;
 const WHEEL_LATERAL: f64 = 32.07;
 const MASS: f64 = 1000.0;
-
-/// The two steering-wheel modes (largest wheel translation energy), as (more vertical, more
-/// lateral) frequencies.
-fn wheel_pair(descs: &[ModeDescription]) -> Option<(f64, f64)> {
-    let mut by_wheel: Vec<&ModeDescription> = descs.iter().collect();
-    let wheel = |d: &ModeDescription| d.wheel_vertical + d.wheel_lateral;
-    by_wheel.sort_by(|a, b| wheel(b).total_cmp(&wheel(a)));
-    let (a, b) = (by_wheel.first()?, by_wheel.get(1)?);
-    let verticality = |d: &ModeDescription| d.wheel_vertical / wheel(d);
-    if verticality(a) >= verticality(b) {
-        Some((a.frequency_hz, b.frequency_hz))
-    } else {
-        Some((b.frequency_hz, a.frequency_hz))
-    }
-}
 
 fn main() -> Result<(), Box<dyn std::error::Error>> {
     let mut config = match std::env::args().nth(1) {
@@ -43,9 +28,12 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         let mass = translational_mass(&asm, 2);
         let modes = lowest_modes(&asm.k, &asm.m, 30, -1.0)?;
         let descs = describe(&chassis.mesh, &asm, &modes)?;
-        let torsion = descs.iter().find(|d| d.kind == ModeKind::GlobalTorsion).map(|d| d.frequency_hz);
-        let (vertical, lateral) = match wheel_pair(&descs) {
-            Some((v, l)) => (Some(v), Some(l)),
+        let torsion = descs
+            .iter()
+            .find(|d| d.kind == ModeKind::GlobalTorsion)
+            .map(|d| d.frequency_hz);
+        let (vertical, lateral) = match steering_wheel_pair(&descs) {
+            Some((v, l)) => (Some(descs[v].frequency_hz), Some(descs[l].frequency_hz)),
             None => (None, None),
         };
         println!(
@@ -76,6 +64,9 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     }
     println!("body_stiffness_scale = {:.4}", config.body_stiffness_scale);
     println!("trim.floor = {:.1}", config.trim.floor);
-    println!("steering.column_section = {:?}", config.steering.column_section);
+    println!(
+        "steering.column_section = {:?}",
+        config.steering.column_section
+    );
     Ok(())
 }

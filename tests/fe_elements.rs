@@ -46,7 +46,12 @@ fn diagonal(a: &Assembled) -> Vec<f64> {
 fn cantilever_bending_and_torsion_frequencies_match_theory_within_one_percent() {
     let (length, n_el) = (1.0, 20);
     // Deliberately unequal: iy (z-bending) ≪ iz so the bending families separate.
-    let section = BeamSection { area: 4.0e-4, iy: 2.0e-9, iz: 8.0e-8, j: 6.0e-9 };
+    let section = BeamSection {
+        area: 4.0e-4,
+        iy: 2.0e-9,
+        iz: 8.0e-8,
+        j: 6.0e-9,
+    };
     let mut mesh = Mesh::default();
     for i in 0..=n_el {
         mesh.add_node(Vector3::new(length * i as f64 / n_el as f64, 0.0, 0.0));
@@ -72,21 +77,35 @@ fn cantilever_bending_and_torsion_frequencies_match_theory_within_one_percent() 
     };
     let expected_bending = [1.875_104_1, 4.694_091_1, 7.854_757_4].map(bending);
     let polar = section.iy + section.iz;
-    let expected_torsion = 1.0 / (4.0 * length)
-        * (STEEL.shear_modulus() * section.j / (STEEL.density * polar)).sqrt();
+    let expected_torsion =
+        1.0 / (4.0 * length) * (STEEL.shear_modulus() * section.j / (STEEL.density * polar)).sqrt();
 
-    let z_bending: Vec<f64> =
-        (0..modes.len()).filter(|&i| dof_fraction(&a, &modes, i, &[2, 4]) > 0.9).map(|i| f[i]).collect();
-    let torsion: Vec<f64> =
-        (0..modes.len()).filter(|&i| dof_fraction(&a, &modes, i, &[3]) > 0.9).map(|i| f[i]).collect();
-    assert!(z_bending.len() >= 3 && !torsion.is_empty(), "modes found: {f:?}");
+    let z_bending: Vec<f64> = (0..modes.len())
+        .filter(|&i| dof_fraction(&a, &modes, i, &[2, 4]) > 0.9)
+        .map(|i| f[i])
+        .collect();
+    let torsion: Vec<f64> = (0..modes.len())
+        .filter(|&i| dof_fraction(&a, &modes, i, &[3]) > 0.9)
+        .map(|i| f[i])
+        .collect();
+    assert!(
+        z_bending.len() >= 3 && !torsion.is_empty(),
+        "modes found: {f:?}"
+    );
     for (got, want) in z_bending.iter().zip(&expected_bending) {
         let err = (got - want).abs() / want;
-        println!("bending: FE {got:.4} Hz, theory {want:.4} Hz, error {:.3} %", 100.0 * err);
+        println!(
+            "bending: FE {got:.4} Hz, theory {want:.4} Hz, error {:.3} %",
+            100.0 * err
+        );
         assert!(err < 0.01, "bending FE {got} vs theory {want}");
     }
     let err = (torsion[0] - expected_torsion).abs() / expected_torsion;
-    println!("torsion: FE {:.3} Hz, theory {expected_torsion:.3} Hz, error {:.3} %", torsion[0], 100.0 * err);
+    println!(
+        "torsion: FE {:.3} Hz, theory {expected_torsion:.3} Hz, error {:.3} %",
+        torsion[0],
+        100.0 * err
+    );
     assert!(err < 0.01);
 }
 
@@ -97,7 +116,11 @@ fn simply_supported_plate_frequency(thickness: f64, n: usize) -> (f64, f64) {
     let id = |i: usize, j: usize| i * (n + 1) + j;
     for i in 0..=n {
         for j in 0..=n {
-            mesh.add_node(Vector3::new(a * i as f64 / n as f64, a * j as f64 / n as f64, 0.0));
+            mesh.add_node(Vector3::new(
+                a * i as f64 / n as f64,
+                a * j as f64 / n as f64,
+                0.0,
+            ));
         }
     }
     for i in 0..n {
@@ -143,7 +166,10 @@ fn simply_supported_plate_first_frequency_within_two_percent_thick_and_very_thin
     for thickness in [1.0e-2, 1.0e-3] {
         let (fe, theory) = simply_supported_plate_frequency(thickness, 16);
         let err = (fe - theory).abs() / theory;
-        println!("t/a = {thickness}: FE {fe:.4} Hz, Kirchhoff {theory:.4} Hz, error {:.3} %", 100.0 * err);
+        println!(
+            "t/a = {thickness}: FE {fe:.4} Hz, Kirchhoff {theory:.4} Hz, error {:.3} %",
+            100.0 * err
+        );
         assert!(err < 0.02, "t = {thickness}: FE {fe} vs Kirchhoff {theory}");
     }
 }
@@ -165,8 +191,20 @@ fn membrane_patch_test_reproduces_a_linear_displacement_field_exactly() {
     for (x, y) in pts {
         mesh.add_node(Vector3::new(x, y, 0.0));
     }
-    for nodes in [[0, 1, 5, 4], [1, 2, 6, 5], [2, 3, 7, 6], [3, 0, 4, 7], [4, 5, 6, 7]] {
-        mesh.shells.push(Shell { nodes, material: STEEL, thickness: 0.001, bending_thickness: 0.001, extra_mass_per_area: 0.0 });
+    for nodes in [
+        [0, 1, 5, 4],
+        [1, 2, 6, 5],
+        [2, 3, 7, 6],
+        [3, 0, 4, 7],
+        [4, 5, 6, 7],
+    ] {
+        mesh.shells.push(Shell {
+            nodes,
+            material: STEEL,
+            thickness: 0.001,
+            bending_thickness: 0.001,
+            extra_mass_per_area: 0.0,
+        });
     }
     let asm = assemble(&mesh).unwrap();
     let n = asm.dofs.n_free();
@@ -201,15 +239,28 @@ fn membrane_patch_test_reproduces_a_linear_displacement_field_exactly() {
         }
     }
     let sol = kff.full_piv_lu().solve(&rhs);
-    for node in 4..8 {
-        let (x, y) = pts[node];
+    for (node, &(x, y)) in pts.iter().enumerate().skip(4) {
         let want = exact(x, y);
-        for d in 0..2 {
-            let r = free.iter().position(|&f| f == asm.dofs.global(node, d).unwrap()).unwrap();
-            assert!((sol[(r, 0)] - want[d]).abs() < 1e-12, "node {node} dof {d}: {} vs {}", sol[(r, 0)], want[d]);
+        for (d, &want_d) in want.iter().enumerate() {
+            let r = free
+                .iter()
+                .position(|&f| f == asm.dofs.global(node, d).unwrap())
+                .unwrap();
+            assert!(
+                (sol[(r, 0)] - want_d).abs() < 1e-12,
+                "node {node} dof {d}: {} vs {want_d}",
+                sol[(r, 0)]
+            );
         }
-        let r = free.iter().position(|&f| f == asm.dofs.global(node, 5).unwrap()).unwrap();
-        assert!(sol[(r, 0)].abs() < 1e-12, "node {node}: drill rotation {}", sol[(r, 0)]);
+        let r = free
+            .iter()
+            .position(|&f| f == asm.dofs.global(node, 5).unwrap())
+            .unwrap();
+        assert!(
+            sol[(r, 0)].abs() < 1e-12,
+            "node {node}: drill rotation {}",
+            sol[(r, 0)]
+        );
     }
 }
 
@@ -220,9 +271,19 @@ fn count_zero_modes(mesh: &Mesh) -> (usize, Vec<f64>) {
     (f.iter().filter(|&&v| v < 1e-3).count(), f)
 }
 
-fn grid(mesh: &mut Mesh, origin: Vector3<f64>, du: Vector3<f64>, dv: Vector3<f64>, n: usize) -> Vec<Vec<usize>> {
+fn grid(
+    mesh: &mut Mesh,
+    origin: Vector3<f64>,
+    du: Vector3<f64>,
+    dv: Vector3<f64>,
+    n: usize,
+) -> Vec<Vec<usize>> {
     let ids: Vec<Vec<usize>> = (0..=n)
-        .map(|i| (0..=n).map(|j| mesh.add_node(origin + du * i as f64 + dv * j as f64)).collect())
+        .map(|i| {
+            (0..=n)
+                .map(|j| mesh.add_node(origin + du * i as f64 + dv * j as f64))
+                .collect()
+        })
         .collect();
     for i in 0..n {
         for j in 0..n {
@@ -241,7 +302,13 @@ fn grid(mesh: &mut Mesh, origin: Vector3<f64>, du: Vector3<f64>, dv: Vector3<f64
 #[test]
 fn free_flat_and_folded_shells_have_exactly_six_zero_frequency_modes() {
     let mut flat = Mesh::default();
-    grid(&mut flat, Vector3::zeros(), Vector3::new(0.1, 0.02, 0.0), Vector3::new(-0.01, 0.12, 0.0), 4);
+    grid(
+        &mut flat,
+        Vector3::zeros(),
+        Vector3::new(0.1, 0.02, 0.0),
+        Vector3::new(-0.01, 0.12, 0.0),
+        4,
+    );
     let (zeros, f) = count_zero_modes(&flat);
     println!("flat: {f:?}");
     assert_eq!(zeros, 6, "flat plate frequencies {f:?}");
@@ -249,9 +316,21 @@ fn free_flat_and_folded_shells_have_exactly_six_zero_frequency_modes() {
 
     // Folded: two panels meeting at a 90° fold, sharing the fold-line nodes.
     let mut folded = Mesh::default();
-    let a = grid(&mut folded, Vector3::zeros(), Vector3::new(0.1, 0.0, 0.0), Vector3::new(0.0, 0.1, 0.0), 4);
+    let a = grid(
+        &mut folded,
+        Vector3::zeros(),
+        Vector3::new(0.1, 0.0, 0.0),
+        Vector3::new(0.0, 0.1, 0.0),
+        4,
+    );
     let fold: Vec<usize> = a.iter().map(|row| row[4]).collect();
-    let b = grid(&mut folded, Vector3::new(0.0, 0.4, 0.0), Vector3::new(0.1, 0.0, 0.0), Vector3::new(0.0, 0.0, 0.1), 4);
+    let b = grid(
+        &mut folded,
+        Vector3::new(0.0, 0.4, 0.0),
+        Vector3::new(0.1, 0.0, 0.0),
+        Vector3::new(0.0, 0.0, 0.1),
+        4,
+    );
     // Merge panel b's first column (on the fold line) into panel a's fold nodes.
     let remap: Vec<(usize, usize)> = b.iter().zip(&fold).map(|(row, &f)| (row[0], f)).collect();
     for s in &mut folded.shells {

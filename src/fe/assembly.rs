@@ -58,10 +58,15 @@ impl TripletSink<'_> {
 
 fn node_of(mesh: &Mesh, what: &str, node: usize) -> Result<Vector3<f64>, FeError> {
     let p = mesh.nodes.get(node).copied().ok_or_else(|| {
-        FeError::Mesh(format!("{what} refers to node {node}, mesh has {} nodes", mesh.nodes.len()))
+        FeError::Mesh(format!(
+            "{what} refers to node {node}, mesh has {} nodes",
+            mesh.nodes.len()
+        ))
     })?;
     if p.iter().any(|c| !c.is_finite()) {
-        return Err(FeError::Mesh(format!("node {node} has non-finite coordinates")));
+        return Err(FeError::Mesh(format!(
+            "node {node} has non-finite coordinates"
+        )));
     }
     Ok(p)
 }
@@ -70,9 +75,18 @@ fn node_of(mesh: &Mesh, what: &str, node: usize) -> Result<Vector3<f64>, FeError
 pub fn assemble(mesh: &Mesh) -> Result<Assembled, FeError> {
     let dofs = DofMap::new(mesh.nodes.len(), &mesh.constraints)?;
     let n = dofs.n_free();
-    let mut k = TripletSink { dofs: &dofs, entries: Vec::new() };
-    let mut m = TripletSink { dofs: &dofs, entries: Vec::new() };
-    let mut c = TripletSink { dofs: &dofs, entries: Vec::new() };
+    let mut k = TripletSink {
+        dofs: &dofs,
+        entries: Vec::new(),
+    };
+    let mut m = TripletSink {
+        dofs: &dofs,
+        entries: Vec::new(),
+    };
+    let mut c = TripletSink {
+        dofs: &dofs,
+        entries: Vec::new(),
+    };
     for (i, b) in mesh.beams.iter().enumerate() {
         let what = format!("beam {i}");
         let p1 = node_of(mesh, &what, b.nodes[0])?;
@@ -109,7 +123,12 @@ pub fn assemble(mesh: &Mesh) -> Result<Assembled, FeError> {
         k.scatter(&s.nodes, &ks);
         c.scatter(&s.nodes, &cs);
     }
-    Ok(Assembled { k: k.finish(n, "K")?, m: m.finish(n, "M")?, c: c.finish(n, "C")?, dofs })
+    Ok(Assembled {
+        k: k.finish(n, "K")?,
+        m: m.finish(n, "M")?,
+        c: c.finish(n, "C")?,
+        dofs,
+    })
 }
 
 /// y = A x for a sparse `a` and a dense vector `x`.

@@ -18,7 +18,9 @@ pub fn local_frame(
     let axis = p2 - p1;
     let length = axis.norm();
     if !(length.is_finite() && length > 1e-9) {
-        return Err(FeError::Mesh(format!("beam {index}: zero or non-finite length {length}")));
+        return Err(FeError::Mesh(format!(
+            "beam {index}: zero or non-finite length {length}"
+        )));
     }
     let ex = axis / length;
     let ez = ex.cross(orientation);
@@ -182,7 +184,10 @@ mod tests {
                     }
                 }
             }
-            assert!((k * u).norm() < 1e-9 * scale, "rigid mode {mode} strains the beam");
+            assert!(
+                (k * u).norm() < 1e-9 * scale,
+                "rigid mode {mode} strains the beam"
+            );
         }
     }
 

@@ -31,8 +31,12 @@ pub enum MountLayout {
 pub const MOUNT_NAMES: [&str; 4] = ["front_left", "front_right", "rear_left", "rear_right"];
 
 /// Names of the wheel-centre nodes.
-pub const WHEEL_CENTRES: [&str; 4] =
-    ["wheel_front_left", "wheel_front_right", "wheel_rear_left", "wheel_rear_right"];
+pub const WHEEL_CENTRES: [&str; 4] = [
+    "wheel_front_left",
+    "wheel_front_right",
+    "wheel_rear_left",
+    "wheel_rear_right",
+];
 
 /// Named node of the steering-wheel centre.
 pub const STEERING_WHEEL: &str = "steering_wheel";
@@ -70,7 +74,10 @@ impl Chassis {
     /// Generates the body described by `config`.
     pub fn build(config: &ChassisConfig) -> Result<Self, FeError> {
         let mesh = Builder::new(config)?.build()?;
-        Ok(Self { mesh, config: config.clone() })
+        Ok(Self {
+            mesh,
+            config: config.clone(),
+        })
     }
 
     /// Node id of a named node; error if absent.
@@ -93,7 +100,11 @@ impl Chassis {
 
 fn key(p: &Vector3<f64>) -> [i64; 3] {
     // 0.1 mm: far below the grid spacing, far above round-off of the grid arithmetic.
-    [(p.x * 1e4).round() as i64, (p.y * 1e4).round() as i64, (p.z * 1e4).round() as i64]
+    [
+        (p.x * 1e4).round() as i64,
+        (p.y * 1e4).round() as i64,
+        (p.z * 1e4).round() as i64,
+    ]
 }
 
 fn v3(p: [f64; 3]) -> Vector3<f64> {
@@ -113,7 +124,13 @@ impl<'a> Builder<'a> {
         validate(cfg)?;
         let mut body = cfg.material;
         body.youngs_modulus *= cfg.body_stiffness_scale;
-        Ok(Self { cfg, body, mesh: Mesh::default(), lookup: HashMap::new(), regions: BTreeMap::new() })
+        Ok(Self {
+            cfg,
+            body,
+            mesh: Mesh::default(),
+            lookup: HashMap::new(),
+            regions: BTreeMap::new(),
+        })
     }
 
     fn node(&mut self, p: Vector3<f64>, region: &str) -> usize {
@@ -141,11 +158,15 @@ impl<'a> Builder<'a> {
 
     fn divisions(&self, d: &Vector3<f64>) -> usize {
         let g = &self.cfg.geometry;
-        let n = [d.x.abs() / g.grid_dx, d.y.abs() / g.grid_dy, d.z.abs() / g.grid_dz]
-            .iter()
-            .map(|v| v.round() as usize)
-            .max()
-            .unwrap_or(1);
+        let n = [
+            d.x.abs() / g.grid_dx,
+            d.y.abs() / g.grid_dy,
+            d.z.abs() / g.grid_dz,
+        ]
+        .iter()
+        .map(|v| v.round() as usize)
+        .max()
+        .unwrap_or(1);
         n.max(1)
     }
 
@@ -219,8 +240,9 @@ impl<'a> Builder<'a> {
         } else {
             Vector3::new(1.0, 0.0, 0.0)
         };
-        let ids: Vec<usize> =
-            (0..=n).map(|i| self.node(a + d * (i as f64 / n as f64), region)).collect();
+        let ids: Vec<usize> = (0..=n)
+            .map(|i| self.node(a + d * (i as f64 / n as f64), region))
+            .collect();
         for w in ids.windows(2) {
             self.mesh.beams.push(Beam {
                 nodes: [w[0], w[1]],
@@ -245,33 +267,116 @@ impl<'a> Builder<'a> {
         let ey = Vector3::new(0.0, 1.0, 0.0);
         let ez = Vector3::new(0.0, 0.0, 1.0);
         let p = Vector3::new;
-        let front_plate = if cfg.options.stiff_front_plate { cfg.options.front_plate_factor } else { 1.0 };
+        let front_plate = if cfg.options.stiff_front_plate {
+            cfg.options.front_plate_factor
+        } else {
+            1.0
+        };
 
         // Panels carry only their own mass; their bending thickness represents beads.
         let bend = t.panel_bending_factor;
-        self.panel(region::FLOOR, p(g.rear_x, -w, g.floor_z), ex * (g.firewall_x - g.rear_x), ey * 2.0 * w, t.floor, bend);
-        self.panel(region::ROOF, p(g.roof_rear_x, -w, g.roof_z), ex * (g.roof_front_x - g.roof_rear_x), ey * 2.0 * w, t.roof, bend);
-        self.panel(region::FIREWALL, p(g.firewall_x, -w, g.floor_z), ey * 2.0 * w, ez * (g.cowl_z - g.floor_z), t.firewall * front_plate, bend);
-        self.panel("cowl", p(g.cowl_x, -w, g.cowl_z), ex * (g.firewall_x - g.cowl_x), ey * 2.0 * w, t.cowl * front_plate, bend);
+        self.panel(
+            region::FLOOR,
+            p(g.rear_x, -w, g.floor_z),
+            ex * (g.firewall_x - g.rear_x),
+            ey * 2.0 * w,
+            t.floor,
+            bend,
+        );
+        self.panel(
+            region::ROOF,
+            p(g.roof_rear_x, -w, g.roof_z),
+            ex * (g.roof_front_x - g.roof_rear_x),
+            ey * 2.0 * w,
+            t.roof,
+            bend,
+        );
+        self.panel(
+            region::FIREWALL,
+            p(g.firewall_x, -w, g.floor_z),
+            ey * 2.0 * w,
+            ez * (g.cowl_z - g.floor_z),
+            t.firewall * front_plate,
+            bend,
+        );
+        self.panel(
+            "cowl",
+            p(g.cowl_x, -w, g.cowl_z),
+            ex * (g.firewall_x - g.cowl_x),
+            ey * 2.0 * w,
+            t.cowl * front_plate,
+            bend,
+        );
         let rear_h = g.shelf_z - g.floor_z;
-        self.panel(region::REAR_PANEL, p(g.rear_x, -w, g.floor_z), ey * 2.0 * w, ez * rear_h, t.rear_panel, bend);
+        self.panel(
+            region::REAR_PANEL,
+            p(g.rear_x, -w, g.floor_z),
+            ey * 2.0 * w,
+            ez * rear_h,
+            t.rear_panel,
+            bend,
+        );
         for side in [-1.0, 1.0] {
-            self.panel("quarter", p(g.rear_x, side * w, g.floor_z), ex * (g.quarter_front_x - g.rear_x), ez * rear_h, t.quarter, bend);
+            self.panel(
+                "quarter",
+                p(g.rear_x, side * w, g.floor_z),
+                ex * (g.quarter_front_x - g.rear_x),
+                ez * rear_h,
+                t.quarter,
+                bend,
+            );
         }
-        self.panel("shelf", p(g.rear_x, -w, g.shelf_z), ex * (g.shelf_x - g.rear_x), ey * 2.0 * w, t.shelf, bend);
+        self.panel(
+            "shelf",
+            p(g.rear_x, -w, g.shelf_z),
+            ex * (g.shelf_x - g.rear_x),
+            ey * 2.0 * w,
+            t.shelf,
+            bend,
+        );
         // Bonded glass: windscreen between cowl and roof, rear window between roof and shelf.
         let mut glass = cfg.glass;
         glass.youngs_modulus *= cfg.body_stiffness_scale;
         let windscreen = p(g.roof_front_x - g.cowl_x, 0.0, g.roof_z - g.cowl_z);
-        self.panel_of("glass", p(g.cowl_x, -w, g.cowl_z), ey * 2.0 * w, windscreen, glass, t.glass, 1.0);
+        self.panel_of(
+            "glass",
+            p(g.cowl_x, -w, g.cowl_z),
+            ey * 2.0 * w,
+            windscreen,
+            glass,
+            t.glass,
+            1.0,
+        );
         let rear_window = p(g.roof_rear_x - g.c_pillar_foot_x, 0.0, g.roof_z - g.shelf_z);
-        self.panel_of("glass", p(g.c_pillar_foot_x, -w, g.shelf_z), ey * 2.0 * w, rear_window, glass, t.glass, 1.0);
+        self.panel_of(
+            "glass",
+            p(g.c_pillar_foot_x, -w, g.shelf_z),
+            ey * 2.0 * w,
+            rear_window,
+            glass,
+            t.glass,
+            1.0,
+        );
         let apron_l = g.front_x - g.firewall_x;
         let apron_h = g.apron_top_z - g.girder_z;
         for side in [-1.0, 1.0] {
-            self.panel(region::FRONT_END, p(g.firewall_x, side * g.girder_y, g.girder_z), ex * apron_l, ez * apron_h, t.apron, bend);
+            self.panel(
+                region::FRONT_END,
+                p(g.firewall_x, side * g.girder_y, g.girder_z),
+                ex * apron_l,
+                ez * apron_h,
+                t.apron,
+                bend,
+            );
         }
-        self.panel(region::FRONT_END, p(g.front_x, -g.girder_y, g.girder_z), ey * 2.0 * g.girder_y, ez * apron_h, t.front_panel, bend);
+        self.panel(
+            region::FRONT_END,
+            p(g.front_x, -g.girder_y, g.girder_z),
+            ey * 2.0 * g.girder_y,
+            ez * apron_h,
+            t.front_panel,
+            bend,
+        );
 
         // Trim per length of each beam group.
         let floor_l = g.firewall_x - g.rear_x;
@@ -287,39 +392,231 @@ impl<'a> Builder<'a> {
         for side in [-1.0, 1.0] {
             let y = side * w;
             let gy = side * g.girder_y;
-            self.line("sill", p(g.rear_x, y, g.floor_z), p(g.firewall_x, y, g.floor_z), &s.sill, "sill", body, floor_trim, None)?;
-            self.line("floor_rail", p(g.rear_x, gy, g.floor_z), p(g.firewall_x, gy, g.floor_z), &s.floor_rail, "floor_rail", body, floor_trim, None)?;
-            self.line(region::FRONT_END, p(g.firewall_x, gy, g.girder_z), p(g.front_x, gy, g.girder_z), &s.girder, "girder", body, front_trim, None)?;
-            self.line(region::FIREWALL, p(g.firewall_x, gy, g.floor_z), p(g.firewall_x, gy, g.girder_z), &s.girder_extension, "girder_extension", body, 0.0, None)?;
-            self.line(region::FRONT_END, p(g.firewall_x, gy, g.apron_top_z), p(g.front_x, gy, g.apron_top_z), &s.upper_rail, "upper_rail", body, front_trim, None)?;
+            self.line(
+                "sill",
+                p(g.rear_x, y, g.floor_z),
+                p(g.firewall_x, y, g.floor_z),
+                &s.sill,
+                "sill",
+                body,
+                floor_trim,
+                None,
+            )?;
+            self.line(
+                "floor_rail",
+                p(g.rear_x, gy, g.floor_z),
+                p(g.firewall_x, gy, g.floor_z),
+                &s.floor_rail,
+                "floor_rail",
+                body,
+                floor_trim,
+                None,
+            )?;
+            self.line(
+                region::FRONT_END,
+                p(g.firewall_x, gy, g.girder_z),
+                p(g.front_x, gy, g.girder_z),
+                &s.girder,
+                "girder",
+                body,
+                front_trim,
+                None,
+            )?;
+            self.line(
+                region::FIREWALL,
+                p(g.firewall_x, gy, g.floor_z),
+                p(g.firewall_x, gy, g.girder_z),
+                &s.girder_extension,
+                "girder_extension",
+                body,
+                0.0,
+                None,
+            )?;
+            self.line(
+                region::FRONT_END,
+                p(g.firewall_x, gy, g.apron_top_z),
+                p(g.front_x, gy, g.apron_top_z),
+                &s.upper_rail,
+                "upper_rail",
+                body,
+                front_trim,
+                None,
+            )?;
             // Load paths from the front end into the body: kick-down of the girder to the floor
             // rail and continuation of the upper rail to the cross-car beam.
-            self.line(region::FIREWALL, p(g.firewall_x, gy, g.girder_z), p(g.cowl_x, gy, g.floor_z), &s.girder_extension, "girder_extension", body, 0.0, None)?;
-            self.line(region::FIREWALL, p(g.firewall_x, gy, g.apron_top_z), p(g.cowl_x, gy, g.cowl_z), &s.upper_rail, "upper_rail", body, 0.0, None)?;
-            self.line(region::FRONT_END, p(0.0, gy, g.apron_top_z), p(g.firewall_x, y, g.apron_top_z), &s.fender_brace, "fender_brace", body, 0.0, None)?;
-            self.line("pillar", p(g.firewall_x, y, g.floor_z), p(g.firewall_x, y, g.cowl_z), &s.hinge_pillar, "hinge_pillar", body, door_trim, None)?;
-            self.line("pillar", p(g.cowl_x, y, g.cowl_z), p(g.roof_front_x, y, g.roof_z), &s.a_pillar, "a_pillar", body, 0.0, None)?;
-            self.line("pillar", p(g.b_pillar_x, y, g.floor_z), p(g.b_pillar_x, y, g.roof_z), &s.b_pillar, "b_pillar", body, door_trim, None)?;
-            self.line("pillar", p(g.roof_rear_x, y, g.roof_z), p(g.c_pillar_foot_x, y, g.shelf_z), &s.c_pillar, "c_pillar", body, 0.0, None)?;
-            self.line("roof_rail", p(g.roof_rear_x, y, g.roof_z), p(g.roof_front_x, y, g.roof_z), &s.roof_rail, "roof_rail", body, roof_trim, None)?;
+            self.line(
+                region::FIREWALL,
+                p(g.firewall_x, gy, g.girder_z),
+                p(g.cowl_x, gy, g.floor_z),
+                &s.girder_extension,
+                "girder_extension",
+                body,
+                0.0,
+                None,
+            )?;
+            self.line(
+                region::FIREWALL,
+                p(g.firewall_x, gy, g.apron_top_z),
+                p(g.cowl_x, gy, g.cowl_z),
+                &s.upper_rail,
+                "upper_rail",
+                body,
+                0.0,
+                None,
+            )?;
+            self.line(
+                region::FRONT_END,
+                p(0.0, gy, g.apron_top_z),
+                p(g.firewall_x, y, g.apron_top_z),
+                &s.fender_brace,
+                "fender_brace",
+                body,
+                0.0,
+                None,
+            )?;
+            self.line(
+                "pillar",
+                p(g.firewall_x, y, g.floor_z),
+                p(g.firewall_x, y, g.cowl_z),
+                &s.hinge_pillar,
+                "hinge_pillar",
+                body,
+                door_trim,
+                None,
+            )?;
+            self.line(
+                "pillar",
+                p(g.cowl_x, y, g.cowl_z),
+                p(g.roof_front_x, y, g.roof_z),
+                &s.a_pillar,
+                "a_pillar",
+                body,
+                0.0,
+                None,
+            )?;
+            self.line(
+                "pillar",
+                p(g.b_pillar_x, y, g.floor_z),
+                p(g.b_pillar_x, y, g.roof_z),
+                &s.b_pillar,
+                "b_pillar",
+                body,
+                door_trim,
+                None,
+            )?;
+            self.line(
+                "pillar",
+                p(g.roof_rear_x, y, g.roof_z),
+                p(g.c_pillar_foot_x, y, g.shelf_z),
+                &s.c_pillar,
+                "c_pillar",
+                body,
+                0.0,
+                None,
+            )?;
+            self.line(
+                "roof_rail",
+                p(g.roof_rear_x, y, g.roof_z),
+                p(g.roof_front_x, y, g.roof_z),
+                &s.roof_rail,
+                "roof_rail",
+                body,
+                roof_trim,
+                None,
+            )?;
         }
-        self.line("tunnel", p(g.rear_x, 0.0, g.floor_z), p(g.firewall_x, 0.0, g.floor_z), &s.tunnel, "tunnel", body, floor_trim, None)?;
+        self.line(
+            "tunnel",
+            p(g.rear_x, 0.0, g.floor_z),
+            p(g.firewall_x, 0.0, g.floor_z),
+            &s.tunnel,
+            "tunnel",
+            body,
+            floor_trim,
+            None,
+        )?;
         for &x in &g.cross_member_x {
-            self.line("cross_member", p(x, -w, g.floor_z), p(x, w, g.floor_z), &s.cross_member, "cross_member", body, floor_trim, None)?;
+            self.line(
+                "cross_member",
+                p(x, -w, g.floor_z),
+                p(x, w, g.floor_z),
+                &s.cross_member,
+                "cross_member",
+                body,
+                floor_trim,
+                None,
+            )?;
         }
-        self.line("rear_cross_member", p(g.rear_x, -w, g.floor_z), p(g.rear_x, w, g.floor_z), &s.cross_member, "rear_cross_member", body, rear_trim, None)?;
+        self.line(
+            "rear_cross_member",
+            p(g.rear_x, -w, g.floor_z),
+            p(g.rear_x, w, g.floor_z),
+            &s.cross_member,
+            "rear_cross_member",
+            body,
+            rear_trim,
+            None,
+        )?;
         for z in [g.girder_z, g.apron_top_z] {
-            self.line(region::FRONT_END, p(g.front_x, -g.girder_y, z), p(g.front_x, g.girder_y, z), &s.front_cross, "front_cross", body, front_trim, None)?;
+            self.line(
+                region::FRONT_END,
+                p(g.front_x, -g.girder_y, z),
+                p(g.front_x, g.girder_y, z),
+                &s.front_cross,
+                "front_cross",
+                body,
+                front_trim,
+                None,
+            )?;
         }
-        self.line("cowl", p(g.cowl_x, -w, g.cowl_z), p(g.cowl_x, w, g.cowl_z), &s.cross_car_beam, "cross_car_beam", body, dash_trim, None)?;
+        self.line(
+            "cowl",
+            p(g.cowl_x, -w, g.cowl_z),
+            p(g.cowl_x, w, g.cowl_z),
+            &s.cross_car_beam,
+            "cross_car_beam",
+            body,
+            dash_trim,
+            None,
+        )?;
         for &x in &g.roof_bow_x {
-            self.line(region::ROOF, p(x, -w, g.roof_z), p(x, w, g.roof_z), &s.roof_bow, "roof_bow", body, roof_trim, None)?;
+            self.line(
+                region::ROOF,
+                p(x, -w, g.roof_z),
+                p(x, w, g.roof_z),
+                &s.roof_bow,
+                "roof_bow",
+                body,
+                roof_trim,
+                None,
+            )?;
         }
-        self.line("shelf", p(g.shelf_x, -w, g.shelf_z), p(g.shelf_x, w, g.shelf_z), &s.shelf_beam, "shelf_beam", body, 0.0, None)?;
+        self.line(
+            "shelf",
+            p(g.shelf_x, -w, g.shelf_z),
+            p(g.shelf_x, w, g.shelf_z),
+            &s.shelf_beam,
+            "shelf_beam",
+            body,
+            0.0,
+            None,
+        )?;
         if cfg.options.stiffening_bar {
             let x = cfg.options.stiffening_bar_x;
-            self.existing(p(x, g.girder_y, g.girder_z), "stiffening bar end (options.stiffening_bar_x)")?;
-            self.line(region::FRONT_END, p(x, -g.girder_y, g.girder_z), p(x, g.girder_y, g.girder_z), &s.stiffening_bar, "stiffening_bar", body, 0.0, None)?;
+            self.existing(
+                p(x, g.girder_y, g.girder_z),
+                "stiffening bar end (options.stiffening_bar_x)",
+            )?;
+            self.line(
+                region::FRONT_END,
+                p(x, -g.girder_y, g.girder_z),
+                p(x, g.girder_y, g.girder_z),
+                &s.stiffening_bar,
+                "stiffening_bar",
+                body,
+                0.0,
+                None,
+            )?;
         }
         let body_nodes: Vec<usize> = (0..self.mesh.nodes.len()).collect();
         self.regions.insert(region::BODY.into(), body_nodes);
@@ -349,17 +646,52 @@ impl<'a> Builder<'a> {
         let n = st.elements_per_segment.max(1);
         // The column is not scaled with the body: it has its own tuning (section, wheel mass).
         let column = self.cfg.material;
-        self.line("column_lower", base, support, &st.column_section, "steering.column_section", column, 0.0, Some(n))?;
-        self.line(region::STEERING, support, wheel, &st.column_section, "steering.column_section", column, 0.0, Some(n))?;
-        self.line("column_bracket", support, above, &st.bracket_section, "steering.bracket_section", self.body, 0.0, Some(1))?;
+        self.line(
+            "column_lower",
+            base,
+            support,
+            &st.column_section,
+            "steering.column_section",
+            column,
+            0.0,
+            Some(n),
+        )?;
+        self.line(
+            region::STEERING,
+            support,
+            wheel,
+            &st.column_section,
+            "steering.column_section",
+            column,
+            0.0,
+            Some(n),
+        )?;
+        self.line(
+            "column_bracket",
+            support,
+            above,
+            &st.bracket_section,
+            "steering.bracket_section",
+            self.body,
+            0.0,
+            Some(1),
+        )?;
         let wheel_node = self.node(wheel, region::STEERING);
         let axis = (wheel - support).normalize();
         let [i_d, i_a] = st.wheel_inertia;
         let inertia = Matrix3::identity() * i_d + axis * axis.transpose() * (i_a - i_d);
-        self.mesh.masses.push(PointMass { node: wheel_node, mass: st.wheel_mass, inertia });
-        self.mesh.named_nodes.insert(STEERING_WHEEL.into(), wheel_node);
+        self.mesh.masses.push(PointMass {
+            node: wheel_node,
+            mass: st.wheel_mass,
+            inertia,
+        });
+        self.mesh
+            .named_nodes
+            .insert(STEERING_WHEEL.into(), wheel_node);
         let support_node = self.existing(support, "steering.column_support")?;
-        self.mesh.named_nodes.insert("column_support".into(), support_node);
+        self.mesh
+            .named_nodes
+            .insert("column_support".into(), support_node);
         Ok(())
     }
 
@@ -368,7 +700,14 @@ impl<'a> Builder<'a> {
         let g = &self.cfg.geometry;
         let series = 1.0 / (1.0 / su.wheel_rate + 1.0 / su.tyre_rate);
         let stiffness = [su.longitudinal_rate, su.lateral_rate, series, 0.0, 0.0, 0.0];
-        let damping = [su.horizontal_damping, su.horizontal_damping, su.vertical_damping, 0.0, 0.0, 0.0];
+        let damping = [
+            su.horizontal_damping,
+            su.horizontal_damping,
+            su.vertical_damping,
+            0.0,
+            0.0,
+            0.0,
+        ];
         let rear_x = -g.wheelbase;
         let rear_attach_x = (rear_x / g.grid_dx).round() * g.grid_dx;
         let corners = [
@@ -393,10 +732,23 @@ impl<'a> Builder<'a> {
             };
             self.existing(attach, &format!("suspension attachment of {name}"))?;
             let link = self.cfg.sections.wheel_link;
-            let ids = self.line("suspension", attach, centre, &link, "wheel_link", self.body, 0.0, Some(1))?;
+            let ids = self.line(
+                "suspension",
+                attach,
+                centre,
+                &link,
+                "wheel_link",
+                self.body,
+                0.0,
+                Some(1),
+            )?;
             let node = ids[1];
             self.mesh.named_nodes.insert(name.into(), node);
-            self.mesh.ground_springs.push(GroundSpring { node, stiffness, damping });
+            self.mesh.ground_springs.push(GroundSpring {
+                node,
+                stiffness,
+                damping,
+            });
         }
         Ok(())
     }
@@ -404,7 +756,12 @@ impl<'a> Builder<'a> {
     fn named_points(&mut self) -> Result<(), FeError> {
         let g = &self.cfg.geometry;
         let m = &self.cfg.mounts;
-        let positions = [(m.front_x, 1.0), (m.front_x, -1.0), (m.rear_x, 1.0), (m.rear_x, -1.0)];
+        let positions = [
+            (m.front_x, 1.0),
+            (m.front_x, -1.0),
+            (m.rear_x, 1.0),
+            (m.rear_x, -1.0),
+        ];
         for (name, (x, side)) in MOUNT_NAMES.iter().zip(positions) {
             let id = self.existing(
                 Vector3::new(x, side * g.girder_y, g.girder_z),
@@ -460,7 +817,10 @@ fn validate(cfg: &ChassisConfig) -> Result<(), FeError> {
     ] {
         on_grid(name, v, g.grid_dx)?;
     }
-    for (name, v) in [("geometry.half_width", g.half_width), ("geometry.girder_y", g.girder_y)] {
+    for (name, v) in [
+        ("geometry.half_width", g.half_width),
+        ("geometry.girder_y", g.girder_y),
+    ] {
         on_grid(name, v, g.grid_dy)?;
     }
     // Heights are measured on the grid from the floor.
@@ -476,14 +836,28 @@ fn validate(cfg: &ChassisConfig) -> Result<(), FeError> {
         ("rear_x < quarter_front_x", g.rear_x < g.quarter_front_x),
         ("rear_x < shelf_x", g.rear_x < g.shelf_x),
         ("roof_rear_x < roof_front_x", g.roof_rear_x < g.roof_front_x),
-        ("cowl_x < firewall_x < front_x", g.cowl_x < g.firewall_x && g.firewall_x < g.front_x),
-        ("floor_z < girder_z < apron_top_z", g.floor_z < g.girder_z && g.girder_z < g.apron_top_z),
-        ("apron_top_z <= cowl_z < roof_z", g.apron_top_z <= g.cowl_z && g.cowl_z < g.roof_z),
-        ("0 < girder_y < half_width", 0.0 < g.girder_y && g.girder_y < g.half_width),
+        (
+            "cowl_x < firewall_x < front_x",
+            g.cowl_x < g.firewall_x && g.firewall_x < g.front_x,
+        ),
+        (
+            "floor_z < girder_z < apron_top_z",
+            g.floor_z < g.girder_z && g.girder_z < g.apron_top_z,
+        ),
+        (
+            "apron_top_z <= cowl_z < roof_z",
+            g.apron_top_z <= g.cowl_z && g.cowl_z < g.roof_z,
+        ),
+        (
+            "0 < girder_y < half_width",
+            0.0 < g.girder_y && g.girder_y < g.half_width,
+        ),
     ];
     for (what, ok) in ordered {
         if !ok {
-            return Err(FeError::InvalidInput(format!("geometry must satisfy {what}")));
+            return Err(FeError::InvalidInput(format!(
+                "geometry must satisfy {what}"
+            )));
         }
     }
     if !MOUNT_NAMES.contains(&cfg.mounts.removed_in_three_mount_layout.as_str()) {

@@ -46,7 +46,10 @@ impl SectionSpec {
             }
             SectionSpec::Explicit { area, iy, iz, j } => BeamSection { area, iy, iz, j },
         };
-        if [s.area, s.iy, s.iz, s.j].iter().all(|v| v.is_finite() && *v > 0.0) {
+        if [s.area, s.iy, s.iz, s.j]
+            .iter()
+            .all(|v| v.is_finite() && *v > 0.0)
+        {
             Ok(s)
         } else {
             bad(format!("non-positive or non-finite properties {s:?}"))
@@ -241,7 +244,10 @@ impl Default for Sections {
             girder: b(0.09, 0.14, 0.0025),
             upper_rail: b(0.05, 0.06, 0.0015),
             front_cross: b(0.05, 0.08, 0.0015),
-            cross_car_beam: SectionSpec::Tube { d: 0.050, t: 0.0020 },
+            cross_car_beam: SectionSpec::Tube {
+                d: 0.050,
+                t: 0.0020,
+            },
             hinge_pillar: b(0.10, 0.12, 0.0020),
             a_pillar: b(0.06, 0.08, 0.0015),
             b_pillar: b(0.08, 0.14, 0.0015),
@@ -252,7 +258,10 @@ impl Default for Sections {
             girder_extension: b(0.07, 0.10, 0.0020),
             fender_brace: b(0.06, 0.08, 0.0020),
             wheel_link: b(0.08, 0.08, 0.0050),
-            stiffening_bar: SectionSpec::Tube { d: 0.040, t: 0.0025 },
+            stiffening_bar: SectionSpec::Tube {
+                d: 0.040,
+                t: 0.0025,
+            },
         }
     }
 }
@@ -292,7 +301,11 @@ impl Default for Steering {
                 iz: 2.294e-8,
                 j: 8.0e-8,
             },
-            bracket_section: SectionSpec::Box { b: 0.05, h: 0.05, t: 0.002 },
+            bracket_section: SectionSpec::Box {
+                b: 0.05,
+                h: 0.05,
+                t: 0.002,
+            },
             elements_per_segment: 4,
             wheel_mass: 6.0,
             wheel_inertia: [0.04, 0.08],
@@ -321,7 +334,14 @@ pub struct Trim {
 
 impl Default for Trim {
     fn default() -> Self {
-        Self { floor: 395.8, roof: 25.0, dash: 45.0, front_end: 50.0, rear: 70.0, doors: 100.0 }
+        Self {
+            floor: 395.8,
+            roof: 25.0,
+            dash: 45.0,
+            front_end: 50.0,
+            rear: 70.0,
+            doors: 100.0,
+        }
     }
 }
 
@@ -380,7 +400,11 @@ pub struct Mounts {
 
 impl Default for Mounts {
     fn default() -> Self {
-        Self { front_x: 0.50, rear_x: -0.10, removed_in_three_mount_layout: "rear_right".into() }
+        Self {
+            front_x: 0.50,
+            rear_x: -0.10,
+            removed_in_three_mount_layout: "rear_right".into(),
+        }
     }
 }
 
@@ -444,7 +468,11 @@ impl Default for ChassisConfig {
     fn default() -> Self {
         Self {
             material: Material::STEEL,
-            glass: Material { youngs_modulus: 70.0e9, poisson_ratio: 0.22, density: 2500.0 },
+            glass: Material {
+                youngs_modulus: 70.0e9,
+                poisson_ratio: 0.22,
+                density: 2500.0,
+            },
             // Tuned by `examples/fe_tune.rs` (with trim.floor and the steering column section).
             body_stiffness_scale: 0.8827,
             geometry: Geometry::default(),
@@ -463,8 +491,7 @@ impl Default for ChassisConfig {
 impl ChassisConfig {
     /// Parses a JSON description; missing fields take their defaults, unknown fields are errors.
     pub fn from_json(text: &str) -> Result<Self, FeError> {
-        serde_json::from_str(text)
-            .map_err(|e| FeError::InvalidInput(format!("chassis JSON: {e}")))
+        serde_json::from_str(text).map_err(|e| FeError::InvalidInput(format!("chassis JSON: {e}")))
     }
 
     /// Pretty JSON of this description.

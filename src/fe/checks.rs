@@ -23,7 +23,12 @@ pub struct CheckLimits {
 
 impl Default for CheckLimits {
     fn default() -> Self {
-        Self { max_warp: 0.01, min_jacobian_ratio: 0.2, min_beam_length: 1e-6, min_shell_area: 1e-10 }
+        Self {
+            max_warp: 0.01,
+            min_jacobian_ratio: 0.2,
+            min_beam_length: 1e-6,
+            min_shell_area: 1e-10,
+        }
     }
 }
 
@@ -38,7 +43,10 @@ fn report(problems: Vec<String>) -> Result<(), FeError> {
     if n > MAX_LISTED {
         text.push(format!("... and {} more", n - MAX_LISTED));
     }
-    Err(FeError::Mesh(format!("{n} problem(s): {}", text.join("; "))))
+    Err(FeError::Mesh(format!(
+        "{n} problem(s): {}",
+        text.join("; ")
+    )))
 }
 
 fn node(mesh: &Mesh, id: usize) -> Option<Vector3<f64>> {
@@ -62,9 +70,16 @@ pub fn check_mesh(mesh: &Mesh, limits: &CheckLimits) -> Result<(), FeError> {
             continue;
         };
         if b.nodes[0] == b.nodes[1] || (p2 - p1).norm() < limits.min_beam_length {
-            problems.push(format!("beam {i}: degenerate (length {:.3e} m)", (p2 - p1).norm()));
-        } else if (p2 - p1).normalize().cross(&b.orientation).norm() < 1e-6 * b.orientation.norm().max(1e-300) {
-            problems.push(format!("beam {i}: orientation vector parallel to the axis or zero"));
+            problems.push(format!(
+                "beam {i}: degenerate (length {:.3e} m)",
+                (p2 - p1).norm()
+            ));
+        } else if (p2 - p1).normalize().cross(&b.orientation).norm()
+            < 1e-6 * b.orientation.norm().max(1e-300)
+        {
+            problems.push(format!(
+                "beam {i}: orientation vector parallel to the axis or zero"
+            ));
         }
         for &k in &b.nodes {
             connected[k] = true;
@@ -91,7 +106,10 @@ pub fn check_mesh(mesh: &Mesh, limits: &CheckLimits) -> Result<(), FeError> {
                     problems.push(format!("shell {i}: degenerate (area {:.3e} m²)", g.area));
                 }
                 if g.warp > limits.max_warp {
-                    problems.push(format!("shell {i}: warped (warp ratio {:.4} > {})", g.warp, limits.max_warp));
+                    problems.push(format!(
+                        "shell {i}: warped (warp ratio {:.4} > {})",
+                        g.warp, limits.max_warp
+                    ));
                 }
                 if g.jacobian_ratio < limits.min_jacobian_ratio {
                     problems.push(format!(
@@ -131,7 +149,9 @@ pub fn check_mesh(mesh: &Mesh, limits: &CheckLimits) -> Result<(), FeError> {
         if !connected[k] && !fully_constrained(k) {
             problems.push(format!("node {k}: not connected to any element"));
         } else if connected[k] && !has_stiffness[k] && !fully_constrained(k) {
-            problems.push(format!("node {k}: carries only masses/springs, no structural element"));
+            problems.push(format!(
+                "node {k}: carries only masses/springs, no structural element"
+            ));
         }
     }
     for (name, &k) in &mesh.named_nodes {
@@ -160,10 +180,10 @@ pub fn check_assembled(asm: &Assembled) -> Result<(), FeError> {
     let names = ["ux", "uy", "uz", "rx", "ry", "rz"];
     let mut problems = Vec::new();
     for (g, &(node, dof)) in asm.dofs.owners().iter().enumerate() {
-        if !(kd[g] > 0.0) {
+        if kd[g].is_nan() || kd[g] <= 0.0 {
             problems.push(format!("node {node} dof {}: no stiffness", names[dof]));
         }
-        if !(md[g] > 0.0) {
+        if md[g].is_nan() || md[g] <= 0.0 {
             problems.push(format!("node {node} dof {}: no mass", names[dof]));
         }
     }
@@ -178,7 +198,12 @@ mod tests {
     use nalgebra::Matrix3;
 
     fn square(mesh: &mut Mesh, z3: f64) {
-        for p in [[0.0, 0.0, 0.0], [1.0, 0.0, 0.0], [1.0, 1.0, z3], [0.0, 1.0, 0.0]] {
+        for p in [
+            [0.0, 0.0, 0.0],
+            [1.0, 0.0, 0.0],
+            [1.0, 1.0, z3],
+            [0.0, 1.0, 0.0],
+        ] {
             mesh.add_node(Vector3::from(p));
         }
         mesh.shells.push(Shell {
@@ -194,7 +219,9 @@ mod tests {
     fn warped_shell_is_named() {
         let mut mesh = Mesh::default();
         square(&mut mesh, 0.2);
-        let err = check_mesh(&mesh, &CheckLimits::default()).unwrap_err().to_string();
+        let err = check_mesh(&mesh, &CheckLimits::default())
+            .unwrap_err()
+            .to_string();
         assert!(err.contains("shell 0: warped"), "{err}");
         let mut flat = Mesh::default();
         square(&mut flat, 0.0);
@@ -213,8 +240,13 @@ mod tests {
             orientation: Vector3::z(),
             extra_mass_per_length: 0.0,
         });
-        let err = check_mesh(&mesh, &CheckLimits::default()).unwrap_err().to_string();
-        assert!(err.contains(&format!("node {lonely}: not connected")), "{err}");
+        let err = check_mesh(&mesh, &CheckLimits::default())
+            .unwrap_err()
+            .to_string();
+        assert!(
+            err.contains(&format!("node {lonely}: not connected")),
+            "{err}"
+        );
         assert!(err.contains("beam 0: degenerate"), "{err}");
     }
 
@@ -223,11 +255,23 @@ mod tests {
         let mut mesh = Mesh::default();
         square(&mut mesh, 0.0);
         let hanging = mesh.add_node(Vector3::new(2.0, 0.0, 0.0));
-        mesh.masses.push(PointMass { node: hanging, mass: 1.0, inertia: Matrix3::identity() });
+        mesh.masses.push(PointMass {
+            node: hanging,
+            mass: 1.0,
+            inertia: Matrix3::identity(),
+        });
         let asm = assemble(&mesh).unwrap();
         let err = check_assembled(&asm).unwrap_err().to_string();
-        assert!(err.contains(&format!("node {hanging} dof ux: no stiffness")), "{err}");
-        let err = check_mesh(&mesh, &CheckLimits::default()).unwrap_err().to_string();
-        assert!(err.contains(&format!("node {hanging}: carries only masses")), "{err}");
+        assert!(
+            err.contains(&format!("node {hanging} dof ux: no stiffness")),
+            "{err}"
+        );
+        let err = check_mesh(&mesh, &CheckLimits::default())
+            .unwrap_err()
+            .to_string();
+        assert!(
+            err.contains(&format!("node {hanging}: carries only masses")),
+            "{err}"
+        );
     }
 }

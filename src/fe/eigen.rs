@@ -28,7 +28,10 @@ pub struct Modes {
 impl Modes {
     /// Natural frequencies f = √λ / 2π [Hz]; negative round-off eigenvalues map to 0.
     pub fn frequencies_hz(&self) -> Vec<f64> {
-        self.eigenvalues.iter().map(|l| l.max(0.0).sqrt() / (2.0 * std::f64::consts::PI)).collect()
+        self.eigenvalues
+            .iter()
+            .map(|l| l.max(0.0).sqrt() / (2.0 * std::f64::consts::PI))
+            .collect()
     }
 
     /// Number of modes.
@@ -103,7 +106,13 @@ impl Basis<'_> {
     /// Appends `v` (already orthogonal) normalised; returns its M-norm before normalisation.
     fn push(&mut self, v: &[f64]) -> f64 {
         let mv = mat_vec(self.m, v);
-        let norm = v.iter().zip(&mv).map(|(a, b)| a * b).sum::<f64>().max(0.0).sqrt();
+        let norm = v
+            .iter()
+            .zip(&mv)
+            .map(|(a, b)| a * b)
+            .sum::<f64>()
+            .max(0.0)
+            .sqrt();
         let c = self.len;
         for i in 0..v.len() {
             self.q[(i, c)] = v[i] / norm;
@@ -126,13 +135,19 @@ fn validate(k: &SparseMat, m: &SparseMat, n_modes: usize, shift: f64) -> Result<
         )));
     }
     if n_modes == 0 || n_modes > n {
-        return Err(FeError::InvalidInput(format!("n_modes = {n_modes} must be in 1..={n}")));
+        return Err(FeError::InvalidInput(format!(
+            "n_modes = {n_modes} must be in 1..={n}"
+        )));
     }
     if !shift.is_finite() {
-        return Err(FeError::InvalidInput(format!("shift must be finite, got {shift}")));
+        return Err(FeError::InvalidInput(format!(
+            "shift must be finite, got {shift}"
+        )));
     }
     if k.val().iter().chain(m.val()).any(|v| !v.is_finite()) {
-        return Err(FeError::InvalidInput("K or M contains a non-finite entry".into()));
+        return Err(FeError::InvalidInput(
+            "K or M contains a non-finite entry".into(),
+        ));
     }
     Ok(())
 }
@@ -149,14 +164,21 @@ pub fn lowest_modes(
 ) -> Result<Modes, FeError> {
     validate(k, m, n_modes, shift)?;
     let n = k.nrows();
-    let llt: Llt<usize, f64> = shifted(k, m, shift)?.sp_cholesky(Side::Lower).map_err(|e| {
-        FeError::Numerical(format!(
+    let llt: Llt<usize, f64> = shifted(k, m, shift)?
+        .sp_cholesky(Side::Lower)
+        .map_err(|e| {
+            FeError::Numerical(format!(
             "K - shift*M is not positive definite at shift {shift} ({e:?}): the shift must lie \
              below the lowest eigenvalue, or the model has a mechanism/unconstrained DOF"
         ))
-    })?;
+        })?;
     let capacity = n.min((4 * n_modes + 6 * BLOCK).max(n_modes + 60));
-    let mut basis = Basis { m, q: Mat::zeros(n, capacity), mq: Mat::zeros(n, capacity), len: 0 };
+    let mut basis = Basis {
+        m,
+        q: Mat::zeros(n, capacity),
+        mq: Mat::zeros(n, capacity),
+        len: 0,
+    };
     let mut h = Mat::<f64>::zeros(capacity, capacity);
     let mut rng = Xorshift(0x9E37_79B9_7F4A_7C15);
 
@@ -172,7 +194,9 @@ pub fn lowest_modes(
                 return Ok(());
             }
         }
-        Err(FeError::Numerical("could not extend the Krylov basis with a new direction".into()))
+        Err(FeError::Numerical(
+            "could not extend the Krylov basis with a new direction".into(),
+        ))
     };
     for _ in 0..BLOCK.min(n) {
         add_fresh(&mut basis, &mut rng)?;
@@ -220,9 +244,9 @@ pub fn lowest_modes(
                 t[(i, j)] = 0.5 * (h[(i, j)] + h[(j, i)]);
             }
         }
-        let evd = t.self_adjoint_eigen(Side::Lower).map_err(|e| {
-            FeError::Numerical(format!("projected eigenproblem failed: {e:?}"))
-        })?;
+        let evd = t
+            .self_adjoint_eigen(Side::Lower)
+            .map_err(|e| FeError::Numerical(format!("projected eigenproblem failed: {e:?}")))?;
         let (s, u) = (evd.S(), evd.U());
         // Largest θ first.
         let picked: Vec<usize> = (0..done).rev().take(n_modes).collect();
@@ -246,7 +270,7 @@ pub fn lowest_modes(
             let mut eigenvalues = Vec::with_capacity(n_modes);
             for (out, &col) in picked.iter().enumerate() {
                 let theta = s[col];
-                if !(theta > 0.0) {
+                if theta.is_nan() || theta <= 0.0 {
                     return Err(FeError::Numerical(format!(
                         "non-positive Ritz value {theta}: K - shift*M is not positive definite"
                     )));
@@ -261,7 +285,10 @@ pub fn lowest_modes(
                     }
                 }
             }
-            return Ok(Modes { eigenvalues, shapes });
+            return Ok(Modes {
+                eigenvalues,
+                shapes,
+            });
         }
     }
 }

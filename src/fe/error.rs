@@ -33,7 +33,9 @@ pub(crate) fn require_positive(what: &str, value: f64) -> Result<f64, FeError> {
     if value.is_finite() && value > 0.0 {
         Ok(value)
     } else {
-        Err(FeError::InvalidInput(format!("{what} must be finite and > 0, got {value}")))
+        Err(FeError::InvalidInput(format!(
+            "{what} must be finite and > 0, got {value}"
+        )))
     }
 }
 
@@ -42,6 +44,8 @@ pub(crate) fn require_non_negative(what: &str, value: f64) -> Result<f64, FeErro
     if value.is_finite() && value >= 0.0 {
         Ok(value)
     } else {
-        Err(FeError::InvalidInput(format!("{what} must be finite and >= 0, got {value}")))
+        Err(FeError::InvalidInput(format!(
+            "{what} must be finite and >= 0, got {value}"
+        )))
     }
 }

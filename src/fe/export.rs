@@ -59,8 +59,14 @@ pub fn write_all(dir: &Path, mesh: &Mesh, asm: &Assembled) -> Result<(), FeError
     let io = |e: std::io::Error| FeError::Io(format!("{}: {e}", dir.display()));
     std::fs::create_dir_all(dir).map_err(io)?;
     let files = [
-        ("K.mtx", matrix_market(&asm.k, "stiffness [N/m, N m/rad]; DOF order in dofs.csv")),
-        ("M.mtx", matrix_market(&asm.m, "lumped mass [kg, kg m^2]; DOF order in dofs.csv")),
+        (
+            "K.mtx",
+            matrix_market(&asm.k, "stiffness [N/m, N m/rad]; DOF order in dofs.csv"),
+        ),
+        (
+            "M.mtx",
+            matrix_market(&asm.m, "lumped mass [kg, kg m^2]; DOF order in dofs.csv"),
+        ),
         ("nodes.csv", node_table(mesh)),
         ("dofs.csv", dof_table(asm)),
     ];
@@ -81,7 +87,12 @@ mod tests {
         let a = SparseColMat::<usize, f64>::try_new_from_triplets(
             2,
             2,
-            &[Triplet::new(0, 0, 2.0), Triplet::new(1, 0, -1.0), Triplet::new(0, 1, -1.0), Triplet::new(1, 1, 3.0)],
+            &[
+                Triplet::new(0, 0, 2.0),
+                Triplet::new(1, 0, -1.0),
+                Triplet::new(0, 1, -1.0),
+                Triplet::new(1, 1, 3.0),
+            ],
         )
         .unwrap();
         let text = matrix_market(&a, "test");
@@ -92,7 +103,11 @@ mod tests {
             .iter()
             .map(|l| {
                 let f: Vec<&str> = l.split_whitespace().collect();
-                (f[0].parse().unwrap(), f[1].parse().unwrap(), f[2].parse().unwrap())
+                (
+                    f[0].parse().unwrap(),
+                    f[1].parse().unwrap(),
+                    f[2].parse().unwrap(),
+                )
             })
             .collect();
         assert_eq!(parsed, vec![(1, 1, 2.0), (2, 1, -1.0), (2, 2, 3.0)]);

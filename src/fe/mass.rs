@@ -10,11 +10,15 @@ pub fn matrix(index: usize, pm: &PointMass) -> Result<SMatrix<f64, 6, 6>, FeErro
     require_non_negative(&format!("point mass {index}: mass"), pm.mass)?;
     let j = &pm.inertia;
     if j.iter().any(|v| !v.is_finite()) {
-        return Err(FeError::InvalidInput(format!("point mass {index}: inertia is not finite")));
+        return Err(FeError::InvalidInput(format!(
+            "point mass {index}: inertia is not finite"
+        )));
     }
     let asym = (j - j.transpose()).abs().max();
     if asym > 1e-9 * j.abs().max().max(1e-300) {
-        return Err(FeError::InvalidInput(format!("point mass {index}: inertia is not symmetric")));
+        return Err(FeError::InvalidInput(format!(
+            "point mass {index}: inertia is not symmetric"
+        )));
     }
     if (0..3).any(|d| j[(d, d)] < 0.0) {
         return Err(FeError::InvalidInput(format!(

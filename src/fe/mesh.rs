@@ -61,7 +61,12 @@ impl BeamSection {
         let di = (d - 2.0 * t).max(0.0);
         let area = std::f64::consts::PI / 4.0 * (d * d - di * di);
         let i = std::f64::consts::PI / 64.0 * (d.powi(4) - di.powi(4));
-        Self { area, iy: i, iz: i, j: 2.0 * i }
+        Self {
+            area,
+            iy: i,
+            iz: i,
+            j: 2.0 * i,
+        }
     }
 }
 

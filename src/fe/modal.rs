@@ -96,7 +96,9 @@ fn translation(asm: &Assembled, shape: &[f64], node: usize) -> Vector3<f64> {
 /// Least-squares rotation about the x axis of a cross-section (nodes), about its centroid.
 fn section_roll(mesh: &Mesh, asm: &Assembled, shape: &[f64], nodes: &[usize]) -> f64 {
     let n = nodes.len().max(1) as f64;
-    let (cy, cz) = nodes.iter().fold((0.0, 0.0), |(y, z), &i| (y + mesh.nodes[i].y, z + mesh.nodes[i].z));
+    let (cy, cz) = nodes.iter().fold((0.0, 0.0), |(y, z), &i| {
+        (y + mesh.nodes[i].y, z + mesh.nodes[i].z)
+    });
     let (cy, cz) = (cy / n, cz / n);
     let (mut num, mut den) = (0.0, 0.0);
     for &i in nodes {
@@ -115,7 +117,10 @@ fn section_roll(mesh: &Mesh, asm: &Assembled, shape: &[f64], nodes: &[usize]) ->
 /// Fraction of the translations of `nodes` not explained by a best-fit rigid-body motion.
 fn elastic_fraction(mesh: &Mesh, asm: &Assembled, shape: &[f64], nodes: &[usize]) -> f64 {
     let n = nodes.len().max(1) as f64;
-    let c = nodes.iter().fold(Vector3::zeros(), |a, &i| a + mesh.nodes[i]) / n;
+    let c = nodes
+        .iter()
+        .fold(Vector3::zeros(), |a, &i| a + mesh.nodes[i])
+        / n;
     let mut ata = Matrix6::zeros();
     let mut atb = Vector6::zeros();
     let mut total = 0.0;
@@ -137,7 +142,9 @@ fn elastic_fraction(mesh: &Mesh, asm: &Assembled, shape: &[f64], nodes: &[usize]
             atb += row * u[d];
         }
     }
-    let Some(x) = ata.try_inverse().map(|inv| inv * atb) else { return 1.0 };
+    let Some(x) = ata.try_inverse().map(|inv| inv * atb) else {
+        return 1.0;
+    };
     let mut residual = 0.0;
     for &i in nodes {
         let r = mesh.nodes[i] - c;
@@ -154,7 +161,10 @@ fn elastic_fraction(mesh: &Mesh, asm: &Assembled, shape: &[f64], nodes: &[usize]
 
 fn rigid_label(mesh: &Mesh, asm: &Assembled, shape: &[f64], nodes: &[usize]) -> String {
     let n = nodes.len().max(1) as f64;
-    let mean = nodes.iter().fold(Vector3::zeros(), |a, &i| a + translation(asm, shape, i)) / n;
+    let mean = nodes
+        .iter()
+        .fold(Vector3::zeros(), |a, &i| a + translation(asm, shape, i))
+        / n;
     let roll = section_roll(mesh, asm, shape, nodes);
     // Pitch and yaw from the first moments of z and y motion along x.
     let cx = nodes.iter().map(|&i| mesh.nodes[i].x).sum::<f64>() / n;
@@ -182,8 +192,34 @@ fn rigid_label(mesh: &Mesh, asm: &Assembled, shape: &[f64], nodes: &[usize]) -> 
         .unwrap_or_default()
 }
 
+/// The two steering-wheel modes, as indices into `descs`: (more vertical, more lateral).
+///
+/// They are the two modes with the largest kinetic-energy share in the translation of the
+/// steering-wheel node. Their frequencies are close (paper: 31.5 and 32.07 Hz), so through the
+/// body they couple and both move the wheel obliquely; "vertical" is the one whose wheel motion
+/// is more vertical.
+pub fn steering_wheel_pair(descs: &[ModeDescription]) -> Option<(usize, usize)> {
+    let wheel = |d: &ModeDescription| d.wheel_vertical + d.wheel_lateral;
+    let mut order: Vec<usize> = (0..descs.len()).collect();
+    order.sort_by(|&a, &b| wheel(&descs[b]).total_cmp(&wheel(&descs[a])));
+    let (&a, &b) = (order.first()?, order.get(1)?);
+    if wheel(&descs[b]) <= 0.0 {
+        return None;
+    }
+    let verticality = |i: usize| descs[i].wheel_vertical / wheel(&descs[i]);
+    if verticality(a) >= verticality(b) {
+        Some((a, b))
+    } else {
+        Some((b, a))
+    }
+}
+
 /// Describes every mode of `modes` of the chassis `mesh` assembled as `asm`.
-pub fn describe(mesh: &Mesh, asm: &Assembled, modes: &Modes) -> Result<Vec<ModeDescription>, FeError> {
+pub fn describe(
+    mesh: &Mesh,
+    asm: &Assembled,
+    modes: &Modes,
+) -> Result<Vec<ModeDescription>, FeError> {
     let need = |name: &str| {
         mesh.regions
             .get(name)
@@ -196,11 +232,14 @@ pub fn describe(mesh: &Mesh, asm: &Assembled, modes: &Modes) -> Result<Vec<ModeD
     let wheel = mesh
         .named(STEERING_WHEEL)
         .ok_or_else(|| FeError::InvalidInput("mesh has no named node 'steering_wheel'".into()))?;
-    let half_width = body.iter().map(|&i| mesh.nodes[i].y.abs()).fold(0.0, f64::max);
+    let half_width = body
+        .iter()
+        .map(|&i| mesh.nodes[i].y.abs())
+        .fold(0.0, f64::max);
     let owners = asm.dofs.owners();
     let freqs = modes.frequencies_hz();
     let mut out = Vec::with_capacity(modes.len());
-    for k in 0..modes.len() {
+    for (k, &frequency_hz) in freqs.iter().enumerate() {
         let shape: Vec<f64> = modes.shapes.col(k).iter().copied().collect();
         let m_phi = mat_vec(&asm.m, &shape);
         let mut node_energy = vec![0.0; mesh.nodes.len()];
@@ -226,8 +265,10 @@ pub fn describe(mesh: &Mesh, asm: &Assembled, modes: &Modes) -> Result<Vec<ModeD
             0.0
         };
         // Sill bending: vertical motion minus its best straight line along x.
-        let pts: Vec<(f64, f64)> =
-            sills.iter().map(|&i| (mesh.nodes[i].x, translation(asm, &shape, i).z)).collect();
+        let pts: Vec<(f64, f64)> = sills
+            .iter()
+            .map(|&i| (mesh.nodes[i].x, translation(asm, &shape, i).z))
+            .collect();
         let n = pts.len().max(1) as f64;
         let (mx, mz) = pts.iter().fold((0.0, 0.0), |(a, b), p| (a + p.0, b + p.1));
         let (mx, mz) = (mx / n, mz / n);
@@ -274,7 +315,7 @@ pub fn describe(mesh: &Mesh, asm: &Assembled, modes: &Modes) -> Result<Vec<ModeD
         };
         out.push(ModeDescription {
             index: k,
-            frequency_hz: freqs[k],
+            frequency_hz,
             kind,
             energy,
             twist,
@@ -283,6 +324,11 @@ pub fn describe(mesh: &Mesh, asm: &Assembled, modes: &Modes) -> Result<Vec<ModeD
             wheel_vertical,
             wheel_lateral,
         });
+    }
+    // The main wheel pair is labelled by relative direction (see `steering_wheel_pair`).
+    if let Some((v, l)) = steering_wheel_pair(&out) {
+        out[v].kind = ModeKind::SteeringWheelVertical;
+        out[l].kind = ModeKind::SteeringWheelLateral;
     }
     Ok(out)
 }

@@ -65,14 +65,18 @@ pub fn geometry(index: usize, p: &[Vector3<f64>; 4]) -> Result<ShellGeometry, Fe
     let normal = (p[2] - p[0]).cross(&(p[3] - p[1]));
     let nn = normal.norm();
     if !(nn.is_finite() && nn > 1e-14) {
-        return Err(FeError::Mesh(format!("shell {index}: degenerate (zero diagonal cross product)")));
+        return Err(FeError::Mesh(format!(
+            "shell {index}: degenerate (zero diagonal cross product)"
+        )));
     }
     let n = normal / nn;
     let d1 = p[1] + p[2] - p[0] - p[3];
     let e1 = d1 - n * n.dot(&d1);
     let e1n = e1.norm();
-    if !(e1n > 1e-14) {
-        return Err(FeError::Mesh(format!("shell {index}: degenerate (collapsed edge direction)")));
+    if e1n.is_nan() || e1n <= 1e-14 {
+        return Err(FeError::Mesh(format!(
+            "shell {index}: degenerate (collapsed edge direction)"
+        )));
     }
     let e1 = e1 / e1n;
     let e2 = n.cross(&e1);
@@ -92,7 +96,11 @@ pub fn geometry(index: usize, p: &[Vector3<f64>; 4]) -> Result<ShellGeometry, Fe
     }
     let max_det = dets.iter().cloned().fold(f64::MIN, f64::max);
     let min_det = dets.iter().cloned().fold(f64::MAX, f64::min);
-    let jacobian_ratio = if max_det > 0.0 { min_det / max_det } else { -1.0 };
+    let jacobian_ratio = if max_det > 0.0 {
+        min_det / max_det
+    } else {
+        -1.0
+    };
     Ok(ShellGeometry {
         frame: Matrix3::from_rows(&[e1.transpose(), e2.transpose(), n.transpose()]),
         local_xy,
@@ -207,8 +215,7 @@ pub fn stiffness(index: usize, shell: &Shell, p: &[Vector3<f64>; 4]) -> Result<M
         let mut covariant = SMatrix::<f64, 2, 24>::zeros();
         for c in 0..24 {
             covariant[(0, c)] = 0.5 * (1.0 - eta) * tie_xi[0][c] + 0.5 * (1.0 + eta) * tie_xi[1][c];
-            covariant[(1, c)] =
-                0.5 * (1.0 - xi) * tie_eta[0][c] + 0.5 * (1.0 + xi) * tie_eta[1][c];
+            covariant[(1, c)] = 0.5 * (1.0 - xi) * tie_eta[0][c] + 0.5 * (1.0 + xi) * tie_eta[1][c];
         }
         let bs = inv * covariant;
         k += (bm.transpose() * dm * bm
@@ -253,7 +260,13 @@ mod tests {
     use crate::fe::mesh::Material;
 
     fn plate() -> Shell {
-        Shell { nodes: [0, 1, 2, 3], material: Material::STEEL, thickness: 0.002, bending_thickness: 0.002, extra_mass_per_area: 0.0 }
+        Shell {
+            nodes: [0, 1, 2, 3],
+            material: Material::STEEL,
+            thickness: 0.002,
+            bending_thickness: 0.002,
+            extra_mass_per_area: 0.0,
+        }
     }
 
     fn corners() -> [Vector3<f64>; 4] {
@@ -287,11 +300,17 @@ mod tests {
                     }
                 }
             }
-            assert!((k * u).norm() < 1e-8 * scale, "rigid mode {mode} strains the shell");
+            assert!(
+                (k * u).norm() < 1e-8 * scale,
+                "rigid mode {mode} strains the shell"
+            );
         }
         let eig = k.symmetric_eigenvalues();
         let zero = eig.iter().filter(|v| v.abs() < 1e-9 * scale).count();
-        assert_eq!(zero, 6, "a single shell must have exactly six zero-energy modes");
+        assert_eq!(
+            zero, 6,
+            "a single shell must have exactly six zero-energy modes"
+        );
     }
 
     #[test]

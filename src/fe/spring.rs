@@ -37,7 +37,12 @@ pub fn two_node_matrices(
     let mut k = SMatrix::<f64, 12, 12>::zeros();
     let mut c = SMatrix::<f64, 12, 12>::zeros();
     for d in 0..6 {
-        for (a, b, sign) in [(d, d, 1.0), (d + 6, d + 6, 1.0), (d, d + 6, -1.0), (d + 6, d, -1.0)] {
+        for (a, b, sign) in [
+            (d, d, 1.0),
+            (d + 6, d + 6, 1.0),
+            (d, d + 6, -1.0),
+            (d + 6, d, -1.0),
+        ] {
             k[(a, b)] = sign * s.stiffness[d];
             c[(a, b)] = sign * s.damping[d];
         }
