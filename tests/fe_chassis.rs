@@ -8,25 +8,46 @@ use engine_mount_chassis::fe::chassis::{
 };
 use engine_mount_chassis::fe::chassis_config::ChassisConfig;
 use engine_mount_chassis::fe::checks::{check_assembled, check_mesh, CheckLimits};
-use engine_mount_chassis::fe::eigen::lowest_modes;
+use engine_mount_chassis::fe::eigen::{lowest_modes, Modes};
 use engine_mount_chassis::fe::modal::{describe, steering_wheel_pair, ModeDescription, ModeKind};
+use faer::linalg::solvers::Solve;
+use faer::{Mat, Side};
 
 struct Analysis {
     chassis: Chassis,
     asm: Assembled,
+    raw: Modes,
     modes: Vec<ModeDescription>,
 }
 
 fn analyse(config: &ChassisConfig) -> Analysis {
     let chassis = Chassis::build(config).unwrap();
     let asm = assemble(&chassis.mesh).unwrap();
-    let modes = lowest_modes(&asm.k, &asm.m, 30, -1.0).unwrap();
-    let modes = describe(&chassis.mesh, &asm, &modes).unwrap();
+    let raw = lowest_modes(&asm.k, &asm.m, 30, -1.0).unwrap();
+    let modes = describe(&chassis.mesh, &asm, &raw).unwrap();
     Analysis {
         chassis,
         asm,
+        raw,
         modes,
     }
+}
+
+/// Static stiffness against spreading the front mount pair apart laterally [N/m].
+fn front_mount_spread_stiffness(an: &Analysis) -> f64 {
+    let n = an.asm.dofs.n_free();
+    let left = an.chassis.node("mount_front_left").unwrap();
+    let right = an.chassis.node("mount_front_right").unwrap();
+    let (gl, gr) = (
+        an.asm.dofs.global(left, 1).unwrap(),
+        an.asm.dofs.global(right, 1).unwrap(),
+    );
+    let mut f = Mat::<f64>::zeros(n, 1);
+    f[(gl, 0)] = 1.0;
+    f[(gr, 0)] = -1.0;
+    let llt = an.asm.k.sp_cholesky(Side::Lower).unwrap();
+    llt.solve_in_place(f.as_mut());
+    1.0 / (f[(gl, 0)] - f[(gr, 0)])
 }
 
 fn within(value: f64, target: f64, tolerance: f64) -> bool {
@@ -40,7 +61,7 @@ fn wheel_pair(modes: &[ModeDescription]) -> (&ModeDescription, &ModeDescription)
 }
 
 /// The front-end mode with the most lateral girder/apron motion.
-fn front_lateral(an: &Analysis, modes_raw: &engine_mount_chassis::fe::eigen::Modes) -> f64 {
+fn front_lateral(an: &Analysis) -> f64 {
     let front = &an.chassis.mesh.regions["front_end"];
     let mut best = (0.0, 0.0);
     for d in &an.modes {
@@ -52,7 +73,7 @@ fn front_lateral(an: &Analysis, modes_raw: &engine_mount_chassis::fe::eigen::Mod
         for &n in front {
             for dof in 0..3 {
                 if let Some(g) = an.asm.dofs.global(n, dof) {
-                    let v = modes_raw.shapes[(g, d.index)].powi(2);
+                    let v = an.raw.shapes[(g, d.index)].powi(2);
                     total += v;
                     if dof == 1 {
                         lateral += v;
@@ -172,16 +193,23 @@ fn special_nodes_sit_where_the_engine_model_expects_them() {
 #[test]
 fn stiffening_bar_raises_the_front_end_and_a_stiffer_front_plate_the_steering_wheel() {
     let base_cfg = ChassisConfig::default();
-    let run = |cfg: &ChassisConfig| {
-        let an = analyse(cfg);
-        let raw = lowest_modes(&an.asm.k, &an.asm.m, 30, -1.0).unwrap();
-        let f = front_lateral(&an, &raw);
-        (an, f)
-    };
-    let (base, base_front) = run(&base_cfg);
+    let base = analyse(&base_cfg);
+    let base_front = front_lateral(&base);
     let mut bar_cfg = base_cfg.clone();
     bar_cfg.options.stiffening_bar = true;
-    let (_, bar_front) = run(&bar_cfg);
+    let bar = analyse(&bar_cfg);
+    let bar_front = front_lateral(&bar);
+    let (base_spread, bar_spread) = (
+        front_mount_spread_stiffness(&base),
+        front_mount_spread_stiffness(&bar),
+    );
+    println!(
+        "static stiffness against spreading the front mounts: {:.0} N/mm -> {:.0} N/mm ({:+.0} %)",
+        base_spread / 1e3,
+        bar_spread / 1e3,
+        100.0 * (bar_spread / base_spread - 1.0)
+    );
+    assert!(bar_spread > base_spread);
     println!(
         "front-end lateral mode: {base_front:.2} Hz -> {bar_front:.2} Hz with the stiffening bar \
          ({:+.1} %)",

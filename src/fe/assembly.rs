@@ -156,3 +156,54 @@ pub fn translational_mass(a: &Assembled, direction: usize) -> f64 {
     let mu = mat_vec(&a.m, &unit);
     unit.iter().zip(&mu).map(|(u, v)| u * v).sum()
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::fe::mesh::{GroundSpring, Spring};
+
+    fn two_nodes() -> Mesh {
+        let mut mesh = Mesh::default();
+        mesh.add_node(Vector3::zeros());
+        mesh.add_node(Vector3::new(1.0, 0.0, 0.0));
+        mesh
+    }
+
+    #[test]
+    fn contributions_to_one_entry_are_summed_and_constrained_dofs_dropped() {
+        let mut mesh = two_nodes();
+        for k in [100.0, 23.0] {
+            mesh.ground_springs.push(GroundSpring {
+                node: 1,
+                stiffness: [k; 6],
+                damping: [0.5; 6],
+            });
+        }
+        mesh.springs.push(Spring {
+            nodes: [0, 1],
+            stiffness: [7.0; 6],
+            damping: [0.0; 6],
+        });
+        mesh.clamp(0);
+        let a = assemble(&mesh).unwrap();
+        assert_eq!(a.dofs.n_free(), 6);
+        let k = a.k.to_dense();
+        let c = a.c.to_dense();
+        for d in 0..6 {
+            assert_eq!(k[(d, d)], 130.0);
+            assert_eq!(c[(d, d)], 1.0);
+        }
+    }
+
+    #[test]
+    fn bad_node_reference_is_named() {
+        let mut mesh = two_nodes();
+        mesh.springs.push(Spring {
+            nodes: [0, 9],
+            stiffness: [1.0; 6],
+            damping: [0.0; 6],
+        });
+        let err = assemble(&mesh).unwrap_err().to_string();
+        assert!(err.contains("spring 0") && err.contains("node 9"), "{err}");
+    }
+}

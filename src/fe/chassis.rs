@@ -15,6 +15,7 @@ use std::collections::{BTreeMap, HashMap};
 use nalgebra::{Matrix3, Vector3};
 
 use super::chassis_config::{ChassisConfig, SectionSpec};
+use super::checks::{check_mesh, CheckLimits};
 use super::error::FeError;
 use super::mesh::{Beam, GroundSpring, Material, Mesh, PointMass, Shell};
 
@@ -74,6 +75,9 @@ impl Chassis {
     /// Generates the body described by `config`.
     pub fn build(config: &ChassisConfig) -> Result<Self, FeError> {
         let mesh = Builder::new(config)?.build()?;
+        // A description that yields a degenerate or disconnected mesh is rejected here, with the
+        // element or node named, rather than surfacing later as a singular factorisation.
+        check_mesh(&mesh, &CheckLimits::default())?;
         Ok(Self {
             mesh,
             config: config.clone(),
