@@ -1,7 +1,13 @@
 //! Modal analysis of the chassis body with mode descriptions:
 //! `cargo run --release --example fe_modes [config.json] [--export DIR]`.
 //! With `--export DIR`, K and M (Matrix Market), the node table and the DOF table are written to
-//! DIR for checking with another tool.
+//! DIR for checking with another tool, e.g. with SciPy:
+//!
+//! ```text
+//! K = scipy.io.mmread("DIR/K.mtx").tocsc(); M = scipy.io.mmread("DIR/M.mtx").tocsc()
+//! lam = scipy.sparse.linalg.eigsh(K, k=12, M=M, sigma=-1.0, return_eigenvectors=False)
+//! print(numpy.sort(numpy.sqrt(abs(lam)) / (2 * numpy.pi)))
+//! ```
 
 use engine_mount_chassis::fe::assembly::{assemble, translational_mass};
 use engine_mount_chassis::fe::chassis::Chassis;
