@@ -14,11 +14,11 @@ pub type SparseMat = SparseColMat<usize, f64>;
 /// The assembled system: stiffness, lumped mass and viscous damping on the free DOFs.
 #[derive(Debug, Clone)]
 pub struct Assembled {
-    /// Stiffness matrix [N/m, N m/rad].
+    /// Stiffness matrix (N/m, N m/rad).
     pub k: SparseMat,
-    /// Lumped mass matrix [kg, kg m²].
+    /// Lumped mass matrix (kg, kg m²).
     pub m: SparseMat,
-    /// Viscous damping of the discrete dampers [N s/m] (structural damping is added modally).
+    /// Viscous damping of the discrete dampers (N s/m) (structural damping is added modally).
     pub c: SparseMat,
     /// Numbering of the free DOFs.
     pub dofs: DofMap,

@@ -19,9 +19,9 @@ use super::mesh::{BeamSection, Material};
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
 #[serde(tag = "shape", rename_all = "snake_case")]
 pub enum SectionSpec {
-    /// Thin-walled rectangular tube: width `b` (local y), height `h` (local z), wall `t` [m].
+    /// Thin-walled rectangular tube: width `b` (local y), height `h` (local z), wall `t` (m).
     Box { b: f64, h: f64, t: f64 },
-    /// Thin-walled circular tube: outer diameter `d`, wall `t` [m].
+    /// Thin-walled circular tube: outer diameter `d`, wall `t` (m).
     Tube { d: f64, t: f64 },
     /// Explicit section properties.
     Explicit { area: f64, iy: f64, iz: f64, j: f64 },
@@ -61,53 +61,53 @@ impl SectionSpec {
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 #[serde(default, deny_unknown_fields)]
 pub struct Geometry {
-    /// Wheelbase [m]: the rear axle is at x = −wheelbase.
+    /// Wheelbase (m): the rear axle is at x = −wheelbase.
     pub wheelbase: f64,
-    /// Half width of floor, sills, roof [m].
+    /// Half width of floor, sills, roof (m).
     pub half_width: f64,
-    /// Floor and sill height [m].
+    /// Floor and sill height (m).
     pub floor_z: f64,
-    /// Firewall (front plate) position [m].
+    /// Firewall (front plate) position (m).
     pub firewall_x: f64,
-    /// Rear end of floor and rear panel [m].
+    /// Rear end of floor and rear panel (m).
     pub rear_x: f64,
-    /// Front end of the girders, front cross panel [m].
+    /// Front end of the girders, front cross panel (m).
     pub front_x: f64,
-    /// Cowl rear edge / cross-car beam position [m].
+    /// Cowl rear edge / cross-car beam position (m).
     pub cowl_x: f64,
-    /// Top of firewall and cowl height [m].
+    /// Top of firewall and cowl height (m).
     pub cowl_z: f64,
-    /// Roof height [m].
+    /// Roof height (m).
     pub roof_z: f64,
-    /// Front edge of the roof (windscreen header) [m].
+    /// Front edge of the roof (windscreen header) (m).
     pub roof_front_x: f64,
-    /// Rear edge of the roof (rear header) [m].
+    /// Rear edge of the roof (rear header) (m).
     pub roof_rear_x: f64,
-    /// B-pillar position [m].
+    /// B-pillar position (m).
     pub b_pillar_x: f64,
-    /// Front edge of the rear quarter panels [m].
+    /// Front edge of the rear quarter panels (m).
     pub quarter_front_x: f64,
-    /// Front edge of the parcel shelf [m].
+    /// Front edge of the parcel shelf (m).
     pub shelf_x: f64,
-    /// Height of parcel shelf and top of rear and quarter panels [m].
+    /// Height of parcel shelf and top of rear and quarter panels (m).
     pub shelf_z: f64,
-    /// Lower end of the C-pillar on the quarter panel top edge [m].
+    /// Lower end of the C-pillar on the quarter panel top edge (m).
     pub c_pillar_foot_x: f64,
-    /// Lateral position of the front girders (engine rails) and floor rails, ± [m].
+    /// Lateral position of the front girders (engine rails) and floor rails, ± (m).
     pub girder_y: f64,
-    /// Height of the front girders [m].
+    /// Height of the front girders (m).
     pub girder_z: f64,
-    /// Height of the top of the wheel-house aprons above the girders [m].
+    /// Height of the top of the wheel-house aprons above the girders (m).
     pub apron_top_z: f64,
-    /// Floor cross-member positions [m].
+    /// Floor cross-member positions (m).
     pub cross_member_x: Vec<f64>,
-    /// Roof header and bow positions [m].
+    /// Roof header and bow positions (m).
     pub roof_bow_x: Vec<f64>,
-    /// Grid spacing along x [m].
+    /// Grid spacing along x (m).
     pub grid_dx: f64,
-    /// Grid spacing along y [m].
+    /// Grid spacing along y (m).
     pub grid_dy: f64,
-    /// Grid spacing along z [m].
+    /// Grid spacing along z (m).
     pub grid_dz: f64,
 }
 
@@ -142,7 +142,7 @@ impl Default for Geometry {
     }
 }
 
-/// Sheet thicknesses of the panels [m].
+/// Sheet thicknesses of the panels (m).
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 #[serde(default, deny_unknown_fields)]
 pub struct Thicknesses {
@@ -270,11 +270,11 @@ impl Default for Sections {
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 #[serde(default, deny_unknown_fields)]
 pub struct Steering {
-    /// Lower column end on the firewall [m].
+    /// Lower column end on the firewall (m).
     pub column_base: [f64; 3],
-    /// Column support point, linked vertically to the cross-car beam [m].
+    /// Column support point, linked vertically to the cross-car beam (m).
     pub column_support: [f64; 3],
-    /// Steering-wheel centre [m].
+    /// Steering-wheel centre (m).
     pub wheel: [f64; 3],
     /// Column section (local y horizontal-lateral, local z in the vertical plane of the column).
     pub column_section: SectionSpec,
@@ -282,9 +282,9 @@ pub struct Steering {
     pub bracket_section: SectionSpec,
     /// Beam elements between base and support, and between support and wheel.
     pub elements_per_segment: usize,
-    /// Steering-wheel mass [kg] (wheel, airbag, hub).
+    /// Steering-wheel mass (kg) (wheel, airbag, hub).
     pub wheel_mass: f64,
-    /// Steering-wheel inertia about its diameter and about its column axis [kg m²].
+    /// Steering-wheel inertia about its diameter and about its column axis (kg m²).
     pub wheel_inertia: [f64; 2],
 }
 
@@ -313,7 +313,7 @@ impl Default for Steering {
     }
 }
 
-/// Non-structural (trim) masses [kg], spread per length over the frame beams of each group (trim
+/// Non-structural (trim) masses (kg), spread per length over the frame beams of each group (trim
 /// hangs on the frame; on the thin panels it would only create spurious local panel modes).
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 #[serde(default, deny_unknown_fields)]
@@ -352,21 +352,21 @@ impl Default for Trim {
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 #[serde(default, deny_unknown_fields)]
 pub struct Suspension {
-    /// Front wheel centre (left side; the right one is mirrored) [m].
+    /// Front wheel centre (left side; the right one is mirrored) (m).
     pub front_wheel_centre: [f64; 3],
-    /// Lateral position and height of the rear wheel centre; x is −wheelbase [m].
+    /// Lateral position and height of the rear wheel centre; x is −wheelbase (m).
     pub rear_wheel_centre_yz: [f64; 2],
-    /// Suspension wheel rate [N/m].
+    /// Suspension wheel rate (N/m).
     pub wheel_rate: f64,
-    /// Tyre vertical rate [N/m].
+    /// Tyre vertical rate (N/m).
     pub tyre_rate: f64,
-    /// Longitudinal restraint per corner [N/m].
+    /// Longitudinal restraint per corner (N/m).
     pub longitudinal_rate: f64,
-    /// Lateral restraint per corner [N/m].
+    /// Lateral restraint per corner (N/m).
     pub lateral_rate: f64,
-    /// Vertical damper per corner [N s/m].
+    /// Vertical damper per corner (N s/m).
     pub vertical_damping: f64,
-    /// Longitudinal and lateral damping per corner [N s/m].
+    /// Longitudinal and lateral damping per corner (N s/m).
     pub horizontal_damping: f64,
 }
 
@@ -389,9 +389,9 @@ impl Default for Suspension {
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 #[serde(default, deny_unknown_fields)]
 pub struct Mounts {
-    /// x of the front and rear mount pairs [m]; y = ±girder_y, z = girder_z.
+    /// x of the front and rear mount pairs (m); y = ±girder_y, z = girder_z.
     pub front_x: f64,
-    /// x of the rear mount pair [m].
+    /// x of the rear mount pair (m).
     pub rear_x: f64,
     /// The mount removed in the paper's improved three-mount vehicle (one of `front_left`,
     /// `front_right`, `rear_left`, `rear_right`).
@@ -414,7 +414,7 @@ impl Default for Mounts {
 pub struct Options {
     /// Add a transverse stiffening bar between the front girders.
     pub stiffening_bar: bool,
-    /// x position of the stiffening bar [m].
+    /// x position of the stiffening bar (m).
     pub stiffening_bar_x: f64,
     /// Stiffer front plate (firewall and cowl) supporting the steering column.
     pub stiff_front_plate: bool,
@@ -458,7 +458,7 @@ pub struct ChassisConfig {
     pub suspension: Suspension,
     /// Engine mounts.
     pub mounts: Mounts,
-    /// Driver's seat-rail node position [m].
+    /// Driver's seat-rail node position (m).
     pub seat_rail: [f64; 3],
     /// Structural options.
     pub options: Options,

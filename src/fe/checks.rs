@@ -15,9 +15,9 @@ pub struct CheckLimits {
     pub max_warp: f64,
     /// Smallest ratio of corner Jacobians of a shell (1 = parallelogram, ≤ 0 = inverted).
     pub min_jacobian_ratio: f64,
-    /// Smallest beam length [m].
+    /// Smallest beam length (m).
     pub min_beam_length: f64,
-    /// Smallest shell area [m²].
+    /// Smallest shell area (m²).
     pub min_shell_area: f64,
 }
 

@@ -19,14 +19,14 @@ use super::error::FeError;
 /// Eigenpairs of (K, M), ascending.
 #[derive(Debug, Clone)]
 pub struct Modes {
-    /// Eigenvalues λ = ω² [rad²/s²].
+    /// Eigenvalues λ = ω² (rad²/s²).
     pub eigenvalues: Vec<f64>,
     /// Mode shapes as columns, M-orthonormal (Φᵀ M Φ = I).
     pub shapes: Mat<f64>,
 }
 
 impl Modes {
-    /// Natural frequencies f = √λ / 2π [Hz]; negative round-off eigenvalues map to 0.
+    /// Natural frequencies f = √λ / 2π (Hz); negative round-off eigenvalues map to 0.
     pub fn frequencies_hz(&self) -> Vec<f64> {
         self.eigenvalues
             .iter()

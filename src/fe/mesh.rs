@@ -8,11 +8,11 @@ use serde::{Deserialize, Serialize};
 /// Linear elastic isotropic material.
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
 pub struct Material {
-    /// Young's modulus [Pa].
+    /// Young's modulus (Pa).
     pub youngs_modulus: f64,
-    /// Poisson's ratio [-].
+    /// Poisson's ratio (-).
     pub poisson_ratio: f64,
-    /// Density [kg/m³].
+    /// Density (kg/m³).
     pub density: f64,
 }
 
@@ -33,13 +33,13 @@ impl Material {
 /// Beam cross-section. `iy` resists bending in the local x-z plane, `iz` in the local x-y plane.
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
 pub struct BeamSection {
-    /// Area [m²].
+    /// Area (m²).
     pub area: f64,
-    /// Second moment about the local y axis [m⁴].
+    /// Second moment about the local y axis (m⁴).
     pub iy: f64,
-    /// Second moment about the local z axis [m⁴].
+    /// Second moment about the local z axis (m⁴).
     pub iz: f64,
-    /// Saint-Venant torsion constant [m⁴].
+    /// Saint-Venant torsion constant (m⁴).
     pub j: f64,
 }
 
@@ -81,7 +81,7 @@ pub struct Beam {
     pub section: BeamSection,
     /// Any vector not parallel to the beam axis; the local y axis lies in its plane with the axis.
     pub orientation: Vector3<f64>,
-    /// Non-structural mass per length [kg/m] (trim carried by the beam).
+    /// Non-structural mass per length (kg/m) (trim carried by the beam).
     pub extra_mass_per_length: f64,
 }
 
@@ -92,12 +92,12 @@ pub struct Shell {
     pub nodes: [usize; 4],
     /// Material.
     pub material: Material,
-    /// Thickness [m] (membrane stiffness and mass).
+    /// Thickness (m) (membrane stiffness and mass).
     pub thickness: f64,
-    /// Effective thickness for plate bending and transverse shear [m]: equal to `thickness` for a
+    /// Effective thickness for plate bending and transverse shear (m): equal to `thickness` for a
     /// plain sheet, larger for a beaded or stiffened panel in a phenomenological model.
     pub bending_thickness: f64,
-    /// Non-structural mass per area [kg/m²] (trim carried by the panel).
+    /// Non-structural mass per area (kg/m²) (trim carried by the panel).
     pub extra_mass_per_area: f64,
 }
 
@@ -106,9 +106,9 @@ pub struct Shell {
 pub struct PointMass {
     /// Node carrying the mass.
     pub node: usize,
-    /// Mass [kg].
+    /// Mass (kg).
     pub mass: f64,
-    /// Rotary inertia tensor about the node in global axes [kg m²] (symmetric).
+    /// Rotary inertia tensor about the node in global axes (kg m²) (symmetric).
     pub inertia: Matrix3<f64>,
 }
 
@@ -117,9 +117,9 @@ pub struct PointMass {
 pub struct GroundSpring {
     /// Node.
     pub node: usize,
-    /// Stiffness per DOF ux, uy, uz [N/m], rx, ry, rz [N m/rad].
+    /// Stiffness per DOF ux, uy, uz (N/m), rx, ry, rz (N m/rad).
     pub stiffness: [f64; 6],
-    /// Viscous damping per DOF [N s/m], [N m s/rad].
+    /// Viscous damping per DOF (N s/m), (N m s/rad).
     pub damping: [f64; 6],
 }
 
@@ -128,16 +128,16 @@ pub struct GroundSpring {
 pub struct Spring {
     /// The two nodes.
     pub nodes: [usize; 2],
-    /// Stiffness per DOF [N/m], [N m/rad].
+    /// Stiffness per DOF (N/m), (N m/rad).
     pub stiffness: [f64; 6],
-    /// Viscous damping per DOF [N s/m], [N m s/rad].
+    /// Viscous damping per DOF (N s/m), (N m s/rad).
     pub damping: [f64; 6],
 }
 
 /// A complete FE model description before assembly.
 #[derive(Debug, Clone, Default, PartialEq)]
 pub struct Mesh {
-    /// Node coordinates [m]; the index is the node id.
+    /// Node coordinates (m); the index is the node id.
     pub nodes: Vec<Vector3<f64>>,
     /// Beam elements.
     pub beams: Vec<Beam>,

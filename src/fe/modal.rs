@@ -36,7 +36,7 @@ pub enum ModeKind {
 pub struct ModeDescription {
     /// Mode number (0-based, ascending frequency).
     pub index: usize,
-    /// Natural frequency [Hz].
+    /// Natural frequency (Hz).
     pub frequency_hz: f64,
     /// Classification.
     pub kind: ModeKind,

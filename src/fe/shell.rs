@@ -29,7 +29,7 @@ pub struct ShellGeometry {
     pub frame: Matrix3<f64>,
     /// Corner coordinates in the element plane.
     pub local_xy: [[f64; 2]; 4],
-    /// Area of the projected quadrilateral [m²].
+    /// Area of the projected quadrilateral (m²).
     pub area: f64,
     /// Largest corner distance from the mean plane divided by √area.
     pub warp: f64,
