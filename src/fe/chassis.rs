@@ -864,6 +864,29 @@ fn validate(cfg: &ChassisConfig) -> Result<(), FeError> {
             )));
         }
     }
+    for (name, list, lo, hi) in [
+        (
+            "geometry.cross_member_x",
+            &g.cross_member_x,
+            g.rear_x,
+            g.firewall_x,
+        ),
+        (
+            "geometry.roof_bow_x",
+            &g.roof_bow_x,
+            g.roof_rear_x,
+            g.roof_front_x,
+        ),
+    ] {
+        for &x in list.iter() {
+            on_grid(name, x, g.grid_dx)?;
+            if !(lo..=hi).contains(&x) {
+                return Err(FeError::InvalidInput(format!(
+                    "{name} entry {x} lies outside its panel ({lo} ..= {hi})"
+                )));
+            }
+        }
+    }
     if !MOUNT_NAMES.contains(&cfg.mounts.removed_in_three_mount_layout.as_str()) {
         return Err(FeError::InvalidInput(format!(
             "mounts.removed_in_three_mount_layout = '{}' must be one of {MOUNT_NAMES:?}",

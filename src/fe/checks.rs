@@ -19,6 +19,8 @@ pub struct CheckLimits {
     pub min_beam_length: f64,
     /// Smallest shell area (m²).
     pub min_shell_area: f64,
+    /// Accept structures made of several parts that share no element.
+    pub allow_disconnected_parts: bool,
 }
 
 impl Default for CheckLimits {
@@ -28,6 +30,7 @@ impl Default for CheckLimits {
             min_jacobian_ratio: 0.2,
             min_beam_length: 1e-6,
             min_shell_area: 1e-10,
+            allow_disconnected_parts: false,
         }
     }
 }
@@ -144,7 +147,14 @@ pub fn check_mesh(mesh: &Mesh, limits: &CheckLimits) -> Result<(), FeError> {
             }
         }
     }
-    let fully_constrained = |k: usize| (0..6).all(|d| mesh.constraints.contains(&(k, d)));
+    let mut constrained_count = vec![0usize; n];
+    let mut seen = std::collections::HashSet::new();
+    for &(k, d) in &mesh.constraints {
+        if k < n && d < 6 && seen.insert((k, d)) {
+            constrained_count[k] += 1;
+        }
+    }
+    let fully_constrained = |k: usize| constrained_count[k] == 6;
     for k in 0..n {
         if !connected[k] && !fully_constrained(k) {
             problems.push(format!("node {k}: not connected to any element"));
@@ -154,12 +164,78 @@ pub fn check_mesh(mesh: &Mesh, limits: &CheckLimits) -> Result<(), FeError> {
             ));
         }
     }
+    if !limits.allow_disconnected_parts {
+        problems.extend(disconnected_parts(mesh, &connected, &fully_constrained));
+    }
     for (name, &k) in &mesh.named_nodes {
         if k >= n {
             problems.push(format!("named node '{name}': node {k} does not exist"));
         }
     }
     report(problems)
+}
+
+fn find(parent: &mut [usize], mut i: usize) -> usize {
+    while parent[i] != i {
+        parent[i] = parent[parent[i]];
+        i = parent[i];
+    }
+    i
+}
+
+/// Parts of the structure (connected through elements and two-node springs) other than the
+/// largest one, each described by its size and first node.
+fn disconnected_parts(
+    mesh: &Mesh,
+    connected: &[bool],
+    fully_constrained: &dyn Fn(usize) -> bool,
+) -> Vec<String> {
+    let n = mesh.nodes.len();
+    let mut parent: Vec<usize> = (0..n).collect();
+    let mut join = |a: usize, b: usize| {
+        if a < n && b < n {
+            let (ra, rb) = (find(&mut parent, a), find(&mut parent, b));
+            parent[ra] = rb;
+        }
+    };
+    let links = mesh
+        .beams
+        .iter()
+        .map(|b| b.nodes.to_vec())
+        .chain(mesh.shells.iter().map(|s| s.nodes.to_vec()))
+        .chain(mesh.springs.iter().map(|s| s.nodes.to_vec()));
+    for nodes in links {
+        for w in nodes.windows(2) {
+            join(w[0], w[1]);
+        }
+    }
+    let mut parts: std::collections::BTreeMap<usize, Vec<usize>> = Default::default();
+    for (k, &is_connected) in connected.iter().enumerate() {
+        if is_connected && !fully_constrained(k) {
+            let root = find(&mut parent, k);
+            parts.entry(root).or_default().push(k);
+        }
+    }
+    let largest = parts.values().map(Vec::len).max().unwrap_or(0);
+    let mut skipped_largest = false;
+    let mut out = Vec::new();
+    for nodes in parts.values() {
+        if nodes.len() == largest && !skipped_largest {
+            skipped_largest = true;
+            continue;
+        }
+        let p = mesh.nodes[nodes[0]];
+        out.push(format!(
+            "node {} at ({:.4}, {:.4}, {:.4}) and {} other node(s) form a part not connected to \
+             the main structure",
+            nodes[0],
+            p.x,
+            p.y,
+            p.z,
+            nodes.len() - 1
+        ));
+    }
+    out
 }
 
 /// Checks every free DOF of the assembled system has positive stiffness and mass on the diagonal.
@@ -248,6 +324,33 @@ mod tests {
             "{err}"
         );
         assert!(err.contains("beam 0: degenerate"), "{err}");
+    }
+
+    #[test]
+    fn a_part_not_connected_to_the_main_structure_is_named() {
+        let mut mesh = Mesh::default();
+        square(&mut mesh, 0.0);
+        let a = mesh.add_node(Vector3::new(3.0, 0.0, 0.0));
+        let b = mesh.add_node(Vector3::new(4.0, 0.0, 0.0));
+        mesh.beams.push(Beam {
+            nodes: [a, b],
+            material: Material::STEEL,
+            section: BeamSection::circular_tube(0.02, 0.002),
+            orientation: Vector3::z(),
+            extra_mass_per_length: 0.0,
+        });
+        let err = check_mesh(&mesh, &CheckLimits::default())
+            .unwrap_err()
+            .to_string();
+        assert!(
+            err.contains(&format!("node {a} at")) && err.contains("not connected to the main"),
+            "{err}"
+        );
+        let lenient = CheckLimits {
+            allow_disconnected_parts: true,
+            ..CheckLimits::default()
+        };
+        check_mesh(&mesh, &lenient).unwrap();
     }
 
     #[test]
