@@ -248,6 +248,22 @@ fn description_errors_name_the_field() {
 }
 
 #[test]
+fn shipped_improved_description_is_the_default_with_the_paper_7_1_options() {
+    let text = std::fs::read_to_string(concat!(
+        env!("CARGO_MANIFEST_DIR"),
+        "/configs/chassis_improved.json"
+    ))
+    .unwrap();
+    let improved = ChassisConfig::from_json(&text).unwrap();
+    let mut expected = ChassisConfig::default();
+    expected.options.stiffening_bar = true;
+    expected.options.stiff_front_plate = true;
+    assert_eq!(improved, expected);
+    let chassis = Chassis::build(&improved).unwrap();
+    assert_eq!(chassis.mount_nodes(MountLayout::Three).unwrap().len(), 3);
+}
+
+#[test]
 fn shipped_json_description_is_the_default() {
     let text =
         std::fs::read_to_string(concat!(env!("CARGO_MANIFEST_DIR"), "/configs/chassis.json"))
