@@ -83,6 +83,61 @@ mod tests {
     use faer::sparse::{SparseColMat, Triplet};
 
     #[test]
+    fn written_files_read_back_to_the_assembled_matrices() {
+        use crate::fe::assembly::assemble;
+        use crate::fe::mesh::{Beam, BeamSection, GroundSpring, Material};
+        use nalgebra::Vector3;
+        let mut mesh = Mesh::default();
+        for x in [0.0, 0.4, 1.0] {
+            mesh.add_node(Vector3::new(x, 0.1 * x, 0.0));
+        }
+        for nodes in [[0, 1], [1, 2]] {
+            mesh.beams.push(Beam {
+                nodes,
+                material: Material::STEEL,
+                section: BeamSection::box_tube(0.03, 0.05, 0.002),
+                orientation: Vector3::z(),
+                extra_mass_per_length: 1.0,
+            });
+        }
+        mesh.ground_springs.push(GroundSpring {
+            node: 0,
+            stiffness: [1e5; 6],
+            damping: [0.0; 6],
+        });
+        mesh.named_nodes.insert("tip".into(), 2);
+        let asm = assemble(&mesh).unwrap();
+        let dir = std::env::temp_dir().join(format!("fe_export_test_{}", std::process::id()));
+        write_all(&dir, &mesh, &asm).unwrap();
+        for (file, matrix) in [("K.mtx", &asm.k), ("M.mtx", &asm.m)] {
+            let text = std::fs::read_to_string(dir.join(file)).unwrap();
+            let dense = matrix.to_dense();
+            let mut read = faer::Mat::<f64>::zeros(dense.nrows(), dense.ncols());
+            for line in text.lines().filter(|l| !l.starts_with('%')).skip(1) {
+                let f: Vec<&str> = line.split_whitespace().collect();
+                let (i, j): (usize, usize) = (f[0].parse().unwrap(), f[1].parse().unwrap());
+                let v: f64 = f[2].parse().unwrap();
+                read[(i - 1, j - 1)] = v;
+                read[(j - 1, i - 1)] = v;
+            }
+            for j in 0..dense.ncols() {
+                for i in 0..dense.nrows() {
+                    let (a, b) = (dense[(i, j)], read[(i, j)]);
+                    assert!(
+                        (a - b).abs() <= 1e-15 * a.abs().max(1.0),
+                        "{file} ({i},{j}): {a} vs {b}"
+                    );
+                }
+            }
+        }
+        let nodes = std::fs::read_to_string(dir.join("nodes.csv")).unwrap();
+        assert!(nodes.lines().nth(3).unwrap().ends_with(",tip"));
+        let dofs = std::fs::read_to_string(dir.join("dofs.csv")).unwrap();
+        assert_eq!(dofs.lines().count(), 1 + asm.dofs.n_free());
+        let _ = std::fs::remove_dir_all(&dir);
+    }
+
+    #[test]
     fn matrix_market_lists_the_lower_triangle_one_based() {
         let a = SparseColMat::<usize, f64>::try_new_from_triplets(
             2,
