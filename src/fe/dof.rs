@@ -65,6 +65,22 @@ impl DofMap {
         self.index.len() / DOF_PER_NODE
     }
 
+    /// Global indices of the local DOFs `local` of each node in `nodes`, node by node (e.g. the
+    /// interface DOFs of the engine-mount nodes for a Craig-Bampton reduction).
+    pub fn indices_of(&self, nodes: &[usize], local: &[usize]) -> Result<Vec<usize>, FeError> {
+        let mut out = Vec::with_capacity(nodes.len() * local.len());
+        for &node in nodes {
+            for &dof in local {
+                out.push(self.global(node, dof).ok_or_else(|| {
+                    FeError::InvalidInput(format!(
+                        "node {node} dof {dof} is constrained or does not exist"
+                    ))
+                })?);
+            }
+        }
+        Ok(out)
+    }
+
     /// Inverse map: (node, dof) of every global index, in order.
     pub fn owners(&self) -> Vec<(usize, usize)> {
         let mut out = Vec::with_capacity(self.n_free);
@@ -91,6 +107,17 @@ mod tests {
         assert_eq!(map.global(1, 4), Some(9));
         assert!(map.is_constrained(1, 5));
         assert_eq!(map.owners()[2], (0, 3));
+    }
+
+    #[test]
+    fn interface_indices_follow_node_then_dof_order() {
+        let map = DofMap::new(3, &[(1, 0)]).unwrap();
+        assert_eq!(
+            map.indices_of(&[2, 0], &[0, 2]).unwrap(),
+            vec![11, 13, 0, 2]
+        );
+        let err = map.indices_of(&[1], &[0]).unwrap_err().to_string();
+        assert!(err.contains("node 1 dof 0"), "{err}");
     }
 
     #[test]

@@ -225,6 +225,23 @@ pub fn describe(
             .get(name)
             .ok_or_else(|| FeError::InvalidInput(format!("mesh has no region '{name}'")))
     };
+    if asm.dofs.n_nodes() != mesh.nodes.len() || modes.shapes.nrows() != asm.dofs.n_free() {
+        return Err(FeError::InvalidInput(format!(
+            "mesh ({} nodes), DOF map ({} nodes, {} DOFs) and mode shapes ({} rows) do not match",
+            mesh.nodes.len(),
+            asm.dofs.n_nodes(),
+            asm.dofs.n_free(),
+            modes.shapes.nrows()
+        )));
+    }
+    for (name, nodes) in &mesh.regions {
+        if let Some(&bad) = nodes.iter().find(|&&k| k >= mesh.nodes.len()) {
+            return Err(FeError::InvalidInput(format!(
+                "region '{name}' refers to node {bad}, mesh has {} nodes",
+                mesh.nodes.len()
+            )));
+        }
+    }
     let body = need(region::BODY)?;
     let front = need(region::FIREWALL)?;
     let rear = need(region::REAR_PANEL)?;
