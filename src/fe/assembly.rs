@@ -1,0 +1,209 @@
+//! Sparse assembly of K, M and C from the element matrices (triplets → faer `SparseColMat`).
+
+use faer::sparse::{SparseColMat, Triplet};
+use nalgebra::{Dim, Matrix, RawStorage, Vector3};
+
+use super::dof::{DofMap, DOF_PER_NODE};
+use super::error::FeError;
+use super::mesh::Mesh;
+use super::{beam, mass, shell, spring};
+
+/// Sparse symmetric matrix type of the FE model (both triangles stored).
+pub type SparseMat = SparseColMat<usize, f64>;
+
+/// The assembled system: stiffness, lumped mass and viscous damping on the free DOFs.
+#[derive(Debug, Clone)]
+pub struct Assembled {
+    /// Stiffness matrix (N/m, N m/rad).
+    pub k: SparseMat,
+    /// Lumped mass matrix (kg, kg m²).
+    pub m: SparseMat,
+    /// Viscous damping of the discrete dampers (N s/m) (structural damping is added modally).
+    pub c: SparseMat,
+    /// Numbering of the free DOFs.
+    pub dofs: DofMap,
+}
+
+struct TripletSink<'a> {
+    dofs: &'a DofMap,
+    entries: Vec<Triplet<usize, usize, f64>>,
+}
+
+impl TripletSink<'_> {
+    fn scatter<R: Dim, C: Dim, S: RawStorage<f64, R, C>>(
+        &mut self,
+        nodes: &[usize],
+        local: &Matrix<f64, R, C, S>,
+    ) {
+        let index = |k: usize| self.dofs.global(nodes[k / DOF_PER_NODE], k % DOF_PER_NODE);
+        for j in 0..local.ncols() {
+            let Some(gj) = index(j) else { continue };
+            for i in 0..local.nrows() {
+                let v = local[(i, j)];
+                if v == 0.0 {
+                    continue;
+                }
+                if let Some(gi) = index(i) {
+                    self.entries.push(Triplet::new(gi, gj, v));
+                }
+            }
+        }
+    }
+
+    fn finish(self, n: usize, what: &str) -> Result<SparseMat, FeError> {
+        SparseColMat::try_new_from_triplets(n, n, &self.entries)
+            .map_err(|e| FeError::Numerical(format!("building sparse {what}: {e:?}")))
+    }
+}
+
+fn node_of(mesh: &Mesh, what: &str, node: usize) -> Result<Vector3<f64>, FeError> {
+    let p = mesh.nodes.get(node).copied().ok_or_else(|| {
+        FeError::Mesh(format!(
+            "{what} refers to node {node}, mesh has {} nodes",
+            mesh.nodes.len()
+        ))
+    })?;
+    if p.iter().any(|c| !c.is_finite()) {
+        return Err(FeError::Mesh(format!(
+            "node {node} has non-finite coordinates"
+        )));
+    }
+    Ok(p)
+}
+
+/// Assembles K, M, C of `mesh` on the DOFs left free by `mesh.constraints`.
+pub fn assemble(mesh: &Mesh) -> Result<Assembled, FeError> {
+    let dofs = DofMap::new(mesh.nodes.len(), &mesh.constraints)?;
+    let n = dofs.n_free();
+    let mut k = TripletSink {
+        dofs: &dofs,
+        entries: Vec::new(),
+    };
+    let mut m = TripletSink {
+        dofs: &dofs,
+        entries: Vec::new(),
+    };
+    let mut c = TripletSink {
+        dofs: &dofs,
+        entries: Vec::new(),
+    };
+    for (i, b) in mesh.beams.iter().enumerate() {
+        let what = format!("beam {i}");
+        let p1 = node_of(mesh, &what, b.nodes[0])?;
+        let p2 = node_of(mesh, &what, b.nodes[1])?;
+        k.scatter(&b.nodes, &beam::stiffness(i, b, &p1, &p2)?);
+        m.scatter(&b.nodes, &beam::lumped_mass(i, b, &p1, &p2)?);
+    }
+    for (i, s) in mesh.shells.iter().enumerate() {
+        let what = format!("shell {i}");
+        let p = [
+            node_of(mesh, &what, s.nodes[0])?,
+            node_of(mesh, &what, s.nodes[1])?,
+            node_of(mesh, &what, s.nodes[2])?,
+            node_of(mesh, &what, s.nodes[3])?,
+        ];
+        k.scatter(&s.nodes, &shell::stiffness(i, s, &p)?);
+        m.scatter(&s.nodes, &shell::lumped_mass(i, s, &p)?);
+    }
+    for (i, pm) in mesh.masses.iter().enumerate() {
+        node_of(mesh, &format!("point mass {i}"), pm.node)?;
+        m.scatter(&[pm.node], &mass::matrix(i, pm)?);
+    }
+    for (i, s) in mesh.ground_springs.iter().enumerate() {
+        node_of(mesh, &format!("ground spring {i}"), s.node)?;
+        let (ks, cs) = spring::ground_matrices(i, s)?;
+        k.scatter(&[s.node], &ks);
+        c.scatter(&[s.node], &cs);
+    }
+    for (i, s) in mesh.springs.iter().enumerate() {
+        let what = format!("spring {i}");
+        node_of(mesh, &what, s.nodes[0])?;
+        node_of(mesh, &what, s.nodes[1])?;
+        let (ks, cs) = spring::two_node_matrices(i, s)?;
+        k.scatter(&s.nodes, &ks);
+        c.scatter(&s.nodes, &cs);
+    }
+    Ok(Assembled {
+        k: k.finish(n, "K")?,
+        m: m.finish(n, "M")?,
+        c: c.finish(n, "C")?,
+        dofs,
+    })
+}
+
+/// y = A x for a sparse `a` and a dense vector `x`.
+pub fn mat_vec(a: &SparseMat, x: &[f64]) -> Vec<f64> {
+    let mut y = vec![0.0; a.nrows()];
+    let (col_ptr, row_idx, val) = (a.symbolic().col_ptr(), a.symbolic().row_idx(), a.val());
+    for (j, xj) in x.iter().enumerate().take(a.ncols()) {
+        for p in col_ptr[j]..col_ptr[j + 1] {
+            y[row_idx[p]] += val[p] * xj;
+        }
+    }
+    y
+}
+
+/// Sum of all entries of the diagonal of `a` belonging to translational DOFs in direction
+/// `direction` (0 = x, 1 = y, 2 = z): the total mass seen by a rigid translation.
+pub fn translational_mass(a: &Assembled, direction: usize) -> f64 {
+    let owners = a.dofs.owners();
+    let mut unit = vec![0.0; owners.len()];
+    for (g, &(_, d)) in owners.iter().enumerate() {
+        if d == direction {
+            unit[g] = 1.0;
+        }
+    }
+    let mu = mat_vec(&a.m, &unit);
+    unit.iter().zip(&mu).map(|(u, v)| u * v).sum()
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::fe::mesh::{GroundSpring, Spring};
+
+    fn two_nodes() -> Mesh {
+        let mut mesh = Mesh::default();
+        mesh.add_node(Vector3::zeros());
+        mesh.add_node(Vector3::new(1.0, 0.0, 0.0));
+        mesh
+    }
+
+    #[test]
+    fn contributions_to_one_entry_are_summed_and_constrained_dofs_dropped() {
+        let mut mesh = two_nodes();
+        for k in [100.0, 23.0] {
+            mesh.ground_springs.push(GroundSpring {
+                node: 1,
+                stiffness: [k; 6],
+                damping: [0.5; 6],
+            });
+        }
+        mesh.springs.push(Spring {
+            nodes: [0, 1],
+            stiffness: [7.0; 6],
+            damping: [0.0; 6],
+        });
+        mesh.clamp(0);
+        let a = assemble(&mesh).unwrap();
+        assert_eq!(a.dofs.n_free(), 6);
+        let k = a.k.to_dense();
+        let c = a.c.to_dense();
+        for d in 0..6 {
+            assert_eq!(k[(d, d)], 130.0);
+            assert_eq!(c[(d, d)], 1.0);
+        }
+    }
+
+    #[test]
+    fn bad_node_reference_is_named() {
+        let mut mesh = two_nodes();
+        mesh.springs.push(Spring {
+            nodes: [0, 9],
+            stiffness: [1.0; 6],
+            damping: [0.0; 6],
+        });
+        let err = assemble(&mesh).unwrap_err().to_string();
+        assert!(err.contains("spring 0") && err.contains("node 9"), "{err}");
+    }
+}

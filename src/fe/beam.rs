@@ -1,0 +1,213 @@
+//! Two-node 3D Euler-Bernoulli beam: stiffness and HRZ-lumped mass in global axes.
+
+use nalgebra::{Matrix3, SMatrix, Vector3};
+
+use super::error::{require_non_negative, require_positive, FeError};
+use super::mesh::Beam;
+
+/// 12 × 12 element matrix, DOF order (ux uy uz rx ry rz) at node 1 then node 2.
+pub type Mat12 = SMatrix<f64, 12, 12>;
+
+/// Local frame of a beam: rows are the local x (axis), y and z unit vectors in global axes.
+pub fn local_frame(
+    index: usize,
+    p1: &Vector3<f64>,
+    p2: &Vector3<f64>,
+    orientation: &Vector3<f64>,
+) -> Result<(Matrix3<f64>, f64), FeError> {
+    let axis = p2 - p1;
+    let length = axis.norm();
+    if !(length.is_finite() && length > 1e-9) {
+        return Err(FeError::Mesh(format!(
+            "beam {index}: zero or non-finite length {length}"
+        )));
+    }
+    let ex = axis / length;
+    let ez = ex.cross(orientation);
+    let ez_norm = ez.norm();
+    if !(ez_norm.is_finite() && ez_norm > 1e-6 * orientation.norm().max(1e-300)) {
+        return Err(FeError::Mesh(format!(
+            "beam {index}: orientation vector {:?} is parallel to the axis or zero",
+            orientation.as_slice()
+        )));
+    }
+    let ez = ez / ez_norm;
+    let ey = ez.cross(&ex);
+    let r = Matrix3::from_rows(&[ex.transpose(), ey.transpose(), ez.transpose()]);
+    Ok((r, length))
+}
+
+fn rotate(local: &Mat12, r: &Matrix3<f64>) -> Mat12 {
+    let mut t = Mat12::zeros();
+    for b in 0..4 {
+        t.fixed_view_mut::<3, 3>(3 * b, 3 * b).copy_from(r);
+    }
+    t.transpose() * local * t
+}
+
+fn validate(index: usize, beam: &Beam) -> Result<(), FeError> {
+    let s = &beam.section;
+    let m = &beam.material;
+    let name = |f: &str| format!("beam {index}: {f}");
+    require_positive(&name("area"), s.area)?;
+    require_positive(&name("iy"), s.iy)?;
+    require_positive(&name("iz"), s.iz)?;
+    require_positive(&name("j"), s.j)?;
+    require_positive(&name("youngs_modulus"), m.youngs_modulus)?;
+    require_non_negative(&name("density"), m.density)?;
+    require_non_negative(&name("extra_mass_per_length"), beam.extra_mass_per_length)?;
+    if !(m.poisson_ratio > -1.0 && m.poisson_ratio < 0.5) {
+        return Err(FeError::InvalidInput(format!(
+            "beam {index}: poisson_ratio must be in (-1, 0.5), got {}",
+            m.poisson_ratio
+        )));
+    }
+    Ok(())
+}
+
+/// Global stiffness matrix of `beam` with end points `p1`, `p2`.
+pub fn stiffness(
+    index: usize,
+    beam: &Beam,
+    p1: &Vector3<f64>,
+    p2: &Vector3<f64>,
+) -> Result<Mat12, FeError> {
+    validate(index, beam)?;
+    let (r, l) = local_frame(index, p1, p2, &beam.orientation)?;
+    let e = beam.material.youngs_modulus;
+    let g = beam.material.shear_modulus();
+    let s = &beam.section;
+    let mut k = Mat12::zeros();
+    let mut put = |i: usize, j: usize, v: f64| {
+        k[(i, j)] += v;
+        if i != j {
+            k[(j, i)] += v;
+        }
+    };
+    let ea = e * s.area / l;
+    put(0, 0, ea);
+    put(6, 6, ea);
+    put(0, 6, -ea);
+    let gj = g * s.j / l;
+    put(3, 3, gj);
+    put(9, 9, gj);
+    put(3, 9, -gj);
+    // Bending in the local x-y plane: v and rz.
+    let ei = e * s.iz;
+    put(1, 1, 12.0 * ei / l.powi(3));
+    put(1, 5, 6.0 * ei / l.powi(2));
+    put(1, 7, -12.0 * ei / l.powi(3));
+    put(1, 11, 6.0 * ei / l.powi(2));
+    put(5, 5, 4.0 * ei / l);
+    put(5, 7, -6.0 * ei / l.powi(2));
+    put(5, 11, 2.0 * ei / l);
+    put(7, 7, 12.0 * ei / l.powi(3));
+    put(7, 11, -6.0 * ei / l.powi(2));
+    put(11, 11, 4.0 * ei / l);
+    // Bending in the local x-z plane: w and ry (a positive ry tilts the axis downwards).
+    let ei = e * s.iy;
+    put(2, 2, 12.0 * ei / l.powi(3));
+    put(2, 4, -6.0 * ei / l.powi(2));
+    put(2, 8, -12.0 * ei / l.powi(3));
+    put(2, 10, -6.0 * ei / l.powi(2));
+    put(4, 4, 4.0 * ei / l);
+    put(4, 8, 6.0 * ei / l.powi(2));
+    put(4, 10, 2.0 * ei / l);
+    put(8, 8, 12.0 * ei / l.powi(3));
+    put(8, 10, 6.0 * ei / l.powi(2));
+    put(10, 10, 4.0 * ei / l);
+    Ok(rotate(&k, &r))
+}
+
+/// Global lumped mass matrix of `beam`. Translations carry half the mass per node; the torsional
+/// inertia is the section's polar moment; the bending rotations get the HRZ diagonal scaling of
+/// the consistent matrix (m L² / 78 per node), which keeps the lumped beam accurate for bending.
+pub fn lumped_mass(
+    index: usize,
+    beam: &Beam,
+    p1: &Vector3<f64>,
+    p2: &Vector3<f64>,
+) -> Result<Mat12, FeError> {
+    validate(index, beam)?;
+    let (r, l) = local_frame(index, p1, p2, &beam.orientation)?;
+    let rho = beam.material.density;
+    let s = &beam.section;
+    let m = (rho * s.area + beam.extra_mass_per_length) * l;
+    let torsion = (rho * (s.iy + s.iz) * l / 2.0).max(1e-12 * m * l * l);
+    let bending = m * l * l / 78.0;
+    let mut local = Mat12::zeros();
+    for node in 0..2 {
+        let o = 6 * node;
+        for d in 0..3 {
+            local[(o + d, o + d)] = m / 2.0;
+        }
+        local[(o + 3, o + 3)] = torsion;
+        local[(o + 4, o + 4)] = bending;
+        local[(o + 5, o + 5)] = bending;
+    }
+    Ok(rotate(&local, &r))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::fe::mesh::{BeamSection, Material};
+
+    fn beam_along(orientation: Vector3<f64>) -> Beam {
+        Beam {
+            nodes: [0, 1],
+            material: Material::STEEL,
+            section: BeamSection::box_tube(0.04, 0.06, 0.002),
+            orientation,
+            extra_mass_per_length: 0.0,
+        }
+    }
+
+    #[test]
+    fn rigid_body_motions_cost_no_energy_for_a_skew_beam() {
+        let p1 = Vector3::new(0.1, -0.2, 0.3);
+        let p2 = Vector3::new(0.9, 0.4, -0.1);
+        let k = stiffness(0, &beam_along(Vector3::new(0.0, 0.0, 1.0)), &p1, &p2).unwrap();
+        let scale = k.abs().max();
+        for mode in 0..6 {
+            let mut u = SMatrix::<f64, 12, 1>::zeros();
+            for (n, p) in [p1, p2].iter().enumerate() {
+                if mode < 3 {
+                    u[6 * n + mode] = 1.0;
+                } else {
+                    let mut w = Vector3::zeros();
+                    w[mode - 3] = 1.0;
+                    let t = w.cross(p);
+                    for d in 0..3 {
+                        u[6 * n + d] = t[d];
+                        u[6 * n + 3 + d] = w[d];
+                    }
+                }
+            }
+            assert!(
+                (k * u).norm() < 1e-9 * scale,
+                "rigid mode {mode} strains the beam"
+            );
+        }
+    }
+
+    #[test]
+    fn parallel_orientation_is_reported_with_the_beam_index() {
+        let p1 = Vector3::zeros();
+        let p2 = Vector3::new(1.0, 0.0, 0.0);
+        let err = stiffness(7, &beam_along(Vector3::new(2.0, 0.0, 0.0)), &p1, &p2).unwrap_err();
+        assert!(err.to_string().contains("beam 7"));
+    }
+
+    #[test]
+    fn lumped_mass_has_the_element_mass_per_direction() {
+        let b = beam_along(Vector3::new(0.0, 1.0, 1.0));
+        let p1 = Vector3::zeros();
+        let p2 = Vector3::new(0.3, 0.4, 0.0);
+        let m = lumped_mass(0, &b, &p1, &p2).unwrap();
+        let expected = b.material.density * b.section.area * 0.5;
+        for d in 0..3 {
+            assert!((m[(d, d)] + m[(6 + d, 6 + d)] - expected).abs() < 1e-12 * expected);
+        }
+    }
+}

@@ -1,0 +1,176 @@
+//! The mesh: nodes, elements, lumped masses, springs, constraints, named nodes and regions.
+
+use std::collections::BTreeMap;
+
+use nalgebra::{Matrix3, Vector3};
+use serde::{Deserialize, Serialize};
+
+/// Linear elastic isotropic material.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+pub struct Material {
+    /// Young's modulus (Pa).
+    pub youngs_modulus: f64,
+    /// Poisson's ratio (-).
+    pub poisson_ratio: f64,
+    /// Density (kg/m³).
+    pub density: f64,
+}
+
+impl Material {
+    /// Structural steel.
+    pub const STEEL: Material = Material {
+        youngs_modulus: 210.0e9,
+        poisson_ratio: 0.3,
+        density: 7850.0,
+    };
+
+    /// Shear modulus G = E / (2 (1 + ν)).
+    pub fn shear_modulus(&self) -> f64 {
+        self.youngs_modulus / (2.0 * (1.0 + self.poisson_ratio))
+    }
+}
+
+/// Beam cross-section. `iy` resists bending in the local x-z plane, `iz` in the local x-y plane.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+pub struct BeamSection {
+    /// Area (m²).
+    pub area: f64,
+    /// Second moment about the local y axis (m⁴).
+    pub iy: f64,
+    /// Second moment about the local z axis (m⁴).
+    pub iz: f64,
+    /// Saint-Venant torsion constant (m⁴).
+    pub j: f64,
+}
+
+impl BeamSection {
+    /// Thin-walled rectangular tube, outer width `b` (local y), height `h` (local z), wall `t`.
+    pub fn box_tube(b: f64, h: f64, t: f64) -> Self {
+        let (bi, hi) = (b - 2.0 * t, h - 2.0 * t);
+        let area = b * h - bi.max(0.0) * hi.max(0.0);
+        let iy = (b * h.powi(3) - bi * hi.powi(3)) / 12.0;
+        let iz = (h * b.powi(3) - hi * bi.powi(3)) / 12.0;
+        // Bredt: J = 4 A_m² t / perimeter of the wall mid-line.
+        let (bm, hm) = (b - t, h - t);
+        let j = 4.0 * (bm * hm).powi(2) * t / (2.0 * (bm + hm));
+        Self { area, iy, iz, j }
+    }
+
+    /// Thin-walled circular tube, outer diameter `d`, wall `t`.
+    pub fn circular_tube(d: f64, t: f64) -> Self {
+        let di = (d - 2.0 * t).max(0.0);
+        let area = std::f64::consts::PI / 4.0 * (d * d - di * di);
+        let i = std::f64::consts::PI / 64.0 * (d.powi(4) - di.powi(4));
+        Self {
+            area,
+            iy: i,
+            iz: i,
+            j: 2.0 * i,
+        }
+    }
+}
+
+/// Two-node 3D Euler-Bernoulli beam (12 DOF).
+#[derive(Debug, Clone, PartialEq)]
+pub struct Beam {
+    /// End nodes.
+    pub nodes: [usize; 2],
+    /// Material.
+    pub material: Material,
+    /// Section properties.
+    pub section: BeamSection,
+    /// Any vector not parallel to the beam axis; the local y axis lies in its plane with the axis.
+    pub orientation: Vector3<f64>,
+    /// Non-structural mass per length (kg/m) (trim carried by the beam).
+    pub extra_mass_per_length: f64,
+}
+
+/// Four-node flat shell (membrane with drilling rotation + MITC4 plate).
+#[derive(Debug, Clone, PartialEq)]
+pub struct Shell {
+    /// Corner nodes, counter-clockwise seen from the side the normal points to.
+    pub nodes: [usize; 4],
+    /// Material.
+    pub material: Material,
+    /// Thickness (m) (membrane stiffness and mass).
+    pub thickness: f64,
+    /// Effective thickness for plate bending and transverse shear (m): equal to `thickness` for a
+    /// plain sheet, larger for a beaded or stiffened panel in a phenomenological model.
+    pub bending_thickness: f64,
+    /// Non-structural mass per area (kg/m²) (trim carried by the panel).
+    pub extra_mass_per_area: f64,
+}
+
+/// Point mass with rotary inertia (global axes) at a node.
+#[derive(Debug, Clone, PartialEq)]
+pub struct PointMass {
+    /// Node carrying the mass.
+    pub node: usize,
+    /// Mass (kg).
+    pub mass: f64,
+    /// Rotary inertia tensor about the node in global axes (kg m²) (symmetric).
+    pub inertia: Matrix3<f64>,
+}
+
+/// Spring-damper from a node to ground, uncoupled per global DOF.
+#[derive(Debug, Clone, PartialEq)]
+pub struct GroundSpring {
+    /// Node.
+    pub node: usize,
+    /// Stiffness per DOF ux, uy, uz (N/m), rx, ry, rz (N m/rad).
+    pub stiffness: [f64; 6],
+    /// Viscous damping per DOF (N s/m), (N m s/rad).
+    pub damping: [f64; 6],
+}
+
+/// Spring-damper between two nodes acting on the relative displacement per global DOF.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Spring {
+    /// The two nodes.
+    pub nodes: [usize; 2],
+    /// Stiffness per DOF (N/m), (N m/rad).
+    pub stiffness: [f64; 6],
+    /// Viscous damping per DOF (N s/m), (N m s/rad).
+    pub damping: [f64; 6],
+}
+
+/// A complete FE model description before assembly.
+#[derive(Debug, Clone, Default, PartialEq)]
+pub struct Mesh {
+    /// Node coordinates (m); the index is the node id.
+    pub nodes: Vec<Vector3<f64>>,
+    /// Beam elements.
+    pub beams: Vec<Beam>,
+    /// Shell elements.
+    pub shells: Vec<Shell>,
+    /// Point masses.
+    pub masses: Vec<PointMass>,
+    /// Springs to ground.
+    pub ground_springs: Vec<GroundSpring>,
+    /// Two-node springs.
+    pub springs: Vec<Spring>,
+    /// Fixed DOFs `(node, local dof 0..5)`.
+    pub constraints: Vec<(usize, usize)>,
+    /// Named special nodes (engine mounts, steering wheel, seat rail, wheel centres …).
+    pub named_nodes: BTreeMap<String, usize>,
+    /// Named node sets used to describe mode shapes (steering column, front end …).
+    pub regions: BTreeMap<String, Vec<usize>>,
+}
+
+impl Mesh {
+    /// Adds a node and returns its id.
+    pub fn add_node(&mut self, p: Vector3<f64>) -> usize {
+        self.nodes.push(p);
+        self.nodes.len() - 1
+    }
+
+    /// Id of a named node.
+    pub fn named(&self, name: &str) -> Option<usize> {
+        self.named_nodes.get(name).copied()
+    }
+
+    /// Clamps all six DOFs of `node`.
+    pub fn clamp(&mut self, node: usize) {
+        self.constraints.extend((0..6).map(|d| (node, d)));
+    }
+}

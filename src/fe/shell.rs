@@ -1,0 +1,334 @@
+//! Four-node flat shell: bilinear membrane with a Hughes–Brezzi drilling rotation, MITC4
+//! (Bathe–Dvorkin) Mindlin plate that does not shear-lock, lumped mass.
+//!
+//! Local DOFs per node: u, v, w, θx, θy, θz in the element frame (e1, e2, normal).
+//! Plate kinematics: the section rotations are βx = θy, βy = −θx.
+
+use nalgebra::{Matrix2, Matrix3, SMatrix, Vector3};
+
+use super::error::{require_non_negative, require_positive, FeError};
+use super::mesh::Shell;
+
+/// 24 × 24 element matrix, DOF order (ux uy uz rx ry rz) per corner node.
+pub type Mat24 = SMatrix<f64, 24, 24>;
+
+/// Drilling penalty γ = α G t (Hughes & Brezzi 1989). The result is insensitive to α over
+/// decades; α = 0.01 keeps membrane behaviour unaffected while removing the singular θz.
+pub const DRILLING_FACTOR: f64 = 0.01;
+
+/// Shear correction factor of the Mindlin plate.
+const SHEAR_CORRECTION: f64 = 5.0 / 6.0;
+
+const XI: [f64; 4] = [-1.0, 1.0, 1.0, -1.0];
+const ETA: [f64; 4] = [-1.0, -1.0, 1.0, 1.0];
+
+/// Geometry of a flat shell projected onto its mean plane.
+#[derive(Debug, Clone, PartialEq)]
+pub struct ShellGeometry {
+    /// Rows e1, e2, normal of the element frame in global axes.
+    pub frame: Matrix3<f64>,
+    /// Corner coordinates in the element plane.
+    pub local_xy: [[f64; 2]; 4],
+    /// Area of the projected quadrilateral (m²).
+    pub area: f64,
+    /// Largest corner distance from the mean plane divided by √area.
+    pub warp: f64,
+    /// Smallest / largest Jacobian determinant at the corners (≤ 0: inverted or degenerate).
+    pub jacobian_ratio: f64,
+}
+
+fn shape(xi: f64, eta: f64) -> ([f64; 4], [f64; 4], [f64; 4]) {
+    let mut n = [0.0; 4];
+    let mut dxi = [0.0; 4];
+    let mut deta = [0.0; 4];
+    for i in 0..4 {
+        n[i] = 0.25 * (1.0 + xi * XI[i]) * (1.0 + eta * ETA[i]);
+        dxi[i] = 0.25 * XI[i] * (1.0 + eta * ETA[i]);
+        deta[i] = 0.25 * ETA[i] * (1.0 + xi * XI[i]);
+    }
+    (n, dxi, deta)
+}
+
+fn jacobian(xy: &[[f64; 2]; 4], dxi: &[f64; 4], deta: &[f64; 4]) -> Matrix2<f64> {
+    let mut j = Matrix2::zeros();
+    for i in 0..4 {
+        j[(0, 0)] += dxi[i] * xy[i][0];
+        j[(0, 1)] += dxi[i] * xy[i][1];
+        j[(1, 0)] += deta[i] * xy[i][0];
+        j[(1, 1)] += deta[i] * xy[i][1];
+    }
+    j
+}
+
+/// Frame, projected corners and quality measures of shell `index` with corners `p`.
+pub fn geometry(index: usize, p: &[Vector3<f64>; 4]) -> Result<ShellGeometry, FeError> {
+    let normal = (p[2] - p[0]).cross(&(p[3] - p[1]));
+    let nn = normal.norm();
+    if !(nn.is_finite() && nn > 1e-14) {
+        return Err(FeError::Mesh(format!(
+            "shell {index}: degenerate (zero diagonal cross product)"
+        )));
+    }
+    let n = normal / nn;
+    let d1 = p[1] + p[2] - p[0] - p[3];
+    let e1 = d1 - n * n.dot(&d1);
+    let e1n = e1.norm();
+    if e1n.is_nan() || e1n <= 1e-14 {
+        return Err(FeError::Mesh(format!(
+            "shell {index}: degenerate (collapsed edge direction)"
+        )));
+    }
+    let e1 = e1 / e1n;
+    let e2 = n.cross(&e1);
+    let c = (p[0] + p[1] + p[2] + p[3]) / 4.0;
+    let mut local_xy = [[0.0; 2]; 4];
+    let mut max_offset: f64 = 0.0;
+    for i in 0..4 {
+        let d = p[i] - c;
+        local_xy[i] = [d.dot(&e1), d.dot(&e2)];
+        max_offset = max_offset.max(d.dot(&n).abs());
+    }
+    let area = 0.5 * nn;
+    let mut dets = [0.0; 4];
+    for i in 0..4 {
+        let (_, dxi, deta) = shape(XI[i], ETA[i]);
+        dets[i] = jacobian(&local_xy, &dxi, &deta).determinant();
+    }
+    let max_det = dets.iter().cloned().fold(f64::MIN, f64::max);
+    let min_det = dets.iter().cloned().fold(f64::MAX, f64::min);
+    let jacobian_ratio = if max_det > 0.0 {
+        min_det / max_det
+    } else {
+        -1.0
+    };
+    Ok(ShellGeometry {
+        frame: Matrix3::from_rows(&[e1.transpose(), e2.transpose(), n.transpose()]),
+        local_xy,
+        area,
+        warp: max_offset / area.sqrt(),
+        jacobian_ratio,
+    })
+}
+
+fn validate(index: usize, shell: &Shell) -> Result<(), FeError> {
+    let m = &shell.material;
+    let name = |f: &str| format!("shell {index}: {f}");
+    require_positive(&name("thickness"), shell.thickness)?;
+    require_positive(&name("bending_thickness"), shell.bending_thickness)?;
+    require_positive(&name("youngs_modulus"), m.youngs_modulus)?;
+    require_non_negative(&name("density"), m.density)?;
+    require_non_negative(&name("extra_mass_per_area"), shell.extra_mass_per_area)?;
+    if !(m.poisson_ratio > -1.0 && m.poisson_ratio < 0.5) {
+        return Err(FeError::InvalidInput(format!(
+            "shell {index}: poisson_ratio must be in (-1, 0.5), got {}",
+            m.poisson_ratio
+        )));
+    }
+    Ok(())
+}
+
+fn to_global(local: &Mat24, frame: &Matrix3<f64>) -> Mat24 {
+    let mut t = Mat24::zeros();
+    for b in 0..8 {
+        t.fixed_view_mut::<3, 3>(3 * b, 3 * b).copy_from(frame);
+    }
+    t.transpose() * local * t
+}
+
+/// Covariant transverse shear strain row e_r (r = ξ if `along_xi`, else η) at (ξ, η).
+fn covariant_shear_row(xy: &[[f64; 2]; 4], xi: f64, eta: f64, along_xi: bool) -> [f64; 24] {
+    let (n, dxi, deta) = shape(xi, eta);
+    let j = jacobian(xy, &dxi, &deta);
+    let (dn, row) = if along_xi { (dxi, 0) } else { (deta, 1) };
+    let (x_r, y_r) = (j[(row, 0)], j[(row, 1)]);
+    let mut out = [0.0; 24];
+    for i in 0..4 {
+        out[6 * i + 2] = dn[i];
+        out[6 * i + 4] = n[i] * x_r;
+        out[6 * i + 3] = -n[i] * y_r;
+    }
+    out
+}
+
+/// Global stiffness matrix of shell `index` with corners `p`.
+pub fn stiffness(index: usize, shell: &Shell, p: &[Vector3<f64>; 4]) -> Result<Mat24, FeError> {
+    validate(index, shell)?;
+    let geo = geometry(index, p)?;
+    if geo.jacobian_ratio <= 0.0 {
+        return Err(FeError::Mesh(format!(
+            "shell {index}: inverted or non-convex corner (Jacobian ratio {:.3})",
+            geo.jacobian_ratio
+        )));
+    }
+    let xy = &geo.local_xy;
+    let mat = &shell.material;
+    let (e, nu, t) = (mat.youngs_modulus, mat.poisson_ratio, shell.thickness);
+    let tb = shell.bending_thickness;
+    let g = mat.shear_modulus();
+    let iso = Matrix3::new(1.0, nu, 0.0, nu, 1.0, 0.0, 0.0, 0.0, (1.0 - nu) / 2.0);
+    let dm = iso * (e * t / (1.0 - nu * nu));
+    let db = iso * (e * tb.powi(3) / (12.0 * (1.0 - nu * nu)));
+    let ds = SHEAR_CORRECTION * g * tb;
+    let gamma = DRILLING_FACTOR * g * t;
+
+    let tie_xi = [
+        covariant_shear_row(xy, 0.0, -1.0, true),
+        covariant_shear_row(xy, 0.0, 1.0, true),
+    ];
+    let tie_eta = [
+        covariant_shear_row(xy, -1.0, 0.0, false),
+        covariant_shear_row(xy, 1.0, 0.0, false),
+    ];
+
+    let gp = 1.0 / 3.0_f64.sqrt();
+    let mut k = Mat24::zeros();
+    for &(xi, eta) in &[(-gp, -gp), (gp, -gp), (gp, gp), (-gp, gp)] {
+        let (n, dxi, deta) = shape(xi, eta);
+        let j = jacobian(xy, &dxi, &deta);
+        let det = j.determinant();
+        let inv = j.try_inverse().ok_or_else(|| {
+            FeError::Mesh(format!("shell {index}: singular Jacobian at a Gauss point"))
+        })?;
+        let mut dndx = [0.0; 4];
+        let mut dndy = [0.0; 4];
+        for i in 0..4 {
+            dndx[i] = inv[(0, 0)] * dxi[i] + inv[(0, 1)] * deta[i];
+            dndy[i] = inv[(1, 0)] * dxi[i] + inv[(1, 1)] * deta[i];
+        }
+        let mut bm = SMatrix::<f64, 3, 24>::zeros();
+        let mut bb = SMatrix::<f64, 3, 24>::zeros();
+        let mut bd = SMatrix::<f64, 1, 24>::zeros();
+        for i in 0..4 {
+            let (u, v, rx, ry, rz) = (6 * i, 6 * i + 1, 6 * i + 3, 6 * i + 4, 6 * i + 5);
+            bm[(0, u)] = dndx[i];
+            bm[(1, v)] = dndy[i];
+            bm[(2, u)] = dndy[i];
+            bm[(2, v)] = dndx[i];
+            bb[(0, ry)] = dndx[i];
+            bb[(1, rx)] = -dndy[i];
+            bb[(2, ry)] = dndy[i];
+            bb[(2, rx)] = -dndx[i];
+            bd[(0, u)] = 0.5 * dndy[i];
+            bd[(0, v)] = -0.5 * dndx[i];
+            bd[(0, rz)] = n[i];
+        }
+        let mut covariant = SMatrix::<f64, 2, 24>::zeros();
+        for c in 0..24 {
+            covariant[(0, c)] = 0.5 * (1.0 - eta) * tie_xi[0][c] + 0.5 * (1.0 + eta) * tie_xi[1][c];
+            covariant[(1, c)] = 0.5 * (1.0 - xi) * tie_eta[0][c] + 0.5 * (1.0 + xi) * tie_eta[1][c];
+        }
+        let bs = inv * covariant;
+        k += (bm.transpose() * dm * bm
+            + bb.transpose() * db * bb
+            + bs.transpose() * bs * ds
+            + bd.transpose() * bd * gamma)
+            * det;
+    }
+    Ok(to_global(&k, &geo.frame))
+}
+
+/// Global lumped mass matrix of shell `index`: each corner carries the row sum of the consistent
+/// translational mass (∫ N_i ρ t dA) and the same share of the rotary inertia (mass per area
+/// × t_b²/12) about all three axes (isotropic, so it stays diagonal in global axes).
+pub fn lumped_mass(index: usize, shell: &Shell, p: &[Vector3<f64>; 4]) -> Result<Mat24, FeError> {
+    validate(index, shell)?;
+    let geo = geometry(index, p)?;
+    let areal = shell.material.density * shell.thickness + shell.extra_mass_per_area;
+    let rotary = areal * shell.bending_thickness.powi(2) / 12.0;
+    let gp = 1.0 / 3.0_f64.sqrt();
+    let mut share = [0.0; 4];
+    for &(xi, eta) in &[(-gp, -gp), (gp, -gp), (gp, gp), (-gp, gp)] {
+        let (n, dxi, deta) = shape(xi, eta);
+        let det = jacobian(&geo.local_xy, &dxi, &deta).determinant();
+        for i in 0..4 {
+            share[i] += n[i] * det;
+        }
+    }
+    let mut m = Mat24::zeros();
+    for i in 0..4 {
+        for d in 0..3 {
+            m[(6 * i + d, 6 * i + d)] = areal * share[i];
+            m[(6 * i + 3 + d, 6 * i + 3 + d)] = rotary * share[i];
+        }
+    }
+    Ok(m)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::fe::mesh::Material;
+
+    fn plate() -> Shell {
+        Shell {
+            nodes: [0, 1, 2, 3],
+            material: Material::STEEL,
+            thickness: 0.002,
+            bending_thickness: 0.002,
+            extra_mass_per_area: 0.0,
+        }
+    }
+
+    fn corners() -> [Vector3<f64>; 4] {
+        // A skew, tilted quadrilateral exercises the frame and the covariant shear interpolation.
+        let r = nalgebra::Rotation3::from_euler_angles(0.3, -0.5, 0.8);
+        [
+            r * Vector3::new(0.0, 0.0, 0.0),
+            r * Vector3::new(1.1, 0.1, 0.0),
+            r * Vector3::new(1.3, 0.9, 0.0),
+            r * Vector3::new(-0.1, 1.0, 0.0),
+        ]
+    }
+
+    #[test]
+    fn rigid_body_motions_cost_no_energy_and_there_are_exactly_six() {
+        let p = corners();
+        let k = stiffness(0, &plate(), &p).unwrap();
+        let scale = k.abs().max();
+        for mode in 0..6 {
+            let mut u = SMatrix::<f64, 24, 1>::zeros();
+            for (n, x) in p.iter().enumerate() {
+                if mode < 3 {
+                    u[6 * n + mode] = 1.0;
+                } else {
+                    let mut w = Vector3::zeros();
+                    w[mode - 3] = 1.0;
+                    let t = w.cross(x);
+                    for d in 0..3 {
+                        u[6 * n + d] = t[d];
+                        u[6 * n + 3 + d] = w[d];
+                    }
+                }
+            }
+            assert!(
+                (k * u).norm() < 1e-8 * scale,
+                "rigid mode {mode} strains the shell"
+            );
+        }
+        let eig = k.symmetric_eigenvalues();
+        let zero = eig.iter().filter(|v| v.abs() < 1e-9 * scale).count();
+        assert_eq!(
+            zero, 6,
+            "a single shell must have exactly six zero-energy modes"
+        );
+    }
+
+    #[test]
+    fn lumped_mass_sums_to_the_panel_mass() {
+        let p = corners();
+        let s = plate();
+        let m = lumped_mass(0, &s, &p).unwrap();
+        let geo = geometry(0, &p).unwrap();
+        let total: f64 = (0..4).map(|i| m[(6 * i, 6 * i)]).sum();
+        let expected = s.material.density * s.thickness * geo.area;
+        assert!((total - expected).abs() < 1e-12 * expected);
+    }
+
+    #[test]
+    fn bow_tie_quadrilateral_is_rejected_with_its_index() {
+        let mut p = corners();
+        p.swap(1, 2);
+        let err = stiffness(42, &plate(), &p).unwrap_err();
+        assert!(err.to_string().contains("shell 42"), "{err}");
+    }
+}

@@ -1,0 +1,275 @@
+//! The procedural body without engine on its suspension against the paper's targets (paper §5.2,
+//! Table 1): 1000 kg, first global torsion 43 Hz, steering wheel 31.5 Hz vertical / ~32 Hz
+//! lateral; structural options of paper §7.1 move the frequencies in the right direction.
+
+use engine_mount_chassis::fe::assembly::{assemble, translational_mass, Assembled};
+use engine_mount_chassis::fe::chassis::{
+    Chassis, MountLayout, SEAT_RAIL, STEERING_WHEEL, WHEEL_CENTRES,
+};
+use engine_mount_chassis::fe::chassis_config::ChassisConfig;
+use engine_mount_chassis::fe::checks::{check_assembled, check_mesh, CheckLimits};
+use engine_mount_chassis::fe::eigen::{lowest_modes, Modes};
+use engine_mount_chassis::fe::modal::{describe, steering_wheel_pair, ModeDescription, ModeKind};
+use faer::linalg::solvers::Solve;
+use faer::{Mat, Side};
+
+struct Analysis {
+    chassis: Chassis,
+    asm: Assembled,
+    raw: Modes,
+    modes: Vec<ModeDescription>,
+}
+
+fn analyse(config: &ChassisConfig) -> Analysis {
+    let chassis = Chassis::build(config).unwrap();
+    let asm = assemble(&chassis.mesh).unwrap();
+    let raw = lowest_modes(&asm.k, &asm.m, 30, -1.0).unwrap();
+    let modes = describe(&chassis.mesh, &asm, &raw).unwrap();
+    Analysis {
+        chassis,
+        asm,
+        raw,
+        modes,
+    }
+}
+
+/// Static stiffness against spreading the front mount pair apart laterally [N/m].
+fn front_mount_spread_stiffness(an: &Analysis) -> f64 {
+    let n = an.asm.dofs.n_free();
+    let left = an.chassis.node("mount_front_left").unwrap();
+    let right = an.chassis.node("mount_front_right").unwrap();
+    let (gl, gr) = (
+        an.asm.dofs.global(left, 1).unwrap(),
+        an.asm.dofs.global(right, 1).unwrap(),
+    );
+    let mut f = Mat::<f64>::zeros(n, 1);
+    f[(gl, 0)] = 1.0;
+    f[(gr, 0)] = -1.0;
+    let llt = an.asm.k.sp_cholesky(Side::Lower).unwrap();
+    llt.solve_in_place(f.as_mut());
+    1.0 / (f[(gl, 0)] - f[(gr, 0)])
+}
+
+fn within(value: f64, target: f64, tolerance: f64) -> bool {
+    (value / target - 1.0).abs() <= tolerance
+}
+
+/// The two steering-wheel modes: (more vertical, more lateral).
+fn wheel_pair(modes: &[ModeDescription]) -> (&ModeDescription, &ModeDescription) {
+    let (v, l) = steering_wheel_pair(modes).expect("steering-wheel modes");
+    (&modes[v], &modes[l])
+}
+
+/// The front-end mode with the most lateral girder/apron motion.
+fn front_lateral(an: &Analysis) -> f64 {
+    let front = &an.chassis.mesh.regions["front_end"];
+    let mut best = (0.0, 0.0);
+    for d in &an.modes {
+        if d.energy["front_end"] < 0.3 || d.kind != ModeKind::FrontEnd {
+            continue;
+        }
+        let mut lateral = 0.0;
+        let mut total = 0.0;
+        for &n in front {
+            for dof in 0..3 {
+                if let Some(g) = an.asm.dofs.global(n, dof) {
+                    let v = an.raw.shapes[(g, d.index)].powi(2);
+                    total += v;
+                    if dof == 1 {
+                        lateral += v;
+                    }
+                }
+            }
+        }
+        if lateral / total > best.0 {
+            best = (lateral / total, d.frequency_hz);
+        }
+    }
+    best.1
+}
+
+#[test]
+fn body_without_engine_meets_the_paper_targets() {
+    let an = analyse(&ChassisConfig::default());
+    let mesh = &an.chassis.mesh;
+    check_mesh(mesh, &CheckLimits::default()).unwrap();
+    check_assembled(&an.asm).unwrap();
+
+    // Size of the paper's model: ~2600 nodes, 2200 shells, 600 beams, 15000 DOF.
+    let n_dof = an.asm.dofs.n_free();
+    println!(
+        "nodes {}, shells {}, beams {}, dofs {n_dof}",
+        mesh.nodes.len(),
+        mesh.shells.len(),
+        mesh.beams.len()
+    );
+    assert!((2300..=2900).contains(&mesh.nodes.len()));
+    assert!((2000..=2600).contains(&mesh.shells.len()));
+    assert!((540..=700).contains(&mesh.beams.len()));
+    assert!((13500..=16500).contains(&n_dof));
+
+    for dir in 0..3 {
+        let mass = translational_mass(&an.asm, dir);
+        println!("mass seen by a rigid translation along axis {dir}: {mass:.1} kg");
+        assert!(within(mass, 1000.0, 0.05), "mass {mass}");
+    }
+
+    for d in &an.modes {
+        println!("{}", d.summary());
+    }
+    // The six lowest modes are the rigid body on its suspension (≤ 5 Hz).
+    for d in &an.modes[..6] {
+        assert!(
+            matches!(d.kind, ModeKind::RigidBody(_)) && d.frequency_hz < 5.0,
+            "{}",
+            d.summary()
+        );
+    }
+    let torsion = an
+        .modes
+        .iter()
+        .find(|d| d.kind == ModeKind::GlobalTorsion)
+        .expect("torsion mode");
+    assert!(
+        within(torsion.frequency_hz, 43.0, 0.05),
+        "torsion {}",
+        torsion.summary()
+    );
+    let (vertical, lateral) = wheel_pair(&an.modes);
+    println!(
+        "steering wheel: vertical {:.2} Hz, lateral {:.2} Hz",
+        vertical.frequency_hz, lateral.frequency_hz
+    );
+    assert!(
+        within(vertical.frequency_hz, 31.5, 0.05),
+        "{}",
+        vertical.summary()
+    );
+    assert!(
+        within(lateral.frequency_hz, 32.07, 0.05),
+        "{}",
+        lateral.summary()
+    );
+    assert!(vertical.energy["steering"] > 0.4 && lateral.energy["steering"] > 0.4);
+    assert_eq!(vertical.kind, ModeKind::SteeringWheelVertical);
+    assert!(
+        vertical.frequency_hz < lateral.frequency_hz,
+        "paper order: vertical below lateral"
+    );
+}
+
+#[test]
+fn special_nodes_sit_where_the_engine_model_expects_them() {
+    let chassis = Chassis::build(&ChassisConfig::default()).unwrap();
+    let at = |name: &str| chassis.mesh.nodes[chassis.node(name).unwrap()];
+    let expect = [
+        ("mount_front_left", [0.50, 0.40, 0.55]),
+        ("mount_front_right", [0.50, -0.40, 0.55]),
+        ("mount_rear_left", [-0.10, 0.40, 0.55]),
+        ("mount_rear_right", [-0.10, -0.40, 0.55]),
+    ];
+    for (name, p) in expect {
+        let q = at(name);
+        for d in 0..3 {
+            assert!((q[d] - p[d]).abs() < 1e-12, "{name}: {q:?} vs {p:?}");
+        }
+    }
+    let four = chassis.mount_nodes(MountLayout::Four).unwrap();
+    let three = chassis.mount_nodes(MountLayout::Three).unwrap();
+    assert_eq!(four.len(), 4);
+    assert_eq!(three.len(), 3);
+    assert!(three.iter().all(|m| four.contains(m)));
+    for name in WHEEL_CENTRES {
+        let x = at(name).x;
+        assert!(
+            (x - 0.0).abs() < 1e-12 || (x + 2.54).abs() < 1e-12,
+            "{name} at x = {x}"
+        );
+    }
+    at(STEERING_WHEEL);
+    at(SEAT_RAIL);
+}
+
+#[test]
+fn stiffening_bar_raises_the_front_end_and_a_stiffer_front_plate_the_steering_wheel() {
+    let base_cfg = ChassisConfig::default();
+    let base = analyse(&base_cfg);
+    let base_front = front_lateral(&base);
+    let mut bar_cfg = base_cfg.clone();
+    bar_cfg.options.stiffening_bar = true;
+    let bar = analyse(&bar_cfg);
+    let bar_front = front_lateral(&bar);
+    let (base_spread, bar_spread) = (
+        front_mount_spread_stiffness(&base),
+        front_mount_spread_stiffness(&bar),
+    );
+    println!(
+        "static stiffness against spreading the front mounts: {:.0} N/mm -> {:.0} N/mm ({:+.0} %)",
+        base_spread / 1e3,
+        bar_spread / 1e3,
+        100.0 * (bar_spread / base_spread - 1.0)
+    );
+    assert!(bar_spread > base_spread);
+    println!(
+        "front-end lateral mode: {base_front:.2} Hz -> {bar_front:.2} Hz with the stiffening bar \
+         ({:+.1} %)",
+        100.0 * (bar_front / base_front - 1.0)
+    );
+    assert!(bar_front > base_front * 1.005);
+
+    let mut plate_cfg = base_cfg.clone();
+    plate_cfg.options.stiff_front_plate = true;
+    let plate = analyse(&plate_cfg);
+    let (bv, bl) = wheel_pair(&base.modes);
+    let (pv, pl) = wheel_pair(&plate.modes);
+    println!(
+        "steering wheel: {:.2} / {:.2} Hz -> {:.2} / {:.2} Hz with the stiffer front plate",
+        bv.frequency_hz, bl.frequency_hz, pv.frequency_hz, pl.frequency_hz
+    );
+    assert!(pv.frequency_hz > bv.frequency_hz && pl.frequency_hz > bl.frequency_hz);
+}
+
+#[test]
+fn description_errors_name_the_field() {
+    let err = ChassisConfig::from_json(r#"{"geometry": {"grid_dx": -1.0}}"#)
+        .and_then(|c| Chassis::build(&c).map(|_| ()))
+        .unwrap_err()
+        .to_string();
+    assert!(err.contains("geometry.grid_dx"), "{err}");
+    let err = ChassisConfig::from_json(r#"{"mounts": {"front_x": 0.55}}"#)
+        .and_then(|c| Chassis::build(&c).map(|_| ()))
+        .unwrap_err()
+        .to_string();
+    assert!(err.contains("mounts.front_x"), "{err}");
+    let err = ChassisConfig::from_json(r#"{"no_such_field": 1}"#)
+        .unwrap_err()
+        .to_string();
+    assert!(err.contains("no_such_field"), "{err}");
+}
+
+#[test]
+fn shipped_improved_description_is_the_default_with_the_paper_7_1_options() {
+    let text = std::fs::read_to_string(concat!(
+        env!("CARGO_MANIFEST_DIR"),
+        "/configs/chassis_improved.json"
+    ))
+    .unwrap();
+    let improved = ChassisConfig::from_json(&text).unwrap();
+    let mut expected = ChassisConfig::default();
+    expected.options.stiffening_bar = true;
+    expected.options.stiff_front_plate = true;
+    assert_eq!(improved, expected);
+    let chassis = Chassis::build(&improved).unwrap();
+    assert_eq!(chassis.mount_nodes(MountLayout::Three).unwrap().len(), 3);
+}
+
+#[test]
+fn shipped_json_description_is_the_default() {
+    let text =
+        std::fs::read_to_string(concat!(env!("CARGO_MANIFEST_DIR"), "/configs/chassis.json"))
+            .unwrap();
+    assert_eq!(
+        ChassisConfig::from_json(&text).unwrap(),
+        ChassisConfig::default()
+    );
+}
