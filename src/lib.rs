@@ -9,6 +9,7 @@
 //! - [`cosim`]: a scene with its integrator and inputs, stepped between communication points.
 //! - [`fmi2`]: the FMI 2.0 co-simulation C ABI (the only `unsafe` code).
 
+pub mod cms;
 pub mod cosim;
 pub mod fe;
 pub mod fmi2;

@@ -1,0 +1,38 @@
+//! The reduced chassis as the coupled model sees it.
+
+use serde::{Deserialize, Serialize};
+
+/// A point of the chassis whose motion is recovered from the modal coordinates.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct RecoveryPoint {
+    /// e.g. "mount_front_left", "steering_wheel", "seat_rail".
+    pub name: String,
+    /// FE node id.
+    pub node: usize,
+    /// Undeformed position, vehicle frame (m).
+    pub position: [f64; 3],
+    /// `shape[k]`: the point's motion (ux, uy, uz, rx, ry, rz; m and rad, vehicle axes) for a unit
+    /// modal coordinate `k`.
+    pub shape: Vec<[f64; 6]>,
+}
+
+/// A Craig-Bampton reduced, constraint-mode-orthogonalised chassis.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct ReducedChassis {
+    /// Natural frequency of each mode, rad/s, ascending (reduced K = diag(ω²), reduced M = I).
+    pub omega: Vec<f64>,
+    /// Modal damping ratio of each mode.
+    pub zeta: Vec<f64>,
+    /// Interface (mount) nodes first, then output points.
+    pub points: Vec<RecoveryPoint>,
+}
+
+impl ReducedChassis {
+    pub fn n_modes(&self) -> usize {
+        self.omega.len()
+    }
+
+    pub fn point(&self, name: &str) -> Option<&RecoveryPoint> {
+        self.points.iter().find(|p| p.name == name)
+    }
+}
