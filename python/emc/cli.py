@@ -103,6 +103,18 @@ def cmd_runup(args) -> int:
     return 0
 
 
+def cmd_bench_effects(args) -> int:
+    from .bench import effects_table
+
+    table = effects_table(args.fmu, scenes=args.scene, rpm=args.rpm_point, seconds=args.seconds,
+                          signal=args.signal_name)
+    with pd.option_context("display.width", 160, "display.max_columns", 20):
+        print(table.to_string(index=False, float_format=lambda v: f"{v:.4g}"))
+    if args.out:
+        save(table, args.out)
+    return 0
+
+
 def main(argv: list[str] | None = None) -> int:
     parser = argparse.ArgumentParser(prog="emc", description=__doc__,
                                      formatter_class=argparse.RawDescriptionHelpFormatter)
@@ -139,7 +151,18 @@ def main(argv: list[str] | None = None) -> int:
     r.add_argument("--window", type=float, default=0.25, help="analysis window (s)")
     r.set_defaults(func=cmd_runup)
 
+    b = sub.add_parser("bench-effects", help="CPU time per simulated second for each scene and effect set")
+    b.add_argument("--fmu", default="dist/EngineMountChassis.fmu")
+    b.add_argument("--scene", type=int, action="append", help="scene(s) to measure (default 1)")
+    b.add_argument("--rpm-point", type=float, default=2000.0)
+    b.add_argument("--seconds", type=float, default=1.0, help="simulated time per case")
+    b.add_argument("--signal-name", default="mount[1].F[3]", help="signal whose RMS is reported")
+    b.add_argument("--out", help="also write the table (CSV or .parquet)")
+    b.set_defaults(func=cmd_bench_effects)
+
     args = parser.parse_args(argv)
+    if getattr(args, "scene", None) is None and args.command == "bench-effects":
+        args.scene = [1]
     return args.func(args)
 
 
