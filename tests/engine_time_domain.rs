@@ -2,7 +2,7 @@
 
 use engine_mount_chassis::model::orders::order_amplitude;
 use engine_mount_chassis::model::{EngineConfig, GroundScene};
-use engine_mount_chassis::ode::{Bdf, BdfOptions, OdeProblem, Tolerance};
+use engine_mount_chassis::ode::{Bdf, BdfOptions, Tolerance};
 
 fn undamped_config() -> EngineConfig {
     let mut cfg = EngineConfig::default();

@@ -47,11 +47,18 @@ pub struct Evaluation {
 
 /// How the model is evaluated.
 #[derive(Debug, Clone, Copy, PartialEq)]
-struct Mode {
+pub(crate) struct Mode {
     /// Engine running (crank speed, gas, fade-in); false: crank at rest, no gas (statics, modes).
-    running: bool,
+    pub(crate) running: bool,
     /// Force the nonlinear mount curves (statics determine the operating point with them).
-    nonlinear_mounts: bool,
+    pub(crate) nonlinear_mounts: bool,
+}
+
+impl Mode {
+    pub(crate) const RUNNING: Mode = Mode {
+        running: true,
+        nonlinear_mounts: false,
+    };
 }
 
 /// Engine on mounts attached to rigid ground.
@@ -305,54 +312,12 @@ impl GroundScene {
     fn evaluate_mode(&self, t: f64, y: &[f64], mode: Mode) -> Evaluation {
         let nb = self.bodies.len();
         let kin: Vec<BodyKinematics> = (0..nb).map(|b| self.kinematics(y, b)).collect();
-        let crank = self.crank_state(t, y, mode);
-        let mut dynamics = vec![BodyDynamics::zero(); nb];
-        for b in 0..nb {
-            add_parts(
-                &self.bodies[b].parts,
-                &kin[b],
-                &crank,
-                &self.gravity,
-                &mut dynamics[b],
-            );
-        }
-        let phi = y[self.crank_index()];
-        if mode.running {
-            self.add_gas_forces(&kin[0], phi, self.excitation(t), &mut dynamics[0]);
-        }
-        if nb == 2 {
-            for rc in &self.ring_carriers {
-                let w = rc.wrench(&kin[0], &kin[1]);
-                dynamics[0].add_point_force(&kin[0], &w.monoblock_point, &w.monoblock_force);
-                dynamics[0].add_wrench(&Vector3::zeros(), &w.monoblock_moment);
-                dynamics[1].add_point_force(&kin[1], &w.housing_point, &w.housing_force);
-                dynamics[1].add_wrench(&Vector3::zeros(), &w.housing_moment);
-            }
-        }
+        let mut dynamics: Vec<BodyDynamics> = (0..nb)
+            .map(|b| self.local_dynamics(t, y, &kin[b], b, mode))
+            .collect();
+        self.add_ring_carriers(&kin, &mut dynamics);
         let hb = nb - 1;
-        let h = &kin[hb];
-        let nonlinear = mode.nonlinear_mounts || self.config.effects.mount_nonlinearity;
-        let mut mounts = Vec::with_capacity(self.mounts.len());
-        for (i, m) in self.mounts.iter().enumerate() {
-            let Some(m) = m else {
-                mounts.push(None);
-                continue;
-            };
-            let local = m.bracket - self.bodies[hb].reference;
-            let x = h.point(&local);
-            let xv = h.point_velocity(&local);
-            let r = m.response(
-                &(x - m.attachment),
-                &xv,
-                self.inputs.stiffness_scale[i],
-                self.inputs.damping_scale[i],
-                nonlinear,
-            );
-            dynamics[hb].add_point_force(h, &x, &r.force);
-            mounts.push(Some(r));
-        }
-        let torque = self.inputs.load_torque.at(t);
-        dynamics[hb].add_wrench(&Vector3::zeros(), &(h.rotation * Vector3::y() * torque));
+        let mounts = self.add_mounts(&kin[hb], mode, &mut dynamics[hb]);
         let e = kin[0].rotation * Vector3::y();
         let crank_rate = if mode.running {
             self.inputs.crank_speed.at(t)
@@ -365,6 +330,73 @@ impl GroundScene {
             mounts,
             crank_rate,
         }
+    }
+
+    /// Contributions that depend on one body's coordinates only (and on the crank angle): its
+    /// parts with gravity, the gas side forces (monoblock), the load torque (housing).
+    pub(crate) fn local_dynamics(
+        &self,
+        t: f64,
+        y: &[f64],
+        kin: &BodyKinematics,
+        b: usize,
+        mode: Mode,
+    ) -> BodyDynamics {
+        let mut d = BodyDynamics::zero();
+        let crank = self.crank_state(t, y, mode);
+        add_parts(&self.bodies[b].parts, kin, &crank, &self.gravity, &mut d);
+        if b == 0 && mode.running {
+            self.add_gas_forces(kin, y[self.crank_index()], self.excitation(t), &mut d);
+        }
+        if b == self.bodies.len() - 1 {
+            let torque = self.inputs.load_torque.at(t);
+            d.add_wrench(&Vector3::zeros(), &(kin.rotation * Vector3::y() * torque));
+        }
+        d
+    }
+
+    /// Ring-carrier forces on monoblock and housing (nothing for a rigid powertrain).
+    pub(crate) fn add_ring_carriers(&self, kin: &[BodyKinematics], dynamics: &mut [BodyDynamics]) {
+        if kin.len() != 2 {
+            return;
+        }
+        for rc in &self.ring_carriers {
+            let w = rc.wrench(&kin[0], &kin[1]);
+            dynamics[0].add_point_force(&kin[0], &w.monoblock_point, &w.monoblock_force);
+            dynamics[0].add_wrench(&Vector3::zeros(), &w.monoblock_moment);
+            dynamics[1].add_point_force(&kin[1], &w.housing_point, &w.housing_force);
+            dynamics[1].add_wrench(&Vector3::zeros(), &w.housing_moment);
+        }
+    }
+
+    /// Mount forces on the housing `h`; returns the responses per configured mount.
+    fn add_mounts(
+        &self,
+        h: &BodyKinematics,
+        mode: Mode,
+        out: &mut BodyDynamics,
+    ) -> Vec<Option<MountResponse>> {
+        let hb = self.bodies.len() - 1;
+        let nonlinear = mode.nonlinear_mounts || self.config.effects.mount_nonlinearity;
+        self.mounts
+            .iter()
+            .enumerate()
+            .map(|(i, m)| {
+                let m = m.as_ref()?;
+                let local = m.bracket - self.bodies[hb].reference;
+                let x = h.point(&local);
+                let xv = h.point_velocity(&local);
+                let r = m.response(
+                    &(x - m.attachment),
+                    &xv,
+                    self.inputs.stiffness_scale[i],
+                    self.inputs.damping_scale[i],
+                    nonlinear,
+                );
+                out.add_point_force(h, &x, &r.force);
+                Some(r)
+            })
+            .collect()
     }
 
     /// Piston side-force pairs (paper §4.2) on the monoblock `body`: `−F_N` at each piston pin,
@@ -400,14 +432,7 @@ impl GroundScene {
 
     /// One evaluation of the equations of motion of the running engine at `(t, y)`.
     pub fn evaluate(&self, t: f64, y: &[f64]) -> Evaluation {
-        self.evaluate_mode(
-            t,
-            y,
-            Mode {
-                running: true,
-                nonlinear_mounts: false,
-            },
-        )
+        self.evaluate_mode(t, y, Mode::RUNNING)
     }
 
     /// Generalised forces at rest (crank standing, no gas), nonlinear mounts: the static residual.
@@ -557,6 +582,11 @@ impl OdeProblem for GroundScene {
 
     fn has_mass_matrix(&self) -> bool {
         true
+    }
+
+    fn jacobian(&mut self, t: f64, y: &[f64], j: MatMut<'_, f64>) -> Result<bool, ProblemError> {
+        self.structured_jacobian(t, y, j)?;
+        Ok(true)
     }
 
     fn mass(&mut self, t: f64, y: &[f64], mut m: MatMut<'_, f64>) -> Result<(), ProblemError> {

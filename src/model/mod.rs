@@ -15,6 +15,7 @@ pub mod effects;
 pub mod gas;
 pub mod ground_scene;
 pub mod inputs;
+mod jacobian;
 pub mod modes;
 pub mod mount;
 pub mod mount_curve;
