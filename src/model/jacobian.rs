@@ -50,7 +50,7 @@ impl GroundScene {
         }
         let kin: Vec<_> = (0..nb).map(|b| self.kinematics(y, b)).collect();
         // Kinematic rows.
-        for b in 0..nb {
+        for (b, kb) in kin.iter().enumerate() {
             let (q, v) = (6 * b, 6 * nb + 6 * b);
             for i in 0..3 {
                 j[(q + i, v + i)] = 1.0;
@@ -59,7 +59,7 @@ impl GroundScene {
             let g_inv = angular_velocity_map(&theta)
                 .try_inverse()
                 .ok_or_else(|| ProblemError::Recoverable("Cardan singularity".into()))?;
-            let rates = g_inv * kin[b].omega;
+            let rates = g_inv * kb.omega;
             for k in 0..3 {
                 let col = -(g_inv * d_angular_velocity_map(&theta, k) * rates);
                 for i in 0..3 {
