@@ -137,3 +137,19 @@ fn linearised_mounts_share_the_operating_point_but_not_the_large_motion() {
         fb[12 + 10]
     );
 }
+
+#[test]
+fn gas_load_can_change_at_run_time() {
+    let mut cfg = EngineConfig::default();
+    cfg.gas.load = 1.0;
+    let full = GroundScene::new(cfg.clone()).expect("scene");
+    cfg.gas.load = 0.0;
+    let mut scene = GroundScene::new(cfg).expect("scene");
+    let tdc = 8f64.to_radians();
+    let idle_p = scene.cylinder_pressure(0, tdc).expect("gas");
+    scene.set_gas_load(1.0).expect("load");
+    let p = scene.cylinder_pressure(0, tdc).expect("gas");
+    assert_eq!(p, full.cylinder_pressure(0, tdc).expect("gas"));
+    assert!(p > 1.5 * idle_p);
+    assert!(scene.set_gas_load(1.2).is_err());
+}

@@ -25,6 +25,8 @@ use crate::ode::{OdeProblem, ProblemError};
 #[derive(Debug, Clone, PartialEq)]
 struct GasExcitation {
     curve: PressureCurve,
+    /// Idle and full-load curves of the Wiebe model, for changing the load at run time.
+    load_points: Option<(PressureCurve, PressureCurve)>,
     area: f64,
     crankcase_pressure: f64,
     radius: f64,
@@ -118,16 +120,17 @@ impl GroundScene {
                 crank_radius: c.crank_radius,
                 conrod: c.conrod_length,
             };
-            let curve = match &config.gas.model {
-                GasModel::Wiebe(w) => PressureCurve::blend(
-                    &PressureCurve::wiebe(w, &w.idle, &geometry),
-                    &PressureCurve::wiebe(w, &w.full_load, &geometry),
-                    config.gas.load,
-                ),
-                GasModel::Table(t) => PressureCurve::from_table(t),
+            let (curve, load_points) = match &config.gas.model {
+                GasModel::Wiebe(w) => {
+                    let idle = PressureCurve::wiebe(w, &w.idle, &geometry);
+                    let full = PressureCurve::wiebe(w, &w.full_load, &geometry);
+                    (PressureCurve::blend(&idle, &full, config.gas.load), Some((idle, full)))
+                }
+                GasModel::Table(t) => (PressureCurve::from_table(t), None),
             };
             GasExcitation {
                 curve,
+                load_points,
                 area: geometry.piston_area(),
                 crankcase_pressure: config.gas.crankcase_pressure,
                 radius: c.crank_radius,
@@ -247,6 +250,22 @@ impl GroundScene {
         }
         self.inputs.stiffness_scale[index] = stiffness;
         self.inputs.damping_scale[index] = damping;
+        Ok(())
+    }
+
+    /// Engine load between idle (0) and full load (1) of the Wiebe gas model, at run time.
+    /// Ignored (Ok) when gas forces are off; an error for a user pressure table.
+    pub fn set_gas_load(&mut self, load: f64) -> Result<(), InputError> {
+        if !(load.is_finite() && (0.0..=1.0).contains(&load)) {
+            return Err(InputError(format!("gas load {load} must lie in [0, 1]")));
+        }
+        if let Some(gas) = &mut self.gas {
+            let Some((idle, full)) = &gas.load_points else {
+                return Err(InputError("the gas pressure comes from a user table; its load cannot change".into()));
+            };
+            gas.curve = PressureCurve::blend(idle, full, load);
+        }
+        self.config.gas.load = load;
         Ok(())
     }
 
