@@ -114,41 +114,54 @@ impl GroundScene {
             Vec::new()
         };
         let c = &config.crank_drive;
-        let gas = config.effects.gas_forces.then(|| {
-            let geometry = CylinderGeometry {
-                bore: c.bore,
-                crank_radius: c.crank_radius,
-                conrod: c.conrod_length,
-            };
-            let (curve, load_points) = match &config.gas.model {
-                GasModel::Wiebe(w) => {
-                    let idle = PressureCurve::wiebe(w, &w.idle, &geometry);
-                    let full = PressureCurve::wiebe(w, &w.full_load, &geometry);
-                    (PressureCurve::blend(&idle, &full, config.gas.load), Some((idle, full)))
-                }
-                GasModel::Table(t) => (PressureCurve::from_table(t), None),
-            };
-            GasExcitation {
-                curve,
-                load_points,
-                area: geometry.piston_area(),
-                crankcase_pressure: config.gas.crankcase_pressure,
-                radius: c.crank_radius,
-                conrod: c.conrod_length,
-                cylinders: c
-                    .cylinders
-                    .iter()
-                    .map(|k| {
+        let gas = if !config.effects.gas_forces {
+            None
+        } else {
+            Some({
+                let geometry = CylinderGeometry {
+                    bore: c.bore,
+                    crank_radius: c.crank_radius,
+                    conrod: c.conrod_length,
+                };
+                let (curve, load_points) = match &config.gas.model {
+                    GasModel::Wiebe(w) => {
+                        let idle = PressureCurve::wiebe(w, &w.idle, &geometry);
+                        let full = PressureCurve::wiebe(w, &w.full_load, &geometry);
                         (
-                            k.y_offset,
-                            k.throw_deg.to_radians(),
-                            k.firing_tdc_deg.to_radians(),
+                            PressureCurve::blend(&idle, &full, config.gas.load),
+                            Some((idle, full)),
                         )
-                    })
-                    .collect(),
-                crank_centre: v3(&c.crank_centre) - bodies[0].reference,
-            }
-        });
+                    }
+                    GasModel::Table(t) => (
+                        PressureCurve::from_table(t).map_err(|message| ConfigError {
+                            field: "gas.model".into(),
+                            message,
+                        })?,
+                        None,
+                    ),
+                };
+                GasExcitation {
+                    curve,
+                    load_points,
+                    area: geometry.piston_area(),
+                    crankcase_pressure: config.gas.crankcase_pressure,
+                    radius: c.crank_radius,
+                    conrod: c.conrod_length,
+                    cylinders: c
+                        .cylinders
+                        .iter()
+                        .map(|k| {
+                            (
+                                k.y_offset,
+                                k.throw_deg.to_radians(),
+                                k.firing_tdc_deg.to_radians(),
+                            )
+                        })
+                        .collect(),
+                    crank_centre: v3(&c.crank_centre) - bodies[0].reference,
+                }
+            })
+        };
         let gravity = Vector3::new(0.0, 0.0, -config.gravity);
         let inputs = EngineInputs::new(config.mounts.len());
         Ok(Self {
@@ -261,7 +274,9 @@ impl GroundScene {
         }
         if let Some(gas) = &mut self.gas {
             let Some((idle, full)) = &gas.load_points else {
-                return Err(InputError("the gas pressure comes from a user table; its load cannot change".into()));
+                return Err(InputError(
+                    "the gas pressure comes from a user table; its load cannot change".into(),
+                ));
             };
             gas.curve = PressureCurve::blend(idle, full, load);
         }
@@ -289,7 +304,7 @@ impl GroundScene {
     }
 
     /// Pose and velocity of body `b` in state `y`.
-    pub fn kinematics(&self, y: &[f64], b: usize) -> BodyKinematics {
+    pub(crate) fn kinematics(&self, y: &[f64], b: usize) -> BodyKinematics {
         let nb = self.bodies.len();
         let q = &y[6 * b..6 * b + 6];
         let v = &y[6 * nb + 6 * b..6 * nb + 6 * b + 6];
@@ -450,7 +465,7 @@ impl GroundScene {
     }
 
     /// One evaluation of the equations of motion of the running engine at `(t, y)`.
-    pub fn evaluate(&self, t: f64, y: &[f64]) -> Evaluation {
+    pub(crate) fn evaluate(&self, t: f64, y: &[f64]) -> Evaluation {
         self.evaluate_mode(t, y, Mode::RUNNING)
     }
 
@@ -511,7 +526,7 @@ impl GroundScene {
     }
 
     /// Mass matrix blocks (one 6×6 per body) at `(t, y)`.
-    pub fn body_mass(&self, t: f64, y: &[f64]) -> Vec<Matrix6<f64>> {
+    pub(crate) fn body_mass(&self, t: f64, y: &[f64]) -> Vec<Matrix6<f64>> {
         self.evaluate(t, y)
             .dynamics
             .iter()
@@ -520,7 +535,7 @@ impl GroundScene {
     }
 
     /// Accelerations `[u'', ω']` per body from one evaluation of the equations of motion.
-    pub fn accelerations(&self, ev: &Evaluation) -> Result<Vec<Vector6<f64>>, ProblemError> {
+    pub(crate) fn accelerations(&self, ev: &Evaluation) -> Result<Vec<Vector6<f64>>, ProblemError> {
         ev.dynamics
             .iter()
             .map(|d| {
@@ -532,8 +547,24 @@ impl GroundScene {
             .collect()
     }
 
+    /// Checks that `y` is a state of this scene.
+    pub fn check_state(&self, y: &[f64]) -> Result<(), ProblemError> {
+        let n = self.dim();
+        if y.len() != n {
+            return Err(ProblemError::Fatal(format!(
+                "state has {} entries, the engine model has {n}",
+                y.len()
+            )));
+        }
+        if let Some(i) = y.iter().position(|v| !v.is_finite()) {
+            return Err(ProblemError::Fatal(format!("state entry {i} is {}", y[i])));
+        }
+        Ok(())
+    }
+
     /// Total mechanical energy: kinetic + gravity + mounts + ring carriers (for energy checks).
-    pub fn energy(&self, t: f64, y: &[f64]) -> f64 {
+    pub fn energy(&self, t: f64, y: &[f64]) -> Result<f64, ProblemError> {
+        self.check_state(y)?;
         let ev = self.evaluate(t, y);
         let nb = self.bodies.len();
         let mut e = 0.0;
@@ -567,7 +598,7 @@ impl GroundScene {
                 e += rc.energy(&rc.wrench(&ev.kinematics[0], &ev.kinematics[1]).deflection);
             }
         }
-        e
+        Ok(e)
     }
 
     /// State with every body at its reference pose and the crank at the start angle.
@@ -595,6 +626,14 @@ impl OdeProblem for GroundScene {
     }
 
     fn rhs(&mut self, t: f64, y: &[f64], f: &mut [f64]) -> Result<(), ProblemError> {
+        if y.len() != self.dim() || f.len() != self.dim() {
+            return Err(ProblemError::Fatal(format!(
+                "state/derivative lengths {}/{} differ from {}",
+                y.len(),
+                f.len(),
+                self.dim()
+            )));
+        }
         let ev = self.evaluate(t, y);
         self.write_rhs(y, &ev, f)
     }
