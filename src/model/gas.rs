@@ -81,7 +81,7 @@ impl Default for WiebeModel {
                     },
                     WiebeStage {
                         fraction: 0.92,
-                        start_deg: -4.0,
+                        start_deg: -6.0,
                         duration_deg: 60.0,
                         shape: 0.9,
                     },
