@@ -284,6 +284,20 @@ impl GroundScene {
         Ok(())
     }
 
+    /// Start of the excitation fade-in.
+    pub fn fade_start(&self) -> f64 {
+        self.fade_start
+    }
+
+    /// Sets the operating points of the linearised mounts (per configured mount).
+    pub(crate) fn set_operating_points(&mut self, points: &[Vector3<f64>]) {
+        for (m, p) in self.mounts.iter_mut().zip(points) {
+            if let Some(m) = m {
+                m.operating_point = *p;
+            }
+        }
+    }
+
     /// Time from which the excitation fades in (set by [`Self::static_equilibrium`]).
     pub fn set_fade_start(&mut self, t: f64) {
         self.fade_start = t;

@@ -54,6 +54,7 @@ pub mod parts;
 pub mod reaction;
 pub mod ring_carrier;
 pub mod rotation;
+pub mod snapshot;
 mod statics;
 
 pub use config::{ConfigError, EngineConfig};
@@ -64,3 +65,4 @@ pub use inputs::{EngineInputs, InputError, RampInput};
 pub use modes::{mode_table, Direction, Mode, ModeKind};
 pub use outputs::{BodyMotion, EngineOutputs};
 pub use reaction::Wrench;
+pub use snapshot::SceneSnapshot;
