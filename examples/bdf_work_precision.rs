@@ -298,8 +298,11 @@ mod cvode {
     }
 }
 
+/// Builds a fresh problem for each run.
+type Maker = Box<dyn FnMut() -> Box<dyn ProblemBox>>;
+
 fn main() {
-    let cases: Vec<(&str, Box<dyn FnMut() -> Box<dyn ProblemBox>>)> = vec![
+    let cases: Vec<(&str, Maker)> = vec![
         (
             "chain 20-DOF + 2 kHz, 1 s",
             Box::new(|| Box::new(Chain(SpringChain::standard(false))) as Box<dyn ProblemBox>),
