@@ -1,5 +1,5 @@
-//! Work-precision table: this crate's BDF against SUNDIALS CVODE (feature `bench-cvode`) on the
-//! same right-hand sides and Jacobians. Run with `scripts/bench-ode.sh`.
+//! Work-precision table: this crate's BDF against SUNDIALS CVODE (feature `bench-cvode`) and
+//! diffsol's BDF (feature `bench-diffsol`) on the same right-hand sides and Jacobians. Run with `scripts/bench-ode.sh`.
 //!
 //! Problems: the 20-DOF spring–mass chain with a 2 kHz mode (error vs the exact modal solution,
 //! relative to the largest state) and Robertson to t = 40 (max relative error vs the literature).
@@ -298,6 +298,97 @@ mod cvode {
     }
 }
 
+#[cfg(feature = "bench-diffsol")]
+mod diffsol_driver {
+    //! diffsol's BDF (faer dense LU) on the same right-hand side; the Jacobian is supplied as a
+    //! Jacobian-vector product backed by the same analytic Jacobian (cached per (t, y)).
+    use super::{ProblemBox, Row};
+    use diffsol::{FaerLU, FaerMat, OdeBuilder, OdeSolverMethod, OdeSolverStopReason, Vector};
+    use std::cell::RefCell;
+    use std::time::Instant;
+
+    struct Shared {
+        pb: Box<dyn ProblemBox>,
+        jac: faer::Mat<f64>,
+        at: Option<(f64, Vec<f64>)>,
+        rhs_calls: u64,
+        jac_calls: u64,
+    }
+
+    pub fn run(make: &mut dyn FnMut() -> Box<dyn ProblemBox>, rtol: f64) -> Row {
+        let pb = make();
+        let y0 = pb.y0();
+        let t_end = pb.t_end();
+        let atol = pb.atol(rtol);
+        let n = y0.len();
+        let shared = RefCell::new(Shared { pb, jac: faer::Mat::zeros(n, n), at: None, rhs_calls: 0, jac_calls: 0 });
+        let clock = Instant::now();
+        let problem = OdeBuilder::<FaerMat<f64>>::new()
+            .rtol(rtol)
+            .atol(atol)
+            .rhs_implicit(
+                |x: &[f64], _p: &[f64], t: f64, y: &mut [f64]| {
+                    let mut s = shared.borrow_mut();
+                    s.rhs_calls += 1;
+                    s.pb.problem().rhs(t, x, y);
+                },
+                |x: &[f64], _p: &[f64], t: f64, v: &[f64], y: &mut [f64]| {
+                    let mut s = shared.borrow_mut();
+                    let fresh = matches!(&s.at, Some((ta, xa)) if *ta == t && xa.as_slice() == x);
+                    if !fresh {
+                        s.jac_calls += 1;
+                        let mut j = std::mem::replace(&mut s.jac, faer::Mat::zeros(0, 0));
+                        s.pb.problem().jac(t, x, &mut j);
+                        s.jac = j;
+                        s.at = Some((t, x.to_vec()));
+                    }
+                    y.iter_mut().for_each(|v| *v = 0.0);
+                    for (c, vc) in v.iter().enumerate() {
+                        for (yi, jic) in y.iter_mut().zip(s.jac.col_as_slice(c)) {
+                            *yi += jic * vc;
+                        }
+                    }
+                },
+            )
+            .init(
+                move |_p: &[f64], _t: f64, y: &mut [f64]| y.copy_from_slice(&y0),
+                n,
+            )
+            .build()
+            .expect("diffsol problem builds");
+        let mut solver = problem.bdf::<FaerLU<f64>>().expect("diffsol BDF");
+        let mut failed = false;
+        if solver.set_stop_time(t_end).is_err() {
+            failed = true;
+        }
+        while !failed {
+            match solver.step() {
+                Ok(OdeSolverStopReason::TstopReached) => break,
+                Ok(_) => {}
+                Err(e) => {
+                    eprintln!("diffsol failed at rtol {rtol}: {e}");
+                    failed = true;
+                }
+            }
+        }
+        let y = solver.state().y.clone_as_vec();
+        let st = solver.get_statistics().clone();
+        let cpu_ms = clock.elapsed().as_secs_f64() * 1e3;
+        drop(solver);
+        drop(problem);
+        let s = shared.into_inner();
+        Row {
+            solver: "diffsol 0.18 BDF",
+            steps: st.number_of_steps as u64,
+            rhs: s.rhs_calls,
+            jac: s.jac_calls,
+            lu: st.number_of_linear_solver_setups as u64,
+            cpu_ms,
+            error: s.pb.error(&y),
+        }
+    }
+}
+
 /// Builds a fresh problem for each run.
 type Maker = Box<dyn FnMut() -> Box<dyn ProblemBox>>;
 
@@ -326,6 +417,8 @@ fn main() {
             ];
             #[cfg(feature = "bench-cvode")]
             rows.push(timed(|| cvode::run(&mut make, rtol)));
+            #[cfg(feature = "bench-diffsol")]
+            rows.push(timed(|| diffsol_driver::run(&mut make, rtol)));
             for r in rows {
                 println!(
                     "| {name} | {rtol:.0e} | {} | {} | {} | {} | {} | {:.2} | {:.2e} |",
@@ -334,6 +427,6 @@ fn main() {
             }
         }
     }
-    #[cfg(not(feature = "bench-cvode"))]
-    println!("\n(CVODE columns need `--features bench-cvode`; see scripts/bench-ode.sh)");
+    #[cfg(not(all(feature = "bench-cvode", feature = "bench-diffsol")))]
+    println!("\n(CVODE and diffsol rows need `--features bench-cvode,bench-diffsol`; see scripts/bench-ode.sh)");
 }

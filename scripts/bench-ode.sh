@@ -8,4 +8,4 @@ fi
 if ! dpkg -s libclang-dev >/dev/null 2>&1; then
     apt-get update && apt-get install -y clang libclang-dev
 fi
-cargo run --release --example bdf_work_precision --features bench-cvode
+cargo run --release --example bdf_work_precision --features bench-cvode,bench-diffsol

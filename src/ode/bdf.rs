@@ -567,15 +567,11 @@ impl Bdf {
         for i in 0..self.s.n {
             let y = self.s.zn.zn[0][i];
             let yp = self.s.zn.zn[1][i];
-            let denom = 0.1 * y.abs()
-                + self
-                    .s
-                    .opts
-                    .atol
-                    .get(i)
-                    .max(self.s.opts.rtol * y.abs())
-                    .max(f64::MIN_POSITIVE);
-            hub_inv = hub_inv.max(yp.abs() / denom);
+            let denom = 0.1 * y.abs() + self.s.opts.atol.get(i);
+            // A component that is zero with zero absolute tolerance gives no bound.
+            if denom > 0.0 {
+                hub_inv = hub_inv.max(yp.abs() / denom);
+            }
         }
         let mut hub = 0.1 * tdist;
         if hub * hub_inv > 1.0 {

@@ -7,7 +7,7 @@
 //! short window and caps the order at 2 (A-stable) for a while; if the pattern recurs soon
 //! after the cap is lifted, the hold doubles.
 
-/// Failures at order >= 3 needed inside the window to trigger the cap.
+/// Steps with failures at order >= 3 needed inside the window to trigger the cap.
 const TRIGGER_FAILURES: usize = 3;
 /// Window length in accepted steps.
 const WINDOW_STEPS: u64 = 25;
@@ -71,7 +71,15 @@ impl StabilityGuard {
         }
         self.failures.retain(|(n, _)| n + WINDOW_STEPS >= nst);
         self.failures.push((nst, h));
-        if self.failures.len() < TRIGGER_FAILURES {
+        // Several failures on one step are ordinary step-size recovery; the instability shows
+        // as failures on distinct steps.
+        let mut distinct_steps = 1;
+        for pair in self.failures.windows(2) {
+            if pair[1].0 != pair[0].0 {
+                distinct_steps += 1;
+            }
+        }
+        if distinct_steps < TRIGGER_FAILURES {
             return;
         }
         let h_first = self.failures[0].1;
@@ -132,7 +140,17 @@ mod tests {
         assert_eq!(g.order_cap(13, 5), 5);
         g.record_error_test_failure(14, 0.0, 3, 0.9e-3);
         assert_eq!(g.order_cap(15, 5), 2);
+        assert_eq!(g.order_cap(14 + INITIAL_HOLD - 1, 5), 2);
         assert_eq!(g.order_cap(14 + INITIAL_HOLD, 5), 5);
+    }
+
+    #[test]
+    fn ignores_repeated_failures_of_one_step() {
+        let mut g = StabilityGuard::default();
+        for _ in 0..5 {
+            g.record_error_test_failure(10, 0.0, 5, 1e-3);
+        }
+        assert_eq!(g.order_cap(11, 5), 5);
     }
 
     #[test]
