@@ -321,7 +321,13 @@ mod diffsol_driver {
         let t_end = pb.t_end();
         let atol = pb.atol(rtol);
         let n = y0.len();
-        let shared = RefCell::new(Shared { pb, jac: faer::Mat::zeros(n, n), at: None, rhs_calls: 0, jac_calls: 0 });
+        let shared = RefCell::new(Shared {
+            pb,
+            jac: faer::Mat::zeros(n, n),
+            at: None,
+            rhs_calls: 0,
+            jac_calls: 0,
+        });
         let clock = Instant::now();
         let problem = OdeBuilder::<FaerMat<f64>>::new()
             .rtol(rtol)

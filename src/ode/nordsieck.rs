@@ -184,7 +184,9 @@ mod tests {
             nd.zn[j][0] = *c;
         }
         // Polynomial in s = (t - t_n) / h.
-        let poly = |zn: &Nordsieck, order: usize, s: f64| (0..=order).rev().fold(0.0, |acc, j| acc * s + zn.zn[j][0]);
+        let poly = |zn: &Nordsieck, order: usize, s: f64| {
+            (0..=order).rev().fold(0.0, |acc, j| acc * s + zn.zn[j][0])
+        };
         let before = nd.clone();
         nd.decrease_order(q, h, &tau);
         let mut past = 0.0;
