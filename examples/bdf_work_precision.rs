@@ -417,6 +417,10 @@ fn main() {
     println!("|---|---|---|---|---|---|---|---|---|");
     for (name, mut make) in cases {
         for rtol in [1e-3, 1e-4, 1e-5, 1e-6, 1e-7, 1e-8] {
+            #[cfg_attr(
+                not(any(feature = "bench-cvode", feature = "bench-diffsol")),
+                allow(unused_mut)
+            )]
             let mut rows = vec![
                 timed(|| run_ours(&mut make, rtol, true)),
                 timed(|| run_ours(&mut make, rtol, false)),
