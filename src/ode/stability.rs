@@ -21,27 +21,29 @@ const MAX_HOLD: u64 = 3200;
 const CAPPED_ORDER: usize = 2;
 /// Steps after the end of a hold at which the guard checks that the hold paid off.
 const PROBE_STEPS: u64 = 30;
-/// The hold paid off when the mean step since it began is at least this multiple of the failing
-/// step size.
-const PAYOFF_GROWTH: f64 = 0.3;
+/// The hold paid off when the mean step after it is at least this multiple of the mean step over
+/// the failing window before it.
+const PAYOFF_GROWTH: f64 = 1.0;
 /// First lock-out after a cap that did not pay off (accepted steps); doubles on each repeat.
 const INITIAL_LOCKOUT: u64 = 500;
 
 /// State of the detector; part of the integrator snapshot.
 #[derive(Debug, Clone, PartialEq)]
 pub struct StabilityGuard {
-    /// (step count, step size) of recent error-test failures at q >= 3.
-    pub(crate) failures: Vec<(u64, f64)>,
+    /// (step count, step size, time) of recent error-test failures at q >= 3.
+    pub(crate) failures: Vec<(u64, f64, f64)>,
     pub(crate) hold_until: u64,
     pub(crate) hold_len: u64,
     pub(crate) last_release: Option<u64>,
     pub(crate) triggers: u64,
-    /// Largest failing step size when the current hold started.
+    /// Mean step over the failing window before the current hold.
     pub(crate) h_trigger: f64,
     /// Step count at which the current hold started.
     pub(crate) hold_start: u64,
     /// Time at which the current hold started.
     pub(crate) t_hold_start: f64,
+    /// Time at which the last hold ended.
+    pub(crate) t_release: f64,
     /// No new hold before this step count (a hold did not pay off recently).
     pub(crate) lockout_until: u64,
     pub(crate) lockout_len: u64,
@@ -58,6 +60,7 @@ impl Default for StabilityGuard {
             h_trigger: 0.0,
             hold_start: 0,
             t_hold_start: 0.0,
+            t_release: 0.0,
             lockout_until: 0,
             lockout_len: INITIAL_LOCKOUT,
         }
@@ -71,8 +74,8 @@ impl StabilityGuard {
         if q < 3 || nst < self.hold_until || nst < self.lockout_until {
             return;
         }
-        self.failures.retain(|(n, _)| n + WINDOW_STEPS >= nst);
-        self.failures.push((nst, h));
+        self.failures.retain(|(n, _, _)| n + WINDOW_STEPS >= nst);
+        self.failures.push((nst, h, t));
         // Several failures on one step are ordinary step-size recovery; the instability shows
         // as failures on distinct steps.
         let mut distinct_steps = 1;
@@ -103,20 +106,28 @@ impl StabilityGuard {
         self.hold_until = nst + self.hold_len;
         self.hold_start = nst;
         self.t_hold_start = t;
-        self.h_trigger = self.failures.iter().map(|f| f.1).fold(0.0, f64::max);
+        // Mean step over the failing window: the rate of progress the hold has to beat.
+        let (n0, _, t0) = self.failures[0];
+        self.h_trigger = if nst > n0 {
+            (t - t0) / (nst - n0) as f64
+        } else {
+            h_max
+        };
         self.failures.clear();
         self.triggers += 1;
     }
 
     /// Notes an accepted step ending at `t`: detects the end of a hold and, a little later,
-    /// whether it paid off. A hold that did not (the mean step stayed below the failing step, so
-    /// accuracy rather than stability limits the step) locks the guard out for a while.
+    /// whether it paid off. A hold pays off when the steps after it are clearly longer than the
+    /// stuck steps before it (the stall is broken); otherwise accuracy, not stability, limits
+    /// the step and the guard locks itself out for a while.
     pub fn on_step_accepted(&mut self, nst: u64, t: f64) {
         if self.hold_until != 0 && nst == self.hold_until {
             self.last_release = Some(nst);
+            self.t_release = t;
         }
-        if self.hold_until != 0 && nst == self.hold_until + PROBE_STEPS && nst > self.hold_start {
-            let mean_h = (t - self.t_hold_start) / (nst - self.hold_start) as f64;
+        if self.hold_until != 0 && nst == self.hold_until + PROBE_STEPS {
+            let mean_h = (t - self.t_release) / PROBE_STEPS as f64;
             if mean_h < PAYOFF_GROWTH * self.h_trigger {
                 self.lockout_until = nst + self.lockout_len;
                 self.lockout_len = self.lockout_len.saturating_mul(2);
