@@ -2,10 +2,16 @@
 //!
 //! BDF3–5 are unstable in a band of `h * omega` near the imaginary axis. When a lightly damped
 //! stiff mode falls in that band the error test keeps failing at order >= 3 while the step size
-//! cannot grow; CVODE's own order selection then oscillates between rejected high-order steps
-//! and recovery. The guard notices repeated failures at q >= 3 with a non-growing step inside a
-//! short window and caps the order at 2 (A-stable) for a while; if the pattern recurs soon
-//! after the cap is lifted, the hold doubles.
+//! stays stuck (CVODE's own order selection then stalls at the band edge whatever the
+//! tolerance). The guard:
+//!
+//! - triggers when, within the last 100 steps, 5 distinct steps at order >= 3 failed the error
+//!   test with step sizes inside a factor-4 band (a growing or collapsing step is not a stall);
+//! - then caps the order at 2 (A-stable, damps the mode) for a hold of 100 steps;
+//! - 30 steps after the hold ends it compares the mean step since the release with the mean step
+//!   of the failing window: if the stall was not broken, accuracy rather than stability limits
+//!   the step and the guard locks itself out (500 steps, doubling on each repeat); if it was
+//!   broken but the failures recur soon, the next hold is twice as long (at most 3200 steps).
 
 /// Steps with failures at order >= 3 needed inside the window to trigger the cap.
 const TRIGGER_FAILURES: usize = 5;
@@ -190,5 +196,59 @@ mod tests {
             g.record_error_test_failure(200 + k, 0.0, 4, 1e-3 * 0.5_f64.powi(k as i32));
         }
         assert_eq!(g.order_cap(210, 5), 5);
+    }
+
+    #[test]
+    fn a_hold_that_does_not_break_the_stall_locks_the_guard_out() {
+        let mut g = StabilityGuard::default();
+        // Stuck at h = 1e-3 (one step per 1e-3 s) with failures every other step.
+        let mut t = 0.0;
+        for k in 0..5u64 {
+            g.record_error_test_failure(2 * k, t, 4, 1e-3);
+            t += 2e-3;
+        }
+        assert_eq!(g.order_cap(9, 5), 2);
+        let start = 8 + INITIAL_HOLD;
+        // After the hold the step is shorter than before: no payoff.
+        let mut nst = 8;
+        while nst <= start + PROBE_STEPS {
+            g.on_step_accepted(nst, t);
+            nst += 1;
+            t += 0.8e-3;
+        }
+        for k in 0..5u64 {
+            g.record_error_test_failure(nst + k, t, 4, 1e-3);
+        }
+        assert_eq!(
+            g.order_cap(nst + 6, 5),
+            5,
+            "locked out after a hold that did not pay off"
+        );
+    }
+
+    #[test]
+    fn a_hold_that_breaks_the_stall_is_kept_and_lengthened_on_recurrence() {
+        let mut g = StabilityGuard::default();
+        let mut t = 0.0;
+        for k in 0..5u64 {
+            g.record_error_test_failure(2 * k, t, 4, 1e-3);
+            t += 2e-3;
+        }
+        let mut nst = 8;
+        while nst <= 8 + INITIAL_HOLD + PROBE_STEPS {
+            g.on_step_accepted(nst, t);
+            nst += 1;
+            t += 5e-3;
+        }
+        for k in 0..5u64 {
+            g.record_error_test_failure(nst + k, t, 4, 1e-3);
+        }
+        let trigger = nst + 4;
+        assert_eq!(g.order_cap(trigger + 1, 5), 2);
+        assert_eq!(
+            g.order_cap(trigger + 2 * INITIAL_HOLD - 1, 5),
+            2,
+            "the second hold is twice as long"
+        );
     }
 }
