@@ -482,9 +482,7 @@ impl Bdf {
                     factor: 2.0 * tolsf,
                 });
             }
-            if steps > 0 || self.s.nst > 0 {
-                self.clip_to_stop_time();
-            }
+            self.clip_to_stop_time();
             self.step(problem)?;
             steps += 1;
             if self.s.tn == self.s.tstop {
@@ -702,7 +700,9 @@ impl Bdf {
         let mut ncf = 0usize;
         let mut nef = 0usize;
         let mut flag = StepFlag::FirstCall;
-        if self.s.nst > 0 && self.s.hprime != self.s.h {
+        // hprime always describes the next step (also before the first step and after a failed
+        // first step), so a pending change is applied whenever it differs.
+        if self.s.hprime != self.s.h {
             self.adjust_params();
         }
         self.apply_stability_cap();
