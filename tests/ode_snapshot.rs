@@ -83,3 +83,16 @@ fn serialisation_rejects_foreign_and_damaged_buffers() {
         Err(BdfError::BadSnapshot(_))
     ));
 }
+
+#[test]
+fn a_forged_huge_dimension_is_refused_without_allocating() {
+    let mut p = SpringChain::standard(false);
+    let y0 = vec![0.0; 40];
+    let bdf = Bdf::new(&mut p, 0.0, &y0, BdfOptions::default()).unwrap();
+    let mut v = bdf.snapshot().to_f64_vec();
+    v[3] = (1u64 << 23) as f64;
+    assert!(matches!(
+        BdfSnapshot::from_f64_slice(&v),
+        Err(BdfError::BadSnapshot(_))
+    ));
+}
