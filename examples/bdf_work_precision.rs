@@ -402,7 +402,10 @@ fn main() {
     let cases: Vec<(&str, Maker)> = vec![
         (
             "chain 20-DOF + 2 kHz, 1 s",
-            Box::new(|| Box::new(Chain(SpringChain::standard(false))) as Box<dyn ProblemBox>),
+            Box::new(|| {
+                Box::new(Chain(SpringChain::standard(false).expect("standard chain")))
+                    as Box<dyn ProblemBox>
+            }),
         ),
         (
             "Robertson, t = 40",

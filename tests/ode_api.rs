@@ -228,3 +228,46 @@ fn an_earlier_stop_time_after_a_failed_first_call_is_honoured() {
         assert!((bdf.y()[i] - exact[i]).abs() < 1e-6, "comp {i}");
     }
 }
+
+/// y' = 1 / (0.5 - t)^2: the solution blows up at t = 0.5.
+struct BlowUp;
+impl OdeProblem for BlowUp {
+    fn dim(&self) -> usize {
+        1
+    }
+    fn rhs(&mut self, t: f64, _y: &[f64], f: &mut [f64]) -> Result<(), ProblemError> {
+        f[0] = 1.0 / ((0.5 - t) * (0.5 - t));
+        Ok(())
+    }
+}
+
+#[test]
+fn a_singularity_ends_in_an_error_value_with_the_last_good_state() {
+    let mut p = BlowUp;
+    let mut bdf = Bdf::new(&mut p, 0.0, &[0.0], BdfOptions::default()).unwrap();
+    let err = bdf.advance_to(&mut p, 1.0).unwrap_err();
+    assert!(
+        matches!(
+            err,
+            BdfError::StepSizeUnderflow { .. }
+                | BdfError::TooManyErrorTestFailures { .. }
+                | BdfError::TooManyConvergenceFailures { .. }
+                | BdfError::TooMuchAccuracy { .. }
+                | BdfError::NonFiniteRhs { .. }
+                | BdfError::TooManySteps { .. }
+        ),
+        "{err}"
+    );
+    let t = bdf.t();
+    assert!(t < 0.5 && t > 0.4, "stopped at t = {t}");
+    // Exact solution 1/(0.5 - t) - 2 at the last good step.
+    let exact = 1.0 / (0.5 - t) - 2.0;
+    assert!(bdf.y()[0].is_finite());
+    // Close to the pole the problem is ill-conditioned; the state is still the right magnitude.
+    assert!(
+        (bdf.y()[0] - exact).abs() <= 0.1 * exact.abs().max(1.0),
+        "{} vs {exact}",
+        bdf.y()[0]
+    );
+    eprintln!("{err}");
+}

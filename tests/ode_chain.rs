@@ -10,7 +10,7 @@ struct Run {
 }
 
 fn run(rtol: f64, stability: bool, mass_matrix: bool) -> Run {
-    let mut p = SpringChain::standard(mass_matrix);
+    let mut p = SpringChain::standard(mass_matrix).expect("standard chain");
     let y0 = vec![0.0; p.dofs() * 2];
     let opts = BdfOptions {
         rtol,
@@ -36,7 +36,7 @@ fn run(rtol: f64, stability: bool, mass_matrix: bool) -> Run {
 
 #[test]
 fn chain_has_the_specified_modes() {
-    let p = SpringChain::standard(false);
+    let p = SpringChain::standard(false).expect("standard chain");
     let f = p.frequencies_hz();
     assert_eq!(f.len(), 20);
     assert!(f[0] > 3.5 && f[0] < 4.5, "lowest mode {}", f[0]);

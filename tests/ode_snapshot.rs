@@ -10,7 +10,7 @@ fn bits(v: &[f64]) -> Vec<u64> {
 
 #[test]
 fn restore_reproduces_the_run_bit_for_bit() {
-    let mut p = SpringChain::standard(true);
+    let mut p = SpringChain::standard(true).expect("standard chain");
     let y0 = vec![0.0; 40];
     let opts = BdfOptions {
         rtol: 1e-5,
@@ -49,7 +49,7 @@ fn restore_reproduces_the_run_bit_for_bit() {
 
 #[test]
 fn serialisation_rejects_foreign_and_damaged_buffers() {
-    let mut p = SpringChain::standard(false);
+    let mut p = SpringChain::standard(false).expect("standard chain");
     let y0 = vec![0.0; 40];
     let mut bdf = Bdf::new(&mut p, 0.0, &y0, BdfOptions::default()).unwrap();
     bdf.advance_to(&mut p, 0.01).unwrap();
@@ -80,6 +80,19 @@ fn serialisation_rejects_foreign_and_damaged_buffers() {
     let mut other = Bdf::new(&mut small, 0.0, &[2.0, 0.0], BdfOptions::default()).unwrap();
     assert!(matches!(
         other.restore(&bdf.snapshot()),
+        Err(BdfError::BadSnapshot(_))
+    ));
+}
+
+#[test]
+fn a_forged_huge_dimension_is_refused_without_allocating() {
+    let mut p = SpringChain::standard(false).expect("standard chain");
+    let y0 = vec![0.0; 40];
+    let bdf = Bdf::new(&mut p, 0.0, &y0, BdfOptions::default()).unwrap();
+    let mut v = bdf.snapshot().to_f64_vec();
+    v[3] = (1u64 << 23) as f64;
+    assert!(matches!(
+        BdfSnapshot::from_f64_slice(&v),
         Err(BdfError::BadSnapshot(_))
     ));
 }

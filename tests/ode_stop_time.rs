@@ -19,7 +19,7 @@ fn opts() -> BdfOptions {
 
 #[test]
 fn chunked_runs_match_the_free_run() {
-    let mut p = SpringChain::without_stiff_mode();
+    let mut p = SpringChain::without_stiff_mode().expect("smooth chain");
     let y0 = vec![0.0; p.dim2()];
     let mut free = Bdf::new(&mut p, 0.0, &y0, opts()).unwrap();
     free.advance_to(&mut p, T_END).unwrap();
@@ -75,7 +75,7 @@ fn chunked_runs_match_the_free_run() {
 
 #[test]
 fn jitter_in_the_stop_time_is_tolerated() {
-    let mut p = SpringChain::standard(false);
+    let mut p = SpringChain::standard(false).expect("standard chain");
     let y0 = vec![0.0; 40];
     let mut b = Bdf::new(&mut p, 0.0, &y0, opts()).unwrap();
     b.advance_to(&mut p, 0.1 + 0.2).unwrap();

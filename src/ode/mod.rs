@@ -2,6 +2,37 @@
 //!
 //! The integrator knows nothing about the model: it integrates any [`OdeProblem`] in linearly
 //! implicit form `M(t, y) y' = f(t, y)`. See [`Bdf`] for the driver API.
+//!
+//! ```
+//! use engine_mount_chassis::ode::{Bdf, BdfOptions, OdeProblem, ProblemError, Tolerance};
+//!
+//! /// y' = -50 (y - cos t)
+//! struct Relax;
+//! impl OdeProblem for Relax {
+//!     fn dim(&self) -> usize {
+//!         1
+//!     }
+//!     fn rhs(&mut self, t: f64, y: &[f64], f: &mut [f64]) -> Result<(), ProblemError> {
+//!         f[0] = -50.0 * (y[0] - t.cos());
+//!         Ok(())
+//!     }
+//! }
+//!
+//! let mut problem = Relax;
+//! let opts = BdfOptions { rtol: 1e-6, atol: Tolerance::Scalar(1e-9), ..Default::default() };
+//! let mut bdf = Bdf::new(&mut problem, 0.0, &[0.0], opts)?;
+//! for k in 1..=10 {
+//!     // Communication points: the integrator lands exactly on each and keeps its history.
+//!     bdf.advance_to(&mut problem, 0.1 * k as f64)?;
+//! }
+//! let saved = bdf.snapshot(); // e.g. for fmi2GetFMUstate
+//! let bytes = saved.to_bytes(); // for fmi2SerializeFMUstate
+//! assert_eq!(bdf.t(), 1.0);
+//! assert!((bdf.y()[0] - 0.5403).abs() < 0.02);
+//! bdf.restore(&engine_mount_chassis::ode::BdfSnapshot::from_bytes(&bytes)?)?;
+//! println!("{} steps, {} RHS evaluations", bdf.stats().steps, bdf.stats().rhs_evals);
+//! # Ok::<(), engine_mount_chassis::ode::BdfError>(())
+//! ```
 
 // Index loops mirror CVODE's formulas, which address several arrays by one index.
 #[allow(clippy::needless_range_loop)]

@@ -223,6 +223,16 @@ impl BdfSnapshot {
                 "implausible sizes n = {n}, history columns = {ncols}"
             )));
         }
+        // The two n x n matrices alone need 2 n^2 values: refuse before allocating anything.
+        if n.checked_mul(n)
+            .and_then(|nn| nn.checked_mul(2))
+            .is_none_or(|need| need > data.len())
+        {
+            return Err(bad(format!(
+                "{} values cannot hold a snapshot of {n} states",
+                data.len()
+            )));
+        }
         let rtol = r.f()?;
         let atol = match r.f()? {
             0.0 => Tolerance::Scalar(r.f()?),

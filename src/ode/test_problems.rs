@@ -180,7 +180,7 @@ pub struct SpringChain {
 
 impl SpringChain {
     /// The standard 20-DOF chain described on the type.
-    pub fn standard(use_mass_matrix: bool) -> Self {
+    pub fn standard(use_mass_matrix: bool) -> Result<Self, String> {
         let chain = 19;
         let n = chain + 1;
         let m = 1.0;
@@ -220,7 +220,7 @@ impl SpringChain {
 
     /// The 19-mass chain of [`Self::standard`] without the stiff mode (modes 4–100 Hz only),
     /// forced at its free end: a smooth, non-stiff-stalling problem.
-    pub fn without_stiff_mode() -> Self {
+    pub fn without_stiff_mode() -> Result<Self, String> {
         let chain = 19;
         let top = (((2 * chain - 1) as f64) * PI / (2.0 * (2 * chain + 1) as f64)).sin();
         let sqrt_km = 2.0 * PI * 100.0 / (2.0 * top);
@@ -254,8 +254,23 @@ impl SpringChain {
         force_amplitude: f64,
         force_omega: f64,
         use_mass_matrix: bool,
-    ) -> Self {
+    ) -> Result<Self, String> {
         let n = mass.len();
+        if stiffness.nrows() != n || stiffness.ncols() != n {
+            return Err(format!(
+                "stiffness is {}x{}, expected {n}x{n}",
+                stiffness.nrows(),
+                stiffness.ncols()
+            ));
+        }
+        if let Some(i) = mass.iter().position(|m| !(m.is_finite() && *m > 0.0)) {
+            return Err(format!("mass {i} must be finite and > 0, got {}", mass[i]));
+        }
+        if force_dof >= n {
+            return Err(format!(
+                "force_dof {force_dof} is not one of the {n} degrees of freedom"
+            ));
+        }
         // K~ = M^{-1/2} K M^{-1/2}, symmetric; its eigenvectors give the modes.
         let ktilde = Mat::from_fn(n, n, |i, j| stiffness[(i, j)] / (mass[i] * mass[j]).sqrt());
         let (omega, modes) = match ktilde.self_adjoint_eigen(Side::Lower) {
@@ -266,7 +281,7 @@ impl SpringChain {
                 let modes = Mat::from_fn(n, n, |i, r| u[(i, r)] / mass[i].sqrt());
                 (omega, modes)
             }
-            Err(_) => (vec![0.0; n], Mat::zeros(n, n)),
+            Err(e) => return Err(format!("modal decomposition failed: {e:?}")),
         };
         // C = M Phi diag(2 zeta omega) Phi^T M
         let damping = Mat::from_fn(n, n, |i, j| {
@@ -274,7 +289,7 @@ impl SpringChain {
                 .map(|r| mass[i] * modes[(i, r)] * 2.0 * zeta * omega[r] * modes[(j, r)] * mass[j])
                 .sum()
         });
-        Self {
+        Ok(Self {
             mass,
             stiffness,
             damping,
@@ -285,7 +300,7 @@ impl SpringChain {
             force_amplitude,
             force_omega,
             use_mass_matrix,
-        }
+        })
     }
 
     /// Number of states (twice the degrees of freedom).
