@@ -583,6 +583,16 @@ impl<'a> Builder<'a> {
             dash_trim,
             None,
         )?;
+        self.line(
+            "cowl",
+            p(g.cowl_x, 0.0, g.cowl_z),
+            p(g.cowl_x, 0.0, g.floor_z),
+            &s.dash_brace,
+            "dash_brace",
+            body,
+            0.0,
+            None,
+        )?;
         for &x in &g.roof_bow_x {
             self.line(
                 region::ROOF,

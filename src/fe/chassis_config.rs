@@ -209,6 +209,8 @@ pub struct Sections {
     pub front_cross: SectionSpec,
     /// Cross-car beam behind the cowl (carries the steering-column support).
     pub cross_car_beam: SectionSpec,
+    /// Centre brace from the cross-car beam down to the tunnel (instrument-panel support).
+    pub dash_brace: SectionSpec,
     /// Hinge pillars (lower A-pillars, firewall side edges).
     pub hinge_pillar: SectionSpec,
     /// A-pillars (cowl to roof).
@@ -248,6 +250,7 @@ impl Default for Sections {
                 d: 0.050,
                 t: 0.0020,
             },
+            dash_brace: b(0.05, 0.05, 0.0020),
             hinge_pillar: b(0.10, 0.12, 0.0020),
             a_pillar: b(0.06, 0.08, 0.0015),
             b_pillar: b(0.08, 0.14, 0.0015),
@@ -297,8 +300,8 @@ impl Default for Steering {
             // Tuned by `examples/fe_tune.rs`.
             column_section: SectionSpec::Explicit {
                 area: 2.5e-4,
-                iy: 1.755e-8,
-                iz: 2.294e-8,
+                iy: 1.713e-8,
+                iz: 2.292e-8,
                 j: 8.0e-8,
             },
             bracket_section: SectionSpec::Box {
@@ -335,7 +338,7 @@ pub struct Trim {
 impl Default for Trim {
     fn default() -> Self {
         Self {
-            floor: 395.8,
+            floor: 393.7,
             roof: 25.0,
             dash: 45.0,
             front_end: 50.0,
@@ -478,7 +481,7 @@ impl Default for ChassisConfig {
                 density: 2500.0,
             },
             // Tuned by `examples/fe_tune.rs` (with trim.floor and the steering column section).
-            body_stiffness_scale: 0.8827,
+            body_stiffness_scale: 0.8787,
             geometry: Geometry::default(),
             thickness: Thicknesses::default(),
             sections: Sections::default(),
