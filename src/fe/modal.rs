@@ -25,6 +25,8 @@ pub enum ModeKind {
     SteeringWheelVertical,
     /// Steering column and wheel, predominantly lateral.
     SteeringWheelLateral,
+    /// Steering column dominant, the wheel rotating rather than translating.
+    SteeringColumn,
     /// Front end (girders, aprons) dominant.
     FrontEnd,
     /// Local mode of the named region.
@@ -65,6 +67,7 @@ impl ModeDescription {
             ModeKind::GlobalBending => "global bending".into(),
             ModeKind::SteeringWheelVertical => "steering wheel vertical".into(),
             ModeKind::SteeringWheelLateral => "steering wheel lateral".into(),
+            ModeKind::SteeringColumn => "steering column (wheel rotation)".into(),
             ModeKind::FrontEnd => "front end".into(),
             ModeKind::Local(r) => format!("local: {r}"),
         };
@@ -318,8 +321,10 @@ pub fn describe(
         let front_end = energy.get(region::FRONT_END).copied().unwrap_or(0.0);
         let kind = if elastic < 0.05 {
             ModeKind::RigidBody(rigid_label(mesh, asm, &shape, body))
-        } else if steering > 0.25 {
-            if wheel_vertical >= wheel_lateral {
+        } else if steering > 0.5 {
+            if wheel_vertical + wheel_lateral < 0.05 {
+                ModeKind::SteeringColumn
+            } else if wheel_vertical >= wheel_lateral {
                 ModeKind::SteeringWheelVertical
             } else {
                 ModeKind::SteeringWheelLateral
