@@ -448,8 +448,8 @@ pub struct ChassisConfig {
     pub material: Material,
     /// Glass of windscreen and rear window.
     pub glass: Material,
-    /// Phenomenological stiffness factor on Young's modulus of the body structure (not the
-    /// steering column): the global tuning knob for the torsion frequency.
+    /// Phenomenological stiffness factor on Young's modulus of the body structure and glass (not
+    /// the steering column): the global tuning knob for the torsion frequency.
     pub body_stiffness_scale: f64,
     /// Main dimensions.
     pub geometry: Geometry,
@@ -499,6 +499,13 @@ impl ChassisConfig {
     /// Parses a JSON description; missing fields take their defaults, unknown fields are errors.
     pub fn from_json(text: &str) -> Result<Self, FeError> {
         serde_json::from_str(text).map_err(|e| FeError::InvalidInput(format!("chassis JSON: {e}")))
+    }
+
+    /// Reads and parses a JSON description file.
+    pub fn from_file(path: &std::path::Path) -> Result<Self, FeError> {
+        let text = std::fs::read_to_string(path)
+            .map_err(|e| FeError::Io(format!("{}: {e}", path.display())))?;
+        Self::from_json(&text)
     }
 
     /// Pretty JSON of this description.

@@ -7,6 +7,11 @@
 //! M-reorthogonalisation (twice, Gram-Schmidt), which keeps it orthogonal to working precision;
 //! the block width (8) resolves eigenvalues of multiplicity up to 8, e.g. the six rigid-body
 //! modes of a free structure. Ritz pairs are accepted when their Lanczos residual is small.
+//!
+//! Why not faer's matrix-free `partial_self_adjoint_eigen`: it works in the Euclidean inner
+//! product with a single start vector. The pencil would first have to be symmetrised with M^-1/2
+//! (M is not diagonal: beams carry 3 × 3 rotary blocks), and a single-vector Krylov method finds
+//! exactly repeated eigenvalues (rigid-body modes, symmetric substructures) only by round-off.
 
 use faer::linalg::solvers::Solve;
 use faer::sparse::linalg::solvers::Llt;
