@@ -194,6 +194,50 @@ fn distorted_thin_plate_does_not_lock() {
 }
 
 #[test]
+fn in_plane_bending_of_a_one_element_deep_strip_matches_beam_theory() {
+    // Pure bending (tip couple) of a 1 × 0.1 strip meshed 10 × 1: the bilinear membrane alone
+    // would be several times too stiff (parasitic shear); the incompatible modes make it exact.
+    let (length, depth, thickness, n) = (1.0, 0.1, 0.01, 10);
+    let mut mesh = Mesh::default();
+    for i in 0..=n {
+        for y in [-depth / 2.0, depth / 2.0] {
+            mesh.add_node(Vector3::new(length * i as f64 / n as f64, y, 0.0));
+        }
+    }
+    for i in 0..n {
+        mesh.shells.push(Shell {
+            nodes: [2 * i, 2 * i + 2, 2 * i + 3, 2 * i + 1],
+            material: STEEL,
+            thickness,
+            bending_thickness: thickness,
+            extra_mass_per_area: 0.0,
+        });
+    }
+    for node in 0..mesh.nodes.len() {
+        mesh.constraints.extend([(node, 2), (node, 3), (node, 4)]);
+    }
+    mesh.constraints.extend([(0, 0), (0, 1), (1, 0), (1, 1)]);
+    let asm = assemble(&mesh).unwrap();
+    let force = 100.0;
+    let (bottom, top) = (2 * n, 2 * n + 1);
+    let mut f = Mat::<f64>::zeros(asm.dofs.n_free(), 1);
+    f[(asm.dofs.global(top, 0).unwrap(), 0)] = force;
+    f[(asm.dofs.global(bottom, 0).unwrap(), 0)] = -force;
+    let u = asm.k.to_dense().full_piv_lu().solve(&f);
+    let tip = 0.5
+        * (u[(asm.dofs.global(top, 1).unwrap(), 0)] + u[(asm.dofs.global(bottom, 1).unwrap(), 0)]);
+    let inertia = thickness * depth.powi(3) / 12.0;
+    let theory = force * depth * length * length / (2.0 * STEEL.youngs_modulus * inertia);
+    let err = (tip.abs() - theory).abs() / theory;
+    println!(
+        "tip deflection {:.6e} m, beam theory {theory:.6e} m, error {:.3} %",
+        tip.abs(),
+        100.0 * err
+    );
+    assert!(err < 0.01, "tip {tip} vs {theory}");
+}
+
+#[test]
 fn membrane_patch_test_reproduces_a_linear_displacement_field_exactly() {
     // MacNeal-Harder distorted patch: 0.24 × 0.12 with four irregular interior nodes.
     let pts = [

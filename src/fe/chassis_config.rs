@@ -481,7 +481,7 @@ impl Default for ChassisConfig {
                 density: 2500.0,
             },
             // Tuned by `examples/fe_tune.rs` (with trim.floor and the steering column section).
-            body_stiffness_scale: 0.8787,
+            body_stiffness_scale: 0.8823,
             geometry: Geometry::default(),
             thickness: Thicknesses::default(),
             sections: Sections::default(),
