@@ -110,17 +110,23 @@ fn cantilever_bending_and_torsion_frequencies_match_theory_within_one_percent() 
 }
 
 /// Square plate a × a of `n` × `n` shells in the x-y plane, hard simple support on all edges.
-fn simply_supported_plate_frequency(thickness: f64, n: usize) -> (f64, f64) {
+/// `distortion` moves interior nodes by up to that fraction of the element size (deterministic
+/// pattern), so the elements become general quadrilaterals.
+fn simply_supported_plate_frequency(thickness: f64, n: usize, distortion: f64) -> (f64, f64) {
     let a = 1.0;
     let mut mesh = Mesh::default();
     let id = |i: usize, j: usize| i * (n + 1) + j;
+    let h = a / n as f64;
     for i in 0..=n {
         for j in 0..=n {
-            mesh.add_node(Vector3::new(
-                a * i as f64 / n as f64,
-                a * j as f64 / n as f64,
-                0.0,
-            ));
+            let interior = i > 0 && i < n && j > 0 && j < n;
+            let (dx, dy) = if interior {
+                let s = (i * 7 + j * 13) as f64;
+                (distortion * h * s.sin(), distortion * h * (1.7 * s).cos())
+            } else {
+                (0.0, 0.0)
+            };
+            mesh.add_node(Vector3::new(h * i as f64 + dx, h * j as f64 + dy, 0.0));
         }
     }
     for i in 0..n {
@@ -164,7 +170,7 @@ fn simply_supported_plate_frequency(thickness: f64, n: usize) -> (f64, f64) {
 #[test]
 fn simply_supported_plate_first_frequency_within_two_percent_thick_and_very_thin() {
     for thickness in [1.0e-2, 1.0e-3] {
-        let (fe, theory) = simply_supported_plate_frequency(thickness, 16);
+        let (fe, theory) = simply_supported_plate_frequency(thickness, 16, 0.0);
         let err = (fe - theory).abs() / theory;
         println!(
             "t/a = {thickness}: FE {fe:.4} Hz, Kirchhoff {theory:.4} Hz, error {:.3} %",
@@ -172,6 +178,63 @@ fn simply_supported_plate_first_frequency_within_two_percent_thick_and_very_thin
         );
         assert!(err < 0.02, "t = {thickness}: FE {fe} vs Kirchhoff {theory}");
     }
+}
+
+#[test]
+fn distorted_thin_plate_does_not_lock() {
+    for thickness in [1.0e-2, 1.0e-3] {
+        let (fe, theory) = simply_supported_plate_frequency(thickness, 16, 0.2);
+        let err = (fe - theory).abs() / theory;
+        println!(
+            "distorted mesh, t/a = {thickness}: FE {fe:.4} Hz, Kirchhoff {theory:.4} Hz, error {:.3} %",
+            100.0 * err
+        );
+        assert!(err < 0.02, "t = {thickness}: FE {fe} vs Kirchhoff {theory}");
+    }
+}
+
+#[test]
+fn in_plane_bending_of_a_one_element_deep_strip_matches_beam_theory() {
+    // Pure bending (tip couple) of a 1 × 0.1 strip meshed 10 × 1: the bilinear membrane alone
+    // would be several times too stiff (parasitic shear); the incompatible modes make it exact.
+    let (length, depth, thickness, n) = (1.0, 0.1, 0.01, 10);
+    let mut mesh = Mesh::default();
+    for i in 0..=n {
+        for y in [-depth / 2.0, depth / 2.0] {
+            mesh.add_node(Vector3::new(length * i as f64 / n as f64, y, 0.0));
+        }
+    }
+    for i in 0..n {
+        mesh.shells.push(Shell {
+            nodes: [2 * i, 2 * i + 2, 2 * i + 3, 2 * i + 1],
+            material: STEEL,
+            thickness,
+            bending_thickness: thickness,
+            extra_mass_per_area: 0.0,
+        });
+    }
+    for node in 0..mesh.nodes.len() {
+        mesh.constraints.extend([(node, 2), (node, 3), (node, 4)]);
+    }
+    mesh.constraints.extend([(0, 0), (0, 1), (1, 0), (1, 1)]);
+    let asm = assemble(&mesh).unwrap();
+    let force = 100.0;
+    let (bottom, top) = (2 * n, 2 * n + 1);
+    let mut f = Mat::<f64>::zeros(asm.dofs.n_free(), 1);
+    f[(asm.dofs.global(top, 0).unwrap(), 0)] = force;
+    f[(asm.dofs.global(bottom, 0).unwrap(), 0)] = -force;
+    let u = asm.k.to_dense().full_piv_lu().solve(&f);
+    let tip = 0.5
+        * (u[(asm.dofs.global(top, 1).unwrap(), 0)] + u[(asm.dofs.global(bottom, 1).unwrap(), 0)]);
+    let inertia = thickness * depth.powi(3) / 12.0;
+    let theory = force * depth * length * length / (2.0 * STEEL.youngs_modulus * inertia);
+    let err = (tip.abs() - theory).abs() / theory;
+    println!(
+        "tip deflection {:.6e} m, beam theory {theory:.6e} m, error {:.3} %",
+        tip.abs(),
+        100.0 * err
+    );
+    assert!(err < 0.01, "tip {tip} vs {theory}");
 }
 
 #[test]

@@ -260,13 +260,30 @@ impl<'a> Builder<'a> {
     }
 
     fn build(mut self) -> Result<Mesh, FeError> {
+        self.panels();
+        self.frame()?;
+        let body_nodes: Vec<usize> = (0..self.mesh.nodes.len()).collect();
+        self.regions.insert(region::BODY.into(), body_nodes);
+
+        self.steering()?;
+        self.suspension()?;
+        self.named_points()?;
+
+        let mut mesh = self.mesh;
+        for (name, mut ids) in self.regions {
+            ids.sort_unstable();
+            ids.dedup();
+            mesh.regions.insert(name, ids);
+        }
+        Ok(mesh)
+    }
+
+    /// Shell panels: floor, roof, firewall, cowl, rear, quarters, shelf, glass, aprons, front.
+    fn panels(&mut self) {
         let cfg = self.cfg;
         let g = &cfg.geometry;
         let t = &cfg.thickness;
-        let s = &cfg.sections;
-        let trim = &cfg.trim;
         let w = g.half_width;
-        let body = self.body;
         let ex = Vector3::new(1.0, 0.0, 0.0);
         let ey = Vector3::new(0.0, 1.0, 0.0);
         let ez = Vector3::new(0.0, 0.0, 1.0);
@@ -381,6 +398,17 @@ impl<'a> Builder<'a> {
             t.front_panel,
             bend,
         );
+    }
+
+    /// Beams of the body frame, with the trim spread over them, and the optional stiffening bar.
+    fn frame(&mut self) -> Result<(), FeError> {
+        let cfg = self.cfg;
+        let g = &cfg.geometry;
+        let s = &cfg.sections;
+        let trim = &cfg.trim;
+        let w = g.half_width;
+        let body = self.body;
+        let p = Vector3::new;
 
         // Trim per length of each beam group.
         let floor_l = g.firewall_x - g.rear_x;
@@ -388,6 +416,7 @@ impl<'a> Builder<'a> {
         let roof_l = g.roof_front_x - g.roof_rear_x;
         let roof_trim = trim.roof / (2.0 * roof_l + 2.0 * w * g.roof_bow_x.len() as f64);
         let dash_trim = trim.dash / (2.0 * w);
+        let apron_l = g.front_x - g.firewall_x;
         let front_trim = trim.front_end / (4.0 * apron_l + 4.0 * g.girder_y);
         let rear_trim = trim.rear / (2.0 * w);
         let door_trim = trim.doors / (2.0 * ((g.cowl_z - g.floor_z) + (g.roof_z - g.floor_z)));
@@ -583,6 +612,16 @@ impl<'a> Builder<'a> {
             dash_trim,
             None,
         )?;
+        self.line(
+            "cowl",
+            p(g.cowl_x, 0.0, g.cowl_z),
+            p(g.cowl_x, 0.0, g.floor_z),
+            &s.dash_brace,
+            "dash_brace",
+            body,
+            0.0,
+            None,
+        )?;
         for &x in &g.roof_bow_x {
             self.line(
                 region::ROOF,
@@ -622,20 +661,7 @@ impl<'a> Builder<'a> {
                 None,
             )?;
         }
-        let body_nodes: Vec<usize> = (0..self.mesh.nodes.len()).collect();
-        self.regions.insert(region::BODY.into(), body_nodes);
-
-        self.steering()?;
-        self.suspension()?;
-        self.named_points()?;
-
-        let mut mesh = self.mesh;
-        for (name, mut ids) in self.regions {
-            ids.sort_unstable();
-            ids.dedup();
-            mesh.regions.insert(name, ids);
-        }
-        Ok(mesh)
+        Ok(())
     }
 
     fn steering(&mut self) -> Result<(), FeError> {

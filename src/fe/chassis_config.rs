@@ -209,6 +209,8 @@ pub struct Sections {
     pub front_cross: SectionSpec,
     /// Cross-car beam behind the cowl (carries the steering-column support).
     pub cross_car_beam: SectionSpec,
+    /// Centre brace from the cross-car beam down to the tunnel (instrument-panel support).
+    pub dash_brace: SectionSpec,
     /// Hinge pillars (lower A-pillars, firewall side edges).
     pub hinge_pillar: SectionSpec,
     /// A-pillars (cowl to roof).
@@ -248,6 +250,7 @@ impl Default for Sections {
                 d: 0.050,
                 t: 0.0020,
             },
+            dash_brace: b(0.05, 0.05, 0.0020),
             hinge_pillar: b(0.10, 0.12, 0.0020),
             a_pillar: b(0.06, 0.08, 0.0015),
             b_pillar: b(0.08, 0.14, 0.0015),
@@ -297,8 +300,8 @@ impl Default for Steering {
             // Tuned by `examples/fe_tune.rs`.
             column_section: SectionSpec::Explicit {
                 area: 2.5e-4,
-                iy: 1.755e-8,
-                iz: 2.294e-8,
+                iy: 1.713e-8,
+                iz: 2.292e-8,
                 j: 8.0e-8,
             },
             bracket_section: SectionSpec::Box {
@@ -335,7 +338,7 @@ pub struct Trim {
 impl Default for Trim {
     fn default() -> Self {
         Self {
-            floor: 395.8,
+            floor: 393.7,
             roof: 25.0,
             dash: 45.0,
             front_end: 50.0,
@@ -445,8 +448,8 @@ pub struct ChassisConfig {
     pub material: Material,
     /// Glass of windscreen and rear window.
     pub glass: Material,
-    /// Phenomenological stiffness factor on Young's modulus of the body structure (not the
-    /// steering column): the global tuning knob for the torsion frequency.
+    /// Phenomenological stiffness factor on Young's modulus of the body structure and glass (not
+    /// the steering column): the global tuning knob for the torsion frequency.
     pub body_stiffness_scale: f64,
     /// Main dimensions.
     pub geometry: Geometry,
@@ -478,7 +481,7 @@ impl Default for ChassisConfig {
                 density: 2500.0,
             },
             // Tuned by `examples/fe_tune.rs` (with trim.floor and the steering column section).
-            body_stiffness_scale: 0.8827,
+            body_stiffness_scale: 0.8823,
             geometry: Geometry::default(),
             thickness: Thicknesses::default(),
             sections: Sections::default(),
@@ -496,6 +499,13 @@ impl ChassisConfig {
     /// Parses a JSON description; missing fields take their defaults, unknown fields are errors.
     pub fn from_json(text: &str) -> Result<Self, FeError> {
         serde_json::from_str(text).map_err(|e| FeError::InvalidInput(format!("chassis JSON: {e}")))
+    }
+
+    /// Reads and parses a JSON description file.
+    pub fn from_file(path: &std::path::Path) -> Result<Self, FeError> {
+        let text = std::fs::read_to_string(path)
+            .map_err(|e| FeError::Io(format!("{}: {e}", path.display())))?;
+        Self::from_json(&text)
     }
 
     /// Pretty JSON of this description.

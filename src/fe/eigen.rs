@@ -7,6 +7,11 @@
 //! M-reorthogonalisation (twice, Gram-Schmidt), which keeps it orthogonal to working precision;
 //! the block width (8) resolves eigenvalues of multiplicity up to 8, e.g. the six rigid-body
 //! modes of a free structure. Ritz pairs are accepted when their Lanczos residual is small.
+//!
+//! Why not faer's matrix-free `partial_self_adjoint_eigen`: it works in the Euclidean inner
+//! product with a single start vector. The pencil would first have to be symmetrised with M^-1/2
+//! (M is not diagonal: beams carry 3 × 3 rotary blocks), and a single-vector Krylov method finds
+//! exactly repeated eigenvalues (rigid-body modes, symmetric substructures) only by round-off.
 
 use faer::linalg::solvers::Solve;
 use faer::sparse::linalg::solvers::Llt;
@@ -83,24 +88,38 @@ struct Basis<'a> {
 }
 
 impl Basis<'_> {
-    /// M-orthogonalises `v` against the basis (twice); returns the coefficients of the projection.
-    fn orthogonalise(&self, v: &mut [f64]) -> Vec<f64> {
-        let mut coef = vec![0.0; self.len];
+    /// M-orthogonalises `v` against basis columns `from..len` (twice); returns the projection
+    /// coefficients of those columns.
+    fn orthogonalise(&self, v: &mut [f64], from: usize) -> Vec<f64> {
+        let mut coef = vec![0.0; self.len - from];
         for _ in 0..2 {
-            for (c, total) in coef.iter_mut().enumerate() {
-                let mqc = self.mq.col(c);
-                let mut dot = 0.0;
-                for (i, vi) in v.iter().enumerate() {
-                    dot += mqc[i] * vi;
-                }
-                let qc = self.q.col(c);
-                for (i, vi) in v.iter_mut().enumerate() {
-                    *vi -= dot * qc[i];
+            for (k, total) in coef.iter_mut().enumerate() {
+                let (mqc, qc) = (self.mq.col(from + k), self.q.col(from + k));
+                let dot: f64 = v.iter().zip(mqc.iter()).map(|(a, b)| a * b).sum();
+                for (vi, qi) in v.iter_mut().zip(qc.iter()) {
+                    *vi -= dot * qi;
                 }
                 *total += dot;
             }
         }
         coef
+    }
+
+    /// M-orthogonalises the columns of `z` against the whole basis (twice, as matrix products);
+    /// returns the projection coefficients (basis length × columns of `z`).
+    fn orthogonalise_block(&self, z: &mut Mat<f64>) -> Mat<f64> {
+        let mut total = Mat::<f64>::zeros(self.len, z.ncols());
+        if self.len == 0 {
+            return total;
+        }
+        let q = self.q.as_ref().subcols(0, self.len);
+        let mq = self.mq.as_ref().subcols(0, self.len);
+        for _ in 0..2 {
+            let c = mq.transpose() * z.as_ref();
+            *z -= q * &c;
+            total += &c;
+        }
+        total
     }
 
     /// Appends `v` (already orthogonal) normalised; returns its M-norm before normalisation.
@@ -172,7 +191,9 @@ pub fn lowest_modes(
              below the lowest eigenvalue, or the model has a mechanism/unconstrained DOF"
         ))
         })?;
-    let capacity = n.min((4 * n_modes + 6 * BLOCK).max(n_modes + 60));
+    // Ritz vectors of a dense spectrum need a basis several times the number of modes; the
+    // shift-invert spectrum of a car body converges 30 modes in about 150 vectors.
+    let capacity = n.min((6 * n_modes + 8 * BLOCK).max(n_modes + 100));
     let mut basis = Basis {
         m,
         q: Mat::zeros(n, capacity),
@@ -187,7 +208,7 @@ pub fn lowest_modes(
         for _attempt in 0..10 {
             let mut v: Vec<f64> = (0..n).map(|_| rng.next()).collect();
             let before = v.iter().map(|x| x * x).sum::<f64>().sqrt();
-            basis.orthogonalise(&mut v);
+            basis.orthogonalise(&mut v, 0);
             let after = v.iter().map(|x| x * x).sum::<f64>().sqrt();
             if after > 1e-8 * before {
                 basis.push(&v);
@@ -215,12 +236,19 @@ pub fn lowest_modes(
             z.col_mut(c).copy_from(basis.mq.col(done + c));
         }
         llt.solve_in_place(z.as_mut());
+        let scales: Vec<f64> = (0..width).map(|c| z.col(c).norm_l2()).collect();
+        let block_coef = basis.orthogonalise_block(&mut z);
+        let len_before = basis.len;
         for c in 0..width {
+            for r in 0..len_before {
+                h[(r, done + c)] = block_coef[(r, c)];
+            }
             let mut v: Vec<f64> = z.col(c).iter().copied().collect();
-            let scale = v.iter().map(|x| x * x).sum::<f64>().sqrt();
-            let coef = basis.orthogonalise(&mut v);
-            for (r, value) in coef.iter().enumerate() {
-                h[(r, done + c)] = *value;
+            let scale = scales[c];
+            // Against the vectors this block has added so far.
+            let coef = basis.orthogonalise(&mut v, len_before);
+            for (k, value) in coef.iter().enumerate() {
+                h[(len_before + k, done + c)] = *value;
             }
             let rest = v.iter().map(|x| x * x).sum::<f64>().sqrt();
             if basis.len < n {
@@ -266,7 +294,7 @@ pub fn lowest_modes(
             });
         }
         if all_converged {
-            let mut shapes = Mat::<f64>::zeros(n, n_modes);
+            let mut selected = Mat::<f64>::zeros(done, n_modes);
             let mut eigenvalues = Vec::with_capacity(n_modes);
             for (out, &col) in picked.iter().enumerate() {
                 let theta = s[col];
@@ -276,15 +304,9 @@ pub fn lowest_modes(
                     )));
                 }
                 eigenvalues.push(shift + 1.0 / theta);
-                for i in 0..done {
-                    let w = u[(i, col)];
-                    if w != 0.0 {
-                        for row in 0..n {
-                            shapes[(row, out)] += w * basis.q[(row, i)];
-                        }
-                    }
-                }
+                selected.col_mut(out).copy_from(u.col(col));
             }
+            let shapes = basis.q.as_ref().subcols(0, done) * &selected;
             return Ok(Modes {
                 eigenvalues,
                 shapes,

@@ -27,7 +27,7 @@
 //! # }
 //! ```
 //!
-//! Elements: [`beam`] (Euler-Bernoulli, 12 DOF, HRZ-lumped mass), [`shell`] (bilinear membrane
+//! Elements: [`beam`] (Euler-Bernoulli, 12 DOF, HRZ-lumped mass), [`shell`] (QM6 membrane
 //! with Hughes–Brezzi drilling rotation + MITC4 plate, lumped mass), [`mass`] (point mass with
 //! rotary inertia), [`spring`] (grounded and two-node spring-dampers).
 

@@ -25,6 +25,8 @@ pub enum ModeKind {
     SteeringWheelVertical,
     /// Steering column and wheel, predominantly lateral.
     SteeringWheelLateral,
+    /// Steering column dominant, the wheel rotating rather than translating.
+    SteeringColumn,
     /// Front end (girders, aprons) dominant.
     FrontEnd,
     /// Local mode of the named region.
@@ -45,7 +47,8 @@ pub struct ModeDescription {
     /// Twist between front and rear sections × half width, relative to the largest body
     /// translation (≈ 1 for a pure torsion mode, ≈ 0 for others).
     pub twist: f64,
-    /// Vertical bending of the sills relative to the largest body translation.
+    /// Vertical bending signature: front end and rear panel moving together against the middle of
+    /// the sills, relative to the largest body translation (0 when the signature is absent).
     pub bending: f64,
     /// Fraction of the body translation not explained by a rigid-body motion.
     pub elastic: f64,
@@ -64,6 +67,7 @@ impl ModeDescription {
             ModeKind::GlobalBending => "global bending".into(),
             ModeKind::SteeringWheelVertical => "steering wheel vertical".into(),
             ModeKind::SteeringWheelLateral => "steering wheel lateral".into(),
+            ModeKind::SteeringColumn => "steering column (wheel rotation)".into(),
             ModeKind::FrontEnd => "front end".into(),
             ModeKind::Local(r) => format!("local: {r}"),
         };
@@ -246,6 +250,17 @@ pub fn describe(
     let front = need(region::FIREWALL)?;
     let rear = need(region::REAR_PANEL)?;
     let sills = need("sill")?;
+    let front_end_nodes = need(region::FRONT_END)?;
+    let (x_min, x_max) = sills.iter().fold((f64::MAX, f64::MIN), |(lo, hi), &i| {
+        (lo.min(mesh.nodes[i].x), hi.max(mesh.nodes[i].x))
+    });
+    // The middle third of the sills.
+    let (centre, half) = ((x_min + x_max) / 2.0, (x_max - x_min) / 6.0);
+    let mid_sill: Vec<usize> = sills
+        .iter()
+        .copied()
+        .filter(|&i| (mesh.nodes[i].x - centre).abs() <= half + 1e-9)
+        .collect();
     let wheel = mesh
         .named(STEERING_WHEEL)
         .ok_or_else(|| FeError::InvalidInput("mesh has no named node 'steering_wheel'".into()))?;
@@ -281,22 +296,21 @@ pub fn describe(
         } else {
             0.0
         };
-        // Sill bending: vertical motion minus its best straight line along x.
-        let pts: Vec<(f64, f64)> = sills
-            .iter()
-            .map(|&i| (mesh.nodes[i].x, translation(asm, &shape, i).z))
-            .collect();
-        let n = pts.len().max(1) as f64;
-        let (mx, mz) = pts.iter().fold((0.0, 0.0), |(a, b), p| (a + p.0, b + p.1));
-        let (mx, mz) = (mx / n, mz / n);
-        let sxx: f64 = pts.iter().map(|p| (p.0 - mx).powi(2)).sum();
-        let sxz: f64 = pts.iter().map(|p| (p.0 - mx) * (p.1 - mz)).sum();
-        let slope = if sxx > 0.0 { sxz / sxx } else { 0.0 };
-        let bending = pts
-            .iter()
-            .map(|p| (p.1 - mz - slope * (p.0 - mx)).abs())
-            .fold(0.0, f64::max)
-            / amplitude;
+        // Vertical bending signature: front end and rear move together against the middle.
+        let mean_uz = |nodes: &[usize]| {
+            nodes
+                .iter()
+                .map(|&i| translation(asm, &shape, i).z)
+                .sum::<f64>()
+                / nodes.len().max(1) as f64
+        };
+        let (front_uz, rear_uz, mid_uz) =
+            (mean_uz(front_end_nodes), mean_uz(rear), mean_uz(&mid_sill));
+        let bending = if front_uz * rear_uz > 0.0 && mid_uz * front_uz < 0.0 {
+            (mid_uz.abs() + front_uz.abs().min(rear_uz.abs())) / amplitude
+        } else {
+            0.0
+        };
         let elastic = elastic_fraction(mesh, asm, &shape, body);
         let wheel_share = |d: usize| match asm.dofs.global(wheel, d) {
             Some(g) if total > 0.0 => shape[g] * m_phi[g] / total,
@@ -307,15 +321,17 @@ pub fn describe(
         let front_end = energy.get(region::FRONT_END).copied().unwrap_or(0.0);
         let kind = if elastic < 0.05 {
             ModeKind::RigidBody(rigid_label(mesh, asm, &shape, body))
-        } else if steering > 0.25 {
-            if wheel_vertical >= wheel_lateral {
+        } else if steering > 0.5 {
+            if wheel_vertical + wheel_lateral < 0.05 {
+                ModeKind::SteeringColumn
+            } else if wheel_vertical >= wheel_lateral {
                 ModeKind::SteeringWheelVertical
             } else {
                 ModeKind::SteeringWheelLateral
             }
         } else if twist > 0.5 && front_end < 0.5 {
             ModeKind::GlobalTorsion
-        } else if bending > 0.5 && front_end < 0.5 {
+        } else if bending > 0.25 {
             ModeKind::GlobalBending
         } else if front_end > 0.3 {
             ModeKind::FrontEnd

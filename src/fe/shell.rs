@@ -1,4 +1,5 @@
-//! Four-node flat shell: bilinear membrane with a Hughes–Brezzi drilling rotation, MITC4
+//! Four-node flat shell: bilinear membrane with incompatible modes (Wilson–Taylor QM6, no
+//! parasitic shear in in-plane bending) and a Hughes–Brezzi drilling rotation, MITC4
 //! (Bathe–Dvorkin) Mindlin plate that does not shear-lock, lumped mass.
 //!
 //! Local DOFs per node: u, v, w, θx, θy, θz in the element frame (e1, e2, normal).
@@ -180,12 +181,38 @@ pub fn stiffness(index: usize, shell: &Shell, p: &[Vector3<f64>; 4]) -> Result<M
         covariant_shear_row(xy, 1.0, 0.0, false),
     ];
 
+    // Incompatible membrane modes (1 − ξ², 1 − η² for u and v) use the centre Jacobian and the
+    // det0/det factor (Taylor, Beresford & Wilson 1976), so they integrate to zero strain and the
+    // element passes the patch test while bending in its plane without parasitic shear.
+    let (_, dxi0, deta0) = shape(0.0, 0.0);
+    let j0 = jacobian(xy, &dxi0, &deta0);
+    let det0 = j0.determinant();
+    let inv0 = j0
+        .try_inverse()
+        .ok_or_else(|| FeError::Mesh(format!("shell {index}: singular Jacobian at the centre")))?;
     let gp = 1.0 / 3.0_f64.sqrt();
     let mut k = Mat24::zeros();
+    let mut k_membrane = Mat24::zeros();
+    let mut k_coupling = SMatrix::<f64, 24, 4>::zeros();
+    let mut k_internal = SMatrix::<f64, 4, 4>::zeros();
     for &(xi, eta) in &[(-gp, -gp), (gp, -gp), (gp, gp), (-gp, gp)] {
         let (n, dxi, deta) = shape(xi, eta);
         let j = jacobian(xy, &dxi, &deta);
         let det = j.determinant();
+        let mut bi = SMatrix::<f64, 3, 4>::zeros();
+        for (mode, (dp_dxi, dp_deta)) in [(-2.0 * xi, 0.0), (0.0, -2.0 * eta)]
+            .into_iter()
+            .enumerate()
+        {
+            let scale = det0 / det;
+            let dp_dx = scale * (inv0[(0, 0)] * dp_dxi + inv0[(0, 1)] * dp_deta);
+            let dp_dy = scale * (inv0[(1, 0)] * dp_dxi + inv0[(1, 1)] * dp_deta);
+            // Internal DOFs: u-modes 0, 1; v-modes 2, 3.
+            bi[(0, mode)] = dp_dx;
+            bi[(2, mode)] = dp_dy;
+            bi[(1, 2 + mode)] = dp_dy;
+            bi[(2, 2 + mode)] = dp_dx;
+        }
         let inv = j.try_inverse().ok_or_else(|| {
             FeError::Mesh(format!("shell {index}: singular Jacobian at a Gauss point"))
         })?;
@@ -218,12 +245,19 @@ pub fn stiffness(index: usize, shell: &Shell, p: &[Vector3<f64>; 4]) -> Result<M
             covariant[(1, c)] = 0.5 * (1.0 - xi) * tie_eta[0][c] + 0.5 * (1.0 + xi) * tie_eta[1][c];
         }
         let bs = inv * covariant;
-        k += (bm.transpose() * dm * bm
-            + bb.transpose() * db * bb
-            + bs.transpose() * bs * ds
-            + bd.transpose() * bd * gamma)
+        k_membrane += bm.transpose() * dm * bm * det;
+        k_coupling += bm.transpose() * dm * bi * det;
+        k_internal += bi.transpose() * dm * bi * det;
+        k += (bb.transpose() * db * bb + bs.transpose() * bs * ds + bd.transpose() * bd * gamma)
             * det;
     }
+    // Static condensation of the internal modes.
+    let internal_inv = k_internal.try_inverse().ok_or_else(|| {
+        FeError::Mesh(format!(
+            "shell {index}: singular incompatible-mode stiffness"
+        ))
+    })?;
+    k += k_membrane - k_coupling * internal_inv * k_coupling.transpose();
     Ok(to_global(&k, &geo.frame))
 }
 
