@@ -128,7 +128,7 @@ impl Simulation {
     /// integrator there.
     pub fn new(settings: &Settings, t0: f64, inputs: &Inputs) -> Result<Simulation, String> {
         inputs.validate()?;
-        let options = BdfOptions {
+        let mut options = BdfOptions {
             rtol: settings.rel_tol,
             atol: Tolerance::Scalar(settings.abs_tol),
             max_order: usize::try_from(settings.max_order).unwrap_or(0),
@@ -137,6 +137,7 @@ impl Simulation {
         };
         let mut scene = Scene::build(settings)?;
         scene.set_inputs(inputs)?;
+        options.magnitude_cap = Some(scene.magnitude_caps());
         let y0 = scene.initial_state(t0)?;
         let integrator = Bdf::new(&mut scene, t0, &y0, options).map_err(|e| e.to_string())?;
         Ok(Simulation {

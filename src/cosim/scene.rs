@@ -83,6 +83,17 @@ impl Scene {
         }
     }
 
+    /// Per state, the largest magnitude the integrator's relative tolerance applies to: one
+    /// revolution for the cumulative crank angle (its phase is what must stay accurate), no cap
+    /// elsewhere.
+    pub fn magnitude_caps(&self) -> Vec<f64> {
+        let mut caps = vec![f64::INFINITY; self.dim()];
+        match self {
+            Scene::Ground(g) => caps[g.crank_index()] = 2.0 * std::f64::consts::PI,
+        }
+        caps
+    }
+
     /// The static equilibrium under the current inputs; the excitation fades in from `t0`.
     pub fn initial_state(&mut self, t0: f64) -> Result<Vec<f64>, String> {
         match self {

@@ -513,7 +513,11 @@ impl Bdf {
     pub(super) fn set_error_weights(&mut self) -> Result<(), BdfError> {
         let rtol = self.s.opts.rtol;
         for (i, (w, y)) in self.w.ewt.iter_mut().zip(&self.s.zn.zn[0]).enumerate() {
-            let tol = rtol * y.abs() + self.s.opts.atol.get(i);
+            let magnitude = match &self.s.opts.magnitude_cap {
+                Some(cap) => y.abs().min(cap[i]),
+                None => y.abs(),
+            };
+            let tol = rtol * magnitude + self.s.opts.atol.get(i);
             if tol.partial_cmp(&0.0) != Some(std::cmp::Ordering::Greater) || !tol.is_finite() {
                 return Err(BdfError::BadErrorWeight {
                     t: self.s.tn,

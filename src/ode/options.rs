@@ -45,6 +45,11 @@ pub struct BdfOptions {
     pub max_conv_fails: usize,
     /// Hold the order below 3 for a while when lightly damped modes make BDF3–5 unstable.
     pub stability_limit_detection: bool,
+    /// Per component, the largest magnitude the relative tolerance applies to: the WRMS weight
+    /// is `1 / (rtol min(|y_i|, cap_i) + atol_i)`. For a state that grows without bound (a crank
+    /// angle), a cap of one period keeps the *phase* accurate instead of allowing an error that
+    /// grows with the number of revolutions. `None`: no cap (CVODE's weights).
+    pub magnitude_cap: Option<Vec<f64>>,
 }
 
 impl Default for BdfOptions {
@@ -60,6 +65,7 @@ impl Default for BdfOptions {
             max_err_test_fails: 7,
             max_conv_fails: 10,
             stability_limit_detection: true,
+            magnitude_cap: None,
         }
     }
 }
@@ -95,6 +101,21 @@ impl BdfOptions {
                         format!("entry {i} must be finite and >= 0, got {a}"),
                     );
                 }
+            }
+        }
+        if let Some(cap) = &self.magnitude_cap {
+            if cap.len() != n {
+                return bad(
+                    "magnitude_cap",
+                    format!("has {} entries, the problem has {n} states", cap.len()),
+                );
+            }
+            if let Some((i, c)) = cap
+                .iter()
+                .enumerate()
+                .find(|(_, c)| c.is_nan() || **c <= 0.0)
+            {
+                return bad("magnitude_cap", format!("entry {i} must be > 0, got {c}"));
             }
         }
         if !(1..=5).contains(&self.max_order) {

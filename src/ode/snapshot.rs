@@ -15,7 +15,7 @@ use super::stats::BdfStats;
 /// Identifies a serialised BDF snapshot.
 const MAGIC: f64 = 4_262_000_917.0;
 /// Layout version of the serialisation.
-const VERSION: f64 = 1.0;
+const VERSION: f64 = 2.0;
 
 /// Everything needed to continue an integration bit for bit.
 #[derive(Debug, Clone, PartialEq)]
@@ -87,6 +87,13 @@ impl BdfSnapshot {
         w.usize(o.max_err_test_fails);
         w.usize(o.max_conv_fails);
         w.bool(o.stability_limit_detection);
+        match &o.magnitude_cap {
+            Some(cap) => {
+                w.f(1.0);
+                w.slice(cap);
+            }
+            None => w.f(0.0),
+        }
         // Step state.
         for v in [s.tn, s.h, s.hprime, s.hscale, s.eta, s.etamax, s.hu] {
             w.f(v);
@@ -255,6 +262,11 @@ impl BdfSnapshot {
             max_err_test_fails: r.usize("max_err_test_fails")?,
             max_conv_fails: r.usize("max_conv_fails")?,
             stability_limit_detection: r.bool()?,
+            magnitude_cap: match r.f()? {
+                0.0 => None,
+                1.0 => Some(r.vec(n)?),
+                t => return Err(bad(format!("unknown magnitude-cap tag {t}"))),
+            },
         };
         opts.validate(n)?;
         if ncols != max_order + 1 {

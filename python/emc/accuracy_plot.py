@@ -1,0 +1,51 @@
+"""Log-log plot of the work-precision table written by `examples/accuracy_cost.rs`.
+
+Usage: python -m emc.accuracy_plot accuracy.csv accuracy.png
+"""
+
+from __future__ import annotations
+
+import sys
+
+import matplotlib
+
+matplotlib.use("Agg")
+import matplotlib.pyplot as plt  # noqa: E402
+import pandas as pd  # noqa: E402
+
+
+def family(knob: str) -> str:
+    if knob.startswith("rtol"):
+        return "tolerance"
+    if knob.startswith("max order"):
+        return "max order (rtol 1e-5)"
+    if knob.startswith("comm") and knob.endswith("interp"):
+        return "comm step, inputs interpolated"
+    if knob.startswith("comm"):
+        return "comm step, inputs held"
+    return "other (rtol 1e-5)"
+
+
+def plot(csv: str, png: str) -> None:
+    table = pd.read_csv(csv)
+    cases = list(dict.fromkeys(table.case))
+    fig, axes = plt.subplots(1, len(cases), figsize=(6 * len(cases), 5), squeeze=False)
+    for ax, case in zip(axes[0], cases):
+        data = table[table.case == case].copy()
+        data["family"] = data.knob.map(family)
+        for name, group in data.groupby("family", sort=False):
+            ax.loglog(group.cpu_s, group.rel_l2, marker="o", label=name)
+            for _, row in group.iterrows():
+                ax.annotate(row.knob.split(" (")[0].replace("comm ", ""), (row.cpu_s, row.rel_l2),
+                            fontsize=6, xytext=(3, 3), textcoords="offset points")
+        ax.set_xlabel("CPU time [s]")
+        ax.set_ylabel("relative L2 error of the mount forces")
+        ax.set_title(f"scene {data.scene.iloc[0]}: {case}")
+        ax.grid(True, which="both", lw=0.3)
+        ax.legend(fontsize=8)
+    fig.tight_layout()
+    fig.savefig(png, dpi=120)
+
+
+if __name__ == "__main__":
+    plot(sys.argv[1], sys.argv[2])
