@@ -1,0 +1,268 @@
+//! Hard cases stay numerically stable: finite outputs, bounded forces, agreement with a tight
+//! reference where one exists, and a clear error (never a hang) where the case is impossible.
+//! All through the co-simulation runtime the FMU uses (`cosim::Simulation`).
+
+use engine_mount_chassis::cosim::{
+    Inputs, Outputs, Settings, Signal, Simulation, RPM_TO_RAD_PER_S,
+};
+
+/// DESIGN §8: the default powertrain weighs 180 kg; the default configuration's gravity.
+fn weight() -> f64 {
+    180.0 * engine_mount_chassis::model::EngineConfig::default().gravity
+}
+
+fn inputs(rpm: f64, torque: f64, stiffness: f64) -> Inputs {
+    Inputs {
+        crank_speed: Signal::constant(rpm * RPM_TO_RAD_PER_S),
+        load_torque: Signal::constant(torque),
+        stiffness_scale: [Signal::constant(stiffness); 4],
+        damping_scale: [Signal::constant(1.0); 4],
+    }
+}
+
+fn at(mut i: Inputs, t: f64) -> Inputs {
+    i.crank_speed.reference_time = t;
+    i.load_torque.reference_time = t;
+    i
+}
+
+/// Steps with communication step `h` to `t_end`, applying `change(t)` inputs when given;
+/// returns the outputs at every communication point.
+fn run(
+    settings: &Settings,
+    start: Inputs,
+    h: f64,
+    t_end: f64,
+    change: impl Fn(f64) -> Option<Inputs>,
+) -> Result<Vec<(f64, Outputs)>, String> {
+    let mut sim = Simulation::new(settings, 0.0, &start)?;
+    let n = (t_end / h).round() as usize;
+    let mut out = Vec::with_capacity(n);
+    for k in 0..n {
+        let t = k as f64 * h;
+        if let Some(i) = change(t) {
+            sim.set_inputs(&at(i, t))?;
+        }
+        let t_next = (k + 1) as f64 * h;
+        sim.advance_to(t_next)
+            .map_err(|e| format!("{} at {}", e.message, e.reached))?;
+        out.push((t_next, sim.outputs()?));
+    }
+    Ok(out)
+}
+
+fn vertical(o: &Outputs) -> f64 {
+    o.mount_force.iter().map(|f| f[2]).sum()
+}
+
+fn assert_finite_and_bounded(out: &[(f64, Outputs)], bound: f64) {
+    for (t, o) in out {
+        for f in o.mount_force.iter().flatten() {
+            assert!(
+                f.is_finite() && f.abs() < bound,
+                "t = {t}: mount force {f} (bound {bound})"
+            );
+        }
+        for a in o.powertrain_acceleration {
+            assert!(a.is_finite(), "t = {t}: acceleration {a}");
+        }
+    }
+}
+
+fn max_force_difference(a: &[(f64, Outputs)], b: &[(f64, Outputs)]) -> f64 {
+    a.iter()
+        .zip(b)
+        .flat_map(|((ta, oa), (tb, ob))| {
+            assert!((ta - tb).abs() < 1e-9);
+            oa.mount_force
+                .iter()
+                .flatten()
+                .zip(ob.mount_force.iter().flatten())
+                .map(|(x, y)| (x - y).abs())
+        })
+        .fold(0.0, f64::max)
+}
+
+fn tight(settings: &Settings) -> Settings {
+    Settings {
+        rel_tol: 1e-9,
+        abs_tol: 1e-12,
+        ..settings.clone()
+    }
+}
+
+#[test]
+fn excitation_switched_on_instantly() {
+    let s = Settings {
+        fade_in_time: 0.0,
+        ..Settings::default()
+    };
+    let out = run(&s, inputs(2500.0, 0.0, 1.0), 1e-3, 0.3, |_| None).unwrap();
+    assert_finite_and_bounded(&out, 5.0 * weight());
+    let reference = run(&tight(&s), inputs(2500.0, 0.0, 1.0), 1e-3, 0.3, |_| None).unwrap();
+    let difference = max_force_difference(&out, &reference);
+    assert!(
+        difference < 0.01 * weight(),
+        "{difference} N from the tight reference"
+    );
+}
+
+#[test]
+fn engine_speed_step_at_a_communication_point() {
+    let s = Settings::default();
+    let step = |t: f64| ((t - 0.2).abs() < 1e-9).then(|| inputs(2500.0, 0.0, 1.0));
+    let out = run(&s, inputs(800.0, 0.0, 1.0), 1e-3, 0.4, step).unwrap();
+    assert_finite_and_bounded(&out, 5.0 * weight());
+    let reference = run(&tight(&s), inputs(800.0, 0.0, 1.0), 1e-3, 0.4, step).unwrap();
+    let difference = max_force_difference(&out, &reference);
+    assert!(
+        difference < 0.01 * weight(),
+        "{difference} N from the tight reference"
+    );
+}
+
+#[test]
+fn engine_at_rest_stays_in_static_equilibrium() {
+    let out = run(
+        &Settings::default(),
+        inputs(0.0, 0.0, 1.0),
+        1e-2,
+        1.0,
+        |_| None,
+    )
+    .unwrap();
+    for (t, o) in &out {
+        assert!(
+            (vertical(o) + weight()).abs() < 1e-6 * weight(),
+            "t = {t}: {}",
+            vertical(o)
+        );
+        assert!(
+            o.powertrain_acceleration.iter().all(|a| a.abs() < 1e-9),
+            "t = {t}: {:?}",
+            o.powertrain_acceleration
+        );
+    }
+}
+
+#[test]
+fn load_torque_into_the_bump_stops() {
+    // 600 N m about the crank axis: the vertical mounts at ±0.30 m take ±1000 N extra each pair,
+    // well into the progressive branch of the curves.
+    let s = Settings::default();
+    let out = run(&s, inputs(1500.0, 600.0, 1.0), 1e-3, 0.6, |_| None).unwrap();
+    assert_finite_and_bounded(&out, 20.0 * weight());
+    let at_rest = run(&s, inputs(0.0, 600.0, 1.0), 1e-2, 0.1, |_| None).unwrap();
+    let o = &at_rest.last().unwrap().1;
+    assert!(
+        (vertical(o) + weight()).abs() < 1e-3 * weight(),
+        "{}",
+        vertical(o)
+    );
+    assert!(
+        o.powertrain_rotation[1].abs() > 1e-3,
+        "the powertrain rolls under the torque"
+    );
+}
+
+#[test]
+fn extreme_mount_stiffness_scales() {
+    for scale in [100.0, 0.01] {
+        let out = run(
+            &Settings::default(),
+            inputs(1500.0, 0.0, scale),
+            1e-3,
+            0.4,
+            |_| None,
+        )
+        .unwrap_or_else(|e| panic!("stiffness scale {scale}: {e}"));
+        assert_finite_and_bounded(&out, 10.0 * weight());
+    }
+}
+
+#[test]
+fn tiny_and_huge_communication_steps_agree_with_one_millisecond() {
+    let s = Settings::default();
+    let fine = run(&s, inputs(1500.0, 0.0, 1.0), 1e-6, 0.004, |_| None).unwrap();
+    let ms = run(&s, inputs(1500.0, 0.0, 1.0), 1e-3, 0.004, |_| None).unwrap();
+    let common: Vec<(f64, Outputs)> = fine.iter().skip(999).step_by(1000).cloned().collect();
+    assert!(max_force_difference(&common, &ms) < 1e-3 * weight());
+
+    let coarse = run(&s, inputs(1500.0, 0.0, 1.0), 0.5, 1.0, |_| None).unwrap();
+    let ms = run(&s, inputs(1500.0, 0.0, 1.0), 1e-3, 1.0, |_| None).unwrap();
+    let common: Vec<(f64, Outputs)> = ms.iter().skip(499).step_by(500).cloned().collect();
+    assert!(max_force_difference(&coarse, &common) < 1e-2 * weight());
+}
+
+#[test]
+fn a_mount_removed_from_the_configuration() {
+    let mut config = engine_mount_chassis::model::EngineConfig::default();
+    config.mounts[3].active = false;
+    let dir = std::env::temp_dir().join(format!("emc-hard-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let path = dir.join("three_mounts.json");
+    std::fs::write(&path, config.to_json()).unwrap();
+    let s = Settings {
+        config_file: Some(path),
+        ..Settings::default()
+    };
+    let out = run(&s, inputs(1500.0, 0.0, 1.0), 1e-3, 0.4, |_| None).unwrap();
+    assert_finite_and_bounded(&out, 10.0 * weight());
+    assert!(out.iter().all(|(_, o)| o.mount_force[3] == [0.0; 3]));
+    let first = &out[0].1;
+    assert!(
+        (vertical(first) + weight()).abs() < 0.05 * weight(),
+        "{}",
+        vertical(first)
+    );
+    let _ = std::fs::remove_dir_all(dir);
+}
+
+#[test]
+fn impossible_cases_fail_with_a_clear_error() {
+    // A configuration that cannot be read.
+    let s = Settings {
+        config_file: Some("/nonexistent/engine.json".into()),
+        ..Settings::default()
+    };
+    let err = Simulation::new(&s, 0.0, &inputs(800.0, 0.0, 1.0))
+        .err()
+        .expect("must fail");
+    assert!(err.contains("/nonexistent/engine.json"), "{err}");
+    // An unknown scene.
+    let s = Settings {
+        scene: 7,
+        ..Settings::default()
+    };
+    let err = Simulation::new(&s, 0.0, &inputs(800.0, 0.0, 1.0))
+        .err()
+        .expect("must fail");
+    assert!(err.contains("scene 7"), "{err}");
+    // Negative engine speed and non-positive stiffness scale.
+    assert!(Simulation::new(&Settings::default(), 0.0, &inputs(-10.0, 0.0, 1.0)).is_err());
+    assert!(Simulation::new(&Settings::default(), 0.0, &inputs(800.0, 0.0, 0.0)).is_err());
+}
+
+#[test]
+fn long_idle_does_not_drift() {
+    // 1000 s of idle at a loose tolerance: the mean mount forces over the last revolutions stay at
+    // their static values, and the crank phase stays locked to the integrated speed.
+    let s = Settings {
+        rel_tol: 1e-4,
+        ..Settings::default()
+    };
+    let h = 0.075; // one full 720° cycle at 800 rpm is 0.15 s: two samples per cycle
+    let out = run(&s, inputs(800.0, 0.0, 1.0), h, 1000.0, |_| None).unwrap();
+    assert_finite_and_bounded(&out, 3.0 * weight());
+    let last = &out[out.len() - 200..];
+    let mean: f64 = last.iter().map(|(_, o)| vertical(o)).sum::<f64>() / last.len() as f64;
+    assert!(
+        (mean + weight()).abs() < 0.01 * weight(),
+        "mean vertical force {mean} vs weight {}",
+        weight()
+    );
+    let (t, o) = out.last().unwrap();
+    let expected = 800.0 * RPM_TO_RAD_PER_S * t;
+    let phase = (o.crank_angle + o.powertrain_rotation[1] - expected).abs();
+    assert!(phase < 0.05, "crank phase off by {phase} rad after {t} s");
+}
