@@ -51,9 +51,9 @@ fn bad_caps_are_rejected_by_name() {
             magnitude_cap: Some(cap),
             ..BdfOptions::default()
         };
-        let err = Bdf::new(&mut Angle, 0.0, &[0.0], opts)
-            .err()
-            .expect("rejected");
+        let Err(err) = Bdf::new(&mut Angle, 0.0, &[0.0], opts) else {
+            panic!("a bad cap was accepted");
+        };
         assert!(err.to_string().contains("magnitude_cap"), "{err}");
     }
 }
