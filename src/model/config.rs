@@ -1,5 +1,5 @@
 //! Engine configuration (serde). Defaults: DESIGN §8, tuned to the paper's Table 1 column
-//! "engine supported by ground" (see [`super::defaults`]).
+//! "engine supported by ground" (tuning rationale in `src/model/defaults.rs`).
 //!
 //! Frame: ISO 8855 vehicle frame, x forward, y left, z up, origin at the front axle centre on the
 //! ground. The engine is transverse: the crank axis is +y, cylinders point to +z in the monoblock.

@@ -81,7 +81,7 @@ impl Default for WiebeModel {
                     },
                     WiebeStage {
                         fraction: 0.92,
-                        start_deg: -4.0,
+                        start_deg: -6.0,
                         duration_deg: 60.0,
                         shape: 0.9,
                     },
@@ -278,7 +278,15 @@ impl PressureCurve {
     }
 
     /// Resamples a user table (periodic linear interpolation, then C¹ Hermite on the grid).
-    pub fn from_table(table: &PressureTable) -> Self {
+    /// An empty or mismatched table is an error.
+    pub fn from_table(table: &PressureTable) -> Result<Self, String> {
+        if table.angle_deg.is_empty() || table.angle_deg.len() != table.pressure.len() {
+            return Err(format!(
+                "pressure table needs matching, non-empty angle and pressure lists, got {} and {}",
+                table.angle_deg.len(),
+                table.pressure.len()
+            ));
+        }
         let n = (720.0 / GRID_DEG).round() as usize;
         let pts: Vec<(f64, f64)> = table
             .angle_deg
@@ -310,7 +318,7 @@ impl PressureCurve {
                 }
             })
             .collect();
-        Self::from_samples(values)
+        Ok(Self::from_samples(values))
     }
 }
 
@@ -353,6 +361,34 @@ mod tests {
                 "{deg}: {got} vs {expect}"
             );
         }
+    }
+
+    #[test]
+    fn user_table_reproduces_a_tabulated_curve_and_rejects_bad_tables() {
+        let model = WiebeModel::default();
+        let wiebe = PressureCurve::wiebe(&model, &model.full_load, &geometry());
+        let angle_deg: Vec<f64> = (0..1440).map(|k| -360.0 + 0.5 * k as f64).collect();
+        let pressure = angle_deg
+            .iter()
+            .map(|a| wiebe.pressure(f64::to_radians(*a)))
+            .collect();
+        let table = PressureCurve::from_table(&PressureTable {
+            angle_deg,
+            pressure,
+        })
+        .expect("table");
+        for deg in [-200.0, -30.0, 0.0, 7.3, 25.0, 180.0] {
+            let (a, b) = (
+                wiebe.pressure(f64::to_radians(deg)),
+                table.pressure(f64::to_radians(deg)),
+            );
+            assert!((a - b).abs() < 2e-3 * wiebe.peak(), "{deg}: {a} vs {b}");
+        }
+        assert!(PressureCurve::from_table(&PressureTable {
+            angle_deg: vec![],
+            pressure: vec![]
+        })
+        .is_err());
     }
 
     #[test]

@@ -25,6 +25,8 @@ use crate::ode::{OdeProblem, ProblemError};
 #[derive(Debug, Clone, PartialEq)]
 struct GasExcitation {
     curve: PressureCurve,
+    /// Idle and full-load curves of the Wiebe model, for changing the load at run time.
+    load_points: Option<(PressureCurve, PressureCurve)>,
     area: f64,
     crankcase_pressure: f64,
     radius: f64,
@@ -47,11 +49,18 @@ pub struct Evaluation {
 
 /// How the model is evaluated.
 #[derive(Debug, Clone, Copy, PartialEq)]
-struct Mode {
+pub(crate) struct Mode {
     /// Engine running (crank speed, gas, fade-in); false: crank at rest, no gas (statics, modes).
-    running: bool,
+    pub(crate) running: bool,
     /// Force the nonlinear mount curves (statics determine the operating point with them).
-    nonlinear_mounts: bool,
+    pub(crate) nonlinear_mounts: bool,
+}
+
+impl Mode {
+    pub(crate) const RUNNING: Mode = Mode {
+        running: true,
+        nonlinear_mounts: false,
+    };
 }
 
 /// Engine on mounts attached to rigid ground.
@@ -105,40 +114,54 @@ impl GroundScene {
             Vec::new()
         };
         let c = &config.crank_drive;
-        let gas = config.effects.gas_forces.then(|| {
-            let geometry = CylinderGeometry {
-                bore: c.bore,
-                crank_radius: c.crank_radius,
-                conrod: c.conrod_length,
-            };
-            let curve = match &config.gas.model {
-                GasModel::Wiebe(w) => PressureCurve::blend(
-                    &PressureCurve::wiebe(w, &w.idle, &geometry),
-                    &PressureCurve::wiebe(w, &w.full_load, &geometry),
-                    config.gas.load,
-                ),
-                GasModel::Table(t) => PressureCurve::from_table(t),
-            };
-            GasExcitation {
-                curve,
-                area: geometry.piston_area(),
-                crankcase_pressure: config.gas.crankcase_pressure,
-                radius: c.crank_radius,
-                conrod: c.conrod_length,
-                cylinders: c
-                    .cylinders
-                    .iter()
-                    .map(|k| {
+        let gas = if !config.effects.gas_forces {
+            None
+        } else {
+            Some({
+                let geometry = CylinderGeometry {
+                    bore: c.bore,
+                    crank_radius: c.crank_radius,
+                    conrod: c.conrod_length,
+                };
+                let (curve, load_points) = match &config.gas.model {
+                    GasModel::Wiebe(w) => {
+                        let idle = PressureCurve::wiebe(w, &w.idle, &geometry);
+                        let full = PressureCurve::wiebe(w, &w.full_load, &geometry);
                         (
-                            k.y_offset,
-                            k.throw_deg.to_radians(),
-                            k.firing_tdc_deg.to_radians(),
+                            PressureCurve::blend(&idle, &full, config.gas.load),
+                            Some((idle, full)),
                         )
-                    })
-                    .collect(),
-                crank_centre: v3(&c.crank_centre) - bodies[0].reference,
-            }
-        });
+                    }
+                    GasModel::Table(t) => (
+                        PressureCurve::from_table(t).map_err(|message| ConfigError {
+                            field: "gas.model".into(),
+                            message,
+                        })?,
+                        None,
+                    ),
+                };
+                GasExcitation {
+                    curve,
+                    load_points,
+                    area: geometry.piston_area(),
+                    crankcase_pressure: config.gas.crankcase_pressure,
+                    radius: c.crank_radius,
+                    conrod: c.conrod_length,
+                    cylinders: c
+                        .cylinders
+                        .iter()
+                        .map(|k| {
+                            (
+                                k.y_offset,
+                                k.throw_deg.to_radians(),
+                                k.firing_tdc_deg.to_radians(),
+                            )
+                        })
+                        .collect(),
+                    crank_centre: v3(&c.crank_centre) - bodies[0].reference,
+                }
+            })
+        };
         let gravity = Vector3::new(0.0, 0.0, -config.gravity);
         let inputs = EngineInputs::new(config.mounts.len());
         Ok(Self {
@@ -243,6 +266,38 @@ impl GroundScene {
         Ok(())
     }
 
+    /// Engine load between idle (0) and full load (1) of the Wiebe gas model, at run time.
+    /// Ignored (Ok) when gas forces are off; an error for a user pressure table.
+    pub fn set_gas_load(&mut self, load: f64) -> Result<(), InputError> {
+        if !(load.is_finite() && (0.0..=1.0).contains(&load)) {
+            return Err(InputError(format!("gas load {load} must lie in [0, 1]")));
+        }
+        if let Some(gas) = &mut self.gas {
+            let Some((idle, full)) = &gas.load_points else {
+                return Err(InputError(
+                    "the gas pressure comes from a user table; its load cannot change".into(),
+                ));
+            };
+            gas.curve = PressureCurve::blend(idle, full, load);
+        }
+        self.config.gas.load = load;
+        Ok(())
+    }
+
+    /// Start of the excitation fade-in.
+    pub fn fade_start(&self) -> f64 {
+        self.fade_start
+    }
+
+    /// Sets the operating points of the linearised mounts (per configured mount).
+    pub(crate) fn set_operating_points(&mut self, points: &[Vector3<f64>]) {
+        for (m, p) in self.mounts.iter_mut().zip(points) {
+            if let Some(m) = m {
+                m.operating_point = *p;
+            }
+        }
+    }
+
     /// Time from which the excitation fades in (set by [`Self::static_equilibrium`]).
     pub fn set_fade_start(&mut self, t: f64) {
         self.fade_start = t;
@@ -263,7 +318,7 @@ impl GroundScene {
     }
 
     /// Pose and velocity of body `b` in state `y`.
-    pub fn kinematics(&self, y: &[f64], b: usize) -> BodyKinematics {
+    pub(crate) fn kinematics(&self, y: &[f64], b: usize) -> BodyKinematics {
         let nb = self.bodies.len();
         let q = &y[6 * b..6 * b + 6];
         let v = &y[6 * nb + 6 * b..6 * nb + 6 * b + 6];
@@ -305,54 +360,12 @@ impl GroundScene {
     fn evaluate_mode(&self, t: f64, y: &[f64], mode: Mode) -> Evaluation {
         let nb = self.bodies.len();
         let kin: Vec<BodyKinematics> = (0..nb).map(|b| self.kinematics(y, b)).collect();
-        let crank = self.crank_state(t, y, mode);
-        let mut dynamics = vec![BodyDynamics::zero(); nb];
-        for b in 0..nb {
-            add_parts(
-                &self.bodies[b].parts,
-                &kin[b],
-                &crank,
-                &self.gravity,
-                &mut dynamics[b],
-            );
-        }
-        let phi = y[self.crank_index()];
-        if mode.running {
-            self.add_gas_forces(&kin[0], phi, self.excitation(t), &mut dynamics[0]);
-        }
-        if nb == 2 {
-            for rc in &self.ring_carriers {
-                let w = rc.wrench(&kin[0], &kin[1]);
-                dynamics[0].add_point_force(&kin[0], &w.monoblock_point, &w.monoblock_force);
-                dynamics[0].add_wrench(&Vector3::zeros(), &w.monoblock_moment);
-                dynamics[1].add_point_force(&kin[1], &w.housing_point, &w.housing_force);
-                dynamics[1].add_wrench(&Vector3::zeros(), &w.housing_moment);
-            }
-        }
+        let mut dynamics: Vec<BodyDynamics> = (0..nb)
+            .map(|b| self.local_dynamics(t, y, &kin[b], b, mode))
+            .collect();
+        self.add_ring_carriers(&kin, &mut dynamics);
         let hb = nb - 1;
-        let h = &kin[hb];
-        let nonlinear = mode.nonlinear_mounts || self.config.effects.mount_nonlinearity;
-        let mut mounts = Vec::with_capacity(self.mounts.len());
-        for (i, m) in self.mounts.iter().enumerate() {
-            let Some(m) = m else {
-                mounts.push(None);
-                continue;
-            };
-            let local = m.bracket - self.bodies[hb].reference;
-            let x = h.point(&local);
-            let xv = h.point_velocity(&local);
-            let r = m.response(
-                &(x - m.attachment),
-                &xv,
-                self.inputs.stiffness_scale[i],
-                self.inputs.damping_scale[i],
-                nonlinear,
-            );
-            dynamics[hb].add_point_force(h, &x, &r.force);
-            mounts.push(Some(r));
-        }
-        let torque = self.inputs.load_torque.at(t);
-        dynamics[hb].add_wrench(&Vector3::zeros(), &(h.rotation * Vector3::y() * torque));
+        let mounts = self.add_mounts(&kin[hb], mode, &mut dynamics[hb]);
         let e = kin[0].rotation * Vector3::y();
         let crank_rate = if mode.running {
             self.inputs.crank_speed.at(t)
@@ -365,6 +378,73 @@ impl GroundScene {
             mounts,
             crank_rate,
         }
+    }
+
+    /// Contributions that depend on one body's coordinates only (and on the crank angle): its
+    /// parts with gravity, the gas side forces (monoblock), the load torque (housing).
+    pub(crate) fn local_dynamics(
+        &self,
+        t: f64,
+        y: &[f64],
+        kin: &BodyKinematics,
+        b: usize,
+        mode: Mode,
+    ) -> BodyDynamics {
+        let mut d = BodyDynamics::zero();
+        let crank = self.crank_state(t, y, mode);
+        add_parts(&self.bodies[b].parts, kin, &crank, &self.gravity, &mut d);
+        if b == 0 && mode.running {
+            self.add_gas_forces(kin, y[self.crank_index()], self.excitation(t), &mut d);
+        }
+        if b == self.bodies.len() - 1 {
+            let torque = self.inputs.load_torque.at(t);
+            d.add_wrench(&Vector3::zeros(), &(kin.rotation * Vector3::y() * torque));
+        }
+        d
+    }
+
+    /// Ring-carrier forces on monoblock and housing (nothing for a rigid powertrain).
+    pub(crate) fn add_ring_carriers(&self, kin: &[BodyKinematics], dynamics: &mut [BodyDynamics]) {
+        if kin.len() != 2 {
+            return;
+        }
+        for rc in &self.ring_carriers {
+            let w = rc.wrench(&kin[0], &kin[1]);
+            dynamics[0].add_point_force(&kin[0], &w.monoblock_point, &w.monoblock_force);
+            dynamics[0].add_wrench(&Vector3::zeros(), &w.monoblock_moment);
+            dynamics[1].add_point_force(&kin[1], &w.housing_point, &w.housing_force);
+            dynamics[1].add_wrench(&Vector3::zeros(), &w.housing_moment);
+        }
+    }
+
+    /// Mount forces on the housing `h`; returns the responses per configured mount.
+    fn add_mounts(
+        &self,
+        h: &BodyKinematics,
+        mode: Mode,
+        out: &mut BodyDynamics,
+    ) -> Vec<Option<MountResponse>> {
+        let hb = self.bodies.len() - 1;
+        let nonlinear = mode.nonlinear_mounts || self.config.effects.mount_nonlinearity;
+        self.mounts
+            .iter()
+            .enumerate()
+            .map(|(i, m)| {
+                let m = m.as_ref()?;
+                let local = m.bracket - self.bodies[hb].reference;
+                let x = h.point(&local);
+                let xv = h.point_velocity(&local);
+                let r = m.response(
+                    &(x - m.attachment),
+                    &xv,
+                    self.inputs.stiffness_scale[i],
+                    self.inputs.damping_scale[i],
+                    nonlinear,
+                );
+                out.add_point_force(h, &x, &r.force);
+                Some(r)
+            })
+            .collect()
     }
 
     /// Piston side-force pairs (paper §4.2) on the monoblock `body`: `−F_N` at each piston pin,
@@ -399,15 +479,8 @@ impl GroundScene {
     }
 
     /// One evaluation of the equations of motion of the running engine at `(t, y)`.
-    pub fn evaluate(&self, t: f64, y: &[f64]) -> Evaluation {
-        self.evaluate_mode(
-            t,
-            y,
-            Mode {
-                running: true,
-                nonlinear_mounts: false,
-            },
-        )
+    pub(crate) fn evaluate(&self, t: f64, y: &[f64]) -> Evaluation {
+        self.evaluate_mode(t, y, Mode::RUNNING)
     }
 
     /// Generalised forces at rest (crank standing, no gas), nonlinear mounts: the static residual.
@@ -467,7 +540,7 @@ impl GroundScene {
     }
 
     /// Mass matrix blocks (one 6×6 per body) at `(t, y)`.
-    pub fn body_mass(&self, t: f64, y: &[f64]) -> Vec<Matrix6<f64>> {
+    pub(crate) fn body_mass(&self, t: f64, y: &[f64]) -> Vec<Matrix6<f64>> {
         self.evaluate(t, y)
             .dynamics
             .iter()
@@ -476,7 +549,7 @@ impl GroundScene {
     }
 
     /// Accelerations `[u'', ω']` per body from one evaluation of the equations of motion.
-    pub fn accelerations(&self, ev: &Evaluation) -> Result<Vec<Vector6<f64>>, ProblemError> {
+    pub(crate) fn accelerations(&self, ev: &Evaluation) -> Result<Vec<Vector6<f64>>, ProblemError> {
         ev.dynamics
             .iter()
             .map(|d| {
@@ -488,8 +561,24 @@ impl GroundScene {
             .collect()
     }
 
+    /// Checks that `y` is a state of this scene.
+    pub fn check_state(&self, y: &[f64]) -> Result<(), ProblemError> {
+        let n = self.dim();
+        if y.len() != n {
+            return Err(ProblemError::Fatal(format!(
+                "state has {} entries, the engine model has {n}",
+                y.len()
+            )));
+        }
+        if let Some(i) = y.iter().position(|v| !v.is_finite()) {
+            return Err(ProblemError::Fatal(format!("state entry {i} is {}", y[i])));
+        }
+        Ok(())
+    }
+
     /// Total mechanical energy: kinetic + gravity + mounts + ring carriers (for energy checks).
-    pub fn energy(&self, t: f64, y: &[f64]) -> f64 {
+    pub fn energy(&self, t: f64, y: &[f64]) -> Result<f64, ProblemError> {
+        self.check_state(y)?;
         let ev = self.evaluate(t, y);
         let nb = self.bodies.len();
         let mut e = 0.0;
@@ -523,7 +612,7 @@ impl GroundScene {
                 e += rc.energy(&rc.wrench(&ev.kinematics[0], &ev.kinematics[1]).deflection);
             }
         }
-        e
+        Ok(e)
     }
 
     /// State with every body at its reference pose and the crank at the start angle.
@@ -551,12 +640,25 @@ impl OdeProblem for GroundScene {
     }
 
     fn rhs(&mut self, t: f64, y: &[f64], f: &mut [f64]) -> Result<(), ProblemError> {
+        if y.len() != self.dim() || f.len() != self.dim() {
+            return Err(ProblemError::Fatal(format!(
+                "state/derivative lengths {}/{} differ from {}",
+                y.len(),
+                f.len(),
+                self.dim()
+            )));
+        }
         let ev = self.evaluate(t, y);
         self.write_rhs(y, &ev, f)
     }
 
     fn has_mass_matrix(&self) -> bool {
         true
+    }
+
+    fn jacobian(&mut self, t: f64, y: &[f64], j: MatMut<'_, f64>) -> Result<bool, ProblemError> {
+        self.structured_jacobian(t, y, j)?;
+        Ok(true)
     }
 
     fn mass(&mut self, t: f64, y: &[f64], mut m: MatMut<'_, f64>) -> Result<(), ProblemError> {

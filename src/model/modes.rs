@@ -132,6 +132,7 @@ impl GroundScene {
     /// Eigenmodes at the equilibrium state `y_eq` (from [`GroundScene::static_equilibrium`]),
     /// sorted by frequency; overdamped and static (zero) eigenvalues are skipped.
     pub fn modes(&self, y_eq: &[f64]) -> Result<Vec<Mode>, String> {
+        self.check_state(y_eq).map_err(|e| format!("{e:?}"))?;
         let nb = self.body_count();
         let n = 12 * nb;
         let dim = self.dim();

@@ -48,6 +48,7 @@ fn arr(v: &Vector3<f64>) -> [f64; 3] {
 impl GroundScene {
     /// Outputs at `(t, y)`.
     pub fn outputs(&self, t: f64, y: &[f64]) -> Result<EngineOutputs, ProblemError> {
+        self.check_state(y)?;
         let ev = self.evaluate(t, y);
         let acc = self.accelerations(&ev)?;
         let nb = self.body_count();

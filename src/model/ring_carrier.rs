@@ -2,7 +2,8 @@
 //!
 //! Deflections are measured in housing axes: translation of the monoblock's copy of the bushing
 //! point relative to the housing's copy, and the rotation vector of the relative rotation
-//! `R_hᵀ R_m` (exact, no small-angle assumption in the kinematics). The force acts at the
+//! `R_hᵀ R_m` (exact, no small-angle assumption in the kinematics; the elastic moment is the exact
+//! gradient of the rotational energy, so the element is conservative). The force acts at the
 //! monoblock point and, opposite, at the housing point; the housing also takes the moment of that
 //! force pair, so the element conserves linear and angular momentum.
 
@@ -11,7 +12,7 @@ use nalgebra::{Matrix3, Vector3};
 use super::assembly::v3;
 use super::composite::BodyKinematics;
 use super::config::BushingConfig;
-use super::rotation::rotation_vector;
+use super::rotation::{left_jacobian_inverse_transpose, rotation_vector};
 
 /// A bushing ready for evaluation.
 #[derive(Debug, Clone, PartialEq)]
@@ -68,11 +69,11 @@ impl RingCarrier {
             k[1] * d.y + c[1] * dv.y,
             k[2] * d.z + c[2] * dv.z,
         );
-        let m_local = Vector3::new(
-            k[3] * th.x + c[3] * w.x,
-            k[4] * th.y + c[4] * w.y,
-            k[5] * th.z + c[5] * w.z,
-        );
+        // Elastic moment conjugate to small relative rotations: J_l⁻ᵀ(θ) K θ, the exact gradient
+        // of ½ θᵀKθ, so the element stays conservative at finite rotations.
+        let elastic = left_jacobian_inverse_transpose(&th)
+            * Vector3::new(k[3] * th.x, k[4] * th.y, k[5] * th.z);
+        let m_local = elastic + Vector3::new(c[3] * w.x, c[4] * w.y, c[5] * w.z);
         let f = -(h.rotation * f_local);
         let m = -(h.rotation * m_local);
         BushingWrench {

@@ -37,17 +37,32 @@ pub fn angle_rates(theta: &Vector3<f64>, omega: &Vector3<f64>) -> Option<Vector3
 
 /// Rotation vector (axis × angle) of a rotation matrix; exact for angles below π.
 pub fn rotation_vector(r: &Matrix3<f64>) -> Vector3<f64> {
-    let cos_angle = ((r.trace() - 1.0) * 0.5).clamp(-1.0, 1.0);
-    let angle = cos_angle.acos();
+    let cos_angle = (r.trace() - 1.0) * 0.5;
     let axis_sin = Vector3::new(
         r[(2, 1)] - r[(1, 2)],
         r[(0, 2)] - r[(2, 0)],
         r[(1, 0)] - r[(0, 1)],
     ) * 0.5;
-    if angle < 1e-8 {
+    let sin_angle = axis_sin.norm();
+    // atan2 keeps full precision at small angles, where acos of the trace would not.
+    let angle = sin_angle.atan2(cos_angle);
+    if sin_angle < 1e-12 {
         return axis_sin;
     }
-    axis_sin * (angle / angle.sin())
+    axis_sin * (angle / sin_angle)
+}
+
+/// `J_l(θ)⁻ᵀ`: maps the gradient with respect to the rotation vector `θ` of `Q = exp([θ]×)` to
+/// the moment conjugate to a small rotation `δQ = [δφ]× Q`.
+pub fn left_jacobian_inverse_transpose(theta: &Vector3<f64>) -> Matrix3<f64> {
+    let t = theta.norm();
+    let k = skew(theta);
+    let c = if t < 1e-4 {
+        1.0 / 12.0 + t * t / 720.0
+    } else {
+        1.0 / (t * t) - (1.0 + t.cos()) / (2.0 * t * t.sin())
+    };
+    Matrix3::identity() + k * 0.5 + k * k * c
 }
 
 /// Skew-symmetric matrix `[a]×` with `[a]× b = a × b`.
@@ -74,6 +89,22 @@ mod tests {
         assert!((omega - mapped).norm() < 1e-8, "{omega} vs {mapped}");
         let back = angle_rates(&theta, &omega).expect("regular");
         assert!((back - rate).norm() < 1e-7);
+    }
+
+    #[test]
+    fn left_jacobian_inverse_transpose_is_the_gradient_map() {
+        // d/dε log(exp([ε]×) Q) at ε = 0 is J_l⁻¹(θ); check its transpose against differences.
+        let theta = Vector3::new(0.3, -0.5, 0.2);
+        let q = nalgebra::Rotation3::new(theta).into_inner();
+        let jt = left_jacobian_inverse_transpose(&theta);
+        let h = 1e-6;
+        for i in 0..3 {
+            let e = Vector3::ith(i, h);
+            let plus = rotation_vector(&(nalgebra::Rotation3::new(e).into_inner() * q));
+            let minus = rotation_vector(&(nalgebra::Rotation3::new(-e).into_inner() * q));
+            let col = (plus - minus) / (2.0 * h);
+            assert!((col - jt.row(i).transpose()).norm() < 1e-8, "column {i}");
+        }
     }
 
     #[test]
