@@ -19,6 +19,7 @@ use crate::fe::assembly::assemble;
 use crate::fe::chassis::{Chassis, MountLayout, SEAT_RAIL, STEERING_WHEEL};
 use crate::fe::chassis_config::ChassisConfig;
 use crate::fe::eigen::lowest_modes;
+use crate::fe::modal::{describe, ModeDescription};
 
 /// What the chassis reduction depends on (every field enters the cache key).
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
@@ -72,6 +73,11 @@ impl ChassisReduction {
 
     /// Builds the body, solves its lowest `max_modes` modes and keeps those up to the cut-off.
     pub fn reduce(&self) -> Result<ReducedChassis, String> {
+        self.reduce_described().map(|(r, _)| r)
+    }
+
+    /// [`Self::reduce`], with the FE description (torsion, steering wheel, …) of every kept mode.
+    pub fn reduce_described(&self) -> Result<(ReducedChassis, Vec<ModeDescription>), String> {
         self.validate()?;
         let body = Chassis::build(&self.body).map_err(|e| format!("chassis body: {e}"))?;
         let asm = assemble(&body.mesh).map_err(|e| format!("chassis assembly: {e}"))?;
@@ -131,10 +137,16 @@ impl ChassisReduction {
                 }
             })
             .collect();
-        Ok(ReducedChassis {
-            omega,
-            zeta,
-            points,
-        })
+        let mut descriptions =
+            describe(&body.mesh, &asm, &modes).map_err(|e| format!("chassis modes: {e}"))?;
+        descriptions.truncate(keep.len());
+        Ok((
+            ReducedChassis {
+                omega,
+                zeta,
+                points,
+            },
+            descriptions,
+        ))
     }
 }

@@ -74,10 +74,7 @@ fn sub3(a: [C; 3], b: [C; 3]) -> [C; 3] {
 /// Small complex displacement of a body point at lever `r` for translation `u`, rotation `th`.
 fn point_motion(u: &[C], th: &[C], r: &Vector3<f64>) -> [C; 3] {
     let c = |a: usize, b: usize, ra: f64, rb: f64| {
-        (
-            th[a].0 * rb - th[b].0 * ra,
-            th[a].1 * rb - th[b].1 * ra,
-        )
+        (th[a].0 * rb - th[b].0 * ra, th[a].1 * rb - th[b].1 * ra)
     };
     let cx = c(1, 2, r.y, r.z);
     let cy = c(2, 0, r.z, r.x);
@@ -219,7 +216,9 @@ impl HybridScene {
                 mode,
                 uncoupled_hz,
                 point,
-            } => format!("chassis mode {mode} ({uncoupled_hz:.2} Hz alone), largest motion at {point}"),
+            } => format!(
+                "chassis mode {mode} ({uncoupled_hz:.2} Hz alone), largest motion at {point}"
+            ),
         };
         HybridMode {
             frequency_hz: mag / (2.0 * std::f64::consts::PI),
@@ -316,9 +315,7 @@ impl HybridScene {
 
 /// Formats coupled modes as a table.
 pub fn hybrid_mode_table(modes: &[HybridMode]) -> String {
-    let mut s = String::from(
-        "  f [Hz]  zeta [%]  engine KE [%]  description\n",
-    );
+    let mut s = String::from("  f [Hz]  zeta [%]  engine KE [%]  description\n");
     for m in modes {
         s += &format!(
             "{:8.2}  {:8.2}  {:13.0}  {}\n",
