@@ -21,8 +21,10 @@ fn arg(i: usize, default: f64) -> f64 {
 const SAMPLES_PER_REV: usize = 72;
 const ORDERS: [f64; 5] = [1.0, 1.5, 2.0, 3.0, 4.5];
 
-/// Runs `scene` for `revs` revolutions, sampling the steering-wheel z acceleration over the second
-/// half. Returns (cpu s, steps, rhs, jacobians, factorisations, samples).
+/// CPU seconds, [steps, rhs, jacobians, factorisations], samples.
+type RunResult = Result<(f64, [u64; 4], Vec<f64>), Box<dyn std::error::Error>>;
+
+/// Runs `scene` for `revs` revolutions, sampling `sample` over the second half.
 fn run<P: OdeProblem>(
     scene: &mut P,
     y0: &[f64],
@@ -30,7 +32,7 @@ fn run<P: OdeProblem>(
     revs: usize,
     rtol: f64,
     mut sample: impl FnMut(&P, f64, &[f64]) -> f64,
-) -> Result<(f64, [u64; 4], Vec<f64>), Box<dyn std::error::Error>> {
+) -> RunResult {
     let opts = BdfOptions {
         rtol,
         atol: Tolerance::Scalar(rtol * 1e-3),

@@ -20,7 +20,7 @@ pub enum Scene {
     Ground(GroundScene),
     /// Engine in the elastic chassis (paper Table 1, middle column), with a log line on how the
     /// reduced chassis was obtained.
-    Hybrid(Box<HybridScene>, String),
+    Hybrid(HybridScene, String),
 }
 
 /// The reduced chassis scene 2 asks for, from the cache or freshly reduced (timed for the log).
@@ -56,7 +56,7 @@ fn hybrid_scene(settings: &Settings, engine: GroundScene) -> Result<Scene, Strin
         if c.stiffening_bar { "on" } else { "off" },
     );
     let scene = HybridScene::new(engine, chassis).map_err(|e| e.to_string())?;
-    Ok(Scene::Hybrid(Box::new(scene), note))
+    Ok(Scene::Hybrid(scene, note))
 }
 
 /// Applies the FMU inputs to the engine model.

@@ -264,7 +264,7 @@ impl HybridScene {
             );
             // The engine evaluation took this mount against a fixed attachment: replace its force.
             let on_ground = ev.mounts[i].map(|g| g.force).unwrap_or_else(Vector3::zeros);
-            let h = ev.kinematics[hb].clone();
+            let h = ev.kinematics[hb];
             ev.dynamics[hb].add_point_force(&h, &x, &(r.force - on_ground));
             ev.mounts[i] = Some(r);
             for (g, s) in modal_force.iter_mut().zip(&self.chassis.points[*p].shape) {
