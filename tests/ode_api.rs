@@ -173,3 +173,58 @@ fn restart_after_a_jump_follows_the_new_solution() {
         );
     }
 }
+
+#[test]
+fn lowering_max_order_mid_run_stays_accurate() {
+    let mut p = LinearOscillator::default();
+    let y0 = p.y0;
+    let opts = BdfOptions {
+        rtol: 1e-8,
+        atol: Tolerance::Scalar(1e-10),
+        ..Default::default()
+    };
+    let mut bdf = Bdf::new(&mut p, 0.0, &y0, opts.clone()).unwrap();
+    bdf.advance_to(&mut p, 1.0).unwrap();
+    assert!(bdf.stats().order >= 3);
+    bdf.set_options(BdfOptions {
+        max_order: 2,
+        ..opts
+    })
+    .unwrap();
+    bdf.advance_to(&mut p, 2.0).unwrap();
+    assert!(bdf.stats().order <= 2);
+    let exact = p.exact_derivative(2.0, 0);
+    for i in 0..3 {
+        assert!((bdf.y()[i] - exact[i]).abs() < 1e-6, "comp {i}");
+    }
+}
+
+#[test]
+fn an_earlier_stop_time_after_a_failed_first_call_is_honoured() {
+    // The first call fails at once (too few steps allowed); a later call with a stop time
+    // shorter than the prepared first step must still land exactly and accurately.
+    let mut p = LinearOscillator::default();
+    let y0 = p.y0;
+    let opts = BdfOptions {
+        rtol: 1e-8,
+        atol: Tolerance::Scalar(1e-10),
+        max_steps_per_call: 1,
+        h_init: Some(0.05),
+        ..Default::default()
+    };
+    let mut bdf = Bdf::new(&mut p, 0.0, &y0, opts.clone()).unwrap();
+    assert!(bdf.advance_to(&mut p, 10.0).is_err());
+    let t1 = bdf.t();
+    bdf.set_options(BdfOptions {
+        max_steps_per_call: 100_000,
+        ..opts
+    })
+    .unwrap();
+    let target = t1 + 1e-3;
+    bdf.advance_to(&mut p, target).unwrap();
+    assert_eq!(bdf.t(), target);
+    let exact = p.exact_derivative(target, 0);
+    for i in 0..3 {
+        assert!((bdf.y()[i] - exact[i]).abs() < 1e-6, "comp {i}");
+    }
+}

@@ -299,8 +299,14 @@ impl GroundScene {
     }
 
     /// Time from which the excitation fades in (set by [`Self::static_equilibrium`]).
-    pub fn set_fade_start(&mut self, t: f64) {
+    pub fn set_fade_start(&mut self, t: f64) -> Result<(), InputError> {
+        if !t.is_finite() {
+            return Err(InputError(format!(
+                "excitation fade-in start {t} s must be finite"
+            )));
+        }
         self.fade_start = t;
+        Ok(())
     }
 
     /// Excitation scale at `t` (C² ramp over `excitation_fade_in`).

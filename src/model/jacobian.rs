@@ -43,6 +43,14 @@ impl GroundScene {
         let nb = self.body_count();
         let n = 12 * nb + 1;
         let ic = self.crank_index();
+        self.check_state(y)?;
+        if j.nrows() != n || j.ncols() != n {
+            return Err(ProblemError::Fatal(format!(
+                "Jacobian is {}×{}, the engine model has {n} states",
+                j.nrows(),
+                j.ncols()
+            )));
+        }
         for r in 0..n {
             for c in 0..n {
                 j[(r, c)] = 0.0;

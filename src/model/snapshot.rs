@@ -129,13 +129,7 @@ impl GroundScene {
         for i in 0..n {
             trial.set_mount_scales(i, s.inputs.stiffness_scale[i], s.inputs.damping_scale[i])?;
         }
-        if !s.fade_start.is_finite() {
-            return Err(InputError(format!(
-                "fade start {} must be finite",
-                s.fade_start
-            )));
-        }
-        trial.set_fade_start(s.fade_start);
+        trial.set_fade_start(s.fade_start)?;
         if trial.effects().gas_forces && s.gas_load != trial.config().gas.load {
             trial.set_gas_load(s.gas_load)?;
         }

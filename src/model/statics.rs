@@ -20,7 +20,7 @@ impl GroundScene {
     /// Fails with a message when Newton does not converge or a mount is pressed beyond its curve
     /// (mounts too soft to carry the weight).
     pub fn static_equilibrium(&mut self, t0: f64) -> Result<Vec<f64>, StaticsError> {
-        self.set_fade_start(t0);
+        self.set_fade_start(t0).map_err(|e| StaticsError(e.0))?;
         let nb = self.body_count();
         let nq = 6 * nb;
         let mut y = self.reference_state();

@@ -482,9 +482,7 @@ impl Bdf {
                     factor: 2.0 * tolsf,
                 });
             }
-            if steps > 0 || self.s.nst > 0 {
-                self.clip_to_stop_time();
-            }
+            self.clip_to_stop_time();
             self.step(problem)?;
             steps += 1;
             if self.s.tn == self.s.tstop {
@@ -567,15 +565,11 @@ impl Bdf {
         for i in 0..self.s.n {
             let y = self.s.zn.zn[0][i];
             let yp = self.s.zn.zn[1][i];
-            let denom = 0.1 * y.abs()
-                + self
-                    .s
-                    .opts
-                    .atol
-                    .get(i)
-                    .max(self.s.opts.rtol * y.abs())
-                    .max(f64::MIN_POSITIVE);
-            hub_inv = hub_inv.max(yp.abs() / denom);
+            let denom = 0.1 * y.abs() + self.s.opts.atol.get(i);
+            // A component that is zero with zero absolute tolerance gives no bound.
+            if denom > 0.0 {
+                hub_inv = hub_inv.max(yp.abs() / denom);
+            }
         }
         let mut hub = 0.1 * tdist;
         if hub * hub_inv > 1.0 {
@@ -706,7 +700,9 @@ impl Bdf {
         let mut ncf = 0usize;
         let mut nef = 0usize;
         let mut flag = StepFlag::FirstCall;
-        if self.s.nst > 0 && self.s.hprime != self.s.h {
+        // hprime always describes the next step (also before the first step and after a failed
+        // first step), so a pending change is applied whenever it differs.
+        if self.s.hprime != self.s.h {
             self.adjust_params();
         }
         self.apply_stability_cap();

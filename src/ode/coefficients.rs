@@ -103,7 +103,7 @@ pub fn increase_order_coefficients(
             prod *= xi;
             alpha0 -= 1.0 / (j + 1) as f64;
             alpha1 += 1.0 / xi;
-            for i in (3..=j + 2).rev() {
+            for i in (2..=j + 2).rev() {
                 l[i] = l[i] * xiold + l[i - 1];
             }
             xiold = xi;
@@ -125,7 +125,7 @@ pub fn decrease_order_coefficients(
     for j in 1..=q.saturating_sub(2) {
         hsum += tau[j];
         let xi = hsum / hscale;
-        for i in (3..=j + 2).rev() {
+        for i in (2..=j + 2).rev() {
             l[i] = l[i] * xi + l[i - 1];
         }
     }

@@ -170,4 +170,33 @@ mod tests {
         nd.derivative(3, 0.0, 0.05, 0, &mut out);
         assert!((out[0] - y(0.05)).abs() < 1e-14);
     }
+
+    /// Lowering the order from q to q-1 must keep value and slope at t_n and the values at the
+    /// q-2 most recent past points (unequal steps), while dropping the degree-q term.
+    #[test]
+    fn order_decrease_keeps_the_interpolation_conditions() {
+        let q = 5;
+        let h = 0.1;
+        let tau = [0.0, 0.1, 0.07, 0.13, 0.05, 0.11, 0.09];
+        let coeffs = [0.3, -1.2, 0.8, 2.0, -0.7, 1.5];
+        let mut nd = Nordsieck::new(1, 5);
+        for (j, c) in coeffs.iter().enumerate() {
+            nd.zn[j][0] = *c;
+        }
+        // Polynomial in s = (t - t_n) / h.
+        let poly = |zn: &Nordsieck, order: usize, s: f64| {
+            (0..=order).rev().fold(0.0, |acc, j| acc * s + zn.zn[j][0])
+        };
+        let before = nd.clone();
+        nd.decrease_order(q, h, &tau);
+        let mut past = 0.0;
+        for j in 1..=q - 2 {
+            past += tau[j];
+            let s = -past / h;
+            let (a, b) = (poly(&before, q, s), poly(&nd, q - 1, s));
+            assert!((a - b).abs() < 1e-12, "past point {j}: {a} vs {b}");
+        }
+        assert_eq!(nd.zn[0][0], before.zn[0][0]);
+        assert_eq!(nd.zn[1][0], before.zn[1][0]);
+    }
 }

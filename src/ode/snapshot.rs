@@ -160,9 +160,10 @@ impl BdfSnapshot {
         }
         let g = &s.stability;
         w.usize(g.failures.len());
-        for &(n, h) in &g.failures {
+        for &(n, h, t) in &g.failures {
             w.u64(n);
             w.f(h);
+            w.f(t);
         }
         w.u64(g.hold_until);
         w.u64(g.hold_len);
@@ -180,6 +181,7 @@ impl BdfSnapshot {
         w.f(g.h_trigger);
         w.u64(g.hold_start);
         w.f(g.t_hold_start);
+        w.f(g.t_release);
         w.u64(g.lockout_until);
         w.u64(g.lockout_len);
         w.bool(s.fixed);
@@ -328,7 +330,7 @@ impl BdfSnapshot {
         }
         let mut failures = Vec::with_capacity(nfail);
         for _ in 0..nfail {
-            failures.push((r.u64()?, r.f()?));
+            failures.push((r.u64()?, r.f()?, r.f()?));
         }
         let hold_until = r.u64()?;
         let hold_len = r.u64()?;
@@ -343,6 +345,7 @@ impl BdfSnapshot {
         let h_trigger = r.f()?;
         let hold_start = r.u64()?;
         let t_hold_start = r.f()?;
+        let t_release = r.f()?;
         let lockout_until = r.u64()?;
         let lockout_len = r.u64()?;
         let fixed = r.bool()?;
@@ -397,6 +400,7 @@ impl BdfSnapshot {
                 h_trigger,
                 hold_start,
                 t_hold_start,
+                t_release,
                 lockout_until,
                 lockout_len,
             },
