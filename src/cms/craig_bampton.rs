@@ -17,6 +17,7 @@ use super::sparse_ops::{sparse_times_dense, Partition};
 use super::spec::ModeSelection;
 use crate::fe::assembly::SparseMat;
 use crate::fe::eigen::{lowest_modes, Modes};
+use crate::fe::FeError;
 
 /// The orthogonalised Craig-Bampton modes of a structure, in the full DOF space.
 #[derive(Debug, Clone)]
@@ -35,6 +36,32 @@ pub struct CraigBampton {
 /// First request of fixed-interface modes when selecting by cut-off frequency.
 const FIRST_CUTOFF_REQUEST: usize = 24;
 
+/// The `count` lowest eigenpairs of (K_II, M_II).
+///
+/// K_II is positive definite (the interface holds the structure), so shift 0 lies below the
+/// lowest fixed-interface eigenvalue. The FE solver sizes its Krylov space by the number of modes
+/// asked for, which for a small count can be too small to converge on clustered spectra; then a
+/// larger set is asked for and truncated.
+fn lowest_of_interior(k_ii: &SparseMat, m_ii: &SparseMat, count: usize) -> Result<Modes, CmsError> {
+    let n = k_ii.nrows();
+    let mut request = count;
+    loop {
+        match lowest_modes(k_ii, m_ii, request, 0.0) {
+            Ok(modes) if request == count => return Ok(modes),
+            Ok(modes) => {
+                return Ok(Modes {
+                    eigenvalues: modes.eigenvalues[..count].to_vec(),
+                    shapes: modes.shapes.subcols(0, count).to_owned(),
+                })
+            }
+            Err(FeError::Numerical(m)) if m.contains("did not converge") && request < n => {
+                request = (2 * request).min(n);
+            }
+            Err(e) => return Err(e.into()),
+        }
+    }
+}
+
 /// Fixed-interface normal modes of (K_II, M_II) as selected.
 fn fixed_interface_modes(
     k_ii: &SparseMat,
@@ -42,9 +69,7 @@ fn fixed_interface_modes(
     selection: ModeSelection,
 ) -> Result<Modes, CmsError> {
     let n = k_ii.nrows();
-    // K_II is positive definite (the interface holds the structure), so shift 0 is below the
-    // lowest fixed-interface eigenvalue.
-    let solve = |count: usize| lowest_modes(k_ii, m_ii, count, 0.0).map_err(CmsError::from);
+    let solve = |count: usize| lowest_of_interior(k_ii, m_ii, count);
     match selection {
         ModeSelection::Count(0) => Ok(Modes {
             eigenvalues: Vec::new(),
