@@ -553,7 +553,10 @@ fn scene_2_runs_with_comfort_outputs_and_restores_bit_for_bit() {
     let last = reference.last().unwrap();
     assert!(last.iter().all(|x| x.is_finite()));
     let wheel = &last[last.len() - 6..last.len() - 3];
-    assert!(wheel.iter().any(|a| a.abs() > 1e-5), "steering wheel a = {wheel:?}");
+    assert!(
+        wheel.iter().any(|a| a.abs() > 1e-5),
+        "steering wheel a = {wheel:?}"
+    );
 
     for restored in [state, s.deserialize(&bytes).1] {
         assert_eq!(s.set_state(restored), OK, "{:?}", s.logs());
@@ -585,7 +588,10 @@ fn chassis_cache_can_be_disabled_and_bad_chassis_parameters_are_refused() {
     let s = fmu.instantiate("hybrid-nocache");
     log_events(&s);
     assert_eq!(s.set_integer(&[integer::SCENE], &[2]), OK);
-    assert_eq!(s.set_boolean(&[boolean::CHASSIS_CACHE_ENABLED], &[false]), OK);
+    assert_eq!(
+        s.set_boolean(&[boolean::CHASSIS_CACHE_ENABLED], &[false]),
+        OK
+    );
     assert_eq!(s.set_integer(&[integer::CHASSIS_MAX_MODES], &[0]), ERROR);
     assert_eq!(s.set_real(&[real::CHASSIS_MODE_CUTOFF], &[f64::NAN]), ERROR);
     assert_eq!(s.set_integer(&[integer::CHASSIS_MAX_MODES], &[20]), OK);

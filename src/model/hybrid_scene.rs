@@ -373,7 +373,9 @@ impl HybridScene {
         // Largest engine translation (m) and rotation (rad) per Newton step, as in the ground
         // scene; the chassis coordinates are linear and need no limit.
         const MAX_STEP: [f64; 2] = [0.002, 0.02];
-        self.engine.set_fade_start(t0);
+        self.engine
+            .set_fade_start(t0)
+            .map_err(|e| StaticsError(e.0))?;
         let nq = 6 * self.engine.body_count();
         let ne = self.engine_dim();
         let m = self.modes_count();
