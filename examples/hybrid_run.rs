@@ -6,7 +6,8 @@
 
 use std::time::Instant;
 
-use engine_mount_chassis::model::hybrid_chassis::ChassisReduction;
+use engine_mount_chassis::cms::{reduce, ModeSelection};
+use engine_mount_chassis::model::hybrid_chassis::reduction_spec;
 use engine_mount_chassis::model::orders::order_amplitude;
 use engine_mount_chassis::model::{EngineConfig, GroundScene, HybridScene};
 use engine_mount_chassis::ode::{Bdf, BdfOptions, OdeProblem, Tolerance};
@@ -85,20 +86,15 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         n[3]
     );
 
-    for (cutoff_hz, max_modes) in [(60.0, 30), (200.0, 60), (400.0, 150)] {
-        let reduction = ChassisReduction {
-            cutoff_hz,
-            max_modes,
-            ..ChassisReduction::default()
-        };
+    for cutoff_hz in [60.0, 200.0, 400.0] {
+        let spec = reduction_spec(cutoff_hz, 0, false);
         let started = Instant::now();
-        let chassis = reduction.reduce()?;
+        let chassis = reduce(&spec)?;
         let reduce_s = started.elapsed().as_secs_f64();
-        let label = format!(
-            "2: chassis {} modes <= {:.0} Hz",
-            chassis.n_modes(),
-            chassis.omega.last().copied().unwrap_or(0.0) / std::f64::consts::TAU
-        );
+        let ModeSelection::CutoffHz(cut) = spec.selection else {
+            unreachable!("selected by cut-off");
+        };
+        let label = format!("2: CB < {cut:.0} Hz: {} modes", chassis.n_modes());
         let mut hybrid = HybridScene::new(GroundScene::new(EngineConfig::default())?, chassis)?;
         let y0 = hybrid.static_equilibrium(0.0)?;
         hybrid.engine_mut().set_crank_speed(0.0, w, 0.0)?;

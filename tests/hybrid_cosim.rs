@@ -2,7 +2,7 @@
 //! stepping, outputs and exact restore.
 
 use engine_mount_chassis::cosim::{
-    CachePolicy, Inputs, Settings, Signal, Simulation, RPM_TO_RAD_PER_S,
+    CacheSetting, Inputs, Settings, Signal, Simulation, RPM_TO_RAD_PER_S,
 };
 
 fn inputs(rpm: f64) -> Inputs {
@@ -19,7 +19,7 @@ fn settings(cache: &std::path::Path) -> Settings {
         scene: 2,
         ..Settings::default()
     };
-    s.chassis.cache = CachePolicy::Directory(cache.to_path_buf());
+    s.chassis.cache = CacheSetting::Dir(cache.to_path_buf());
     s
 }
 
@@ -84,12 +84,12 @@ fn restored_scene_2_state_continues_bit_for_bit() {
 fn bad_chassis_settings_are_errors_naming_the_value() {
     let dir = temp_cache("bad");
     let mut s = settings(&dir);
-    s.chassis.max_modes = 0;
+    s.chassis.max_modes = -1;
     let err = Simulation::new(&s, 0.0, &inputs(800.0)).err().unwrap();
-    assert!(err.contains("mode count 0"), "{err}");
+    assert!(err.contains("chassis.maxModes = -1"), "{err}");
     let mut s = settings(&dir);
-    s.chassis.mode_cutoff_hz = 0.5;
+    s.chassis.mode_cutoff_hz = f64::NAN;
     let err = Simulation::new(&s, 0.0, &inputs(800.0)).err().unwrap();
-    assert!(err.contains("cut-off 0.5 Hz"), "{err}");
+    assert!(err.contains("chassis.modeCutoff = NaN"), "{err}");
     let _ = std::fs::remove_dir_all(&dir);
 }

@@ -133,7 +133,7 @@ def test_simulate_hybrid_scene_with_fmpy(fmu_path, tmp_path):
     assert np.std(result["steeringWheel.a[3]"][100:]) > 1e-3
     assert np.std(result["seat.a[3]"][100:]) > 1e-4
     # the reduction was cached for the next instantiation
-    assert list((tmp_path / "cache").glob("chassis-*.json"))
+    assert list((tmp_path / "cache").glob("cms-*.json"))
 
 
 def test_comfort_outputs_are_declared_in_g_display_units(fmu_path):

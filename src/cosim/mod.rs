@@ -6,11 +6,10 @@
 //! The integrator keeps its history across communication points and lands exactly on each one
 //! (a stop time, not a restart); it restarts at order 1 only where an input really jumps.
 
-pub mod reduction_cache;
 mod scene;
 mod signals;
 
-pub use reduction_cache::CachePolicy;
+pub use crate::cms::CacheSetting;
 pub use scene::{Scene, FMU_MOUNTS};
 pub use signals::{Inputs, Signal};
 
@@ -51,23 +50,23 @@ impl Default for EffectSwitches {
 /// The elastic chassis of scene 2.
 #[derive(Debug, Clone, PartialEq)]
 pub struct ChassisSettings {
-    /// Keep chassis modes up to this frequency, Hz.
+    /// Keep the fixed-interface chassis modes below this frequency, Hz.
     pub mode_cutoff_hz: f64,
-    /// At most this many chassis modes.
+    /// If positive: keep exactly this many fixed-interface modes instead (the cut-off is unused).
     pub max_modes: i32,
     /// Transverse stiffening bar between the front girders (paper §7.1).
     pub stiffening_bar: bool,
     /// Where the reduced chassis is cached.
-    pub cache: CachePolicy,
+    pub cache: CacheSetting,
 }
 
 impl Default for ChassisSettings {
     fn default() -> Self {
         ChassisSettings {
             mode_cutoff_hz: 200.0,
-            max_modes: 60,
+            max_modes: 0,
             stiffening_bar: false,
-            cache: CachePolicy::UserCache,
+            cache: CacheSetting::Default,
         }
     }
 }

@@ -2,10 +2,9 @@
 
 use faer::MatMut;
 
-use super::reduction_cache::{load_or_reduce, CacheOutcome};
 use super::{Inputs, Outputs, Settings};
-use crate::fe::chassis_config::ChassisConfig;
-use crate::model::hybrid_chassis::ChassisReduction;
+use crate::cms::{reduce_cached, CacheOutcome};
+use crate::model::hybrid_chassis::reduction_spec;
 use crate::model::{EngineConfig, EngineOutputs, GroundScene, HybridScene};
 use crate::ode::{OdeProblem, ProblemError};
 
@@ -26,34 +25,42 @@ pub enum Scene {
 /// The reduced chassis scene 2 asks for, from the cache or freshly reduced (timed for the log).
 fn hybrid_scene(settings: &Settings, engine: GroundScene) -> Result<Scene, String> {
     let c = &settings.chassis;
-    let max_modes = usize::try_from(c.max_modes)
-        .map_err(|_| format!("chassis.maxModes = {} must be positive", c.max_modes))?;
-    let mut body = ChassisConfig::default();
-    body.options.stiffening_bar = c.stiffening_bar;
-    let reduction = ChassisReduction {
-        body,
-        cutoff_hz: c.mode_cutoff_hz,
-        max_modes,
-    };
+    let max_modes = usize::try_from(c.max_modes).map_err(|_| {
+        format!(
+            "chassis.maxModes = {} must be >= 0 (0: select by chassis.modeCutoff)",
+            c.max_modes
+        )
+    })?;
+    if !(c.mode_cutoff_hz.is_finite() && c.mode_cutoff_hz > 0.0) {
+        return Err(format!(
+            "chassis.modeCutoff = {} Hz must be positive and finite",
+            c.mode_cutoff_hz
+        ));
+    }
+    let spec = reduction_spec(c.mode_cutoff_hz, max_modes, c.stiffening_bar);
     let started = std::time::Instant::now();
-    let (chassis, outcome) = load_or_reduce(&reduction, &c.cache)?;
+    let (chassis, outcome) =
+        reduce_cached(&spec, &c.cache).map_err(|e| format!("chassis reduction: {e}"))?;
     let seconds = started.elapsed().as_secs_f64();
     let source = match outcome {
         CacheOutcome::Hit(path) => format!("read from cache {}", path.display()),
-        CacheOutcome::Reduced { stored: Ok(path) } => {
-            format!("reduced and cached at {}", path.display())
+        CacheOutcome::Stored(path) => format!("reduced and cached at {}", path.display()),
+        CacheOutcome::Replaced { path, reason } => {
+            format!(
+                "reduced and cached at {} (old entry: {reason})",
+                path.display()
+            )
         }
-        CacheOutcome::Reduced { stored: Err(why) } => {
-            format!("reduced (not cached: {why})")
-        }
-        CacheOutcome::Uncached => "reduced (caching disabled)".to_owned(),
+        CacheOutcome::NotStored { reason } => format!("reduced (not cached: {reason})"),
+        CacheOutcome::Disabled => "reduced (caching disabled)".to_owned(),
     };
     let note = format!(
-        "chassis: {} modes up to {:.1} Hz (cut-off {} Hz, at most {max_modes}, stiffening bar {}), {source} in {seconds:.2} s",
-        chassis.n_modes(),
-        chassis.omega.last().copied().unwrap_or(0.0) / (2.0 * std::f64::consts::PI),
-        c.mode_cutoff_hz,
+        "chassis (Craig-Bampton, {:?}, stiffening bar {}): {} modes, {:.1}..{:.1} Hz, {source} in {seconds:.2} s",
+        spec.selection,
         if c.stiffening_bar { "on" } else { "off" },
+        chassis.n_modes(),
+        chassis.omega.first().copied().unwrap_or(0.0) / (2.0 * std::f64::consts::PI),
+        chassis.omega.last().copied().unwrap_or(0.0) / (2.0 * std::f64::consts::PI),
     );
     let scene = HybridScene::new(engine, chassis).map_err(|e| e.to_string())?;
     Ok(Scene::Hybrid(scene, note))

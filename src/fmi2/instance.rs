@@ -271,11 +271,11 @@ impl Instance {
                 max_modes: v.integers[integer::CHASSIS_MAX_MODES as usize],
                 stiffening_bar: v.booleans[boolean::CHASSIS_STIFFENING_BAR as usize],
                 cache: if !v.booleans[boolean::CHASSIS_CACHE_ENABLED as usize] {
-                    cosim::CachePolicy::Disabled
+                    cosim::CacheSetting::Disabled
                 } else {
                     match v.strings[string::CHASSIS_CACHE_DIR as usize].trim() {
-                        "" => cosim::CachePolicy::UserCache,
-                        dir => cosim::CachePolicy::Directory(PathBuf::from(dir)),
+                        "" => cosim::CacheSetting::Default,
+                        dir => cosim::CacheSetting::Dir(PathBuf::from(dir)),
                     }
                 },
             },
