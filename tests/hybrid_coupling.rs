@@ -282,3 +282,62 @@ fn mounts_are_matched_by_position_and_removed_mounts_carry_nothing() {
         .to_string();
     assert!(err.contains("chassis mode 1"), "{err}");
 }
+
+#[test]
+fn comfort_accelerations_equal_the_derivative_of_the_integrated_velocity() {
+    use engine_mount_chassis::ode::{Bdf, BdfOptions, Tolerance};
+    let cfg = EngineConfig::default();
+    let engine = GroundScene::new(cfg).unwrap();
+    let mut chassis = rigid_chassis(&engine, 300.0, [2.0, 3.0, 4.0]);
+    chassis.zeta = vec![0.02; 3];
+    // The steering wheel on a lever: it moves twice as much as the body vertically.
+    let wheel = chassis
+        .points
+        .iter_mut()
+        .find(|p| p.name == "steering_wheel")
+        .unwrap();
+    wheel.shape[2][2] *= 2.0;
+    let mut hybrid = HybridScene::new(engine, chassis).unwrap();
+    let y0 = hybrid.static_equilibrium(0.0).unwrap();
+    hybrid
+        .engine_mut()
+        .set_crank_speed(0.0, 1500.0 * std::f64::consts::PI / 30.0, 0.0)
+        .unwrap();
+    let options = BdfOptions {
+        rtol: 1e-10,
+        atol: Tolerance::Scalar(1e-13),
+        ..BdfOptions::default()
+    };
+    let mut bdf = Bdf::new(&mut hybrid, 0.0, &y0, options).unwrap();
+    let (wheel, seat) = hybrid.output_points();
+    let velocity = |h: &HybridScene, y: &[f64], p: usize| {
+        let rates = &y[h.eta_rate_index()..];
+        h.point_translation(p, rates)
+    };
+    let (t0, dt) = (0.15, 2e-5);
+    bdf.advance_to(&mut hybrid, t0 - dt).unwrap();
+    let before = [wheel, seat].map(|p| velocity(&hybrid, bdf.y(), p));
+    bdf.advance_to(&mut hybrid, t0).unwrap();
+    let out = hybrid.outputs(t0, bdf.y()).unwrap();
+    bdf.advance_to(&mut hybrid, t0 + dt).unwrap();
+    let after = [wheel, seat].map(|p| velocity(&hybrid, bdf.y(), p));
+    for (k, a) in [out.steering_wheel_acceleration, out.seat_acceleration]
+        .iter()
+        .enumerate()
+    {
+        let fd = (after[k] - before[k]) / (2.0 * dt);
+        let norm = (a[0] * a[0] + a[1] * a[1] + a[2] * a[2]).sqrt();
+        assert!(norm > 1e-3, "point {k} hardly moves: {a:?}");
+        for i in 0..3 {
+            assert!(
+                (fd[i] - a[i]).abs() < 2e-3 * norm,
+                "point {k} axis {i}: output {} vs d/dt of the integrated velocity {}",
+                a[i],
+                fd[i]
+            );
+        }
+    }
+    // The lever doubles the vertical acceleration.
+    let ratio = out.steering_wheel_acceleration[2] / out.seat_acceleration[2];
+    assert!((ratio - 2.0).abs() < 1e-12, "{ratio}");
+}
