@@ -93,3 +93,35 @@ fn bad_chassis_settings_are_errors_naming_the_value() {
     assert!(err.contains("chassis.modeCutoff = NaN"), "{err}");
     let _ = std::fs::remove_dir_all(&dir);
 }
+
+#[test]
+fn improved_vehicle_three_mounts_and_stiffening_bar() {
+    use engine_mount_chassis::model::EngineConfig;
+    let dir = temp_cache("improved");
+    let mut engine = EngineConfig::default();
+    engine.mounts[3].active = false;
+    let config = dir.join("engine_three_mounts.json");
+    std::fs::create_dir_all(&dir).unwrap();
+    std::fs::write(&config, serde_json::to_string(&engine).unwrap()).unwrap();
+    let mut s = settings(&dir);
+    s.config_file = Some(config);
+    s.chassis.stiffening_bar = true;
+    s.chassis.mode_cutoff_hz = 100.0;
+    let mut sim = Simulation::new(&s, 0.0, &inputs(1500.0)).unwrap();
+    let log = sim.describe().join("\n");
+    assert!(
+        log.contains("stiffening bar on") && log.contains("3 of 4 mounts active"),
+        "{log}"
+    );
+    let o = sim.outputs().unwrap();
+    assert_eq!(o.mount_force[3], [0.0; 3]);
+    let fz: f64 = o.mount_force.iter().map(|f| f[2]).sum();
+    assert!((fz + 1765.8).abs() < 0.5, "sum Fz {fz}");
+    for k in 1..=20 {
+        sim.advance_to(k as f64 * 2e-3).unwrap();
+    }
+    let o = sim.outputs().unwrap();
+    assert_eq!(o.mount_force[3], [0.0; 3]);
+    assert!(o.steering_wheel_acceleration.iter().all(|a| a.is_finite()));
+    let _ = std::fs::remove_dir_all(&dir);
+}
