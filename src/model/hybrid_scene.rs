@@ -531,10 +531,9 @@ impl OdeProblem for HybridScene {
     fn mass(&mut self, t: f64, y: &[f64], mut m: MatMut<'_, f64>) -> Result<(), ProblemError> {
         let n = self.dim();
         let ne = self.engine_dim();
-        for i in 0..n {
-            for j in 0..n {
-                m[(i, j)] = if i == j { 1.0 } else { 0.0 };
-            }
+        m.fill(0.0);
+        for i in ne..n {
+            m[(i, i)] = 1.0;
         }
         self.engine
             .mass(t, &y[..ne], m.as_mut().submatrix_mut(0, 0, ne, ne))
