@@ -1,5 +1,6 @@
 //! Timing and memory of the chassis reduction:
-//! `cargo run --release --example cms_benchmark [n_fixed_interface_modes]`.
+//! `cargo run --release --example cms_benchmark [N | cutoff=HZ]` (default N = 40 fixed-interface
+//! modes).
 //!
 //! Prints one table: FE build + assembly, the full reduction with the given number of
 //! fixed-interface modes (default 40), the first (storing) and second (cached) `reduce_cached`
@@ -22,12 +23,15 @@ fn peak_rss_mb() -> Option<f64> {
 }
 
 fn main() -> Result<(), Box<dyn std::error::Error>> {
-    let n_modes: usize = match std::env::args().nth(1) {
-        Some(a) => a.parse()?,
-        None => 40,
+    let selection = match std::env::args().nth(1) {
+        Some(a) => match a.strip_prefix("cutoff=") {
+            Some(hz) => ModeSelection::CutoffHz(hz.parse()?),
+            None => ModeSelection::Count(a.parse()?),
+        },
+        None => ModeSelection::Count(40),
     };
     let spec = ReductionSpec {
-        selection: ModeSelection::Count(n_modes),
+        selection,
         ..ReductionSpec::default()
     };
 
@@ -42,6 +46,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     let detailed = reduce_detailed(&spec)?;
     let t_reduce = t0.elapsed().as_secs_f64();
     let n_reduced = detailed.reduced.n_modes();
+    let n_fi = detailed.modes.fixed_interface_hz.len();
     let top_fi = detailed
         .modes
         .fixed_interface_hz
@@ -66,7 +71,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
 
     println!("chassis: {n_dof} DOFs; interface: 4 mounts x 3 translations");
     println!(
-        "reduced: {n_reduced} modes ({n_modes} fixed-interface up to {top_fi:.1} Hz + 12 constraint), \
+        "reduced: {n_reduced} modes ({n_fi} fixed-interface up to {top_fi:.1} Hz + 12 constraint), \
          {} recovery points",
         reduced.points.len()
     );

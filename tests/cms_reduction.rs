@@ -4,8 +4,11 @@
 
 use std::sync::OnceLock;
 
-use engine_mount_chassis::cms::{reduce, reduce_detailed, ModeSelection, Reduction, ReductionSpec};
+use engine_mount_chassis::cms::{
+    reduce, reduce_detailed, InterfaceDofs, ModeSelection, ReducedChassis, Reduction, ReductionSpec,
+};
 use engine_mount_chassis::fe::assembly::{mat_vec, SparseMat};
+use engine_mount_chassis::fe::chassis::MountLayout;
 use engine_mount_chassis::fe::eigen::lowest_modes;
 use faer::linalg::solvers::Solve;
 use faer::{Mat, Side};
@@ -107,62 +110,89 @@ fn final_modes_are_mass_orthonormal_and_stiffness_diagonal_in_the_full_matrices(
     assert!(r.reduced.omega.windows(2).all(|w| w[0] <= w[1]));
 }
 
-/// Interface flexibility of the reduced chassis, Σ_k φ_a,k φ_b,k / ω_k², from its recovery rows.
-fn reduced_flexibility(r: &engine_mount_chassis::cms::ReducedChassis) -> Mat<f64> {
+/// Flexibility Σ_k φ_a,k φ_b,k / ω_k² of the reduced chassis between the local DOFs `local` of
+/// its mount points, from the recovery rows.
+fn reduced_flexibility(r: &ReducedChassis, local: &[usize]) -> Mat<f64> {
     let mounts: Vec<_> = r
         .points
         .iter()
         .filter(|p| p.name.starts_with("mount_"))
         .collect();
-    assert_eq!(mounts.len(), 4);
-    let nb = 12;
+    let nl = local.len();
+    let nb = mounts.len() * nl;
     Mat::from_fn(nb, nb, |a, b| {
-        let (pa, da) = (mounts[a / 3], a % 3);
-        let (pb, db) = (mounts[b / 3], b % 3);
+        let (pa, da) = (mounts[a / nl], local[a % nl]);
+        let (pb, db) = (mounts[b / nl], local[b % nl]);
         (0..r.n_modes())
             .map(|k| pa.shape[k][da] * pb.shape[k][db] / r.omega[k].powi(2))
             .sum()
     })
 }
 
-#[test]
-fn static_interface_flexibility_equals_the_full_models() {
-    let r = reduction_40();
-    // Full model: K u = e_b for each interface DOF, by its own sparse Cholesky.
-    let llt = r
-        .assembled
-        .k
-        .sp_cholesky(Side::Lower)
-        .expect("K is positive definite");
-    let n = r.assembled.dofs.n_free();
-    let nb = r.interface.len();
-    let mut rhs = Mat::<f64>::zeros(n, nb);
-    for (b, &g) in r.interface.iter().enumerate() {
+/// Flexibility of the full model between the given equations: K u = e_b by its own Cholesky.
+fn full_flexibility(k: &SparseMat, equations: &[usize]) -> Mat<f64> {
+    let llt = k.sp_cholesky(Side::Lower).expect("K is positive definite");
+    let nb = equations.len();
+    let mut rhs = Mat::<f64>::zeros(k.nrows(), nb);
+    for (b, &g) in equations.iter().enumerate() {
         rhs[(g, b)] = 1.0;
     }
     llt.solve_in_place(rhs.as_mut());
-    let full = Mat::from_fn(nb, nb, |a, b| rhs[(r.interface[a], b)]);
-    let scale = (0..nb).map(|i| full[(i, i)]).fold(0.0, f64::max);
+    Mat::from_fn(nb, nb, |a, b| rhs[(equations[a], b)])
+}
 
+/// max |G_reduced − G_full| / max diag G_full.
+fn flexibility_error(reduced: &Mat<f64>, full: &Mat<f64>) -> f64 {
+    let n = full.nrows();
+    assert_eq!(reduced.nrows(), n);
+    let scale = (0..n).map(|i| full[(i, i)]).fold(0.0, f64::max);
+    let mut worst = 0.0f64;
+    for a in 0..n {
+        for b in 0..n {
+            worst = worst.max((reduced[(a, b)] - full[(a, b)]).abs() / scale);
+        }
+    }
+    worst
+}
+
+#[test]
+fn static_interface_flexibility_equals_the_full_models() {
+    let r = reduction_40();
+    let full = full_flexibility(&r.assembled.k, &r.interface);
     let guyan = reduce(&ReductionSpec {
         selection: ModeSelection::Count(0),
         ..ReductionSpec::default()
     })
     .expect("static reduction");
     for (what, reduced) in [("40 modes", &r.reduced), ("0 modes", &guyan)] {
-        let g = reduced_flexibility(reduced);
-        let mut worst = 0.0f64;
-        for a in 0..nb {
-            for b in 0..nb {
-                worst = worst.max((g[(a, b)] - full[(a, b)]).abs() / scale);
-            }
-        }
+        let worst = flexibility_error(&reduced_flexibility(reduced, &[0, 1, 2]), &full);
         println!("{what}: max |G_red - G_full| / max G_full = {worst:.2e}");
         assert!(
             worst < 1e-8,
             "{what}: interface flexibility error {worst:e}"
         );
     }
+}
+
+#[test]
+fn six_dof_interface_of_the_three_mount_layout_is_statically_exact() {
+    let spec = ReductionSpec {
+        layout: MountLayout::Three,
+        interface_dofs: InterfaceDofs::All,
+        selection: ModeSelection::Count(0),
+        ..ReductionSpec::default()
+    };
+    let r = reduce_detailed(&spec).expect("reduction");
+    let mounts = r.chassis.mount_nodes(MountLayout::Three).expect("mounts");
+    let names: Vec<&str> = r.reduced.points.iter().map(|p| p.name.as_str()).collect();
+    let mut expected: Vec<&str> = mounts.iter().map(|(n, _)| n.as_str()).collect();
+    expected.extend(["steering_wheel", "seat_rail"]);
+    assert_eq!(names, expected);
+    assert_eq!(r.reduced.n_modes(), 3 * 6);
+    let full = full_flexibility(&r.assembled.k, &r.interface);
+    let worst = flexibility_error(&reduced_flexibility(&r.reduced, &[0, 1, 2, 3, 4, 5]), &full);
+    println!("3 mounts x 6 DOFs: max |G_red - G_full| / max G_full = {worst:.2e}");
+    assert!(worst < 1e-8, "interface flexibility error {worst:e}");
 }
 
 #[test]

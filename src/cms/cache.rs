@@ -2,7 +2,8 @@
 //!
 //! Entries live in `$XDG_CACHE_HOME/engine_mount_chassis` (else `~/.cache/engine_mount_chassis`)
 //! or a directory the caller names. An entry is named by a hash of its key and stores the full
-//! key: the format version, the crate version and the canonical JSON of the [`ReductionSpec`].
+//! key: the format version, the crate version, a fingerprint of the source code of the FE
+//! generator and the reduction, and the canonical JSON of the [`ReductionSpec`].
 //! It is used only if the stored key equals the wanted one and the data is consistent and
 //! finite; anything else (corrupt, truncated, foreign, older format) is ignored, rebuilt and
 //! replaced. Entries are written to a temporary file in the same directory and renamed into
@@ -13,6 +14,7 @@ use std::fs;
 use std::io::Write;
 use std::path::{Path, PathBuf};
 use std::sync::atomic::{AtomicU64, Ordering};
+use std::sync::OnceLock;
 
 use serde::{Deserialize, Serialize};
 
@@ -71,11 +73,44 @@ struct Entry {
     reduced: ReducedChassis,
 }
 
-/// The full cache key of `spec`: every input of the reduction and the format version.
+/// The source of every file whose code turns a spec into a reduction (FE generator, elements,
+/// assembly, eigen solver, reduction). Hashing it into the key means an edited generator or
+/// solver can never be served a reduction computed by the old code, even without a bump of
+/// [`FORMAT_VERSION`]. A new file that affects the result must be added here.
+const ALGORITHM_SOURCES: [&str; 18] = [
+    include_str!("../fe/assembly.rs"),
+    include_str!("../fe/beam.rs"),
+    include_str!("../fe/chassis.rs"),
+    include_str!("../fe/chassis_config.rs"),
+    include_str!("../fe/checks.rs"),
+    include_str!("../fe/dof.rs"),
+    include_str!("../fe/eigen.rs"),
+    include_str!("../fe/mass.rs"),
+    include_str!("../fe/mesh.rs"),
+    include_str!("../fe/shell.rs"),
+    include_str!("../fe/spring.rs"),
+    include_str!("craig_bampton.rs"),
+    include_str!("damping.rs"),
+    include_str!("reduce.rs"),
+    include_str!("reduced.rs"),
+    include_str!("sparse_ops.rs"),
+    include_str!("spec.rs"),
+    include_str!("cache.rs"),
+];
+
+/// Fingerprint of [`ALGORITHM_SOURCES`], computed once per process.
+fn algorithm_fingerprint() -> u64 {
+    static FINGERPRINT: OnceLock<u64> = OnceLock::new();
+    *FINGERPRINT.get_or_init(|| fnv1a64(ALGORITHM_SOURCES.concat().as_bytes()))
+}
+
+/// The full cache key of `spec`: the format version, the fingerprint of the code and every
+/// input of the reduction.
 fn key_text(spec: &ReductionSpec) -> Result<String, CmsError> {
     Ok(format!(
-        "engine_mount_chassis cms format {FORMAT_VERSION} crate {}\n{}",
+        "engine_mount_chassis cms format {FORMAT_VERSION} crate {} code {:016x}\n{}",
         env!("CARGO_PKG_VERSION"),
+        algorithm_fingerprint(),
         spec.canonical_json()?
     ))
 }
