@@ -1,7 +1,8 @@
 //! Jacobian `∂f/∂y` of the hybrid scene.
 //!
 //! The chassis columns (η, η̇) are exact: the right-hand side depends on them only through the
-//! modal terms and the mount forces, whose derivatives the mount law returns. The engine columns
+//! modal terms and the mount forces, whose derivatives the mount law returns (the housing rows
+//! are accelerations, so they carry the housing's inverse mass matrix, which η does not change). The engine columns
 //! (a few dozen) are central differences of the whole right-hand side, so every coupling of the
 //! engine motion into the mounts and the chassis is included.
 
@@ -51,6 +52,8 @@ impl HybridScene {
         let nb = self.engine().body_count();
         let housing_row = 6 * nb + 6 * hb;
         let h = &ev.engine.kinematics[hb];
+        // The housing rows are accelerations: generalised forces premultiplied by M_h⁻¹.
+        let housing_mass = ev.engine.dynamics[hb].mass.lu();
         let reference = self.engine().bodies()[hb].reference;
         let chassis = self.chassis();
         let (eta_row, rate_row) = (self.eta_index(), self.eta_rate_index());
@@ -78,8 +81,11 @@ impl HybridScene {
                 ] {
                     let mut q = BodyDynamics::zero();
                     q.add_point_force(h, &x, &df);
+                    let acc = housing_mass.solve(&q.force).ok_or_else(|| {
+                        ProblemError::Fatal("singular housing mass matrix".into())
+                    })?;
                     for a in 0..6 {
-                        j[(housing_row + a, col)] += q.force[a];
+                        j[(housing_row + a, col)] += acc[a];
                     }
                     // The chassis receives −F at the node.
                     for (l, s) in shape.iter().enumerate() {

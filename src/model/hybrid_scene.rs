@@ -4,7 +4,9 @@
 //!
 //! State `y = [engine state (q, v, φ) | η_1 … η_m | η̇_1 … η̇_m]`: the engine part is laid out
 //! exactly as in [`GroundScene`], followed by the chassis modal coordinates and their rates.
-//! Linearly implicit form `blockdiag(I, M_engine(q, φ), 1, I_m, I_m) y' = f(t, y)` with
+//! Explicit form `y' = f(t, y)`: the engine's velocity rows are its accelerations `M_b⁻¹ Q_b`
+//! (one 6×6 solve per body), so the integrator needs no mass matrix — assembling and scanning a
+//! dense mass matrix of all states at every Newton set-up cost more than these small solves — and
 //! `η̈_k = −2ζ_k ω_k η̇_k − ω_k² η_k + Σ_mounts φ_{p,k} · (−F_mount)`.
 //!
 //! A mount force depends on the motion of its housing bracket relative to its attachment, and the
@@ -291,6 +293,10 @@ impl HybridScene {
         let ne = self.engine_dim();
         let m = self.modes_count();
         self.engine.write_rhs(&y[..ne], &ev.engine, &mut f[..ne])?;
+        let nb = self.engine.body_count();
+        for (b, acc) in self.engine.accelerations(&ev.engine)?.iter().enumerate() {
+            f[6 * nb + 6 * b..6 * nb + 6 * b + 6].copy_from_slice(acc.as_slice());
+        }
         let c = &self.chassis;
         for k in 0..m {
             let (eta, rate) = (y[ne + k], y[ne + m + k]);
@@ -519,23 +525,8 @@ impl OdeProblem for HybridScene {
         self.write_rhs(y, &ev, f)
     }
 
-    fn has_mass_matrix(&self) -> bool {
-        true
-    }
-
     fn jacobian(&mut self, t: f64, y: &[f64], j: MatMut<'_, f64>) -> Result<bool, ProblemError> {
         self.coupled_jacobian(t, y, j)?;
         Ok(true)
-    }
-
-    fn mass(&mut self, t: f64, y: &[f64], mut m: MatMut<'_, f64>) -> Result<(), ProblemError> {
-        let n = self.dim();
-        let ne = self.engine_dim();
-        m.fill(0.0);
-        for i in ne..n {
-            m[(i, i)] = 1.0;
-        }
-        self.engine
-            .mass(t, &y[..ne], m.as_mut().submatrix_mut(0, 0, ne, ne))
     }
 }
