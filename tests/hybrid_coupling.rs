@@ -341,3 +341,52 @@ fn comfort_accelerations_equal_the_derivative_of_the_integrated_velocity() {
     let ratio = out.steering_wheel_acceleration[2] / out.seat_acceleration[2];
     assert!((ratio - 2.0).abs() < 1e-12, "{ratio}");
 }
+
+#[test]
+fn a_heavy_stiff_chassis_runs_like_rigid_ground() {
+    use engine_mount_chassis::ode::{Bdf, BdfOptions, Tolerance};
+    let cfg = EngineConfig::default();
+    let w = 1500.0 * std::f64::consts::PI / 30.0;
+    let options = BdfOptions {
+        rtol: 1e-8,
+        atol: Tolerance::Scalar(1e-11),
+        ..BdfOptions::default()
+    };
+    let times: Vec<f64> = (1..=40).map(|k| 0.1 + k as f64 * 2.5e-3).collect();
+
+    let mut ground = GroundScene::new(cfg.clone()).unwrap();
+    let y0 = ground.static_equilibrium(0.0).unwrap();
+    ground.set_crank_speed(0.0, w, 0.0).unwrap();
+    let mut bdf = Bdf::new(&mut ground, 0.0, &y0, options.clone()).unwrap();
+    let mut reference = Vec::new();
+    for &t in &times {
+        bdf.advance_to(&mut ground, t).unwrap();
+        reference.push(ground.outputs(t, bdf.y()).unwrap().mount_forces);
+    }
+
+    // 10⁷ kg on 20 Hz springs: it moves by ~10⁻⁸ m under the mount forces.
+    let engine = GroundScene::new(cfg).unwrap();
+    let mut chassis = rigid_chassis(&engine, 1e7, [20.0; 3]);
+    chassis.zeta = vec![0.05; 3];
+    let mut hybrid = HybridScene::new(engine, chassis).unwrap();
+    let y0 = hybrid.static_equilibrium(0.0).unwrap();
+    hybrid.engine_mut().set_crank_speed(0.0, w, 0.0).unwrap();
+    let mut bdf = Bdf::new(&mut hybrid, 0.0, &y0, options).unwrap();
+    let mut scale: f64 = 0.0;
+    let mut worst: f64 = 0.0;
+    for (&t, r) in times.iter().zip(&reference) {
+        bdf.advance_to(&mut hybrid, t).unwrap();
+        let f = hybrid.outputs(t, bdf.y()).unwrap().engine.mount_forces;
+        for (a, b) in f.iter().zip(r) {
+            for i in 0..3 {
+                scale = scale.max(b[i].abs());
+                worst = worst.max((a[i] - b[i]).abs());
+            }
+        }
+    }
+    assert!(scale > 100.0);
+    assert!(
+        worst < 1e-6 * scale,
+        "largest mount-force difference {worst} N of {scale} N"
+    );
+}
