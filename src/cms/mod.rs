@@ -18,6 +18,36 @@
 //!
 //! Damping: modal, per [`DampingTable`]; the discrete suspension dampers of the FE model are not
 //! projected onto the modes.
+//!
+//! Mode selection ([`ModeSelection`]) applies to the fixed-interface modes; all constraint modes
+//! are always kept, so the reduced chassis has `n_fixed + 3 × mounts` (or `6 ×`) modes, the
+//! highest of them stiff interface modes (kHz) that the ADAMS table damps critically. Rule of
+//! thumb from `tests/cms_*.rs`: keep fixed-interface modes up to 3× the highest frequency of
+//! interest (frequencies within 0.2 %, transfer functions within 1 % up to a ninth of the
+//! cut-off and 10 % up to a third).
+//!
+//! ```no_run
+//! use engine_mount_chassis::cms::{
+//!     reduce_cached, CacheSetting, ModeSelection, PointDof, ReductionSpec, Response,
+//! };
+//! # fn main() -> Result<(), engine_mount_chassis::cms::CmsError> {
+//! let spec = ReductionSpec {
+//!     selection: ModeSelection::CutoffHz(450.0),
+//!     ..ReductionSpec::default()
+//! };
+//! let (chassis, _outcome) = reduce_cached(&spec, &CacheSetting::Default)?;
+//! let wheel = chassis.point("steering_wheel").expect("recovered by default");
+//! println!("{} modes, wheel uz in mode 0: {}", chassis.n_modes(), wheel.shape[0][2]);
+//! let h = chassis.transfer_function(
+//!     PointDof { point: "mount_front_left", dof: 2 },
+//!     PointDof { point: "steering_wheel", dof: 2 },
+//!     Response::Acceleration,
+//!     &[30.0, 31.5, 33.0],
+//! )?;
+//! # let _ = h;
+//! # Ok(())
+//! # }
+//! ```
 
 mod cache;
 mod craig_bampton;
