@@ -539,7 +539,12 @@ fn documentation(table: &Value, scalars: &[Scalar], guid: &str) -> String {
     let _ = writeln!(h, "<p>FMI 2.0 co-simulation, GUID <code>{guid}</code>.</p>");
     h.push_str(
         "<h2>Scenes</h2>\n<ul><li><b>1</b>: engine on rigid ground: monoblock and housing (with gearbox) as rigid bodies \
-         connected by ring carriers, on nonlinear engine mounts fixed to ground (paper Table 1, left column).</li></ul>\n\
+         connected by ring carriers, on nonlinear engine mounts fixed to ground (paper Table 1, left column).</li>\
+         <li><b>2</b>: engine in the elastic car body: the mounts connect the housing brackets to the mount nodes of the \
+         Craig-Bampton reduced FE body (paper Table 1, middle column); adds the steering-wheel and seat-rail accelerations \
+         (zero in scene 1). The body is linear about a reference state carrying its own weight, so only the mount forces \
+         act on it. The reduction runs at instantiation (parameters <code>chassis.*</code>) and is cached in the user's \
+         cache directory unless disabled.</li></ul>\n\
          <h2>Units and frames</h2>\n<p>SI inside. The vehicle frame is ISO 8855: x forward, y left, z up, origin at the \
          front axle centre on the ground plane; the engine is transverse with the crank axis along y. Engine speed is given \
          in rpm (base unit rad/s); angles are in rad with display unit deg, displacements in m with display unit mm.</p>\n\

@@ -492,3 +492,110 @@ fn model_exchange_is_refused() {
     };
     assert!(c.is_null());
 }
+
+fn comfort_outputs() -> Vec<u32> {
+    let mut v = observed();
+    v.extend(real::STEERING_WHEEL_A);
+    v.extend(real::SEAT_A);
+    v
+}
+
+/// Turns on the logEvents category (set-up messages).
+fn log_events(s: &Slave) {
+    let cats = [c"logEvents".as_ptr()];
+    // SAFETY: an array of one valid C string.
+    unsafe {
+        assert_eq!((s.f().fmi2SetDebugLogging)(s.c, 1, 1, cats.as_ptr()), OK);
+    }
+}
+
+/// Scene 2 with the chassis cache in a directory of its own.
+fn hybrid_slave<'a>(fmu: &'a Fmu, name: &str, cache: &std::path::Path) -> Slave<'a> {
+    let s = fmu.instantiate(name);
+    log_events(&s);
+    assert_eq!(s.set_integer(&[integer::SCENE], &[2]), OK);
+    assert_eq!(
+        s.set_string(&[string::CHASSIS_CACHE_DIR], &[cache.to_str().unwrap()]),
+        OK
+    );
+    assert_eq!(s.set_real(&[real::RPM], &[1500.0]), OK);
+    s
+}
+
+#[test]
+fn scene_2_runs_with_comfort_outputs_and_restores_bit_for_bit() {
+    let cache = std::env::temp_dir().join(format!("emc-abi-hybrid-{}", std::process::id()));
+    let fmu = Fmu::load();
+    let s = hybrid_slave(&fmu, "hybrid", &cache);
+    assert_eq!(s.setup(0.0, None), OK);
+    assert_eq!(s.enter_init(), OK);
+    let f = s.reals(&all_mount_forces());
+    let vertical: f64 = (0..4).map(|i| f[3 * i + 2]).sum();
+    assert!(
+        (vertical + 1765.8).abs() < 0.5,
+        "static vertical mount forces {vertical} N"
+    );
+    assert_eq!(s.exit_init(), OK);
+    assert_logged(&s, "scene 2 (engine in the elastic chassis)");
+    assert_logged(&s, "chassis (Craig-Bampton");
+
+    let steps = vec![1e-3; 40];
+    let t1 = run(&s, &steps[..20]).last().unwrap().0;
+    let state = s.get_state();
+    let bytes = s.serialize(state);
+    let mut reference = Vec::new();
+    let mut t = t1;
+    for h in &steps[20..] {
+        assert_eq!(s.do_step(t, *h), OK, "{:?}", s.logs());
+        t += h;
+        reference.push(s.reals(&comfort_outputs()));
+    }
+    let last = reference.last().unwrap();
+    assert!(last.iter().all(|x| x.is_finite()));
+    let wheel = &last[last.len() - 6..last.len() - 3];
+    assert!(
+        wheel.iter().any(|a| a.abs() > 1e-5),
+        "steering wheel a = {wheel:?}"
+    );
+
+    for restored in [state, s.deserialize(&bytes).1] {
+        assert_eq!(s.set_state(restored), OK, "{:?}", s.logs());
+        let mut t = t1;
+        for out_ref in &reference {
+            assert_eq!(s.do_step(t, 1e-3), OK);
+            t += 1e-3;
+            assert_eq!(&s.reals(&comfort_outputs()), out_ref);
+        }
+        s.free_state(restored);
+    }
+    drop(s);
+    let _ = std::fs::remove_dir_all(&cache);
+}
+
+#[test]
+fn scene_1_reports_zero_comfort_accelerations() {
+    let fmu = Fmu::load();
+    let s = fmu.instantiate("ground-comfort");
+    s.initialize();
+    run(&s, &[1e-3; 5]);
+    let a = s.reals(&[real::STEERING_WHEEL_A, real::SEAT_A].concat());
+    assert_eq!(a, vec![0.0; 6]);
+}
+
+#[test]
+fn chassis_cache_can_be_disabled_and_bad_chassis_parameters_are_refused() {
+    let fmu = Fmu::load();
+    let s = fmu.instantiate("hybrid-nocache");
+    log_events(&s);
+    assert_eq!(s.set_integer(&[integer::SCENE], &[2]), OK);
+    assert_eq!(
+        s.set_boolean(&[boolean::CHASSIS_CACHE_ENABLED], &[false]),
+        OK
+    );
+    assert_eq!(s.set_integer(&[integer::CHASSIS_MAX_MODES], &[-1]), ERROR);
+    assert_eq!(s.set_real(&[real::CHASSIS_MODE_CUTOFF], &[f64::NAN]), ERROR);
+    assert_eq!(s.set_integer(&[integer::CHASSIS_MAX_MODES], &[20]), OK);
+    s.initialize();
+    assert_logged(&s, "caching disabled");
+    run(&s, &[1e-3; 5]);
+}

@@ -111,3 +111,39 @@ def test_libcosim_gets_the_same_outputs_as_fmpy(fmu_path):
     scale = np.max(np.abs(fmpy_values))
     np.testing.assert_allclose(cosim, fmpy_values, rtol=0, atol=1e-9 * scale)
     assert CosimVariableType.REAL is not None
+
+
+COMFORT = [f"steeringWheel.a[{i}]" for i in range(1, 4)] + [f"seat.a[{i}]" for i in range(1, 4)]
+
+
+def test_simulate_hybrid_scene_with_fmpy(fmu_path, tmp_path):
+    """Scene 2: engine in the elastic chassis, the reduced chassis cached in a directory of its own."""
+    start = {"scene": 2, "rpm": 1800.0, "chassis.cacheDir": str(tmp_path / "cache")}
+    result = simulate_fmu(str(fmu_path), stop_time=0.2, output_interval=1e-3, start_values=start,
+                          output=MOUNT_FORCES + COMFORT)
+    assert len(result) == 201
+    for name in result.dtype.names:
+        assert np.all(np.isfinite(result[name])), name
+    # static equilibrium of engine and chassis together: the mounts carry the powertrain's weight
+    vertical = sum(result[f"mount[{i}].F[3]"][0] for i in range(1, 5))
+    assert vertical == pytest.approx(-POWERTRAIN_MASS * config_gravity(), rel=1e-3)
+    # at rest the body does not accelerate; running, the steering wheel and the seat vibrate
+    for name in COMFORT:
+        assert abs(result[name][0]) < 1e-6, name
+    assert np.std(result["steeringWheel.a[3]"][100:]) > 1e-3
+    assert np.std(result["seat.a[3]"][100:]) > 1e-4
+    # the reduction was cached for the next instantiation
+    assert list((tmp_path / "cache").glob("cms-*.json"))
+
+
+def test_comfort_outputs_are_declared_in_g_display_units(fmu_path):
+    md = read_model_description(str(fmu_path))
+    by_name = {v.name: v for v in md.modelVariables}
+    for name in COMFORT:
+        v = by_name[name]
+        assert v.causality == "output" and v.unit == "m/s2" and v.displayUnit == "g"
+    scene = by_name["scene"]
+    assert scene.max == "2" or scene.max == 2
+    for name in ["chassis.modeCutoff", "chassis.maxModes", "chassis.stiffeningBar",
+                 "chassis.cacheEnabled", "chassis.cacheDir"]:
+        assert by_name[name].causality == "parameter", name

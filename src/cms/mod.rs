@@ -5,7 +5,66 @@
 //! mass matrix is the identity and the stiffness diagonal, so the chassis enters the coupled model
 //! as `η̈_k + 2 ζ_k ω_k η̇_k + ω_k² η_k = Σ_p φ_{p,k} · F_p`, with `F_p` the force (and moment)
 //! acting on recovery point `p` and `φ_{p,k}` that point's 6-DOF motion in mode `k`.
+//!
+//! Pipeline: [`ReductionSpec`] → [`reduce`] (builds and assembles the body, interface = the
+//! translational, or all six, DOFs of the layout's mount nodes) → [`craig_bampton()`] (constraint
+//! modes by sparse Cholesky, fixed-interface modes by the FE module's shift-invert Lanczos,
+//! orthogonalisation) → [`ReducedChassis`] with the rows of the recovery points only.
+//! [`reduce_cached`] keeps the result in the user's cache directory.
+//!
+//! Recovery points, in order: the layout's mount nodes (`mount_front_left`, `mount_front_right`,
+//! `mount_rear_left`, `mount_rear_right`, minus the one the three-mount layout removes), then the
+//! spec's `outputs` (default `steering_wheel`, `seat_rail`; any named FE node is allowed).
+//!
+//! Damping: modal, per [`DampingTable`]; the discrete suspension dampers of the FE model are not
+//! projected onto the modes.
+//!
+//! Mode selection ([`ModeSelection`]) applies to the fixed-interface modes; all constraint modes
+//! are always kept, so the reduced chassis has `n_fixed + 3 × mounts` (or `6 ×`) modes, the
+//! highest of them stiff interface modes (kHz) that the ADAMS table damps critically. Rule of
+//! thumb from `tests/cms_*.rs`: keep fixed-interface modes up to 3× the highest frequency of
+//! interest (frequencies within 0.2 %, transfer functions within 1 % up to a ninth of the
+//! cut-off and 10 % up to a third).
+//!
+//! ```no_run
+//! use engine_mount_chassis::cms::{
+//!     reduce_cached, CacheSetting, ModeSelection, PointDof, ReductionSpec, Response,
+//! };
+//! # fn main() -> Result<(), engine_mount_chassis::cms::CmsError> {
+//! let spec = ReductionSpec {
+//!     selection: ModeSelection::CutoffHz(450.0),
+//!     ..ReductionSpec::default()
+//! };
+//! let (chassis, _outcome) = reduce_cached(&spec, &CacheSetting::Default)?;
+//! let wheel = chassis.point("steering_wheel").expect("recovered by default");
+//! println!("{} modes, wheel uz in mode 0: {}", chassis.n_modes(), wheel.shape[0][2]);
+//! let h = chassis.transfer_function(
+//!     PointDof { point: "mount_front_left", dof: 2 },
+//!     PointDof { point: "steering_wheel", dof: 2 },
+//!     Response::Acceleration,
+//!     &[30.0, 31.5, 33.0],
+//! )?;
+//! # let _ = h;
+//! # Ok(())
+//! # }
+//! ```
 
+mod cache;
+mod craig_bampton;
+mod damping;
+mod error;
+mod hash;
+mod reduce;
 mod reduced;
+mod sparse_ops;
+mod spec;
+mod transfer;
 
+pub use cache::{reduce_cached, CacheOutcome, CacheSetting, FORMAT_VERSION};
+pub use craig_bampton::{craig_bampton, CraigBampton};
+pub use damping::{DampingBand, DampingTable};
+pub use error::CmsError;
+pub use reduce::{reduce, reduce_detailed, Reduction};
 pub use reduced::{RecoveryPoint, ReducedChassis};
+pub use spec::{InterfaceDofs, ModeSelection, ReductionSpec};
+pub use transfer::{PointDof, Response};

@@ -9,6 +9,7 @@
 mod scene;
 mod signals;
 
+pub use crate::cms::CacheSetting;
 pub use scene::{Scene, FMU_MOUNTS};
 pub use signals::{Inputs, Signal};
 
@@ -46,10 +47,34 @@ impl Default for EffectSwitches {
     }
 }
 
+/// The elastic chassis of scene 2.
+#[derive(Debug, Clone, PartialEq)]
+pub struct ChassisSettings {
+    /// Keep the fixed-interface chassis modes below this frequency, Hz.
+    pub mode_cutoff_hz: f64,
+    /// If positive: keep exactly this many fixed-interface modes instead (the cut-off is unused).
+    pub max_modes: i32,
+    /// Transverse stiffening bar between the front girders (paper §7.1).
+    pub stiffening_bar: bool,
+    /// Where the reduced chassis is cached.
+    pub cache: CacheSetting,
+}
+
+impl Default for ChassisSettings {
+    fn default() -> Self {
+        ChassisSettings {
+            mode_cutoff_hz: 200.0,
+            max_modes: 0,
+            stiffening_bar: false,
+            cache: CacheSetting::Default,
+        }
+    }
+}
+
 /// Everything fixed at initialisation.
 #[derive(Debug, Clone, PartialEq)]
 pub struct Settings {
-    /// 1 = engine on rigid ground.
+    /// 1 = engine on rigid ground, 2 = engine in the elastic chassis.
     pub scene: i32,
     /// Engine configuration JSON; `None` = built-in defaults.
     pub config_file: Option<PathBuf>,
@@ -62,6 +87,8 @@ pub struct Settings {
     pub abs_tol: f64,
     pub max_order: i32,
     pub stability_limit_detection: bool,
+    /// Used by scene 2 only.
+    pub chassis: ChassisSettings,
 }
 
 impl Default for Settings {
@@ -76,6 +103,7 @@ impl Default for Settings {
             abs_tol: 1e-8,
             max_order: 5,
             stability_limit_detection: true,
+            chassis: ChassisSettings::default(),
         }
     }
 }
@@ -93,6 +121,10 @@ pub struct Outputs {
     pub powertrain_rotation: [f64; 3],
     /// Powertrain (housing) CG acceleration from the equations of motion, m/s².
     pub powertrain_acceleration: [f64; 3],
+    /// Steering-wheel acceleration from the equations of motion, m/s² (scene 2; zero in scene 1).
+    pub steering_wheel_acceleration: [f64; 3],
+    /// Seat-rail acceleration from the equations of motion, m/s² (scene 2; zero in scene 1).
+    pub seat_acceleration: [f64; 3],
 }
 
 /// Work counters of the integrator since initialisation.

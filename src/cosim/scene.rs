@@ -3,7 +3,9 @@
 use faer::MatMut;
 
 use super::{Inputs, Outputs, Settings};
-use crate::model::{EngineConfig, GroundScene};
+use crate::cms::{reduce_cached, CacheOutcome};
+use crate::model::hybrid_chassis::reduction_spec;
+use crate::model::{EngineConfig, EngineOutputs, GroundScene, HybridScene};
 use crate::ode::{OdeProblem, ProblemError};
 
 /// Number of mounts the FMU's variables expose (`mount[1..4]`).
@@ -15,6 +17,87 @@ pub const FMU_MOUNTS: usize = 4;
 pub enum Scene {
     /// Engine on rigid ground (paper Table 1, left column).
     Ground(GroundScene),
+    /// Engine in the elastic chassis (paper Table 1, middle column), with a log line on how the
+    /// reduced chassis was obtained.
+    Hybrid(HybridScene, String),
+}
+
+/// The reduced chassis scene 2 asks for, from the cache or freshly reduced (timed for the log).
+fn hybrid_scene(settings: &Settings, engine: GroundScene) -> Result<Scene, String> {
+    let c = &settings.chassis;
+    let max_modes = usize::try_from(c.max_modes).map_err(|_| {
+        format!(
+            "chassis.maxModes = {} must be >= 0 (0: select by chassis.modeCutoff)",
+            c.max_modes
+        )
+    })?;
+    if !(c.mode_cutoff_hz.is_finite() && c.mode_cutoff_hz > 0.0) {
+        return Err(format!(
+            "chassis.modeCutoff = {} Hz must be positive and finite",
+            c.mode_cutoff_hz
+        ));
+    }
+    let spec = reduction_spec(c.mode_cutoff_hz, max_modes, c.stiffening_bar);
+    let started = std::time::Instant::now();
+    let (chassis, outcome) =
+        reduce_cached(&spec, &c.cache).map_err(|e| format!("chassis reduction: {e}"))?;
+    let seconds = started.elapsed().as_secs_f64();
+    let source = match outcome {
+        CacheOutcome::Hit(path) => format!("read from cache {}", path.display()),
+        CacheOutcome::Stored(path) => format!("reduced and cached at {}", path.display()),
+        CacheOutcome::Replaced { path, reason } => {
+            format!(
+                "reduced and cached at {} (old entry: {reason})",
+                path.display()
+            )
+        }
+        CacheOutcome::NotStored { reason } => format!("reduced (not cached: {reason})"),
+        CacheOutcome::Disabled => "reduced (caching disabled)".to_owned(),
+    };
+    let note = format!(
+        "chassis (Craig-Bampton, {:?}, stiffening bar {}): {} modes, {:.1}..{:.1} Hz, {source} in {seconds:.2} s",
+        spec.selection,
+        if c.stiffening_bar { "on" } else { "off" },
+        chassis.n_modes(),
+        chassis.omega.first().copied().unwrap_or(0.0) / (2.0 * std::f64::consts::PI),
+        chassis.omega.last().copied().unwrap_or(0.0) / (2.0 * std::f64::consts::PI),
+    );
+    let scene = HybridScene::new(engine, chassis).map_err(|e| e.to_string())?;
+    Ok(Scene::Hybrid(scene, note))
+}
+
+/// Applies the FMU inputs to the engine model.
+fn apply_inputs(g: &mut GroundScene, inputs: &Inputs) -> Result<(), String> {
+    let w = &inputs.crank_speed;
+    g.set_crank_speed(w.reference_time, w.value, w.derivative)
+        .map_err(|e| e.0)?;
+    let m = &inputs.load_torque;
+    g.set_load_torque(m.reference_time, m.value, m.derivative)
+        .map_err(|e| e.0)?;
+    for i in 0..g.config().mounts.len().min(FMU_MOUNTS) {
+        g.set_mount_scales(
+            i,
+            inputs.stiffness_scale[i].value,
+            inputs.damping_scale[i].value,
+        )
+        .map_err(|e| e.0)?;
+    }
+    Ok(())
+}
+
+/// The FMU outputs the engine outputs carry.
+fn engine_outputs(o: &EngineOutputs) -> Outputs {
+    let mut out = Outputs {
+        crank_angle: o.crank_angle,
+        powertrain_displacement: o.housing.displacement,
+        powertrain_rotation: o.housing.rotation,
+        powertrain_acceleration: o.housing.acceleration,
+        ..Outputs::default()
+    };
+    for (slot, f) in out.mount_force.iter_mut().zip(&o.mount_forces) {
+        *slot = *f;
+    }
+    out
 }
 
 /// Reads the engine configuration the settings name, with the FMU parameters applied on top.
@@ -55,31 +138,21 @@ impl Scene {
                     .map(Scene::Ground)
                     .map_err(|e| e.to_string())
             }
+            2 => {
+                let config = engine_config(settings)?;
+                let engine = GroundScene::new(config).map_err(|e| e.to_string())?;
+                hybrid_scene(settings, engine)
+            }
             other => Err(format!(
-                "scene {other} is not available (1 = engine on rigid ground)"
+                "scene {other} is not available (1 = engine on rigid ground, 2 = engine in the elastic chassis)"
             )),
         }
     }
 
     pub fn set_inputs(&mut self, inputs: &Inputs) -> Result<(), String> {
         match self {
-            Scene::Ground(g) => {
-                let w = &inputs.crank_speed;
-                g.set_crank_speed(w.reference_time, w.value, w.derivative)
-                    .map_err(|e| e.0)?;
-                let m = &inputs.load_torque;
-                g.set_load_torque(m.reference_time, m.value, m.derivative)
-                    .map_err(|e| e.0)?;
-                for i in 0..g.config().mounts.len().min(FMU_MOUNTS) {
-                    g.set_mount_scales(
-                        i,
-                        inputs.stiffness_scale[i].value,
-                        inputs.damping_scale[i].value,
-                    )
-                    .map_err(|e| e.0)?;
-                }
-                Ok(())
-            }
+            Scene::Ground(g) => apply_inputs(g, inputs),
+            Scene::Hybrid(h, _) => apply_inputs(h.engine_mut(), inputs),
         }
     }
 
@@ -98,6 +171,7 @@ impl Scene {
     pub fn initial_state(&mut self, t0: f64) -> Result<Vec<f64>, String> {
         match self {
             Scene::Ground(g) => g.static_equilibrium(t0).map_err(|e| e.to_string()),
+            Scene::Hybrid(h, _) => h.static_equilibrium(t0).map_err(|e| e.to_string()),
         }
     }
 
@@ -105,17 +179,15 @@ impl Scene {
         match self {
             Scene::Ground(g) => {
                 let o = g.outputs(t, y).map_err(|e| format!("{e:?}"))?;
-                let mut out = Outputs {
-                    crank_angle: o.crank_angle,
-                    powertrain_displacement: o.housing.displacement,
-                    powertrain_rotation: o.housing.rotation,
-                    powertrain_acceleration: o.housing.acceleration,
-                    ..Outputs::default()
-                };
-                for (slot, f) in out.mount_force.iter_mut().zip(&o.mount_forces) {
-                    *slot = *f;
-                }
-                Ok(out)
+                Ok(engine_outputs(&o))
+            }
+            Scene::Hybrid(h, _) => {
+                let o = h.outputs(t, y).map_err(|e| format!("{e:?}"))?;
+                Ok(Outputs {
+                    steering_wheel_acceleration: o.steering_wheel_acceleration,
+                    seat_acceleration: o.seat_acceleration,
+                    ..engine_outputs(&o.engine)
+                })
             }
         }
     }
@@ -133,6 +205,21 @@ impl Scene {
                     c.effects
                 )]
             }
+            Scene::Hybrid(h, note) => {
+                let c = h.engine().config();
+                let active = c.mounts.iter().filter(|m| m.active).count();
+                vec![
+                    note.clone(),
+                    format!(
+                        "scene 2 (engine in the elastic chassis): {} bodies, {active} of {} mounts active, {} chassis modes, {} states; effects {:?}",
+                        h.engine().body_count(),
+                        c.mounts.len(),
+                        h.modes_count(),
+                        h.dim(),
+                        c.effects
+                    ),
+                ]
+            }
         }
     }
 }
@@ -141,30 +228,35 @@ impl OdeProblem for Scene {
     fn dim(&self) -> usize {
         match self {
             Scene::Ground(g) => g.dim(),
+            Scene::Hybrid(h, _) => h.dim(),
         }
     }
 
     fn rhs(&mut self, t: f64, y: &[f64], f: &mut [f64]) -> Result<(), ProblemError> {
         match self {
             Scene::Ground(g) => g.rhs(t, y, f),
+            Scene::Hybrid(h, _) => h.rhs(t, y, f),
         }
     }
 
     fn has_mass_matrix(&self) -> bool {
         match self {
             Scene::Ground(g) => g.has_mass_matrix(),
+            Scene::Hybrid(h, _) => h.has_mass_matrix(),
         }
     }
 
     fn mass(&mut self, t: f64, y: &[f64], m: MatMut<'_, f64>) -> Result<(), ProblemError> {
         match self {
             Scene::Ground(g) => g.mass(t, y, m),
+            Scene::Hybrid(h, _) => h.mass(t, y, m),
         }
     }
 
     fn jacobian(&mut self, t: f64, y: &[f64], j: MatMut<'_, f64>) -> Result<bool, ProblemError> {
         match self {
             Scene::Ground(g) => g.jacobian(t, y, j),
+            Scene::Hybrid(h, _) => h.jacobian(t, y, j),
         }
     }
 }

@@ -266,6 +266,19 @@ impl Instance {
             max_order: v.integers[integer::SOLVER_MAX_ORDER as usize],
             stability_limit_detection: v.booleans
                 [boolean::SOLVER_STABILITY_LIMIT_DETECTION as usize],
+            chassis: cosim::ChassisSettings {
+                mode_cutoff_hz: v.reals[real::CHASSIS_MODE_CUTOFF as usize],
+                max_modes: v.integers[integer::CHASSIS_MAX_MODES as usize],
+                stiffening_bar: v.booleans[boolean::CHASSIS_STIFFENING_BAR as usize],
+                cache: if !v.booleans[boolean::CHASSIS_CACHE_ENABLED as usize] {
+                    cosim::CacheSetting::Disabled
+                } else {
+                    match v.strings[string::CHASSIS_CACHE_DIR as usize].trim() {
+                        "" => cosim::CacheSetting::Default,
+                        dir => cosim::CacheSetting::Dir(PathBuf::from(dir)),
+                    }
+                },
+            },
         })
     }
 
@@ -290,6 +303,8 @@ impl Instance {
             r[real::POWERTRAIN_R[k] as usize] = o.powertrain_displacement[k];
             r[real::POWERTRAIN_PHI[k] as usize] = o.powertrain_rotation[k];
             r[real::POWERTRAIN_A[k] as usize] = o.powertrain_acceleration[k];
+            r[real::STEERING_WHEEL_A[k] as usize] = o.steering_wheel_acceleration[k];
+            r[real::SEAT_A[k] as usize] = o.seat_acceleration[k];
         }
         let n = &mut self.core.values.integers;
         let clamp = |x: u64| x.min(i32::MAX as u64) as i32;

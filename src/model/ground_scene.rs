@@ -363,7 +363,7 @@ impl GroundScene {
         }
     }
 
-    fn evaluate_mode(&self, t: f64, y: &[f64], mode: Mode) -> Evaluation {
+    pub(crate) fn evaluate_mode(&self, t: f64, y: &[f64], mode: Mode) -> Evaluation {
         let nb = self.bodies.len();
         let kin: Vec<BodyKinematics> = (0..nb).map(|b| self.kinematics(y, b)).collect();
         let mut dynamics: Vec<BodyDynamics> = (0..nb)
@@ -518,7 +518,12 @@ impl GroundScene {
         self.write_rhs(y, &ev, f)
     }
 
-    fn write_rhs(&self, y: &[f64], ev: &Evaluation, f: &mut [f64]) -> Result<(), ProblemError> {
+    pub(crate) fn write_rhs(
+        &self,
+        y: &[f64],
+        ev: &Evaluation,
+        f: &mut [f64],
+    ) -> Result<(), ProblemError> {
         let nb = self.bodies.len();
         for b in 0..nb {
             let q = &y[6 * b..6 * b + 6];

@@ -1,0 +1,329 @@
+//! On-disk cache of reductions, so that a second instantiation with the same inputs is fast.
+//!
+//! Entries live in `$XDG_CACHE_HOME/engine_mount_chassis` (else `~/.cache/engine_mount_chassis`)
+//! or a directory the caller names. An entry is named by a hash of its key and stores the full
+//! key: the format version, the crate version, a fingerprint of the source code of the FE
+//! generator and the reduction, and the canonical JSON of the [`ReductionSpec`].
+//! It is used only if the stored key equals the wanted one and the data is consistent and
+//! finite; anything else (corrupt, truncated, foreign, older format) is ignored, rebuilt and
+//! replaced. Entries are written to a temporary file in the same directory and renamed into
+//! place, so concurrent processes see either no entry or a complete one; a failed write never
+//! fails the reduction.
+
+use std::fs;
+use std::io::Write;
+use std::path::{Path, PathBuf};
+use std::sync::atomic::{AtomicU64, Ordering};
+use std::sync::OnceLock;
+
+use serde::{Deserialize, Serialize};
+
+use super::error::CmsError;
+use super::hash::fnv1a64;
+use super::reduce::reduce;
+use super::reduced::ReducedChassis;
+use super::spec::ReductionSpec;
+
+/// Version of the entry layout and of the reduction algorithm; bump it whenever the entry
+/// format, the reduction or the FE generator changes results for the same spec.
+pub const FORMAT_VERSION: u32 = 1;
+
+const CACHE_SUBDIR: &str = "engine_mount_chassis";
+
+/// Where reductions are cached.
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub enum CacheSetting {
+    /// The user cache directory (`$XDG_CACHE_HOME` or `~/.cache`), subdirectory
+    /// `engine_mount_chassis`.
+    Default,
+    /// This directory (created if missing).
+    Dir(PathBuf),
+    /// No cache: always reduce.
+    Disabled,
+}
+
+/// What [`reduce_cached`] did.
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub enum CacheOutcome {
+    /// A valid entry was read from this file.
+    Hit(PathBuf),
+    /// No entry existed; the reduction was built and stored in this file.
+    Stored(PathBuf),
+    /// The existing entry was unusable (`reason`); the reduction was rebuilt and the entry
+    /// replaced.
+    Replaced {
+        /// The entry's file.
+        path: PathBuf,
+        /// Why the old entry was rejected.
+        reason: String,
+    },
+    /// The reduction was built but could not be stored (`reason`), e.g. a read-only directory.
+    NotStored {
+        /// What failed.
+        reason: String,
+    },
+    /// Caching is disabled; the reduction was built.
+    Disabled,
+}
+
+#[derive(Serialize, Deserialize)]
+struct Entry {
+    format: u32,
+    key: String,
+    reduced: ReducedChassis,
+}
+
+/// The source of every file whose code turns a spec into a reduction (FE generator, elements,
+/// assembly, eigen solver, reduction). Hashing it into the key means an edited generator or
+/// solver can never be served a reduction computed by the old code, even without a bump of
+/// [`FORMAT_VERSION`]. A new file that affects the result must be added here.
+const ALGORITHM_SOURCES: [&str; 18] = [
+    include_str!("../fe/assembly.rs"),
+    include_str!("../fe/beam.rs"),
+    include_str!("../fe/chassis.rs"),
+    include_str!("../fe/chassis_config.rs"),
+    include_str!("../fe/checks.rs"),
+    include_str!("../fe/dof.rs"),
+    include_str!("../fe/eigen.rs"),
+    include_str!("../fe/mass.rs"),
+    include_str!("../fe/mesh.rs"),
+    include_str!("../fe/shell.rs"),
+    include_str!("../fe/spring.rs"),
+    include_str!("craig_bampton.rs"),
+    include_str!("damping.rs"),
+    include_str!("reduce.rs"),
+    include_str!("reduced.rs"),
+    include_str!("sparse_ops.rs"),
+    include_str!("spec.rs"),
+    include_str!("cache.rs"),
+];
+
+/// Fingerprint of [`ALGORITHM_SOURCES`], computed once per process.
+fn algorithm_fingerprint() -> u64 {
+    static FINGERPRINT: OnceLock<u64> = OnceLock::new();
+    *FINGERPRINT.get_or_init(|| fnv1a64(ALGORITHM_SOURCES.concat().as_bytes()))
+}
+
+/// The full cache key of `spec`: the format version, the fingerprint of the code and every
+/// input of the reduction.
+fn key_text(spec: &ReductionSpec) -> Result<String, CmsError> {
+    Ok(format!(
+        "engine_mount_chassis cms format {FORMAT_VERSION} crate {} code {:016x}\n{}",
+        env!("CARGO_PKG_VERSION"),
+        algorithm_fingerprint(),
+        spec.canonical_json()?
+    ))
+}
+
+fn default_dir() -> Option<PathBuf> {
+    let absolute = |v: std::ffi::OsString| {
+        let p = PathBuf::from(v);
+        p.is_absolute().then_some(p)
+    };
+    std::env::var_os("XDG_CACHE_HOME")
+        .and_then(absolute)
+        .or_else(|| {
+            std::env::var_os("HOME")
+                .and_then(absolute)
+                .map(|h| h.join(".cache"))
+        })
+        .map(|base| base.join(CACHE_SUBDIR))
+}
+
+/// Checks that a loaded reduction is complete and finite.
+fn check_consistent(r: &ReducedChassis) -> Result<(), String> {
+    let n = r.omega.len();
+    if n == 0 {
+        return Err("no modes".into());
+    }
+    if r.zeta.len() != n {
+        return Err(format!("{} damping ratios for {n} modes", r.zeta.len()));
+    }
+    if let Some(k) = r.omega.iter().position(|w| !(w.is_finite() && *w > 0.0)) {
+        return Err(format!("omega[{k}] = {} is not finite and > 0", r.omega[k]));
+    }
+    if r.omega.windows(2).any(|w| w[1] < w[0]) {
+        return Err("omega is not ascending".into());
+    }
+    if let Some(k) = r.zeta.iter().position(|z| !(z.is_finite() && *z >= 0.0)) {
+        return Err(format!("zeta[{k}] = {} is not finite and >= 0", r.zeta[k]));
+    }
+    if r.points.is_empty() {
+        return Err("no recovery points".into());
+    }
+    for p in &r.points {
+        if p.shape.len() != n {
+            return Err(format!(
+                "point '{}' has {} rows for {n} modes",
+                p.name,
+                p.shape.len()
+            ));
+        }
+        if p.position
+            .iter()
+            .chain(p.shape.iter().flatten())
+            .any(|v| !v.is_finite())
+        {
+            return Err(format!("point '{}' has a non-finite value", p.name));
+        }
+    }
+    Ok(())
+}
+
+/// Reads the entry at `path` if it holds a valid reduction for `key`.
+fn load(path: &Path, key: &str) -> Result<ReducedChassis, String> {
+    let text = fs::read_to_string(path).map_err(|e| format!("unreadable: {e}"))?;
+    let entry: Entry = serde_json::from_str(&text).map_err(|e| format!("corrupt: {e}"))?;
+    if entry.format != FORMAT_VERSION {
+        return Err(format!(
+            "format {} (expected {FORMAT_VERSION})",
+            entry.format
+        ));
+    }
+    if entry.key != key {
+        return Err("written for different inputs".into());
+    }
+    check_consistent(&entry.reduced).map_err(|e| format!("inconsistent: {e}"))?;
+    Ok(entry.reduced)
+}
+
+/// Writes `entry` to `path` atomically: a unique temporary file in the same directory, then a
+/// rename over the target.
+fn store(path: &Path, entry: &Entry) -> Result<(), String> {
+    static COUNTER: AtomicU64 = AtomicU64::new(0);
+    let dir = path
+        .parent()
+        .ok_or_else(|| format!("{} has no parent directory", path.display()))?;
+    fs::create_dir_all(dir).map_err(|e| format!("creating {}: {e}", dir.display()))?;
+    let text = serde_json::to_string(entry).map_err(|e| format!("serialising: {e}"))?;
+    let nanos = std::time::SystemTime::now()
+        .duration_since(std::time::UNIX_EPOCH)
+        .map_or(0, |d| d.subsec_nanos());
+    let file_name = path
+        .file_name()
+        .map(|n| n.to_string_lossy().into_owned())
+        .unwrap_or_default();
+    let tmp = dir.join(format!(
+        ".{file_name}.{}.{nanos}.{}.tmp",
+        std::process::id(),
+        COUNTER.fetch_add(1, Ordering::Relaxed)
+    ));
+    let written = (|| {
+        let mut f = fs::File::create(&tmp)?;
+        f.write_all(text.as_bytes())?;
+        f.sync_all()?;
+        fs::rename(&tmp, path)
+    })();
+    written.map_err(|e| {
+        let _ = fs::remove_file(&tmp);
+        format!("writing {}: {e}", path.display())
+    })
+}
+
+/// [`reduce`] through the cache selected by `cache`.
+pub fn reduce_cached(
+    spec: &ReductionSpec,
+    cache: &CacheSetting,
+) -> Result<(ReducedChassis, CacheOutcome), CmsError> {
+    let dir = match cache {
+        CacheSetting::Disabled => return Ok((reduce(spec)?, CacheOutcome::Disabled)),
+        CacheSetting::Dir(d) => Some(d.clone()),
+        CacheSetting::Default => default_dir(),
+    };
+    spec.validate()?;
+    let key = key_text(spec)?;
+    let Some(dir) = dir else {
+        let reduced = reduce(spec)?;
+        let reason = "no cache directory: neither XDG_CACHE_HOME nor HOME is an absolute path";
+        return Ok((
+            reduced,
+            CacheOutcome::NotStored {
+                reason: reason.into(),
+            },
+        ));
+    };
+    let path = dir.join(format!("cms-{:016x}.json", fnv1a64(key.as_bytes())));
+    let rejected = if path.exists() {
+        match load(&path, &key) {
+            Ok(reduced) => return Ok((reduced, CacheOutcome::Hit(path))),
+            Err(reason) => Some(reason),
+        }
+    } else {
+        None
+    };
+    let reduced = reduce(spec)?;
+    let entry = Entry {
+        format: FORMAT_VERSION,
+        key,
+        reduced,
+    };
+    let outcome = match (store(&path, &entry), rejected) {
+        (Ok(()), None) => CacheOutcome::Stored(path),
+        (Ok(()), Some(reason)) => CacheOutcome::Replaced { path, reason },
+        (Err(reason), _) => CacheOutcome::NotStored { reason },
+    };
+    Ok((entry.reduced, outcome))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::cms::reduced::RecoveryPoint;
+
+    fn tiny() -> ReducedChassis {
+        ReducedChassis {
+            omega: vec![10.0, 20.0],
+            zeta: vec![0.01, 0.01],
+            points: vec![RecoveryPoint {
+                name: "p".into(),
+                node: 3,
+                position: [0.0, 1.0, 2.0],
+                shape: vec![[1.0; 6], [2.0; 6]],
+            }],
+        }
+    }
+
+    #[test]
+    fn consistency_check_names_the_defect() {
+        assert!(check_consistent(&tiny()).is_ok());
+        let mut r = tiny();
+        r.omega[1] = 5.0;
+        assert!(check_consistent(&r).unwrap_err().contains("ascending"));
+        let mut r = tiny();
+        r.points[0].shape.pop();
+        assert!(check_consistent(&r).unwrap_err().contains("'p' has 1 rows"));
+        let mut r = tiny();
+        r.points[0].shape[0][4] = f64::INFINITY;
+        assert!(check_consistent(&r).unwrap_err().contains("non-finite"));
+        let mut r = tiny();
+        r.zeta.push(0.1);
+        assert!(check_consistent(&r)
+            .unwrap_err()
+            .contains("3 damping ratios"));
+    }
+
+    #[test]
+    fn store_then_load_round_trips_and_rejects_other_keys() {
+        let dir = std::env::temp_dir().join(format!("cms-cache-unit-{}", std::process::id()));
+        let path = dir.join("entry.json");
+        let entry = Entry {
+            format: FORMAT_VERSION,
+            key: "k1".into(),
+            reduced: tiny(),
+        };
+        store(&path, &entry).unwrap();
+        assert_eq!(load(&path, "k1").unwrap(), tiny());
+        assert!(load(&path, "k2").unwrap_err().contains("different inputs"));
+        fs::write(&path, "{\"format\": 1, \"key\": \"k1\", \"reduced\": {").unwrap();
+        assert!(load(&path, "k1").unwrap_err().contains("corrupt"));
+        let old = Entry {
+            format: FORMAT_VERSION + 1,
+            ..entry
+        };
+        store(&path, &old).unwrap();
+        assert!(load(&path, "k1").unwrap_err().contains("format"));
+        let leftovers = fs::read_dir(&dir).unwrap().count();
+        assert_eq!(leftovers, 1, "temporary files must not remain");
+        let _ = fs::remove_dir_all(&dir);
+    }
+}

@@ -1,0 +1,105 @@
+//! The chassis reduction: body description → FE model → Craig-Bampton → recovery rows and
+//! modal damping of the named points the coupled model needs.
+
+use super::craig_bampton::{craig_bampton, CraigBampton};
+use super::error::CmsError;
+use super::reduced::{RecoveryPoint, ReducedChassis};
+use super::spec::ReductionSpec;
+use crate::fe::assembly::{assemble, Assembled};
+use crate::fe::chassis::Chassis;
+use crate::fe::dof::{DofMap, DOF_PER_NODE};
+
+/// A reduction together with the full model it came from, for verification and tools. The
+/// coupled model needs only [`Reduction::reduced`]; use [`reduce`] to drop the rest.
+#[derive(Debug, Clone)]
+pub struct Reduction {
+    /// The generated body.
+    pub chassis: Chassis,
+    /// Its assembled K, M, C.
+    pub assembled: Assembled,
+    /// Global equations of the interface DOFs, mount by mount, DOF order of the spec.
+    pub interface: Vec<usize>,
+    /// The orthogonalised modes over all equations.
+    pub modes: CraigBampton,
+    /// What the coupled model gets.
+    pub reduced: ReducedChassis,
+}
+
+/// The reduced chassis described by `spec` (only recovery rows are kept).
+pub fn reduce(spec: &ReductionSpec) -> Result<ReducedChassis, CmsError> {
+    Ok(reduce_detailed(spec)?.reduced)
+}
+
+/// The reduction of `spec` with the full model and full mode shapes kept.
+pub fn reduce_detailed(spec: &ReductionSpec) -> Result<Reduction, CmsError> {
+    spec.validate()?;
+    let chassis = Chassis::build(&spec.chassis)?;
+    let assembled = assemble(&chassis.mesh)?;
+    let mounts = chassis.mount_nodes(spec.layout)?;
+    let mount_ids: Vec<usize> = mounts.iter().map(|(_, id)| *id).collect();
+    let interface = assembled
+        .dofs
+        .indices_of(&mount_ids, spec.interface_dofs.local())?;
+    let modes = craig_bampton(&assembled.k, &assembled.m, &interface, spec.selection)?;
+
+    let mut named: Vec<(String, usize)> = mounts;
+    for name in &spec.outputs {
+        if !named.iter().any(|(n, _)| n == name) {
+            named.push((name.clone(), chassis.node(name)?));
+        }
+    }
+    let points = named
+        .into_iter()
+        .map(|(name, node)| recovery_point(&chassis, &assembled.dofs, &modes, name, node))
+        .collect::<Result<Vec<_>, _>>()?;
+    let zeta = modes
+        .omega
+        .iter()
+        .map(|w| spec.damping.zeta(w / (2.0 * std::f64::consts::PI)))
+        .collect();
+    let reduced = ReducedChassis {
+        omega: modes.omega.clone(),
+        zeta,
+        points,
+    };
+    Ok(Reduction {
+        chassis,
+        assembled,
+        interface,
+        modes,
+        reduced,
+    })
+}
+
+/// The rows of node `node` in every mode; constrained DOFs of the node do not move.
+fn recovery_point(
+    chassis: &Chassis,
+    dofs: &DofMap,
+    modes: &CraigBampton,
+    name: String,
+    node: usize,
+) -> Result<RecoveryPoint, CmsError> {
+    let p = chassis.mesh.nodes.get(node).ok_or_else(|| {
+        CmsError::InvalidInput(format!(
+            "recovery point '{name}' refers to missing node {node}"
+        ))
+    })?;
+    let rows: Vec<Option<usize>> = (0..DOF_PER_NODE).map(|d| dofs.global(node, d)).collect();
+    let shape = (0..modes.omega.len())
+        .map(|k| {
+            let mut row = [0.0; 6];
+            for (d, g) in rows.iter().enumerate() {
+                if let Some(g) = g {
+                    row[d] = modes.shapes[(*g, k)];
+                }
+            }
+            row
+        })
+        .collect();
+    Ok(RecoveryPoint {
+        name,
+        node,
+        position: [p.x, p.y, p.z],
+        shape,
+    })
+}

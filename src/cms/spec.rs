@@ -1,0 +1,159 @@
+//! What a reduction depends on: the body description, the interface, the mode selection, the
+//! damping and the recovered output points. Its canonical JSON is the cache key.
+
+use serde::{Deserialize, Serialize};
+
+use super::damping::DampingTable;
+use super::error::CmsError;
+use crate::fe::chassis::{MountLayout, SEAT_RAIL, STEERING_WHEEL};
+use crate::fe::chassis_config::ChassisConfig;
+
+/// Serde mirror of [`MountLayout`] (the FE type carries no serde derive).
+#[derive(Serialize, Deserialize)]
+#[serde(remote = "MountLayout", rename_all = "snake_case")]
+enum MountLayoutDef {
+    Four,
+    Three,
+}
+
+/// Which DOFs of each mount node form the Craig-Bampton interface.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum InterfaceDofs {
+    /// ux, uy, uz: the mounts transmit forces only (default).
+    Translations,
+    /// ux, uy, uz, rx, ry, rz: the mounts also transmit moments.
+    All,
+}
+
+impl InterfaceDofs {
+    /// Local node DOFs (0..6 = ux, uy, uz, rx, ry, rz) in the interface.
+    pub fn local(self) -> &'static [usize] {
+        match self {
+            InterfaceDofs::Translations => &[0, 1, 2],
+            InterfaceDofs::All => &[0, 1, 2, 3, 4, 5],
+        }
+    }
+}
+
+/// Which fixed-interface normal modes are kept. All constraint modes are always kept, so the
+/// static interface compliance stays exact.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum ModeSelection {
+    /// The `n` lowest fixed-interface modes (0: a static, Guyan-like reduction).
+    Count(usize),
+    /// Every fixed-interface mode below this frequency (Hz).
+    CutoffHz(f64),
+}
+
+/// Everything the reduction depends on.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct ReductionSpec {
+    /// The body description.
+    pub chassis: ChassisConfig,
+    /// Engine-mount layout: its mount nodes form the interface.
+    #[serde(with = "MountLayoutDef")]
+    pub layout: MountLayout,
+    /// Interface DOFs per mount node.
+    pub interface_dofs: InterfaceDofs,
+    /// Fixed-interface normal modes to keep.
+    pub selection: ModeSelection,
+    /// Modal damping of the final (orthogonalised) modes.
+    pub damping: DampingTable,
+    /// Named FE nodes recovered after the mount nodes (see [`crate::fe::chassis`] for names).
+    pub outputs: Vec<String>,
+}
+
+impl Default for ReductionSpec {
+    /// The default body, four mounts with translational interface DOFs, the 40 lowest
+    /// fixed-interface modes, ADAMS damping, steering wheel and seat rail recovered.
+    fn default() -> Self {
+        Self {
+            chassis: ChassisConfig::default(),
+            layout: MountLayout::Four,
+            interface_dofs: InterfaceDofs::Translations,
+            selection: ModeSelection::Count(40),
+            damping: DampingTable::default(),
+            outputs: vec![STEERING_WHEEL.to_string(), SEAT_RAIL.to_string()],
+        }
+    }
+}
+
+impl ReductionSpec {
+    /// Checks the fields the FE generator does not check itself.
+    pub fn validate(&self) -> Result<(), CmsError> {
+        if let ModeSelection::CutoffHz(f) = self.selection {
+            if !(f.is_finite() && f > 0.0) {
+                return Err(CmsError::InvalidInput(format!(
+                    "selection.cutoff_hz = {f} must be finite and > 0"
+                )));
+            }
+        }
+        self.damping.validate()?;
+        if let Some(i) = self.outputs.iter().position(|o| o.is_empty()) {
+            return Err(CmsError::InvalidInput(format!(
+                "outputs[{i}] is an empty node name"
+            )));
+        }
+        Ok(())
+    }
+
+    /// Canonical JSON: struct fields in declaration order, maps sorted, floats round-tripping
+    /// exactly, so equal specs give equal text and any changed input changes it.
+    pub fn canonical_json(&self) -> Result<String, CmsError> {
+        serde_json::to_string(self)
+            .map_err(|e| CmsError::InvalidInput(format!("reduction spec to JSON: {e}")))
+    }
+
+    /// Parses a spec from JSON; unknown fields are errors.
+    pub fn from_json(text: &str) -> Result<Self, CmsError> {
+        serde_json::from_str(text)
+            .map_err(|e| CmsError::InvalidInput(format!("reduction spec JSON: {e}")))
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn json_round_trip_is_exact_and_canonical() {
+        let mut spec = ReductionSpec {
+            layout: MountLayout::Three,
+            selection: ModeSelection::Count(17),
+            ..ReductionSpec::default()
+        };
+        spec.chassis.body_stiffness_scale = 0.1 + 0.2;
+        let text = spec.canonical_json().unwrap();
+        let back = ReductionSpec::from_json(&text).unwrap();
+        assert_eq!(back, spec);
+        assert_eq!(back.canonical_json().unwrap(), text);
+        assert!(text.contains("\"layout\":\"three\""), "{text}");
+    }
+
+    #[test]
+    fn bad_fields_are_named() {
+        let spec = ReductionSpec {
+            selection: ModeSelection::CutoffHz(-3.0),
+            ..ReductionSpec::default()
+        };
+        assert!(spec
+            .validate()
+            .unwrap_err()
+            .to_string()
+            .contains("cutoff_hz"));
+        let spec = ReductionSpec {
+            outputs: vec!["steering_wheel".into(), String::new()],
+            ..ReductionSpec::default()
+        };
+        assert!(spec
+            .validate()
+            .unwrap_err()
+            .to_string()
+            .contains("outputs[1]"));
+        let e = ReductionSpec::from_json("{\"bogus\": 1}").unwrap_err();
+        assert!(e.to_string().contains("bogus"), "{e}");
+    }
+}
