@@ -163,6 +163,8 @@ impl Scene {
         let mut caps = vec![f64::INFINITY; self.dim()];
         match self {
             Scene::Ground(g) => caps[g.crank_index()] = 2.0 * std::f64::consts::PI,
+            // The hybrid state starts with the engine's, crank angle included.
+            Scene::Hybrid(h, _) => caps[h.engine().crank_index()] = 2.0 * std::f64::consts::PI,
         }
         caps
     }
