@@ -5,7 +5,7 @@ use super::craig_bampton::{craig_bampton, CraigBampton};
 use super::error::CmsError;
 use super::reduced::{RecoveryPoint, ReducedChassis};
 use super::spec::ReductionSpec;
-use crate::fe::assembly::{assemble, Assembled};
+use crate::fe::assembly::{assemble, mat_vec, Assembled, SparseMat};
 use crate::fe::chassis::Chassis;
 use crate::fe::dof::{DofMap, DOF_PER_NODE};
 
@@ -52,11 +52,16 @@ pub fn reduce_detailed(spec: &ReductionSpec) -> Result<Reduction, CmsError> {
         .into_iter()
         .map(|(name, node)| recovery_point(&chassis, &assembled.dofs, &modes, name, node))
         .collect::<Result<Vec<_>, _>>()?;
-    let zeta = modes
+    let mut zeta: Vec<f64> = modes
         .omega
         .iter()
         .map(|w| spec.damping.zeta(w / (2.0 * std::f64::consts::PI)))
         .collect();
+    if spec.discrete_dampers {
+        for (k, z) in zeta.iter_mut().enumerate() {
+            *z += projected_damping(&assembled.c, &modes, k) / (2.0 * modes.omega[k]);
+        }
+    }
     let reduced = ReducedChassis {
         omega: modes.omega.clone(),
         zeta,
@@ -69,6 +74,12 @@ pub fn reduce_detailed(spec: &ReductionSpec) -> Result<Reduction, CmsError> {
         modes,
         reduced,
     })
+}
+
+/// `φ_kᵀ C φ_k` of mode `k`.
+fn projected_damping(c: &SparseMat, modes: &CraigBampton, k: usize) -> f64 {
+    let phi: Vec<f64> = modes.shapes.col(k).iter().copied().collect();
+    mat_vec(c, &phi).iter().zip(&phi).map(|(a, b)| a * b).sum()
 }
 
 /// The rows of node `node` in every mode; constrained DOFs of the node do not move.

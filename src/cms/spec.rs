@@ -62,6 +62,11 @@ pub struct ReductionSpec {
     pub selection: ModeSelection,
     /// Modal damping of the final (orthogonalised) modes.
     pub damping: DampingTable,
+    /// Also turn the FE model's discrete dampers (the suspension) into modal damping,
+    /// `ζ_k += φ_kᵀ C φ_k / (2 ω_k)`: the diagonal of the projected damping matrix, neglecting
+    /// the coupling it adds between modes. Off by default (ADAMS' table only).
+    #[serde(default)]
+    pub discrete_dampers: bool,
     /// Named FE nodes recovered after the mount nodes (see [`crate::fe::chassis`] for names).
     pub outputs: Vec<String>,
 }
@@ -76,6 +81,7 @@ impl Default for ReductionSpec {
             interface_dofs: InterfaceDofs::Translations,
             selection: ModeSelection::Count(40),
             damping: DampingTable::default(),
+            discrete_dampers: false,
             outputs: vec![STEERING_WHEEL.to_string(), SEAT_RAIL.to_string()],
         }
     }
