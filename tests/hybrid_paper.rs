@@ -97,7 +97,7 @@ fn hybrid_modes_reproduce_paper_section_6_2() {
     assert!(wheel.iter().all(|f| (31.0..=33.0).contains(f)), "{wheel:?}");
     let torsion = by_chassis_kind(ChassisMode::GlobalTorsion);
     assert_eq!(torsion.len(), 1, "torsion modes {torsion:?}");
-    // Paper: 46.2 Hz; this body is tuned to 43 Hz without the engine, which the soft mounts
-    // barely change.
-    assert!((42.0..=48.0).contains(&torsion[0]), "torsion {torsion:?}");
+    // Paper: 46.2 Hz with the engine, 43 Hz without. The soft mounts barely move the torsion
+    // mode in this model, so the body is tuned to 44.5 Hz, inside both bands (see fe_tune).
+    assert!((44.0..=48.0).contains(&torsion[0]), "torsion {torsion:?}");
 }

@@ -300,8 +300,8 @@ impl Default for Steering {
             // Tuned by `examples/fe_tune.rs`.
             column_section: SectionSpec::Explicit {
                 area: 2.5e-4,
-                iy: 1.713e-8,
-                iz: 2.292e-8,
+                iy: 1.630e-8,
+                iz: 2.268e-8,
                 j: 8.0e-8,
             },
             bracket_section: SectionSpec::Box {
@@ -481,7 +481,7 @@ impl Default for ChassisConfig {
                 density: 2500.0,
             },
             // Tuned by `examples/fe_tune.rs` (with trim.floor and the steering column section).
-            body_stiffness_scale: 0.8823,
+            body_stiffness_scale: 0.9464,
             geometry: Geometry::default(),
             thickness: Thicknesses::default(),
             sections: Sections::default(),
