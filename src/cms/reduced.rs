@@ -35,4 +35,23 @@ impl ReducedChassis {
     pub fn point(&self, name: &str) -> Option<&RecoveryPoint> {
         self.points.iter().find(|p| p.name == name)
     }
+
+    /// Only the modes below `hz` (e.g. the rigid-body modes on the suspension: a rigid chassis).
+    pub fn keep_below(&self, hz: f64) -> ReducedChassis {
+        let keep: Vec<usize> = (0..self.n_modes())
+            .filter(|k| self.omega[*k] < 2.0 * std::f64::consts::PI * hz)
+            .collect();
+        ReducedChassis {
+            omega: keep.iter().map(|k| self.omega[*k]).collect(),
+            zeta: keep.iter().map(|k| self.zeta[*k]).collect(),
+            points: self
+                .points
+                .iter()
+                .map(|p| RecoveryPoint {
+                    shape: keep.iter().map(|k| p.shape[*k]).collect(),
+                    ..p.clone()
+                })
+                .collect(),
+        }
+    }
 }

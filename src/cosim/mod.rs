@@ -15,7 +15,7 @@ pub use signals::{Inputs, Signal};
 
 use std::path::PathBuf;
 
-use crate::ode::{Bdf, BdfOptions, BdfSnapshot, Tolerance};
+use crate::ode::{Bdf, BdfOptions, BdfSnapshot, OdeProblem, Tolerance};
 
 /// Name of the default configuration in the FMU's resources folder.
 pub const DEFAULT_CONFIG_NAME: &str = "engine.json";
@@ -32,6 +32,8 @@ pub struct EffectSwitches {
     pub gyroscopic: bool,
     pub ring_carrier: bool,
     pub mount_nonlinearity: bool,
+    /// Scene 2: elastic chassis; off: only its rigid-body modes on the suspension.
+    pub chassis_flexibility: bool,
 }
 
 impl Default for EffectSwitches {
@@ -43,6 +45,7 @@ impl Default for EffectSwitches {
             gyroscopic: true,
             ring_carrier: true,
             mount_nonlinearity: true,
+            chassis_flexibility: true,
         }
     }
 }
@@ -50,8 +53,12 @@ impl Default for EffectSwitches {
 /// The elastic chassis of scene 2.
 #[derive(Debug, Clone, PartialEq)]
 pub struct ChassisSettings {
-    /// Keep the fixed-interface chassis modes below this frequency, Hz.
+    /// Keep the fixed-interface chassis modes below this frequency, Hz; 0 = automatic, from the
+    /// highest excitation frequency the scene needs (see [`ChassisSettings::cutoff_hz`]).
     pub mode_cutoff_hz: f64,
+    /// Highest engine speed (rpm) and engine order the automatic cut-off must cover.
+    pub max_rpm: f64,
+    pub max_engine_order: f64,
     /// If positive: keep exactly this many fixed-interface modes instead (the cut-off is unused).
     pub max_modes: i32,
     /// Transverse stiffening bar between the front girders (paper §7.1).
@@ -60,10 +67,27 @@ pub struct ChassisSettings {
     pub cache: CacheSetting,
 }
 
+/// Margin of the automatic cut-off over the highest excitation frequency: the mode nearest to it
+/// must respond dynamically, not only quasi-statically.
+pub const AUTO_CUTOFF_MARGIN: f64 = 1.2;
+
+impl ChassisSettings {
+    /// The cut-off in use: the explicit one, or max rpm × max order × margin.
+    pub fn cutoff_hz(&self) -> f64 {
+        if self.mode_cutoff_hz > 0.0 {
+            self.mode_cutoff_hz
+        } else {
+            self.max_rpm / 60.0 * self.max_engine_order * AUTO_CUTOFF_MARGIN
+        }
+    }
+}
+
 impl Default for ChassisSettings {
     fn default() -> Self {
         ChassisSettings {
-            mode_cutoff_hz: 200.0,
+            mode_cutoff_hz: 0.0,
+            max_rpm: 2500.0,
+            max_engine_order: 4.5,
             max_modes: 0,
             stiffening_bar: false,
             cache: CacheSetting::Default,
@@ -184,6 +208,11 @@ impl Simulation {
     /// Lines for the log describing the scene.
     pub fn describe(&self) -> Vec<String> {
         self.scene.describe()
+    }
+
+    /// Number of integrator states (what a switched-off effect saves).
+    pub fn state_count(&self) -> usize {
+        self.scene.dim()
     }
 
     pub fn time(&self) -> f64 {

@@ -11,6 +11,10 @@ use crate::ode::{OdeProblem, ProblemError};
 /// Number of mounts the FMU's variables expose (`mount[1..4]`).
 pub const FMU_MOUNTS: usize = 4;
 
+/// With chassis flexibility off, the chassis modes kept: the rigid-body modes on the suspension
+/// (1–5 Hz; the first elastic mode is above 20 Hz).
+const RIGID_CHASSIS_HZ: f64 = 10.0;
+
 /// A model the runtime can integrate. An enum rather than a trait object: scenes are cloned for
 /// FMU states and the set is closed.
 #[derive(Clone)]
@@ -31,13 +35,41 @@ fn hybrid_scene(settings: &Settings, engine: GroundScene) -> Result<Scene, Strin
             c.max_modes
         )
     })?;
-    if !(c.mode_cutoff_hz.is_finite() && c.mode_cutoff_hz > 0.0) {
+    if !(c.mode_cutoff_hz.is_finite() && c.mode_cutoff_hz >= 0.0) {
         return Err(format!(
-            "chassis.modeCutoff = {} Hz must be positive and finite",
+            "chassis.modeCutoff = {} Hz must be >= 0 and finite (0: automatic)",
             c.mode_cutoff_hz
         ));
     }
-    let spec = reduction_spec(c.mode_cutoff_hz, max_modes, c.stiffening_bar);
+    if !(c.max_rpm > 0.0 && c.max_engine_order > 0.0 && c.cutoff_hz().is_finite()) {
+        return Err(format!(
+            "scene.maxRpm = {} and scene.maxEngineOrder = {} must be positive",
+            c.max_rpm, c.max_engine_order
+        ));
+    }
+    let flexible = settings.effects.chassis_flexibility;
+    // A rigid chassis needs no fixed-interface modes: the constraint modes alone contain its
+    // rigid-body motion on the suspension, the only part kept below.
+    let (cutoff, max_modes) = if flexible {
+        (c.cutoff_hz(), max_modes)
+    } else {
+        (1.0, 0)
+    };
+    let cutoff_origin = if !flexible {
+        "rigid chassis: rigid-body modes on the suspension only".to_owned()
+    } else if max_modes > 0 {
+        format!("{max_modes} fixed-interface modes")
+    } else if c.mode_cutoff_hz > 0.0 {
+        format!("cut-off {cutoff:.0} Hz (chassis.modeCutoff)")
+    } else {
+        format!(
+            "automatic cut-off {cutoff:.0} Hz = {} rpm / 60 x order {} x margin {}",
+            c.max_rpm,
+            c.max_engine_order,
+            super::AUTO_CUTOFF_MARGIN
+        )
+    };
+    let spec = reduction_spec(cutoff, max_modes, c.stiffening_bar);
     let started = std::time::Instant::now();
     let (chassis, outcome) =
         reduce_cached(&spec, &c.cache).map_err(|e| format!("chassis reduction: {e}"))?;
@@ -54,9 +86,13 @@ fn hybrid_scene(settings: &Settings, engine: GroundScene) -> Result<Scene, Strin
         CacheOutcome::NotStored { reason } => format!("reduced (not cached: {reason})"),
         CacheOutcome::Disabled => "reduced (caching disabled)".to_owned(),
     };
+    let chassis = if flexible {
+        chassis
+    } else {
+        chassis.keep_below(RIGID_CHASSIS_HZ)
+    };
     let note = format!(
-        "chassis (Craig-Bampton, {:?}, stiffening bar {}): {} modes, {:.1}..{:.1} Hz, {source} in {seconds:.2} s",
-        spec.selection,
+        "chassis (Craig-Bampton, {cutoff_origin}, stiffening bar {}): {} modes, {:.1}..{:.1} Hz, {source} in {seconds:.2} s",
         if c.stiffening_bar { "on" } else { "off" },
         chassis.n_modes(),
         chassis.omega.first().copied().unwrap_or(0.0) / (2.0 * std::f64::consts::PI),

@@ -258,6 +258,7 @@ impl Instance {
                 gyroscopic: v.booleans[boolean::EFFECT_GYROSCOPIC as usize],
                 ring_carrier: v.booleans[boolean::EFFECT_RING_CARRIER as usize],
                 mount_nonlinearity: v.booleans[boolean::EFFECT_MOUNT_NONLINEARITY as usize],
+                chassis_flexibility: v.booleans[boolean::EFFECT_CHASSIS_FLEXIBILITY as usize],
             },
             fade_in_time: v.reals[real::FADE_IN_TIME as usize],
             crank_start_angle: v.reals[real::CRANK_START_ANGLE as usize],
@@ -268,6 +269,8 @@ impl Instance {
                 [boolean::SOLVER_STABILITY_LIMIT_DETECTION as usize],
             chassis: cosim::ChassisSettings {
                 mode_cutoff_hz: v.reals[real::CHASSIS_MODE_CUTOFF as usize],
+                max_rpm: v.reals[real::SCENE_MAX_RPM as usize],
+                max_engine_order: v.reals[real::SCENE_MAX_ENGINE_ORDER as usize],
                 max_modes: v.integers[integer::CHASSIS_MAX_MODES as usize],
                 stiffening_bar: v.booleans[boolean::CHASSIS_STIFFENING_BAR as usize],
                 cache: if !v.booleans[boolean::CHASSIS_CACHE_ENABLED as usize] {

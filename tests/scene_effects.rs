@@ -1,0 +1,99 @@
+//! Scene-level effect switches: the automatic chassis cut-off and the rigid chassis.
+
+use engine_mount_chassis::cosim::{
+    ChassisSettings, EffectSwitches, Inputs, Settings, Signal, Simulation, RPM_TO_RAD_PER_S,
+};
+
+fn inputs(rpm: f64) -> Inputs {
+    Inputs {
+        crank_speed: Signal::constant(rpm * RPM_TO_RAD_PER_S),
+        load_torque: Signal::constant(0.0),
+        stiffness_scale: [Signal::constant(1.0); 4],
+        damping_scale: [Signal::constant(1.0); 4],
+    }
+}
+
+/// RMS of the vertical steering-wheel acceleration over 0.3–0.5 s, and the number of states.
+fn steering_wheel_rms(settings: &Settings) -> (f64, usize, Vec<String>) {
+    let mut sim = Simulation::new(settings, 0.0, &inputs(1900.0)).unwrap();
+    let describe = sim.describe();
+    let mut sum = 0.0;
+    let mut n = 0;
+    for k in 1..=500 {
+        let t = k as f64 * 1e-3;
+        sim.advance_to(t).unwrap();
+        if t > 0.3 {
+            let a = sim.outputs().unwrap().steering_wheel_acceleration[2];
+            sum += a * a;
+            n += 1;
+        }
+    }
+    ((sum / n as f64).sqrt(), sim.state_count(), describe)
+}
+
+#[test]
+fn automatic_cutoff_follows_the_scene() {
+    let c = ChassisSettings::default();
+    assert_eq!(c.mode_cutoff_hz, 0.0);
+    assert!((c.cutoff_hz() - 2500.0 / 60.0 * 4.5 * 1.2).abs() < 1e-9);
+    let low = ChassisSettings {
+        max_rpm: 1200.0,
+        max_engine_order: 2.0,
+        ..c.clone()
+    };
+    assert!((low.cutoff_hz() - 48.0).abs() < 1e-9);
+    let explicit = ChassisSettings {
+        mode_cutoff_hz: 80.0,
+        ..c
+    };
+    assert_eq!(explicit.cutoff_hz(), 80.0);
+
+    let settings = Settings {
+        scene: 2,
+        chassis: ChassisSettings {
+            max_rpm: 1200.0,
+            max_engine_order: 2.0,
+            ..ChassisSettings::default()
+        },
+        ..Settings::default()
+    };
+    let sim = Simulation::new(&settings, 0.0, &inputs(1000.0)).unwrap();
+    let text = sim.describe().join("\n");
+    assert!(text.contains("automatic cut-off 48 Hz"), "{text}");
+}
+
+#[test]
+fn a_rigid_chassis_removes_the_body_resonances_and_costs_less() {
+    // 1900 rpm: the 1st order (31.7 Hz) sits on the steering-wheel modes of the elastic body.
+    let elastic = Settings {
+        scene: 2,
+        effects: EffectSwitches {
+            balance_shaft: false,
+            ..EffectSwitches::default()
+        },
+        chassis: ChassisSettings {
+            mode_cutoff_hz: 100.0,
+            ..ChassisSettings::default()
+        },
+        ..Settings::default()
+    };
+    let rigid = Settings {
+        effects: EffectSwitches {
+            chassis_flexibility: false,
+            ..elastic.effects
+        },
+        ..elastic.clone()
+    };
+    let (a_elastic, states_elastic, _) = steering_wheel_rms(&elastic);
+    let (a_rigid, states_rigid, text) = steering_wheel_rms(&rigid);
+    assert!(text.join(" ").contains("rigid chassis"), "{text:?}");
+    assert!(
+        a_rigid < 0.2 * a_elastic,
+        "rigid {a_rigid} vs elastic {a_elastic} m/s2"
+    );
+    assert!(
+        states_rigid + 40 < states_elastic,
+        "{states_rigid} vs {states_elastic} states"
+    );
+    eprintln!("steering wheel z RMS: elastic {a_elastic:.3}, rigid {a_rigid:.4} m/s2; states {states_elastic} -> {states_rigid}");
+}
