@@ -151,3 +151,28 @@ fn resource_file_equals_the_defaults() {
         "regenerate with `cargo run --release --example engine_default_config`"
     );
 }
+
+#[test]
+fn three_mount_resource_carries_the_weight_at_the_design_position() {
+    let text = std::fs::read_to_string(concat!(
+        env!("CARGO_MANIFEST_DIR"),
+        "/resources/engine_three_mounts.json"
+    ))
+    .expect("resources/engine_three_mounts.json");
+    let cfg = EngineConfig::from_json(&text).expect("resource parses");
+    let names: Vec<&str> = cfg.mounts.iter().filter(|m| m.active).map(|m| m.name.as_str()).collect();
+    assert_eq!(names, ["front_left", "front_right", "rear_left"]);
+    let mut rest = EngineConfig::default();
+    rest.mounts = cfg.mounts.clone();
+    assert_eq!(rest, cfg, "only the mounts differ from the default");
+    let mut scene = GroundScene::new(cfg).expect("valid");
+    let y = scene.static_equilibrium(0.0).expect("equilibrium");
+    let out = scene.outputs(0.0, &y).expect("outputs");
+    let vertical: f64 = out.mount_forces.iter().map(|f| f[2]).sum();
+    let weight = 180.0 * scene.config().gravity;
+    assert!((vertical + weight).abs() < 1e-3 * weight, "{vertical}");
+    // the preloads balance the weight at the design position: the operating points stay linear
+    for d in out.housing.displacement {
+        assert!(d.abs() < 1e-5, "static displacement {d} m");
+    }
+}

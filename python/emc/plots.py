@@ -63,3 +63,35 @@ def order_cuts(orders: pd.DataFrame, signal: str, path: str, title: str | None =
         fig.tight_layout()
         fig.savefig(path, dpi=120)
         plt.close(fig)
+
+
+def side_by_side(spectra: pd.DataFrame, orders: pd.DataFrame, signal: str, cases: list[str],
+                 waterfall_path: str, order_cut_path: str):
+    """Waterfalls and order cuts of several cases next to each other, on common scales."""
+    data = spectra[spectra.signal == signal]
+    top = data.frequency.max()
+    fig, axes = plt.subplots(1, len(cases), figsize=(7 * len(cases), 6), squeeze=False)
+    peak = data.amplitude.max()
+    for ax, case in zip(axes[0], cases):
+        d = data[data.case == case]
+        shown = d[d.amplitude > 0.02 * peak]
+        ax.scatter(shown.rpm, shown.frequency, s=400 * shown.amplitude / peak, alpha=0.6,
+                   color="tab:blue", edgecolors="none")
+        rpm = np.linspace(d.rpm.min(), d.rpm.max(), 2)
+        for k in range(1, 13):
+            order = k / 2
+            ax.plot(rpm, order * rpm / 60, "-" if order in MAIN_ORDERS else ":", color="gray", lw=0.7)
+        ax.set_ylim(0, top)
+        ax.set_xlabel("engine speed [rpm]")
+        ax.set_ylabel("frequency [Hz]")
+        ax.set_title(f"{case}: {signal} (common scale, max {peak:.3g})")
+    fig.tight_layout()
+    fig.savefig(waterfall_path, dpi=120)
+    plt.close(fig)
+
+    fig, axes = plt.subplots(1, len(cases), figsize=(7 * len(cases), 5), squeeze=False, sharey=True)
+    for ax, case in zip(axes[0], cases):
+        order_cuts(orders[orders.case == case], signal, "", title=f"{case}: {signal}", ax=ax)
+    fig.tight_layout()
+    fig.savefig(order_cut_path, dpi=120)
+    plt.close(fig)
