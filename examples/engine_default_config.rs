@@ -19,7 +19,9 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     for mount in three.mounts.iter_mut().filter(|m| m.name == "rear_right") {
         mount.active = false;
     }
-    let active: Vec<usize> = (0..three.mounts.len()).filter(|i| three.mounts[*i].active).collect();
+    let active: Vec<usize> = (0..three.mounts.len())
+        .filter(|i| three.mounts[*i].active)
+        .collect();
     if active.len() != 3 {
         return Err("the three-mount vehicle needs exactly three active mounts".into());
     }
@@ -38,7 +40,10 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     for (col, i) in active.iter().enumerate() {
         three.mounts[*i].preload = [0.0, 0.0, loads[col]];
     }
-    for (name, config) in [("engine.json", &default), ("engine_three_mounts.json", &three)] {
+    for (name, config) in [
+        ("engine.json", &default),
+        ("engine_three_mounts.json", &three),
+    ] {
         let path = format!("{dir}/{name}");
         std::fs::write(&path, config.to_json() + "\n")?;
         println!("wrote {path}");

@@ -257,7 +257,11 @@ fn doubling_the_modal_damping_halves_the_resonance_peaks() {
                 "{}/{} peak at {f:.2} Hz: ratio {ratio:.3}, background of other modes {beta:.3}",
                 out.point, out.dof
             );
-            assert!(ratio > 1.0, "more damping raised the peak at {f} Hz");
+            // With |b| = β|H| the ratio is at least (1 − β)/(½ + β), above 1 for β < ¼; a peak
+            // that is mostly the interference of neighbouring modes may rise with damping.
+            if beta < 0.25 {
+                assert!(ratio > 1.0, "more damping raised the peak at {f} Hz");
+            }
             // Resonant term m ∝ 1/ζ plus a background b, |b| = β|H|, that damping hardly
             // changes: |m + b| / |m/2 + b| lies within 2/(1 ± 3β). Allow 3 % for the shift of
             // the peak and of the background with damping.

@@ -160,7 +160,12 @@ fn three_mount_resource_carries_the_weight_at_the_design_position() {
     ))
     .expect("resources/engine_three_mounts.json");
     let cfg = EngineConfig::from_json(&text).expect("resource parses");
-    let names: Vec<&str> = cfg.mounts.iter().filter(|m| m.active).map(|m| m.name.as_str()).collect();
+    let names: Vec<&str> = cfg
+        .mounts
+        .iter()
+        .filter(|m| m.active)
+        .map(|m| m.name.as_str())
+        .collect();
     assert_eq!(names, ["front_left", "front_right", "rear_left"]);
     let mut rest = EngineConfig::default();
     rest.mounts = cfg.mounts.clone();

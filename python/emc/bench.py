@@ -17,12 +17,17 @@ from .runner import OperatingPoint, Runner
 EFFECTS = ("gasForces", "massForces", "balanceShaft", "gyroscopic", "ringCarrier", "mountNonlinearity")
 
 
-def effect_sets() -> list[tuple[str, dict]]:
-    """All effects on, then each switched off alone, then everything but gas and mass forces off."""
+def effect_sets(scene: int) -> list[tuple[str, dict]]:
+    """All effects on, then each switched off alone, then everything but gas and mass forces off;
+    in scene 2 also the rigid chassis and explicit chassis mode cut-offs."""
     cases = [("all effects", {})]
     for e in EFFECTS:
         cases.append((f"without {e}", {f"effects.{e}": False}))
     cases.append(("gas + mass forces only", {f"effects.{e}": False for e in EFFECTS[2:]}))
+    if scene == 2:
+        cases.append(("without chassisFlexibility", {"effects.chassisFlexibility": False}))
+        for cutoff in (60.0, 120.0, 400.0):
+            cases.append((f"chassis cut-off {cutoff:g} Hz", {"chassis.modeCutoff": cutoff}))
     return cases
 
 
@@ -49,7 +54,7 @@ def effects_table(fmu_path: str, scenes=(1,), rpm: float = 2000.0, seconds: floa
     rows = []
     with Runner(fmu_path) as runner:
         for scene in scenes:
-            for name, params in effect_sets():
+            for name, params in effect_sets(scene):
                 row = measure(runner, rpm, seconds, {"scene": scene, **params}, signal)
                 rows.append({"scene": scene, "effects": name, **row})
     return pd.DataFrame(rows)

@@ -64,7 +64,9 @@ def run_sweep(fmu_path: str, points: list[OperatingPoint], signals: list[str] | 
                                    dashboard_address=None)
             client = Client(cluster)
         try:
-            npart = max(1, min(len(points), workers if not scheduler else len(points)))
+            # Several points per partition reuse one FMU instance; more partitions than workers
+            # balance slow low-speed points and give the progress bar something to show.
+            npart = max(1, min(len(points), 3 * workers if not scheduler else len(points)))
             bag = db.from_sequence(points, npartitions=npart)
             delayed_parts = bag.map_partitions(lambda part: _run_partition(fmu_path, list(part), signals, case))
             futures = client.compute(delayed_parts)
