@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import dataclasses
 import math
+import time
 import shutil
 import tempfile
 from typing import Iterable
@@ -97,14 +98,20 @@ class Runner:
         vrs = [self.vr[s] for s in signals]
         samples = np.empty((n_window, len(vrs)))
         t = 0.0
+        # CPU time of the stepping only (instantiation may include a chassis reduction).
+        cpu = time.process_time()
+        wall = time.perf_counter()
         for k in range(n_settle + n_window):
             self.slave.doStep(currentCommunicationPoint=t, communicationStepSize=h)
             t = (k + 1) * h
             if k >= n_settle:
                 samples[k - n_settle] = self.slave.getReal(vrs)
+        cpu = time.process_time() - cpu
+        wall = time.perf_counter() - wall
         if not np.all(np.isfinite(samples)):
             raise RuntimeError(f"non-finite outputs at {point.rpm} rpm")
-        return {"point": point, "dt": h, "signals": signals, "samples": samples}
+        return {"point": point, "dt": h, "signals": signals, "samples": samples,
+                "cpu": cpu, "wall": wall, "simulated": t}
 
     def run_up(self, rpm_from: float, rpm_to: float, duration: float, signals: list[str],
                step: float = 2e-4, start_values: dict | None = None) -> dict:
