@@ -103,6 +103,8 @@ pub struct Settings {
     /// Engine configuration JSON; `None` = built-in defaults.
     pub config_file: Option<PathBuf>,
     pub effects: EffectSwitches,
+    /// Combustion load, 0 = idle … 1 = full load (blends the Wiebe pressure curves).
+    pub gas_load: f64,
     /// Smooth fade-in of the engine excitation, s (0 = instantly).
     pub fade_in_time: f64,
     /// Crank angle at the start time, rad.
@@ -121,6 +123,7 @@ impl Default for Settings {
             scene: 1,
             config_file: None,
             effects: EffectSwitches::default(),
+            gas_load: 0.0,
             fade_in_time: 0.1,
             crank_start_angle: 0.0,
             rel_tol: 1e-5,

@@ -154,6 +154,7 @@ fn engine_config(settings: &Settings) -> Result<EngineConfig, String> {
     config.effects.gyroscopic = e.gyroscopic;
     config.effects.ring_carrier_elasticity = e.ring_carrier;
     config.effects.mount_nonlinearity = e.mount_nonlinearity;
+    config.gas.load = settings.gas_load;
     config.excitation_fade_in = settings.fade_in_time;
     config.start_crank_angle_deg = settings.crank_start_angle.to_degrees();
     if config.mounts.len() > FMU_MOUNTS {

@@ -260,6 +260,7 @@ impl Instance {
                 mount_nonlinearity: v.booleans[boolean::EFFECT_MOUNT_NONLINEARITY as usize],
                 chassis_flexibility: v.booleans[boolean::EFFECT_CHASSIS_FLEXIBILITY as usize],
             },
+            gas_load: v.reals[real::ENGINE_LOAD as usize],
             fade_in_time: v.reals[real::FADE_IN_TIME as usize],
             crank_start_angle: v.reals[real::CRANK_START_ANGLE as usize],
             rel_tol: v.reals[real::SOLVER_REL_TOL as usize],
