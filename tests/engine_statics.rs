@@ -167,8 +167,10 @@ fn three_mount_resource_carries_the_weight_at_the_design_position() {
         .map(|m| m.name.as_str())
         .collect();
     assert_eq!(names, ["front_left", "front_right", "rear_left"]);
-    let mut rest = EngineConfig::default();
-    rest.mounts = cfg.mounts.clone();
+    let rest = EngineConfig {
+        mounts: cfg.mounts.clone(),
+        ..EngineConfig::default()
+    };
     assert_eq!(rest, cfg, "only the mounts differ from the default");
     let mut scene = GroundScene::new(cfg).expect("valid");
     let y = scene.static_equilibrium(0.0).expect("equilibrium");
