@@ -452,34 +452,57 @@ impl Instance {
         }
     }
 
+    /// The values after `vrs := values`, if every reference is known, settable now and passes
+    /// `check`; otherwise the logged refusal. Nothing is applied here.
+    fn candidate<T: Clone, S: 'static>(
+        &self,
+        function: &str,
+        table: &[Variable<S>],
+        current: &[T],
+        vrs: &[u32],
+        values: &[T],
+        check: impl Fn(&Variable<S>, &T) -> Result<(), String>,
+    ) -> Result<Vec<T>, Status> {
+        let mut candidate = current.to_vec();
+        for (vr, value) in vrs.iter().zip(values) {
+            let Some(v) = table.get(*vr as usize) else {
+                return Err(self.error(&format!("{function}: unknown value reference {vr}")));
+            };
+            if let Err(m) = self.settable(v).and_then(|()| check(v, value)) {
+                return Err(self.error(&format!("{function}: {m}")));
+            }
+            candidate[*vr as usize] = value.clone();
+        }
+        Ok(candidate)
+    }
+
     pub fn set_real(&mut self, vrs: &[u32], values: &[f64]) -> Status {
-        if let Err(s) = self.allowed("fmi2SetReal", state::SET_VALUES) {
+        const F: &str = "fmi2SetReal";
+        if let Err(s) = self.allowed(F, state::SET_VALUES) {
             return s;
         }
-        let mut candidate = self.core.values.reals.clone();
-        for (vr, value) in vrs.iter().zip(values) {
-            let Some(v) = REALS.get(*vr as usize) else {
-                return self.error(&format!("fmi2SetReal: unknown value reference {vr}"));
-            };
-            if let Err(m) = self.settable(v) {
-                return self.error(&format!("fmi2SetReal: {m}"));
-            }
+        let check = |v: &Variable<f64>, value: &f64| {
             if !value.is_finite() {
-                return self.error(&format!("fmi2SetReal: {} = {value} is not finite", v.name));
+                return Err(format!("{} = {value} is not finite", v.name));
             }
             if v.min.is_some_and(|m| *value < m) || v.max.is_some_and(|m| *value > m) {
-                return self.error(&format!(
-                    "fmi2SetReal: {} = {value} is outside [{}, {}]",
+                return Err(format!(
+                    "{} = {value} is outside [{}, {}]",
                     v.name,
                     v.min.unwrap_or(f64::NEG_INFINITY),
                     v.max.unwrap_or(f64::INFINITY)
                 ));
             }
-            candidate[*vr as usize] = *value;
-        }
+            Ok(())
+        };
+        let candidate = match self.candidate(F, REALS, &self.core.values.reals, vrs, values, check)
+        {
+            Ok(c) => c,
+            Err(s) => return s,
+        };
         let inputs = inputs_from(&candidate, &self.core.input_derivatives, self.core.time);
         if let Err(m) = inputs.validate() {
-            return self.error(&format!("fmi2SetReal: {m}"));
+            return self.error(&format!("{F}: {m}"));
         }
         // A new input value starts a new linear segment: its derivative is reset until the
         // master sets it again with fmi2SetRealInputDerivatives.
@@ -494,66 +517,65 @@ impl Instance {
     }
 
     pub fn set_integer(&mut self, vrs: &[u32], values: &[i32]) -> Status {
-        if let Err(s) = self.allowed("fmi2SetInteger", state::SET_VALUES) {
+        const F: &str = "fmi2SetInteger";
+        if let Err(s) = self.allowed(F, state::SET_VALUES) {
             return s;
         }
-        let mut candidate = self.core.values.integers.clone();
-        for (vr, value) in vrs.iter().zip(values) {
-            let Some(v) = INTEGERS.get(*vr as usize) else {
-                return self.error(&format!("fmi2SetInteger: unknown value reference {vr}"));
-            };
-            if let Err(m) = self.settable(v) {
-                return self.error(&format!("fmi2SetInteger: {m}"));
-            }
+        let check = |v: &Variable<i32>, value: &i32| {
             if v.min.is_some_and(|m| *value < m) || v.max.is_some_and(|m| *value > m) {
-                return self.error(&format!(
-                    "fmi2SetInteger: {} = {value} is outside [{}, {}]",
+                return Err(format!(
+                    "{} = {value} is outside [{}, {}]",
                     v.name,
                     v.min.unwrap_or(i32::MIN),
                     v.max.unwrap_or(i32::MAX)
                 ));
             }
-            candidate[*vr as usize] = *value;
+            Ok(())
+        };
+        match self.candidate(F, INTEGERS, &self.core.values.integers, vrs, values, check) {
+            Ok(c) => self.core.values.integers = c,
+            Err(s) => return s,
         }
-        self.core.values.integers = candidate;
         self.after_set(true);
         Status::Ok
     }
 
     pub fn set_boolean(&mut self, vrs: &[u32], values: &[bool]) -> Status {
-        if let Err(s) = self.allowed("fmi2SetBoolean", state::SET_VALUES) {
+        const F: &str = "fmi2SetBoolean";
+        if let Err(s) = self.allowed(F, state::SET_VALUES) {
             return s;
         }
-        let mut candidate = self.core.values.booleans.clone();
-        for (vr, value) in vrs.iter().zip(values) {
-            let Some(v) = BOOLEANS.get(*vr as usize) else {
-                return self.error(&format!("fmi2SetBoolean: unknown value reference {vr}"));
-            };
-            if let Err(m) = self.settable(v) {
-                return self.error(&format!("fmi2SetBoolean: {m}"));
-            }
-            candidate[*vr as usize] = *value;
+        match self.candidate(
+            F,
+            BOOLEANS,
+            &self.core.values.booleans,
+            vrs,
+            values,
+            |_, _| Ok(()),
+        ) {
+            Ok(c) => self.core.values.booleans = c,
+            Err(s) => return s,
         }
-        self.core.values.booleans = candidate;
         self.after_set(true);
         Status::Ok
     }
 
     pub fn set_string(&mut self, vrs: &[u32], values: &[String]) -> Status {
-        if let Err(s) = self.allowed("fmi2SetString", state::SET_VALUES) {
+        const F: &str = "fmi2SetString";
+        if let Err(s) = self.allowed(F, state::SET_VALUES) {
             return s;
         }
-        let mut candidate = self.core.values.strings.clone();
-        for (vr, value) in vrs.iter().zip(values) {
-            let Some(v) = STRINGS.get(*vr as usize) else {
-                return self.error(&format!("fmi2SetString: unknown value reference {vr}"));
-            };
-            if let Err(m) = self.settable(v) {
-                return self.error(&format!("fmi2SetString: {m}"));
-            }
-            candidate[*vr as usize] = value.clone();
+        match self.candidate(
+            F,
+            STRINGS,
+            &self.core.values.strings,
+            vrs,
+            values,
+            |_, _| Ok(()),
+        ) {
+            Ok(c) => self.core.values.strings = c,
+            Err(s) => return s,
         }
-        self.core.values.strings = candidate;
         self.after_set(true);
         Status::Ok
     }
