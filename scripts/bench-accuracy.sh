@@ -5,6 +5,14 @@ set -euo pipefail
 root=$(cd "$(dirname "$0")/.." && pwd)
 cd "$root"
 bash scripts/setup.sh
+if ! dpkg -s libsundials-dev >/dev/null 2>&1; then
+  sudo_cmd=""
+  [ "$(id -u)" -eq 0 ] || sudo_cmd="sudo"
+  $sudo_cmd apt-get update -qq
+  DEBIAN_FRONTEND=noninteractive $sudo_cmd apt-get install -y -qq libsundials-dev >/dev/null
+fi
+# The tight reference cross-checked once against SUNDIALS CVODE on the same right-hand side.
+cargo run --release --example reference_vs_cvode --features bench-cvode
 mkdir -p out/accuracy
 cargo run --release --example accuracy_cost -- --scene "${1:-1}" --csv out/accuracy/accuracy.csv
 .venv/bin/python -m emc.accuracy_plot out/accuracy/accuracy.csv out/accuracy/accuracy.png
