@@ -16,7 +16,8 @@
 use std::time::Instant;
 
 use engine_mount_chassis::cosim::{
-    Counters, Inputs, Settings, Signal, Simulation, RPM_TO_RAD_PER_S,
+    ChassisSettings, Counters, EffectSwitches, Inputs, Settings, Signal, Simulation,
+    RPM_TO_RAD_PER_S,
 };
 
 /// One run's samples: every mount force component at each communication point in the window.
@@ -55,8 +56,9 @@ fn inputs_at(case: &Case, t: f64, interpolate: bool) -> Inputs {
 
 /// Runs a case with communication step `h`, recording every communication point in the window.
 fn run(case: &Case, settings: &Settings, h: f64, interpolate: bool) -> Result<Run, String> {
-    let started = Instant::now();
     let mut sim = Simulation::new(settings, 0.0, &inputs_at(case, 0.0, interpolate))?;
+    // The clock starts after set-up: instantiation may reduce the chassis (cached afterwards).
+    let started = Instant::now();
     let n = (case.t_end / h).round() as usize;
     let mut times = Vec::new();
     let mut samples = Vec::new();
@@ -69,7 +71,9 @@ fn run(case: &Case, settings: &Settings, h: f64, interpolate: bool) -> Result<Ru
         if t_next > case.t_window + 1e-9 {
             let o = sim.outputs()?;
             times.push(t_next);
-            samples.push(o.mount_force.iter().flatten().copied().collect());
+            let mut row: Vec<f64> = o.mount_force.iter().flatten().copied().collect();
+            row.extend(o.steering_wheel_acceleration);
+            samples.push(row);
         }
     }
     Ok(Run {
@@ -80,9 +84,14 @@ fn run(case: &Case, settings: &Settings, h: f64, interpolate: bool) -> Result<Ru
     })
 }
 
-/// Relative L2 error of `run` against `reference` at the run's sample times (which are
-/// reference sample times too: the reference step divides every communication step).
-fn relative_l2(run: &Run, reference: &Run) -> f64 {
+/// Columns of a sample row: the 12 mount-force components, then the steering-wheel acceleration.
+const FORCES: std::ops::Range<usize> = 0..12;
+const STEERING_WHEEL: std::ops::Range<usize> = 12..15;
+
+/// Relative L2 error of `run` against `reference` in the columns `cols`, at the run's sample
+/// times (which are reference sample times too: the reference step divides every communication
+/// step).
+fn relative_l2(run: &Run, reference: &Run, cols: std::ops::Range<usize>) -> f64 {
     let h_ref = reference.times[1] - reference.times[0];
     let pairs: Vec<(&Vec<f64>, &Vec<f64>)> = run
         .times
@@ -95,18 +104,21 @@ fn relative_l2(run: &Run, reference: &Run) -> f64 {
         })
         .collect();
     let n = pairs.len().max(1);
-    let width = reference.samples[0].len();
-    let mean: Vec<f64> = (0..width)
+    let mean: Vec<f64> = cols
+        .clone()
         .map(|j| pairs.iter().map(|(_, b)| b[j]).sum::<f64>() / n as f64)
         .collect();
     let (mut num, mut den) = (0.0, 0.0);
     for (a, b) in pairs {
-        for j in 0..b.len() {
+        for (k, j) in cols.clone().enumerate() {
             num += (a[j] - b[j]).powi(2);
-            den += (b[j] - mean[j]).powi(2);
+            den += (b[j] - mean[k]).powi(2);
         }
     }
-    (num / den.max(1e-300)).sqrt()
+    if den == 0.0 {
+        return f64::NAN; // scene 1 has no steering wheel
+    }
+    (num / den).sqrt()
 }
 
 /// Amplitude of order `order` in component `j` of a window of whole revolutions at constant rpm.
@@ -163,8 +175,18 @@ fn main() {
 
     let mut rows = Vec::new();
     println!(
-        "{:<22} {:<26} {:>10} {:>9} {:>9} {:>9} {:>6} {:>6} {:>10} {:>10}",
-        "case", "knob", "rel L2", "ord err", "cpu [s]", "steps", "jac", "lu", "rhs", "x realtime"
+        "{:<22} {:<26} {:>10} {:>10} {:>9} {:>9} {:>9} {:>6} {:>6} {:>10} {:>10}",
+        "case",
+        "knob",
+        "L2 forces",
+        "L2 wheel",
+        "ord err",
+        "cpu [s]",
+        "steps",
+        "jac",
+        "lu",
+        "rhs",
+        "x realtime"
     );
     for case in [&stationary, &runup] {
         let reference_settings = Settings {
@@ -178,6 +200,26 @@ fn main() {
                 println!("{}: reference failed: {e}", case.name);
                 continue;
             }
+        };
+        // Knobs that change the model (cut-off, effects) are measured against a reference of the
+        // most complete model; accuracy knobs against the reference of the default model.
+        let complete = if scene == 2 {
+            let s = Settings {
+                chassis: ChassisSettings {
+                    mode_cutoff_hz: 400.0,
+                    ..base.chassis.clone()
+                },
+                ..reference_settings.clone()
+            };
+            match run(case, &s, 1e-4, true) {
+                Ok(r) => Some(r),
+                Err(e) => {
+                    println!("{}: 400 Hz reference failed: {e}", case.name);
+                    None
+                }
+            }
+        } else {
+            None
         };
         let mut knobs: Vec<(String, Settings, f64, bool)> = Vec::new();
         for rtol in [1e-2, 1e-3, 1e-4, 1e-5, 1e-6, 1e-7, 1e-8] {
@@ -209,6 +251,52 @@ fn main() {
                 knobs.push((label, base.clone(), h, interpolate));
             }
         }
+        let mut model_knobs: Vec<(String, Settings)> = vec![
+            (
+                "without gyroscopic terms".to_owned(),
+                Settings {
+                    effects: EffectSwitches {
+                        gyroscopic: false,
+                        ..base.effects
+                    },
+                    ..base.clone()
+                },
+            ),
+            (
+                "rigid ring carriers".to_owned(),
+                Settings {
+                    effects: EffectSwitches {
+                        ring_carrier: false,
+                        ..base.effects
+                    },
+                    ..base.clone()
+                },
+            ),
+        ];
+        if scene == 2 {
+            for cutoff in [50.0, 100.0, 200.0, 400.0] {
+                model_knobs.push((
+                    format!("chassis cut-off {cutoff:.0} Hz"),
+                    Settings {
+                        chassis: ChassisSettings {
+                            mode_cutoff_hz: cutoff,
+                            ..base.chassis.clone()
+                        },
+                        ..base.clone()
+                    },
+                ));
+            }
+            model_knobs.push((
+                "rigid chassis".to_owned(),
+                Settings {
+                    effects: EffectSwitches {
+                        chassis_flexibility: false,
+                        ..base.effects
+                    },
+                    ..base.clone()
+                },
+            ));
+        }
         let main_orders = [1.5, 2.0, 3.0];
         // The reference's order amplitudes from its samples at the run's sample times, so that
         // both see the same (not quite periodic) window.
@@ -226,10 +314,19 @@ fn main() {
                 .map(|o| order_amplitude(&decimated, 2, *o, 2000.0, h))
                 .collect()
         };
-        for (label, settings, h, interpolate) in knobs {
+        let all = knobs
+            .into_iter()
+            .map(|(l, s, h, i)| (l, s, h, i, &reference))
+            .chain(
+                model_knobs
+                    .into_iter()
+                    .map(|(l, s)| (l, s, 1e-3, true, complete.as_ref().unwrap_or(&reference))),
+            );
+        for (label, settings, h, interpolate, against) in all {
             match run(case, &settings, h, interpolate) {
                 Ok(r) => {
-                    let l2 = relative_l2(&r, &reference);
+                    let l2 = relative_l2(&r, against, FORCES);
+                    let l2_wheel = relative_l2(&r, against, STEERING_WHEEL);
                     // Order amplitudes need samples well above the 3rd order (100 Hz at 2000 rpm).
                     let order_error = if case.name.contains("stationary") && h <= 1e-3 {
                         main_orders
@@ -244,10 +341,11 @@ fn main() {
                     };
                     let realtime = case.t_end / r.cpu;
                     println!(
-                        "{:<22} {:<26} {:>10.2e} {:>9.1e} {:>9.3} {:>9} {:>6} {:>6} {:>10} {:>10.1}",
+                        "{:<22} {:<26} {:>10.2e} {:>10.2e} {:>9.1e} {:>9.3} {:>9} {:>6} {:>6} {:>10} {:>10.1}",
                         case.name,
                         label,
                         l2,
+                        l2_wheel,
                         order_error,
                         r.cpu,
                         r.counters.steps,
@@ -257,11 +355,12 @@ fn main() {
                         realtime
                     );
                     rows.push(format!(
-                        "{},{},{},{},{},{},{},{},{},{},{}",
+                        "{},{},{},{},{},{},{},{},{},{},{},{}",
                         scene,
                         case.name,
                         label,
                         l2,
+                        l2_wheel,
                         order_error,
                         r.cpu,
                         r.counters.steps,
@@ -277,7 +376,7 @@ fn main() {
     }
     if let Some(path) = csv {
         let mut text = String::from(
-            "scene,case,knob,rel_l2,order_error,cpu_s,steps,rhs,jacobians,factorizations,realtime_factor\n",
+            "scene,case,knob,rel_l2,rel_l2_wheel,order_error,cpu_s,steps,rhs,jacobians,factorizations,realtime_factor\n",
         );
         for r in rows {
             text.push_str(&r);

@@ -266,3 +266,76 @@ fn long_idle_does_not_drift() {
     let phase = (o.crank_angle + o.powertrain_rotation[1] - expected).abs();
     assert!(phase < 0.05, "crank phase off by {phase} rad after {t} s");
 }
+
+fn hybrid(chassis: engine_mount_chassis::cosim::ChassisSettings) -> Settings {
+    Settings {
+        scene: 2,
+        chassis,
+        ..Settings::default()
+    }
+}
+
+#[test]
+fn undamped_chassis_modes_stay_bounded() {
+    use engine_mount_chassis::cosim::ChassisSettings;
+    let s = hybrid(ChassisSettings {
+        mode_cutoff_hz: 100.0,
+        modal_damping_scale: 0.0,
+        ..ChassisSettings::default()
+    });
+    let mut sim = Simulation::new(&s, 0.0, &inputs(1500.0, 0.0, 1.0)).unwrap();
+    assert!(
+        sim.describe().join(" ").contains("modal damping x0"),
+        "{:?}",
+        sim.describe()
+    );
+    let mut peak: f64 = 0.0;
+    for k in 1..=500 {
+        sim.advance_to(k as f64 * 1e-3).unwrap();
+        let o = sim.outputs().unwrap();
+        for a in o.steering_wheel_acceleration {
+            assert!(a.is_finite());
+            peak = peak.max(a.abs());
+        }
+        assert!(o
+            .mount_force
+            .iter()
+            .flatten()
+            .all(|f| f.is_finite() && f.abs() < 5.0 * weight()));
+    }
+    assert!(
+        peak < 100.0,
+        "steering-wheel acceleration {peak} m/s2 without chassis damping"
+    );
+}
+
+#[test]
+fn kilohertz_interface_modes_are_integrated_stably() {
+    // The constraint-mode part of the reduction puts the mount-node interface modes in the kHz
+    // range (100 % damped): all of them are kept, the integrator must cope.
+    use engine_mount_chassis::cosim::ChassisSettings;
+    let s = hybrid(ChassisSettings {
+        mode_cutoff_hz: 100.0,
+        ..ChassisSettings::default()
+    });
+    let sim = Simulation::new(&s, 0.0, &inputs(2000.0, 0.0, 1.0)).unwrap();
+    let text = sim.describe().join(" ");
+    let highest: f64 = text
+        .split("..")
+        .nth(1)
+        .and_then(|rest| rest.split(' ').next())
+        .and_then(|hz| hz.parse().ok())
+        .unwrap_or_else(|| panic!("no frequency range in {text}"));
+    assert!(
+        highest > 1000.0,
+        "highest chassis mode {highest} Hz: {text}"
+    );
+    let out = run(&s, inputs(2000.0, 0.0, 1.0), 1e-3, 0.3, |_| None).unwrap();
+    assert_finite_and_bounded(&out, 5.0 * weight());
+    let reference = run(&tight(&s), inputs(2000.0, 0.0, 1.0), 1e-3, 0.3, |_| None).unwrap();
+    let difference = max_force_difference(&out, &reference);
+    assert!(
+        difference < 0.01 * weight(),
+        "{difference} N from the tight reference"
+    );
+}

@@ -23,6 +23,8 @@ def family(knob: str) -> str:
         return "comm step, inputs interpolated"
     if knob.startswith("comm"):
         return "comm step, inputs held"
+    if knob.startswith("chassis cut-off"):
+        return "chassis cut-off (vs 400 Hz reference)"
     return "other (rtol 1e-5)"
 
 

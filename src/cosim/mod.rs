@@ -56,6 +56,8 @@ pub struct ChassisSettings {
     /// Keep the fixed-interface chassis modes below this frequency, Hz; 0 = automatic, from the
     /// highest excitation frequency the scene needs (see [`ChassisSettings::cutoff_hz`]).
     pub mode_cutoff_hz: f64,
+    /// Factor on every chassis modal damping ratio (1 = the ADAMS table; 0 = undamped).
+    pub modal_damping_scale: f64,
     /// Highest engine speed (rpm) and engine order the automatic cut-off must cover.
     pub max_rpm: f64,
     pub max_engine_order: f64,
@@ -86,6 +88,7 @@ impl Default for ChassisSettings {
     fn default() -> Self {
         ChassisSettings {
             mode_cutoff_hz: 0.0,
+            modal_damping_scale: 1.0,
             max_rpm: 2500.0,
             max_engine_order: 4.5,
             max_modes: 0,

@@ -92,8 +92,9 @@ fn hybrid_scene(settings: &Settings, engine: GroundScene) -> Result<Scene, Strin
         chassis.keep_below(RIGID_CHASSIS_HZ)
     };
     let note = format!(
-        "chassis (Craig-Bampton, {cutoff_origin}, stiffening bar {}): {} modes, {:.1}..{:.1} Hz, {source} in {seconds:.2} s",
+        "chassis (Craig-Bampton, {cutoff_origin}, stiffening bar {}, modal damping x{}): {} modes, {:.1}..{:.1} Hz, {source} in {seconds:.2} s",
         if c.stiffening_bar { "on" } else { "off" },
+        c.modal_damping_scale,
         chassis.n_modes(),
         chassis.omega.first().copied().unwrap_or(0.0) / (2.0 * std::f64::consts::PI),
         chassis.omega.last().copied().unwrap_or(0.0) / (2.0 * std::f64::consts::PI),
