@@ -31,22 +31,28 @@ def family(knob: str) -> str:
 def plot(csv: str, png: str) -> None:
     table = pd.read_csv(csv)
     cases = list(dict.fromkeys(table.case))
-    fig, axes = plt.subplots(1, len(cases), figsize=(6 * len(cases), 5), squeeze=False)
-    for ax, case in zip(axes[0], cases):
-        data = table[table.case == case].copy()
-        data["family"] = data.knob.map(family)
-        for name, group in data.groupby("family", sort=False):
-            ax.loglog(group.cpu_s, group.rel_l2, marker="o", label=name)
-            for _, row in group.iterrows():
-                ax.annotate(row.knob.split(" (")[0].replace("comm ", ""), (row.cpu_s, row.rel_l2),
-                            fontsize=6, xytext=(3, 3), textcoords="offset points")
-        ax.set_xlabel("CPU time [s]")
-        ax.set_ylabel("relative L2 error of the mount forces")
-        ax.set_title(f"scene {data.scene.iloc[0]}: {case}")
-        ax.grid(True, which="both", lw=0.3)
-        ax.legend(fontsize=8)
+    metrics = [("rel_l2", "relative L2 error of the mount forces")]
+    if "rel_l2_wheel" in table and table.rel_l2_wheel.notna().any():
+        metrics.append(("rel_l2_wheel", "relative L2 error of the steering-wheel acceleration"))
+    fig, axes = plt.subplots(len(metrics), len(cases), figsize=(6 * len(cases), 5 * len(metrics)),
+                             squeeze=False)
+    for row, (column, label) in enumerate(metrics):
+        for ax, case in zip(axes[row], cases):
+            data = table[table.case == case].copy()
+            data["family"] = data.knob.map(family)
+            for name, group in data.groupby("family", sort=False):
+                style = "o" if name.startswith("other") else "o-"
+                ax.loglog(group.cpu_s, group[column], style, label=name)
+                for _, r in group.iterrows():
+                    ax.annotate(r.knob.split(" (")[0].replace("comm ", ""), (r.cpu_s, r[column]),
+                                fontsize=6, xytext=(3, 3), textcoords="offset points")
+            ax.set_xlabel("CPU time [s]")
+            ax.set_ylabel(label)
+            ax.set_title(f"scene {data.scene.iloc[0]}: {case}")
+            ax.grid(True, which="both", lw=0.3)
+            ax.legend(fontsize=7)
     fig.tight_layout()
-    fig.savefig(png, dpi=120)
+    fig.savefig(png, dpi=110)
 
 
 if __name__ == "__main__":
