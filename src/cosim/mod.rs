@@ -56,6 +56,9 @@ pub struct ChassisSettings {
     /// Keep the fixed-interface chassis modes below this frequency, Hz; 0 = automatic, from the
     /// highest excitation frequency the scene needs (see [`ChassisSettings::cutoff_hz`]).
     pub mode_cutoff_hz: f64,
+    /// Interface DOFs of the mount nodes: translations (the mounts transmit forces only) or all
+    /// six (adds the rotational constraint modes, up to several kHz, as a stiffness test).
+    pub interface_rotations: bool,
     /// Factor on every chassis modal damping ratio (1 = the ADAMS table; 0 = undamped).
     pub modal_damping_scale: f64,
     /// Highest engine speed (rpm) and engine order the automatic cut-off must cover.
@@ -89,6 +92,7 @@ impl Default for ChassisSettings {
         ChassisSettings {
             mode_cutoff_hz: 0.0,
             modal_damping_scale: 1.0,
+            interface_rotations: false,
             max_rpm: 2500.0,
             max_engine_order: 4.5,
             max_modes: 0,

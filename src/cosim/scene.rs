@@ -69,7 +69,10 @@ fn hybrid_scene(settings: &Settings, engine: GroundScene) -> Result<Scene, Strin
             super::AUTO_CUTOFF_MARGIN
         )
     };
-    let spec = reduction_spec(cutoff, max_modes, c.stiffening_bar);
+    let mut spec = reduction_spec(cutoff, max_modes, c.stiffening_bar);
+    if c.interface_rotations {
+        spec.interface_dofs = crate::cms::InterfaceDofs::All;
+    }
     let started = std::time::Instant::now();
     let (chassis, outcome) =
         reduce_cached(&spec, &c.cache).map_err(|e| format!("chassis reduction: {e}"))?;

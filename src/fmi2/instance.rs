@@ -271,6 +271,7 @@ impl Instance {
             chassis: cosim::ChassisSettings {
                 mode_cutoff_hz: v.reals[real::CHASSIS_MODE_CUTOFF as usize],
                 modal_damping_scale: v.reals[real::CHASSIS_MODAL_DAMPING_SCALE as usize],
+                interface_rotations: v.booleans[boolean::CHASSIS_INTERFACE_ROTATIONS as usize],
                 max_rpm: v.reals[real::SCENE_MAX_RPM as usize],
                 max_engine_order: v.reals[real::SCENE_MAX_ENGINE_ORDER as usize],
                 max_modes: v.integers[integer::CHASSIS_MAX_MODES as usize],
