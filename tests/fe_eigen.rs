@@ -145,3 +145,46 @@ fn a_shift_above_the_lowest_eigenvalue_is_reported() {
         .to_string();
     assert!(err.contains("n_modes"), "{err}");
 }
+
+/// Fixed-fixed chain of `n` unit masses and unit springs: λ_j = 2 (1 − cos(jπ/(n+1))).
+fn chain(
+    n: usize,
+) -> (
+    engine_mount_chassis::fe::assembly::SparseMat,
+    engine_mount_chassis::fe::assembly::SparseMat,
+) {
+    use faer::sparse::{SparseColMat, Triplet};
+    let mut k = Vec::new();
+    let mut m = Vec::new();
+    for i in 0..n {
+        k.push(Triplet::new(i, i, 2.0));
+        m.push(Triplet::new(i, i, 1.0));
+        if i + 1 < n {
+            k.push(Triplet::new(i, i + 1, -1.0));
+            k.push(Triplet::new(i + 1, i, -1.0));
+        }
+    }
+    (
+        SparseColMat::try_new_from_triplets(n, n, &k).unwrap(),
+        SparseColMat::try_new_from_triplets(n, n, &m).unwrap(),
+    )
+}
+
+#[test]
+fn small_systems_and_all_of_their_modes() {
+    // Fewer DOFs than two Lanczos blocks, and sizes that are no multiple of the block width.
+    for (n, wanted) in [(5, 5), (12, 12), (13, 4), (21, 21)] {
+        let (k, m) = chain(n);
+        let modes = lowest_modes(&k, &m, wanted, -0.1)
+            .unwrap_or_else(|e| panic!("n = {n}, {wanted} modes: {e}"));
+        assert_eq!(modes.eigenvalues.len(), wanted);
+        for (j, lambda) in modes.eigenvalues.iter().enumerate() {
+            let exact =
+                2.0 * (1.0 - ((j + 1) as f64 * std::f64::consts::PI / (n + 1) as f64).cos());
+            assert!(
+                (lambda - exact).abs() < 1e-10 * exact.max(1.0),
+                "n = {n}, mode {j}: {lambda} vs {exact}"
+            );
+        }
+    }
+}

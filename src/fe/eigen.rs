@@ -226,7 +226,9 @@ pub fn lowest_modes(
     let mut done = 0; // columns whose operator image has been added to the basis
     loop {
         let width = (basis.len - done).min(BLOCK);
-        if width == 0 || (basis.len + width > capacity && basis.len < n) {
+        // A block whose new directions would not fit makes the residuals unknowable, unless the
+        // basis may grow to the whole space (capacity = n): there the residuals vanish.
+        if width == 0 || (basis.len + width > capacity && capacity < n) {
             return Err(FeError::Numerical(format!(
                 "shift-invert Lanczos did not converge {n_modes} modes within {capacity} vectors"
             )));
