@@ -23,6 +23,7 @@ use faer::MatMut;
 use nalgebra::Vector3;
 
 use super::ground_scene::{Evaluation, GroundScene, Mode, StaticsError};
+use super::statics::{damped_newton, NewtonFailure};
 use crate::cms::ReducedChassis;
 use crate::fe::chassis::{SEAT_RAIL, STEERING_WHEEL};
 use crate::ode::{OdeProblem, ProblemError};
@@ -390,61 +391,22 @@ impl HybridScene {
         let mut z = vec![0.0; n];
         let weight = self.powertrain_weight();
         let tol = 1e-9 * weight.max(1.0);
-        let mut converged = false;
-        let mut last = f64::INFINITY;
-        for _ in 0..MAX_ITERATIONS {
-            let r = self.static_residual(&z, &mut y);
-            let norm = r.iter().map(|x| x * x).sum::<f64>().sqrt();
-            if !norm.is_finite() {
-                return Err(StaticsError(format!("residual became {norm}")));
+        let limit = |i: usize| (i < nq).then(|| MAX_STEP[(i % 6) / 3]);
+        let mut scratch = y.clone();
+        let outcome = damped_newton(&mut z, tol, MAX_ITERATIONS, limit, |z| {
+            self.static_residual(z, &mut scratch)
+        });
+        match outcome {
+            Ok(()) => {}
+            Err(NewtonFailure::NonFinite(norm)) => {
+                return Err(StaticsError(format!("residual became {norm}")))
             }
-            last = norm;
-            if norm < tol {
-                converged = true;
-                break;
-            }
-            let mut k = faer::Mat::<f64>::zeros(n, n);
-            for j in 0..n {
-                let h = 1e-7;
-                let mut zp = z.clone();
-                zp[j] += h;
-                let mut zm = z.clone();
-                zm[j] -= h;
-                let rp = self.static_residual(&zp, &mut y);
-                let rm = self.static_residual(&zm, &mut y);
-                for i in 0..n {
-                    k[(i, j)] = (rp[i] - rm[i]) / (2.0 * h);
-                }
-            }
-            let mut rhs = faer::Mat::<f64>::zeros(n, 1);
-            for i in 0..n {
-                rhs[(i, 0)] = -r[i];
-            }
-            use faer::linalg::solvers::Solve;
-            k.partial_piv_lu().solve_in_place(rhs.as_mut());
-            let mut scale: f64 = 1.0;
-            for i in 0..n {
-                let d = rhs[(i, 0)];
-                if !d.is_finite() {
-                    return Err(StaticsError(
-                        "the coupled tangent stiffness is singular: the mounts or the chassis do not hold the powertrain in every direction".into(),
-                    ));
-                }
-                if i < nq {
-                    let limit = MAX_STEP[(i % 6) / 3];
-                    if d.abs() > limit {
-                        scale = scale.min(limit / d.abs());
-                    }
-                }
-            }
-            for i in 0..n {
-                z[i] += scale * rhs[(i, 0)];
-            }
-        }
-        if !converged {
-            return Err(StaticsError(format!(
+            Err(NewtonFailure::Singular) => return Err(StaticsError(
+                "the coupled tangent stiffness is singular: the mounts or the chassis do not hold the powertrain in every direction".into(),
+            )),
+            Err(NewtonFailure::NotConverged(last)) => return Err(StaticsError(format!(
                 "engine and chassis: Newton did not converge in {MAX_ITERATIONS} iterations (residual {last:.3e}, tolerance {tol:.3e})"
-            )));
+            ))),
         }
         y[..nq].copy_from_slice(&z[..nq]);
         y[ne..ne + m].copy_from_slice(&z[nq..]);

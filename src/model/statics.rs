@@ -12,6 +12,75 @@ const MAX_ITERATIONS: usize = 60;
 /// branch it starts from instead of jumping across bump stops.
 const MAX_STEP: [f64; 2] = [0.002, 0.02];
 
+/// Why [`damped_newton`] stopped without a solution.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub(crate) enum NewtonFailure {
+    /// The residual norm became NaN or infinite.
+    NonFinite(f64),
+    /// The tangent stiffness could not be solved.
+    Singular,
+    /// The iteration limit was reached with this residual norm.
+    NotConverged(f64),
+}
+
+/// Newton on `residual(x) = 0` with a central-difference tangent and a damped step: the whole
+/// step is scaled so that no component `i` moves more than `limit(i)` (None: unlimited). Shared by
+/// the ground and the hybrid statics; `x` holds the last iterate on return.
+pub(crate) fn damped_newton(
+    x: &mut [f64],
+    tol: f64,
+    max_iterations: usize,
+    limit: impl Fn(usize) -> Option<f64>,
+    mut residual: impl FnMut(&[f64]) -> Vec<f64>,
+) -> Result<(), NewtonFailure> {
+    let n = x.len();
+    let mut last = f64::INFINITY;
+    for _ in 0..max_iterations {
+        let r = residual(x);
+        let norm = r.iter().map(|v| v * v).sum::<f64>().sqrt();
+        if !norm.is_finite() {
+            return Err(NewtonFailure::NonFinite(norm));
+        }
+        last = norm;
+        if norm < tol {
+            return Ok(());
+        }
+        let mut k = Mat::<f64>::zeros(n, n);
+        for j in 0..n {
+            let h = 1e-7;
+            let mut xp = x.to_vec();
+            xp[j] += h;
+            let mut xm = x.to_vec();
+            xm[j] -= h;
+            let (rp, rm) = (residual(&xp), residual(&xm));
+            for i in 0..n {
+                k[(i, j)] = (rp[i] - rm[i]) / (2.0 * h);
+            }
+        }
+        let mut rhs = Mat::<f64>::zeros(n, 1);
+        for i in 0..n {
+            rhs[(i, 0)] = -r[i];
+        }
+        k.partial_piv_lu().solve_in_place(rhs.as_mut());
+        let mut scale: f64 = 1.0;
+        for i in 0..n {
+            let d = rhs[(i, 0)];
+            if !d.is_finite() {
+                return Err(NewtonFailure::Singular);
+            }
+            if let Some(limit) = limit(i) {
+                if d.abs() > limit {
+                    scale = scale.min(limit / d.abs());
+                }
+            }
+        }
+        for i in 0..n {
+            x[i] += scale * rhs[(i, 0)];
+        }
+    }
+    Err(NewtonFailure::NotConverged(last))
+}
+
 impl GroundScene {
     /// Solves the static equilibrium (crank at rest at the configured start angle, no gas) under
     /// gravity, mount preloads and the current load torque, sets the operating point of the
@@ -32,56 +101,23 @@ impl GroundScene {
             .sum::<f64>()
             * self.config().gravity;
         let tol = 1e-9 * weight.max(1.0);
-        let mut converged = false;
-        let mut last = f64::INFINITY;
-        for _ in 0..MAX_ITERATIONS {
-            let r = self.static_residual(&y);
-            let norm = r.iter().map(|x| x * x).sum::<f64>().sqrt();
-            if !norm.is_finite() {
-                return Err(StaticsError(format!("residual became {norm}")));
+        let limit = |i: usize| Some(MAX_STEP[(i % 6) / 3]);
+        let at_rest = y.clone();
+        match damped_newton(&mut y[..nq], tol, MAX_ITERATIONS, limit, |q| {
+            let mut full = at_rest.clone();
+            full[..nq].copy_from_slice(q);
+            self.static_residual(&full)
+        }) {
+            Ok(()) => {}
+            Err(NewtonFailure::NonFinite(norm)) => {
+                return Err(StaticsError(format!("residual became {norm}")))
             }
-            last = norm;
-            if norm < tol {
-                converged = true;
-                break;
-            }
-            // Tangent stiffness by central differences of the residual.
-            let mut k = Mat::<f64>::zeros(nq, nq);
-            for j in 0..nq {
-                let h = 1e-7;
-                let mut yp = y.clone();
-                yp[j] += h;
-                let mut ym = y.clone();
-                ym[j] -= h;
-                let (rp, rm) = (self.static_residual(&yp), self.static_residual(&ym));
-                for i in 0..nq {
-                    k[(i, j)] = (rp[i] - rm[i]) / (2.0 * h);
-                }
-            }
-            let mut rhs = Mat::<f64>::zeros(nq, 1);
-            for i in 0..nq {
-                rhs[(i, 0)] = -r[i];
-            }
-            k.partial_piv_lu().solve_in_place(rhs.as_mut());
-            let mut scale: f64 = 1.0;
-            for i in 0..nq {
-                let d = rhs[(i, 0)];
-                if !d.is_finite() {
-                    return Err(StaticsError("the tangent stiffness is singular: the mounts do not hold the powertrain in every direction".into()));
-                }
-                let limit = MAX_STEP[(i % 6) / 3];
-                if d.abs() > limit {
-                    scale = scale.min(limit / d.abs());
-                }
-            }
-            for i in 0..nq {
-                y[i] += scale * rhs[(i, 0)];
-            }
-        }
-        if !converged {
-            return Err(StaticsError(format!(
+            Err(NewtonFailure::Singular) => return Err(StaticsError(
+                "the tangent stiffness is singular: the mounts do not hold the powertrain in every direction".into(),
+            )),
+            Err(NewtonFailure::NotConverged(last)) => return Err(StaticsError(format!(
                 "Newton did not converge in {MAX_ITERATIONS} iterations (residual {last:.3e} N, tolerance {tol:.3e} N); the mounts may be too soft to carry the weight"
-            )));
+            ))),
         }
         self.check_mount_range(&y)?;
         self.set_operating_point(&y);
