@@ -1,4 +1,4 @@
-//! The structured Jacobian agrees with a central finite difference of the full nonlinear
+//! The assembled Jacobian of the ground scene agrees with a central finite difference of the full nonlinear
 //! right-hand side.
 
 use engine_mount_chassis::model::{EngineConfig, GroundScene};
@@ -49,7 +49,7 @@ fn check(cfg: EngineConfig) {
 }
 
 #[test]
-fn structured_jacobian_matches_finite_differences_two_bodies() {
+fn assembled_jacobian_matches_finite_differences_two_bodies() {
     let mut cfg = EngineConfig::default();
     cfg.gas.load = 1.0;
     // No preload: mounts sit in their progressive range, where the curves bend.
@@ -60,7 +60,7 @@ fn structured_jacobian_matches_finite_differences_two_bodies() {
 }
 
 #[test]
-fn structured_jacobian_matches_finite_differences_rigid_powertrain_linear_mounts() {
+fn assembled_jacobian_matches_finite_differences_rigid_powertrain_linear_mounts() {
     let mut cfg = EngineConfig::default();
     cfg.effects.ring_carrier_elasticity = false;
     cfg.effects.mount_nonlinearity = false;

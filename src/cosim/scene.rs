@@ -6,7 +6,9 @@ use super::{Inputs, Outputs, Settings};
 use crate::cms::{reduce_cached, CacheOutcome};
 use crate::model::hybrid_chassis::reduction_spec;
 use crate::model::{EngineConfig, EngineOutputs, GroundScene, HybridScene};
-use crate::ode::{OdeProblem, ProblemError};
+use crate::ode::{
+    BlockLowRankJacobian, BlockLowRankShape, JacobianPattern, OdeProblem, ProblemError,
+};
 
 /// Number of mounts the FMU's variables expose (`mount[1..4]`).
 pub const FMU_MOUNTS: usize = 4;
@@ -300,6 +302,39 @@ impl OdeProblem for Scene {
         match self {
             Scene::Ground(g) => g.jacobian(t, y, j),
             Scene::Hybrid(h, _) => h.jacobian(t, y, j),
+        }
+    }
+
+    fn jacobian_structure(&self) -> Option<BlockLowRankShape> {
+        match self {
+            Scene::Ground(g) => g.jacobian_structure(),
+            Scene::Hybrid(h, _) => h.jacobian_structure(),
+        }
+    }
+
+    fn structured_jacobian(
+        &mut self,
+        t: f64,
+        y: &[f64],
+        j: &mut BlockLowRankJacobian,
+    ) -> Result<(), ProblemError> {
+        match self {
+            Scene::Ground(g) => g.structured_jacobian(t, y, j),
+            Scene::Hybrid(h, _) => h.structured_jacobian(t, y, j),
+        }
+    }
+
+    fn mass_is_constant(&self) -> bool {
+        match self {
+            Scene::Ground(g) => g.mass_is_constant(),
+            Scene::Hybrid(h, _) => h.mass_is_constant(),
+        }
+    }
+
+    fn jacobian_pattern(&self) -> Option<JacobianPattern> {
+        match self {
+            Scene::Ground(g) => g.jacobian_pattern(),
+            Scene::Hybrid(h, _) => h.jacobian_pattern(),
         }
     }
 }

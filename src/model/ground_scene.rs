@@ -668,7 +668,7 @@ impl OdeProblem for GroundScene {
     }
 
     fn jacobian(&mut self, t: f64, y: &[f64], j: MatMut<'_, f64>) -> Result<bool, ProblemError> {
-        self.structured_jacobian(t, y, j)?;
+        self.assembled_jacobian(t, y, j)?;
         Ok(true)
     }
 

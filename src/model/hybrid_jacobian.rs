@@ -1,99 +1,169 @@
-//! Jacobian `∂f/∂y` of the hybrid scene.
+//! Jacobian `∂f/∂y` of the hybrid scene in block-diagonal plus low-rank form
+//! ([`BlockLowRankJacobian`]): `J = blockdiag(J_engine, J_mode 1, …, J_mode m) + U Vᵀ`.
 //!
-//! The chassis columns (η, η̇) are exact: the right-hand side depends on them only through the
-//! modal terms and the mount forces, whose derivatives the mount law returns (the housing rows
-//! are accelerations, so they carry the housing's inverse mass matrix, which η does not change). The engine columns
-//! (a few dozen) are central differences of the whole right-hand side, so every coupling of the
-//! engine motion into the mounts and the chassis is included.
+//! - The engine block (a few dozen states) is a central difference of the engine rows.
+//! - Each chassis mode is the exact 2×2 block `[[0, 1], [−ω², −2ζω]]` on `(η_k, η̇_k)`.
+//! - Everything that couples engine and chassis, or one mode to another, passes through the
+//!   mount forces `F_p` (3 per connected mount). With `R_c = ∂F/∂(η, η̇)` (exact: the attachment
+//!   moves with `φ_p`, so `∂F/∂η_k = −S_p φ_{p,k}`, `∂F/∂η̇_k = −D_p φ_{p,k}`), `R_e = ∂F/∂y_engine`
+//!   (central differences, taken with the engine block), `H = ∂(housing acceleration)/∂F`
+//!   (`M_h⁻¹` times the point-force map) and `B = ∂η̈/∂F = −Φᵀ`:
+//!   `J_engine,chassis = H R_c`, `J_chassis,chassis += B R_c`, `J_chassis,engine = B R_e`.
+//!   So `U = [[H, 0], [B, B]]` and `Vᵀ = [[0, R_c], [R_e, 0]]`: rank 6 per connected mount,
+//!   whatever the number of modes. (`H R_e`, the engine's own mount stiffness, stays inside the
+//!   engine block, which therefore is the engine on mounts, not a free body.)
 
 use faer::MatMut;
 use nalgebra::Vector3;
 
 use super::composite::BodyDynamics;
 use super::hybrid_scene::HybridScene;
-use crate::ode::{OdeProblem, ProblemError};
+use crate::ode::{BlockLowRankJacobian, BlockLowRankShape, ProblemError};
 
 impl HybridScene {
-    pub(crate) fn coupled_jacobian(
+    /// Number of connected mounts (each contributes rank 6 to the coupling).
+    fn connected_mounts(&self) -> usize {
+        self.engine()
+            .mounts()
+            .iter()
+            .zip(self.links())
+            .filter(|(m, l)| m.is_some() && l.is_some())
+            .count()
+    }
+
+    /// The shape of [`Self::coupled_jacobian`]: the engine block, one 2×2 block per mode.
+    pub fn coupled_jacobian_shape(&self) -> BlockLowRankShape {
+        let ne = self.engine_dim();
+        let m = self.modes_count();
+        let mut blocks = vec![(0..ne).collect::<Vec<_>>()];
+        blocks.extend((0..m).map(|k| vec![ne + k, ne + m + k]));
+        BlockLowRankShape {
+            blocks,
+            rank: 6 * self.connected_mounts(),
+        }
+    }
+
+    /// Writes `∂f/∂y` at `(t, y)` into `j` (shaped by [`Self::coupled_jacobian_shape`], zeroed).
+    pub fn coupled_jacobian(
         &self,
         t: f64,
         y: &[f64],
-        mut j: MatMut<'_, f64>,
+        j: &mut BlockLowRankJacobian,
     ) -> Result<(), ProblemError> {
         self.check_state(y)?;
-        let n = self.dim();
+        if j.shape().blocks.len() != 1 + self.modes_count() || j.dim() != y.len() {
+            return Err(ProblemError::Fatal(
+                "the Jacobian storage does not have the hybrid scene's shape".into(),
+            ));
+        }
         let ne = self.engine_dim();
         let m = self.modes_count();
-        for r in 0..n {
-            for c in 0..n {
-                j[(r, c)] = 0.0;
-            }
-        }
-        // Engine columns: central differences.
+        let (eta_row, rate_row) = (self.eta_index(), self.eta_rate_index());
+        let n_links = self.connected_mounts();
+        let connected: Vec<(usize, usize)> = self
+            .engine()
+            .mounts()
+            .iter()
+            .zip(self.links())
+            .enumerate()
+            .filter_map(|(i, (mount, link))| mount.as_ref().and(*link).map(|p| (i, p)))
+            .collect();
+        let mount_force = |ev: &super::hybrid_scene::HybridEvaluation, i: usize| {
+            ev.engine.mounts[i]
+                .map(|r| r.force)
+                .unwrap_or_else(Vector3::zeros)
+        };
+
+        // Engine block and R_e: central differences of the engine rows and the mount forces.
         let mut yp = y.to_vec();
-        let mut fp = vec![0.0; n];
-        let mut fm = vec![0.0; n];
+        let mut fp = vec![0.0; y.len()];
+        let mut fm = vec![0.0; y.len()];
         for c in 0..ne {
             let h = 1e-7 * y[c].abs().max(1.0);
             yp[c] = y[c] + h;
-            let ev = self.evaluate(t, &yp);
-            self.write_rhs(&yp, &ev, &mut fp)?;
+            let ev_p = self.evaluate(t, &yp);
+            self.write_rhs(&yp, &ev_p, &mut fp)?;
             yp[c] = y[c] - h;
-            let ev = self.evaluate(t, &yp);
-            self.write_rhs(&yp, &ev, &mut fm)?;
+            let ev_m = self.evaluate(t, &yp);
+            self.write_rhs(&yp, &ev_m, &mut fm)?;
             yp[c] = y[c];
-            for r in 0..n {
-                j[(r, c)] = (fp[r] - fm[r]) / (2.0 * h);
+            let mut block = j.block_mut(0);
+            for r in 0..ne {
+                block[(r, c)] = (fp[r] - fm[r]) / (2.0 * h);
+            }
+            let mut v = j.v_mut();
+            for (a, &(i, _)) in connected.iter().enumerate() {
+                let df = (mount_force(&ev_p, i) - mount_force(&ev_m, i)) / (2.0 * h);
+                for d in 0..3 {
+                    v[(c, 3 * n_links + 3 * a + d)] = df[d];
+                }
             }
         }
-        // Chassis columns: exact.
+
+        // Modal blocks.
+        let chassis = self.chassis();
+        for k in 0..m {
+            let w = chassis.omega[k];
+            let mut b = j.block_mut(1 + k);
+            b[(0, 1)] = 1.0;
+            b[(1, 0)] = -w * w;
+            b[(1, 1)] = -2.0 * chassis.zeta[k] * w;
+        }
+
+        // Coupling through the mount forces: H, B, R_c.
         let ev = self.evaluate(t, y);
         let hb = self.engine().housing_index();
-        let nb = self.engine().body_count();
-        let housing_row = 6 * nb + 6 * hb;
+        let housing_row = 6 * self.engine().body_count() + 6 * hb;
         let h = &ev.engine.kinematics[hb];
-        // The housing rows are accelerations: generalised forces premultiplied by M_h⁻¹.
         let housing_mass = ev.engine.dynamics[hb].mass.lu();
         let reference = self.engine().bodies()[hb].reference;
-        let chassis = self.chassis();
-        let (eta_row, rate_row) = (self.eta_index(), self.eta_rate_index());
-        for k in 0..m {
-            j[(eta_row + k, rate_row + k)] = 1.0;
-            let w = chassis.omega[k];
-            j[(rate_row + k, eta_row + k)] -= w * w;
-            j[(rate_row + k, rate_row + k)] -= 2.0 * chassis.zeta[k] * w;
-        }
-        for (i, (mount, link)) in self.engine().mounts().iter().zip(self.links()).enumerate() {
-            let (Some(mount), Some(p)) = (mount, link) else {
+        for (a, &(i, p)) in connected.iter().enumerate() {
+            let Some(mount) = &self.engine().mounts()[i] else {
                 continue;
             };
             let Some(r) = ev.engine.mounts[i] else {
                 continue;
             };
             let x = h.point(&(mount.bracket - reference));
-            let shape = &chassis.points[*p].shape;
-            for k in 0..m {
-                let phi_k = Vector3::new(shape[k][0], shape[k][1], shape[k][2]);
-                // ∂F/∂η_k = −S φ_k and ∂F/∂η̇_k = −D φ_k (the attachment moves with η).
-                for (col, df) in [
-                    (eta_row + k, -(r.stiffness * phi_k)),
-                    (rate_row + k, -(r.damping * phi_k)),
-                ] {
-                    let mut q = BodyDynamics::zero();
-                    q.add_point_force(h, &x, &df);
-                    let acc = housing_mass.solve(&q.force).ok_or_else(|| {
-                        ProblemError::Fatal("singular housing mass matrix".into())
-                    })?;
-                    for a in 0..6 {
-                        j[(housing_row + a, col)] += acc[a];
-                    }
-                    // The chassis receives −F at the node.
-                    for (l, s) in shape.iter().enumerate() {
-                        j[(rate_row + l, col)] -= s[0] * df.x + s[1] * df.y + s[2] * df.z;
-                    }
+            let shape = &chassis.points[p].shape;
+            for d in 0..3 {
+                let (c_chassis, c_engine) = (3 * a + d, 3 * n_links + 3 * a + d);
+                let mut unit = Vector3::zeros();
+                unit[d] = 1.0;
+                let mut q = BodyDynamics::zero();
+                q.add_point_force(h, &x, &unit);
+                let acc = housing_mass
+                    .solve(&q.force)
+                    .ok_or_else(|| ProblemError::Fatal("singular housing mass matrix".into()))?;
+                let mut u = j.u_mut();
+                for e in 0..6 {
+                    u[(housing_row + e, c_chassis)] = acc[e];
+                }
+                for (k, s) in shape.iter().enumerate() {
+                    u[(rate_row + k, c_chassis)] = -s[d];
+                    u[(rate_row + k, c_engine)] = -s[d];
+                }
+                let mut v = j.v_mut();
+                for (k, s) in shape.iter().enumerate() {
+                    let phi = Vector3::new(s[0], s[1], s[2]);
+                    v[(eta_row + k, c_chassis)] = -(r.stiffness * phi)[d];
+                    v[(rate_row + k, c_chassis)] = -(r.damping * phi)[d];
                 }
             }
         }
+        Ok(())
+    }
+
+    /// The same Jacobian as a dense matrix (`dim × dim`).
+    pub fn dense_jacobian(
+        &self,
+        t: f64,
+        y: &[f64],
+        out: MatMut<'_, f64>,
+    ) -> Result<(), ProblemError> {
+        let mut j = BlockLowRankJacobian::new(self.coupled_jacobian_shape());
+        self.coupled_jacobian(t, y, &mut j)?;
+        j.to_dense(out);
         Ok(())
     }
 }

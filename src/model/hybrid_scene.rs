@@ -26,7 +26,7 @@ use super::ground_scene::{Evaluation, GroundScene, Mode, StaticsError};
 use super::statics::{damped_newton, NewtonFailure};
 use crate::cms::ReducedChassis;
 use crate::fe::chassis::{SEAT_RAIL, STEERING_WHEEL};
-use crate::ode::{OdeProblem, ProblemError};
+use crate::ode::{BlockLowRankJacobian, BlockLowRankShape, OdeProblem, ProblemError};
 
 /// Largest distance (m) between an engine mount's attachment and the chassis point it is
 /// connected to.
@@ -50,6 +50,8 @@ pub struct HybridScene {
     links: Vec<Option<usize>>,
     steering_wheel: usize,
     seat_rail: usize,
+    /// Hand the integrator a dense Jacobian instead of the block-low-rank one (comparisons).
+    dense_newton: bool,
 }
 
 /// Why the hybrid scene could not be assembled.
@@ -174,7 +176,15 @@ impl HybridScene {
             links,
             steering_wheel,
             seat_rail,
+            dense_newton: false,
         })
+    }
+
+    /// Makes the integrator use a dense `n × n` Newton matrix (`true`) instead of the
+    /// block-diagonal plus low-rank one (the default): the two must give the same solution; the
+    /// dense one costs `O(n³)` per factorisation.
+    pub fn set_dense_newton(&mut self, dense: bool) {
+        self.dense_newton = dense;
     }
 
     pub fn engine(&self) -> &GroundScene {
@@ -488,7 +498,20 @@ impl OdeProblem for HybridScene {
     }
 
     fn jacobian(&mut self, t: f64, y: &[f64], j: MatMut<'_, f64>) -> Result<bool, ProblemError> {
-        self.coupled_jacobian(t, y, j)?;
+        self.dense_jacobian(t, y, j)?;
         Ok(true)
+    }
+
+    fn jacobian_structure(&self) -> Option<BlockLowRankShape> {
+        (!self.dense_newton).then(|| self.coupled_jacobian_shape())
+    }
+
+    fn structured_jacobian(
+        &mut self,
+        t: f64,
+        y: &[f64],
+        j: &mut BlockLowRankJacobian,
+    ) -> Result<(), ProblemError> {
+        self.coupled_jacobian(t, y, j)
     }
 }

@@ -1,4 +1,4 @@
-//! Structured Jacobian `∂f/∂y` of the ground scene.
+//! Assembled Jacobian `∂f/∂y` of the ground scene.
 //!
 //! Assembled block by block, each block from what it depends on:
 //! - kinematic rows (`u' = v`, `θ' = G(θ)⁻¹ ω`, `φ' = ω_c − e·ω`): analytic,
@@ -34,7 +34,7 @@ fn d_angular_velocity_map(theta: &Vector3<f64>, k: usize) -> Matrix3<f64> {
 
 impl GroundScene {
     /// Writes `∂f/∂y` at `(t, y)` into `j` (dimension `dim × dim`).
-    pub fn structured_jacobian(
+    pub fn assembled_jacobian(
         &self,
         t: f64,
         y: &[f64],

@@ -6,7 +6,7 @@ use faer::Mat;
 use super::coefficients::{bdf_coefficients, L_MAX};
 use super::error::BdfError;
 use super::jacobian::JacobianPattern;
-use super::linear_solver::DenseLu;
+use super::linear_solver::{DenseLu, IterationMatrix};
 use super::newton::{eval_mass, eval_rhs};
 use super::nordsieck::{wrms_norm, Nordsieck};
 use super::options::BdfOptions;
@@ -56,8 +56,7 @@ pub(super) enum NlsOutcome {
 /// Newton iteration matrix `M - gamma J` and the Jacobian it was built from.
 #[derive(Debug, Clone, PartialEq)]
 pub(super) struct LinearSystem {
-    pub saved_j: Mat<f64>,
-    pub lu: DenseLu,
+    pub matrix: IterationMatrix,
     /// Step count (since the last (re)start) of the last Jacobian evaluation.
     pub nstlj: u64,
     /// Whether the Jacobian was evaluated at the current step attempt.
@@ -183,6 +182,23 @@ impl Bdf {
             None => None,
         };
         let has_mass = problem.has_mass_matrix();
+        let matrix = match problem.jacobian_structure() {
+            None => IterationMatrix::dense(n),
+            Some(shape) => {
+                let invalid = |message: String| BdfError::InvalidInput {
+                    field: "jacobian_structure",
+                    message,
+                };
+                shape.validate(n).map_err(invalid)?;
+                if has_mass {
+                    return Err(invalid(
+                        "a block-low-rank Jacobian needs M = I; this problem has a mass matrix"
+                            .into(),
+                    ));
+                }
+                IterationMatrix::block_low_rank(shape)
+            }
+        };
         let max_order = opts.max_order;
         let state = BdfState {
             n,
@@ -213,8 +229,7 @@ impl Bdf {
             zn: Nordsieck::new(n, max_order),
             acor: vec![0.0; n],
             lin: LinearSystem {
-                saved_j: Mat::zeros(n, n),
-                lu: DenseLu::new(n),
+                matrix,
                 nstlj: 0,
                 jcur: false,
             },

@@ -1,9 +1,68 @@
-//! Dense LU factorisation with partial pivoting through faer, with reusable storage.
+//! The Newton iteration matrix `M − γ J`: the Jacobian it is built from and its factorisation,
+//! dense (faer's partial-pivoting LU) or block-diagonal plus low rank ([`super::block_low_rank`]).
 
 use faer::dyn_stack::{MemBuffer, MemStack};
 use faer::linalg::lu::partial_pivoting::{factor, solve};
 use faer::perm::PermRef;
 use faer::{Mat, MatMut, Par};
+
+use super::block_low_rank::{BlockLowRankJacobian, BlockLowRankLu, BlockLowRankShape};
+
+/// The saved Jacobian and the factorised iteration matrix built from it.
+#[derive(Debug, Clone, PartialEq)]
+pub enum IterationMatrix {
+    /// Any problem: `J` dense (analytic or by finite differences), `M − γ J` by dense LU.
+    Dense { saved_j: Mat<f64>, lu: DenseLu },
+    /// Problems that supply `J = blockdiag + U Vᵀ` (with `M = I`): Woodbury solve, no n × n matrix.
+    BlockLowRank {
+        saved_j: Box<BlockLowRankJacobian>,
+        lu: Box<BlockLowRankLu>,
+    },
+}
+
+impl IterationMatrix {
+    pub fn dense(n: usize) -> Self {
+        Self::Dense {
+            saved_j: Mat::zeros(n, n),
+            lu: DenseLu::new(n),
+        }
+    }
+
+    pub fn block_low_rank(shape: BlockLowRankShape) -> Self {
+        Self::BlockLowRank {
+            lu: Box::new(BlockLowRankLu::new(&shape)),
+            saved_j: Box::new(BlockLowRankJacobian::new(shape)),
+        }
+    }
+
+    pub fn is_factored(&self) -> bool {
+        match self {
+            Self::Dense { lu, .. } => lu.is_factored(),
+            Self::BlockLowRank { lu, .. } => lu.is_factored(),
+        }
+    }
+
+    /// Whether `other` has the same kind, dimension and block shape (snapshots must match).
+    pub fn same_structure(&self, other: &Self) -> bool {
+        match (self, other) {
+            (Self::Dense { saved_j: a, .. }, Self::Dense { saved_j: b, .. }) => {
+                a.nrows() == b.nrows()
+            }
+            (Self::BlockLowRank { saved_j: a, .. }, Self::BlockLowRank { saved_j: b, .. }) => {
+                a.shape() == b.shape()
+            }
+            _ => false,
+        }
+    }
+
+    /// Solves `(M − γ J) x = b` in place with the last factorisation.
+    pub fn solve_in_place(&self, b: &mut [f64]) {
+        match self {
+            Self::Dense { lu, .. } => lu.solve_in_place(b),
+            Self::BlockLowRank { lu, .. } => lu.solve_in_place(b),
+        }
+    }
+}
 
 /// A factorised square matrix `P A = L U`, stored in place.
 #[derive(Debug, Clone, PartialEq)]
@@ -63,10 +122,19 @@ impl DenseLu {
     /// Solves `A x = b` in place. Must follow a successful [`Self::factor`].
     pub fn solve_in_place(&self, b: &mut [f64]) {
         let n = self.lu.nrows();
+        self.solve_columns_in_place(MatMut::from_column_major_slice_mut(b, n, 1));
+    }
+
+    /// Solves `A X = B` in place for all columns of `B` at once.
+    pub fn solve_columns_in_place(&self, rhs: MatMut<'_, f64>) {
+        let n = self.lu.nrows();
         let par = Par::Seq;
-        let mut mem = MemBuffer::new(solve::solve_in_place_scratch::<usize, f64>(n, 1, par));
+        let mut mem = MemBuffer::new(solve::solve_in_place_scratch::<usize, f64>(
+            n,
+            rhs.ncols(),
+            par,
+        ));
         let perm = PermRef::new_checked(&self.perm, &self.perm_inv, n);
-        let rhs = MatMut::from_column_major_slice_mut(b, n, 1);
         solve::solve_in_place(
             self.lu.as_ref(),
             self.lu.as_ref(),

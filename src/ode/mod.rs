@@ -37,6 +37,7 @@
 // Index loops mirror CVODE's formulas, which address several arrays by one index.
 #[allow(clippy::needless_range_loop)]
 mod bdf;
+mod block_low_rank;
 // Index loops mirror CVODE's formulas, which address several arrays by one index.
 #[allow(clippy::needless_range_loop)]
 mod coefficients;
@@ -61,6 +62,7 @@ pub mod test_problems;
 mod tests;
 
 pub use bdf::Bdf;
+pub use block_low_rank::{BlockLowRankJacobian, BlockLowRankLu, BlockLowRankShape};
 pub use error::BdfError;
 pub use jacobian::JacobianPattern;
 pub use options::{BdfOptions, Tolerance};

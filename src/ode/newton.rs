@@ -8,6 +8,7 @@ use faer::Mat;
 
 use super::bdf::{Bdf, NlsOutcome, StepFlag};
 use super::jacobian::{finite_difference_jacobian, DifferenceQuotient};
+use super::linear_solver::IterationMatrix;
 use super::nordsieck::wrms_norm;
 use super::problem::{OdeProblem, ProblemError};
 use super::stats::BdfStats;
@@ -98,7 +99,7 @@ impl Bdf {
             || s.nst == 0
             || s.nst >= s.nstlp + MSBP
             || (s.gamrat - 1.0).abs() > DGMAX_LSETUP
-            || !s.lin.lu.is_factored();
+            || !s.lin.matrix.is_factored();
         self.s.acor.iter_mut().for_each(|v| *v = 0.0);
         let mut jcur = false;
         loop {
@@ -136,7 +137,7 @@ impl Bdf {
             for d in self.w.delta.iter_mut() {
                 *d = -*d;
             }
-            self.s.lin.lu.solve_in_place(&mut self.w.delta);
+            self.s.lin.matrix.solve_in_place(&mut self.w.delta);
             if self.s.gamrat != 1.0 {
                 let scale = 2.0 / (1.0 + self.s.gamrat);
                 self.w.delta.iter_mut().for_each(|d| *d *= scale);
@@ -241,38 +242,47 @@ impl Bdf {
         if jbad {
             s.stats.jac_evals += 1;
             s.lin.nstlj = s.nst;
-            s.lin.saved_j.fill(0.0);
-            let analytic = problem
-                .jacobian(s.tn, &w.y, s.lin.saved_j.as_mut())
-                .map_err(recoverable)?;
-            if analytic {
-                if s.lin
-                    .saved_j
-                    .col_iter()
-                    .any(|c| c.iter().any(|v| !v.is_finite()))
-                {
-                    return Err(NlsOutcome::RhsRecoverable(ProblemError::NonFinite));
+            match &mut s.lin.matrix {
+                IterationMatrix::Dense { saved_j, .. } => {
+                    saved_j.fill(0.0);
+                    let analytic = problem
+                        .jacobian(s.tn, &w.y, saved_j.as_mut())
+                        .map_err(recoverable)?;
+                    if analytic {
+                        if saved_j.col_iter().any(|c| c.iter().any(|v| !v.is_finite())) {
+                            return Err(NlsOutcome::RhsRecoverable(ProblemError::NonFinite));
+                        }
+                    } else {
+                        let at = DifferenceQuotient {
+                            t: s.tn,
+                            h: s.h,
+                            y: &w.y,
+                            fy: &w.ftemp,
+                            ewt: &w.ewt,
+                        };
+                        let groups = self.pattern.as_ref().map(|(p, g)| (p, g.as_slice()));
+                        let evals = finite_difference_jacobian(
+                            problem,
+                            &at,
+                            groups,
+                            saved_j,
+                            &mut w.jac_y,
+                            &mut w.jac_f,
+                        )
+                        .map_err(recoverable)?;
+                        s.stats.rhs_evals += evals;
+                        s.stats.rhs_evals_jac += evals;
+                    }
                 }
-            } else {
-                let at = DifferenceQuotient {
-                    t: s.tn,
-                    h: s.h,
-                    y: &w.y,
-                    fy: &w.ftemp,
-                    ewt: &w.ewt,
-                };
-                let groups = self.pattern.as_ref().map(|(p, g)| (p, g.as_slice()));
-                let evals = finite_difference_jacobian(
-                    problem,
-                    &at,
-                    groups,
-                    &mut s.lin.saved_j,
-                    &mut w.jac_y,
-                    &mut w.jac_f,
-                )
-                .map_err(recoverable)?;
-                s.stats.rhs_evals += evals;
-                s.stats.rhs_evals_jac += evals;
+                IterationMatrix::BlockLowRank { saved_j, .. } => {
+                    saved_j.clear();
+                    problem
+                        .structured_jacobian(s.tn, &w.y, saved_j)
+                        .map_err(recoverable)?;
+                    if !saved_j.is_finite() {
+                        return Err(NlsOutcome::RhsRecoverable(ProblemError::NonFinite));
+                    }
+                }
             }
         }
         let gamma = s.gamma;
@@ -287,25 +297,28 @@ impl Bdf {
             )
             .map_err(recoverable)?;
         }
-        {
-            let a = s.lin.lu.matrix_mut();
-            for j in 0..n {
-                let jc = s.lin.saved_j.col_as_slice(j);
-                let ac = a.col_as_slice_mut(j);
-                for (x, jv) in ac.iter_mut().zip(jc) {
-                    *x = -gamma * jv;
-                }
-                if self.has_mass {
-                    for (x, mv) in ac.iter_mut().zip(w.mass.col_as_slice(j)) {
-                        *x += mv;
+        let ok = match &mut s.lin.matrix {
+            IterationMatrix::Dense { saved_j, lu } => {
+                let a = lu.matrix_mut();
+                for j in 0..n {
+                    let jc = saved_j.col_as_slice(j);
+                    let ac = a.col_as_slice_mut(j);
+                    for (x, jv) in ac.iter_mut().zip(jc) {
+                        *x = -gamma * jv;
                     }
-                } else {
-                    ac[j] += 1.0;
+                    if self.has_mass {
+                        for (x, mv) in ac.iter_mut().zip(w.mass.col_as_slice(j)) {
+                            *x += mv;
+                        }
+                    } else {
+                        ac[j] += 1.0;
+                    }
                 }
+                lu.factor()
             }
-        }
+            IterationMatrix::BlockLowRank { saved_j, lu } => lu.factor(saved_j, gamma),
+        };
         s.stats.factorizations += 1;
-        let ok = s.lin.lu.factor();
         s.gamrat = 1.0;
         s.gammap = s.gamma;
         s.crate_ = 1.0;

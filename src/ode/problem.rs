@@ -2,6 +2,7 @@
 
 use faer::MatMut;
 
+use super::block_low_rank::{BlockLowRankJacobian, BlockLowRankShape};
 use super::jacobian::JacobianPattern;
 
 /// Why a problem could not evaluate its equations at the requested point.
@@ -47,6 +48,26 @@ pub trait OdeProblem {
     /// finite-difference Jacobian perturbs structurally independent columns together.
     fn jacobian_pattern(&self) -> Option<JacobianPattern> {
         None
+    }
+
+    /// Optional structure `J = blockdiag(J_1, …, J_k) + U Vᵀ` (requires `M = I`). When given, the
+    /// integrator never forms an n × n matrix: it calls [`Self::structured_jacobian`] instead of
+    /// [`Self::jacobian`] and solves with `I − γ J` by the Woodbury identity.
+    fn jacobian_structure(&self) -> Option<BlockLowRankShape> {
+        None
+    }
+
+    /// Writes `J` in the shape of [`Self::jacobian_structure`] (called only when that is given;
+    /// `j` arrives zeroed).
+    fn structured_jacobian(
+        &mut self,
+        _t: f64,
+        _y: &[f64],
+        _j: &mut BlockLowRankJacobian,
+    ) -> Result<(), ProblemError> {
+        Err(ProblemError::Fatal(
+            "the problem declares a Jacobian structure but does not supply it".into(),
+        ))
     }
 
     /// Whether `M` is constant in `t` and `y`; then it is evaluated once and cached.

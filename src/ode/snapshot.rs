@@ -4,9 +4,10 @@
 use faer::Mat;
 
 use super::bdf::{Bdf, BdfState, LinearSystem};
+use super::block_low_rank::{BlockLowRankJacobian, BlockLowRankLu, BlockLowRankShape};
 use super::coefficients::L_MAX;
 use super::error::BdfError;
-use super::linear_solver::DenseLu;
+use super::linear_solver::{DenseLu, IterationMatrix};
 use super::nordsieck::Nordsieck;
 use super::options::{BdfOptions, Tolerance};
 use super::stability::StabilityGuard;
@@ -15,7 +16,7 @@ use super::stats::BdfStats;
 /// Identifies a serialised BDF snapshot.
 const MAGIC: f64 = 4_262_000_917.0;
 /// Layout version of the serialisation.
-const VERSION: f64 = 2.0;
+const VERSION: f64 = 3.0;
 
 /// Everything needed to continue an integration bit for bit.
 #[derive(Debug, Clone, PartialEq)]
@@ -39,6 +40,11 @@ impl Bdf {
                 "snapshot has {} states, this integrator {}",
                 snapshot.state.n, self.s.n
             )));
+        }
+        if !snapshot.state.lin.matrix.same_structure(&self.s.lin.matrix) {
+            return Err(BdfError::BadSnapshot(
+                "the snapshot's Jacobian structure differs from this problem's".to_string(),
+            ));
         }
         self.s = snapshot.state.clone();
         Ok(())
@@ -124,13 +130,36 @@ impl BdfSnapshot {
         }
         w.slice(&s.acor);
         // Linear system.
-        w.mat(&s.lin.saved_j);
-        let (lu, perm, perm_inv, factored) = s.lin.lu.parts();
-        w.mat(lu);
-        for &p in perm.iter().chain(perm_inv) {
-            w.usize(p);
+        match &s.lin.matrix {
+            IterationMatrix::Dense { saved_j, lu } => {
+                w.f(0.0);
+                w.mat(saved_j);
+                let (lu, perm, perm_inv, factored) = lu.parts();
+                w.mat(lu);
+                for &p in perm.iter().chain(perm_inv) {
+                    w.usize(p);
+                }
+                w.bool(factored);
+            }
+            IterationMatrix::BlockLowRank { saved_j, lu } => {
+                // The factorisation is a deterministic function of J and gammap: it is rebuilt.
+                w.f(1.0);
+                let shape = saved_j.shape();
+                w.usize(shape.blocks.len());
+                for b in &shape.blocks {
+                    w.usize(b.len());
+                    for &i in b {
+                        w.usize(i);
+                    }
+                }
+                w.usize(shape.rank);
+                let (values, u, v) = saved_j.values();
+                w.slice(values);
+                w.cols(u);
+                w.cols(v);
+                w.bool(lu.is_factored());
+            }
         }
-        w.bool(factored);
         w.u64(s.lin.nstlj);
         w.bool(s.lin.jcur);
         // Counters.
@@ -230,16 +259,6 @@ impl BdfSnapshot {
                 "implausible sizes n = {n}, history columns = {ncols}"
             )));
         }
-        // The two n x n matrices alone need 2 n^2 values: refuse before allocating anything.
-        if n.checked_mul(n)
-            .and_then(|nn| nn.checked_mul(2))
-            .is_none_or(|need| need > data.len())
-        {
-            return Err(bad(format!(
-                "{} values cannot hold a snapshot of {n} states",
-                data.len()
-            )));
-        }
         let rtol = r.f()?;
         let atol = match r.f()? {
             0.0 => Tolerance::Scalar(r.f()?),
@@ -303,22 +322,84 @@ impl BdfSnapshot {
             *col = r.vec(n)?;
         }
         let acor = r.vec(n)?;
-        let saved_j = r.mat(n)?;
-        let lu = r.mat(n)?;
-        let mut perm = Vec::with_capacity(n);
-        for _ in 0..n {
-            perm.push(r.usize("permutation")?);
-        }
-        let mut perm_inv = Vec::with_capacity(n);
-        for _ in 0..n {
-            perm_inv.push(r.usize("permutation")?);
-        }
-        if (0..n).any(|i| perm[i] >= n || perm_inv[i] >= n || perm_inv[perm[i]] != i) {
-            return Err(bad(
-                "the LU row permutation is not a permutation".to_string()
-            ));
-        }
-        let factored = r.bool()?;
+        let matrix = match r.f()? {
+            0.0 => {
+                // The two n x n matrices alone need 2 n^2 values: refuse before allocating.
+                if n.checked_mul(n)
+                    .and_then(|nn| nn.checked_mul(2))
+                    .is_none_or(|need| need > data.len() - r.pos)
+                {
+                    return Err(bad(format!(
+                        "{} values cannot hold the dense Jacobian of {n} states",
+                        data.len()
+                    )));
+                }
+                let saved_j = r.mat(n)?;
+                let lu = r.mat(n)?;
+                let mut perm = Vec::with_capacity(n);
+                for _ in 0..n {
+                    perm.push(r.usize("permutation")?);
+                }
+                let mut perm_inv = Vec::with_capacity(n);
+                for _ in 0..n {
+                    perm_inv.push(r.usize("permutation")?);
+                }
+                if (0..n).any(|i| perm[i] >= n || perm_inv[i] >= n || perm_inv[perm[i]] != i) {
+                    return Err(bad(
+                        "the LU row permutation is not a permutation".to_string()
+                    ));
+                }
+                let factored = r.bool()?;
+                IterationMatrix::Dense {
+                    saved_j,
+                    lu: DenseLu::from_parts(lu, perm, perm_inv, factored),
+                }
+            }
+            1.0 => {
+                let nblocks = r.usize("block count")?;
+                if nblocks > n {
+                    return Err(bad(format!("{nblocks} blocks for {n} states")));
+                }
+                let mut blocks = Vec::with_capacity(nblocks);
+                let mut entries = 0usize;
+                for _ in 0..nblocks {
+                    let len = r.usize("block size")?;
+                    if len > n {
+                        return Err(bad(format!("a block of {len} states in a system of {n}")));
+                    }
+                    let mut b = Vec::with_capacity(len);
+                    for _ in 0..len {
+                        b.push(r.usize("block index")?);
+                    }
+                    entries += len * len;
+                    blocks.push(b);
+                }
+                let rank = r.usize("rank")?;
+                let shape = BlockLowRankShape { blocks, rank };
+                shape.validate(n).map_err(bad)?;
+                if entries + 2 * n * rank > data.len() - r.pos {
+                    return Err(bad(format!(
+                        "{} values cannot hold a rank-{rank} Jacobian of {n} states",
+                        data.len()
+                    )));
+                }
+                let values = r.vec(entries)?;
+                let u = r.cols(n, rank)?;
+                let v = r.cols(n, rank)?;
+                let factored = r.bool()?;
+                let saved_j = BlockLowRankJacobian::from_values(shape, values, u, v)
+                    .ok_or_else(|| bad("Jacobian sizes do not match its shape".to_string()))?;
+                let mut lu = BlockLowRankLu::new(saved_j.shape());
+                if factored && !lu.factor(&saved_j, gammap) {
+                    return Err(bad("the saved iteration matrix is singular".to_string()));
+                }
+                IterationMatrix::BlockLowRank {
+                    saved_j: Box::new(saved_j),
+                    lu: Box::new(lu),
+                }
+            }
+            t => return Err(bad(format!("unknown linear-system tag {t}"))),
+        };
         let nstlj = r.u64()?;
         let jcur = r.bool()?;
         let mut counters = [0u64; 9];
@@ -404,8 +485,7 @@ impl BdfSnapshot {
             zn,
             acor,
             lin: LinearSystem {
-                saved_j,
-                lu: DenseLu::from_parts(lu, perm, perm_inv, factored),
+                matrix,
                 nstlj,
                 jcur,
             },
@@ -474,6 +554,9 @@ impl Writer {
         self.0.extend_from_slice(v);
     }
     fn mat(&mut self, m: &Mat<f64>) {
+        self.cols(m);
+    }
+    fn cols(&mut self, m: &Mat<f64>) {
         for j in 0..m.ncols() {
             self.0.extend_from_slice(m.col_as_slice(j));
         }
@@ -538,9 +621,12 @@ impl Reader<'_> {
         Ok(a)
     }
     fn mat(&mut self, n: usize) -> Result<Mat<f64>, BdfError> {
-        let mut m = Mat::zeros(n, n);
-        for j in 0..n {
-            let col = self.vec(n)?;
+        self.cols(n, n)
+    }
+    fn cols(&mut self, rows: usize, cols: usize) -> Result<Mat<f64>, BdfError> {
+        let mut m = Mat::zeros(rows, cols);
+        for j in 0..cols {
+            let col = self.vec(rows)?;
             m.col_as_slice_mut(j).copy_from_slice(&col);
         }
         Ok(m)

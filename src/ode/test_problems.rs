@@ -4,6 +4,7 @@ use std::f64::consts::PI;
 
 use faer::{Mat, MatMut, Side};
 
+use super::block_low_rank::{BlockLowRankJacobian, BlockLowRankShape};
 use super::problem::{OdeProblem, ProblemError};
 
 /// `y' = A y` with `A` in real Jordan form: a decaying oscillation `lambda = a ± i b` in
@@ -417,5 +418,137 @@ impl OdeProblem for SpringChain {
             }
         }
         Ok(true)
+    }
+}
+
+/// The 19-mass chain of [`SpringChain::without_stiff_mode`] in its own modal coordinates, with a
+/// two-mass absorber hung from its middle mass (0.01 kg at 2 kHz, then 0.005 kg at 700 Hz, each
+/// spring with a parallel dashpot of 5 % critical damping): a modal body
+/// coupled to a small multibody part through one spring, the shape a block-diagonal plus
+/// low-rank Jacobian is made for. State `[x1, x2, v1, v2 | η_1 … η_19 | η̇_1 … η̇_19]`.
+/// With `structured` false it declares no structure and hands out the same Jacobian dense.
+#[derive(Debug, Clone)]
+pub struct ModalChainWithAbsorber {
+    pub chain: SpringChain,
+    pub attach: usize,
+    pub masses: [f64; 2],
+    pub springs: [f64; 2],
+    pub dashpots: [f64; 2],
+    pub structured: bool,
+}
+
+impl ModalChainWithAbsorber {
+    pub fn new(structured: bool) -> Result<Self, String> {
+        let chain = SpringChain::without_stiff_mode()?;
+        let attach = chain.dofs() / 2;
+        let masses = [0.01, 0.005];
+        let w1 = 2.0 * PI * 2000.0;
+        let w2 = 2.0 * PI * 700.0;
+        Ok(Self {
+            chain,
+            attach,
+            masses,
+            springs: [masses[0] * w1 * w1, masses[1] * w2 * w2],
+            dashpots: [0.1 * masses[0] * w1, 0.1 * masses[1] * w2],
+            structured,
+        })
+    }
+
+    fn modes(&self) -> usize {
+        self.chain.dofs()
+    }
+
+    /// Mass-normalised mode shape `r` at the attachment.
+    fn phi(&self, r: usize) -> f64 {
+        self.chain.modes[(self.attach, r)]
+    }
+
+    pub fn shape(&self) -> BlockLowRankShape {
+        let m = self.modes();
+        let mut blocks = vec![vec![0, 1, 2, 3]];
+        blocks.extend((0..m).map(|r| vec![4 + r, 4 + m + r]));
+        BlockLowRankShape { blocks, rank: 2 }
+    }
+
+    fn fill(&self, j: &mut BlockLowRankJacobian) {
+        let m = self.modes();
+        let ([m1, m2], [k1, k2], [c1, c2]) = (self.masses, self.springs, self.dashpots);
+        let mut b = j.block_mut(0);
+        b[(0, 2)] = 1.0;
+        b[(1, 3)] = 1.0;
+        b[(2, 0)] = -(k1 + k2) / m1;
+        b[(2, 1)] = k2 / m1;
+        b[(3, 0)] = k2 / m2;
+        b[(3, 1)] = -k2 / m2;
+        b[(2, 2)] = -(c1 + c2) / m1;
+        b[(2, 3)] = c2 / m1;
+        b[(3, 2)] = c2 / m2;
+        b[(3, 3)] = -c2 / m2;
+        for r in 0..m {
+            let w = self.chain.omega[r];
+            let mut b = j.block_mut(1 + r);
+            b[(0, 1)] = 1.0;
+            b[(1, 0)] = -w * w;
+            b[(1, 1)] = -2.0 * self.chain.zeta * w;
+        }
+        // The absorber's first spring and dashpot carry s1 = k1 (x1 − u_a) + c1 (v1 − u̇_a) with
+        // u_a = Σ φ_r η_r. Column 0: ∂s1/∂(η, η̇) acting on mass 1 and on every mode; column 1:
+        // ∂s1/∂(x1, v1) acting on every mode.
+        for r in 0..m {
+            let phi = self.phi(r);
+            j.u_mut()[(4 + m + r, 0)] = -phi;
+            j.v_mut()[(4 + r, 0)] = k1 * phi;
+            j.v_mut()[(4 + m + r, 0)] = c1 * phi;
+            j.u_mut()[(4 + m + r, 1)] = phi;
+        }
+        j.u_mut()[(2, 0)] = 1.0 / m1;
+        j.v_mut()[(0, 1)] = k1;
+        j.v_mut()[(2, 1)] = c1;
+    }
+}
+
+impl OdeProblem for ModalChainWithAbsorber {
+    fn dim(&self) -> usize {
+        4 + 2 * self.modes()
+    }
+    fn rhs(&mut self, t: f64, y: &[f64], f: &mut [f64]) -> Result<(), ProblemError> {
+        let m = self.modes();
+        let ([m1, m2], [k1, k2], [c1, c2]) = (self.masses, self.springs, self.dashpots);
+        let u_a: f64 = (0..m).map(|r| self.phi(r) * y[4 + r]).sum();
+        let v_a: f64 = (0..m).map(|r| self.phi(r) * y[4 + m + r]).sum();
+        let s1 = k1 * (y[0] - u_a) + c1 * (y[2] - v_a);
+        let s2 = k2 * (y[1] - y[0]) + c2 * (y[3] - y[2]);
+        f[0] = y[2];
+        f[1] = y[3];
+        f[2] = (-s1 + s2) / m1;
+        f[3] = -s2 / m2;
+        let load = self.chain.force_amplitude * (self.chain.force_omega * t).sin();
+        for r in 0..m {
+            let (eta, rate) = (y[4 + r], y[4 + m + r]);
+            let w = self.chain.omega[r];
+            f[4 + r] = rate;
+            f[4 + m + r] = -w * w * eta - 2.0 * self.chain.zeta * w * rate
+                + self.chain.modes[(self.chain.force_dof, r)] * load
+                + self.phi(r) * s1;
+        }
+        Ok(())
+    }
+    fn jacobian(&mut self, _t: f64, _y: &[f64], j: MatMut<'_, f64>) -> Result<bool, ProblemError> {
+        let mut s = BlockLowRankJacobian::new(self.shape());
+        self.fill(&mut s);
+        s.to_dense(j);
+        Ok(true)
+    }
+    fn jacobian_structure(&self) -> Option<BlockLowRankShape> {
+        self.structured.then(|| self.shape())
+    }
+    fn structured_jacobian(
+        &mut self,
+        _t: f64,
+        _y: &[f64],
+        j: &mut BlockLowRankJacobian,
+    ) -> Result<(), ProblemError> {
+        self.fill(j);
+        Ok(())
     }
 }
