@@ -5,7 +5,7 @@
 //! and speed: CPU seconds per simulated second, the real-time factor and the integrator's work
 //! per simulated second.
 //!
-//! `cargo run --release --example realtime -- [--window SECONDS] [--scene N] [--cutoff HZ]
+//! `cargo run --release --example realtime -- [--window SECONDS] [--scene N] [--cutoff HZ] [--rtol R]
 //! [--without gas,mass,balance,gyro,ring,nonlinear,flex]`
 
 use std::time::Instant;
@@ -64,6 +64,10 @@ fn main() -> Result<(), String> {
                     "flex" => e.chassis_flexibility = false,
                     other => return Err(format!("unknown effect {other}")),
                 }
+            }
+            if let Some(r) = value("--rtol") {
+                settings.rel_tol = r;
+                settings.abs_tol = r * 1e-3;
             }
             if let Some(c) = value("--cutoff") {
                 settings.chassis.mode_cutoff_hz = c;

@@ -1,12 +1,12 @@
 //! Jacobian `∂f/∂y` of the hybrid scene in block-diagonal plus low-rank form
 //! ([`BlockLowRankJacobian`]): `J = blockdiag(J_engine, J_mode 1, …, J_mode m) + U Vᵀ`.
 //!
-//! - The engine block (a few dozen states) is a central difference of the engine rows.
+//! - The engine block (a few dozen states) is a forward difference of the engine rows.
 //! - Each chassis mode is the exact 2×2 block `[[0, 1], [−ω², −2ζω]]` on `(η_k, η̇_k)`.
 //! - Everything that couples engine and chassis, or one mode to another, passes through the
 //!   mount forces `F_p` (3 per connected mount). With `R_c = ∂F/∂(η, η̇)` (exact: the attachment
 //!   moves with `φ_p`, so `∂F/∂η_k = −S_p φ_{p,k}`, `∂F/∂η̇_k = −D_p φ_{p,k}`), `R_e = ∂F/∂y_engine`
-//!   (central differences, taken with the engine block), `H = ∂(housing acceleration)/∂F`
+//!   (forward differences, taken with the engine block), `H = ∂(housing acceleration)/∂F`
 //!   (`M_h⁻¹` times the point-force map) and `B = ∂η̈/∂F = −Φᵀ`:
 //!   `J_engine,chassis = H R_c`, `J_chassis,chassis += B R_c`, `J_chassis,engine = B R_e`.
 //!   So `U = [[H, 0], [B, B]]` and `Vᵀ = [[0, R_c], [R_e, 0]]`: rank 6 per connected mount,
@@ -74,26 +74,27 @@ impl HybridScene {
                 .unwrap_or_else(Vector3::zeros)
         };
 
-        // Engine block and R_e: central differences of the engine rows and the mount forces.
+        // Engine block and R_e: forward differences of the engine rows and the mount forces (a
+        // Newton matrix needs no more than the square root of the working precision).
+        let ev = self.evaluate(t, y);
+        let mut f0 = vec![0.0; y.len()];
+        self.write_rhs(y, &ev, &mut f0)?;
         let mut yp = y.to_vec();
         let mut fp = vec![0.0; y.len()];
-        let mut fm = vec![0.0; y.len()];
         for c in 0..ne {
-            let h = 1e-7 * y[c].abs().max(1.0);
+            let h = f64::EPSILON.sqrt() * y[c].abs().max(1.0);
             yp[c] = y[c] + h;
+            let h = yp[c] - y[c];
             let ev_p = self.evaluate(t, &yp);
             self.write_rhs(&yp, &ev_p, &mut fp)?;
-            yp[c] = y[c] - h;
-            let ev_m = self.evaluate(t, &yp);
-            self.write_rhs(&yp, &ev_m, &mut fm)?;
             yp[c] = y[c];
             let mut block = j.block_mut(0);
             for r in 0..ne {
-                block[(r, c)] = (fp[r] - fm[r]) / (2.0 * h);
+                block[(r, c)] = (fp[r] - f0[r]) / h;
             }
             let mut v = j.v_mut();
             for (a, &(i, _)) in connected.iter().enumerate() {
-                let df = (mount_force(&ev_p, i) - mount_force(&ev_m, i)) / (2.0 * h);
+                let df = (mount_force(&ev_p, i) - mount_force(&ev, i)) / h;
                 for d in 0..3 {
                     v[(c, 3 * n_links + 3 * a + d)] = df[d];
                 }
@@ -111,7 +112,6 @@ impl HybridScene {
         }
 
         // Coupling through the mount forces: H, B, R_c.
-        let ev = self.evaluate(t, y);
         let hb = self.engine().housing_index();
         let housing_row = 6 * self.engine().body_count() + 6 * hb;
         let h = &ev.engine.kinematics[hb];
