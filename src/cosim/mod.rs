@@ -182,6 +182,10 @@ pub struct StepFailure {
 pub struct Simulation {
     scene: Scene,
     integrator: Bdf,
+    /// Communication time and the state there. The integrator steps past communication points
+    /// and interpolates, so its own time is usually a little ahead.
+    time: f64,
+    state: Vec<f64>,
     inputs: Inputs,
     /// Where and under which inputs the static equilibrium was found: with the settings, this
     /// rebuilds the scene exactly (fade-in start, mount operating points).
@@ -209,6 +213,8 @@ impl Simulation {
         Ok(Simulation {
             scene,
             integrator,
+            time: t0,
+            state: y0,
             inputs: *inputs,
             initial_time: t0,
             initial_inputs: *inputs,
@@ -225,42 +231,56 @@ impl Simulation {
         self.scene.dim()
     }
 
+    /// The communication time reached.
     pub fn time(&self) -> f64 {
-        self.integrator.t()
+        self.time
     }
 
     /// Applies inputs valid from the current time on. Returns whether an input jumped, in which
-    /// case the integrator restarted at order 1 (its history describes the old inputs).
+    /// case the integrator restarted at order 1 from the state at the communication time (its
+    /// history, and any step it took past that time, describe the old inputs).
     pub fn set_inputs(&mut self, inputs: &Inputs) -> Result<bool, String> {
         inputs.validate()?;
-        let t = self.integrator.t();
+        let t = self.time;
         let jumped = !self.inputs.continue_into(inputs, t);
+        let previous = self.inputs;
         self.scene.set_inputs(inputs)?;
         self.inputs = *inputs;
         if jumped {
-            self.integrator
-                .restart(&mut self.scene, None)
-                .map_err(|e| e.to_string())?;
+            if let Err(e) = self.integrator.restart_at(&mut self.scene, t, &self.state) {
+                // Leave everything as it was: the old inputs still describe the integrator.
+                self.scene.set_inputs(&previous)?;
+                self.inputs = previous;
+                return Err(e.to_string());
+            }
         }
         Ok(jumped)
     }
 
-    /// Integrates to exactly `t`, keeping the history for the next call.
+    /// Integrates to `t`, keeping the history for the next call. The integrator takes the
+    /// steps its error control wants, past `t` if need be, and the state at `t` is
+    /// interpolated: communication points cost no extra steps.
     pub fn advance_to(&mut self, t: f64) -> Result<(), StepFailure> {
+        if t < self.time {
+            return Err(StepFailure {
+                message: format!("{t} is behind the current time {}", self.time),
+                reached: self.time,
+            });
+        }
         self.integrator
-            .advance_to(&mut self.scene, t)
+            .advance_past(&mut self.scene, t, &mut self.state)
             .map_err(|e| StepFailure {
                 message: e.to_string(),
-                reached: self.integrator.t(),
-            })
+                reached: self.integrator.t().min(t),
+            })?;
+        self.time = t;
+        Ok(())
     }
 
-    /// Outputs at the current time, with accelerations from one evaluation of the equations of
-    /// motion.
+    /// Outputs at the communication time, with accelerations from one evaluation of the
+    /// equations of motion.
     pub fn outputs(&mut self) -> Result<Outputs, String> {
-        let t = self.integrator.t();
-        let y = self.integrator.y().to_vec();
-        self.scene.outputs(t, &y)
+        self.scene.outputs(self.time, &self.state)
     }
 
     pub fn counters(&self) -> Counters {
@@ -279,6 +299,8 @@ impl Simulation {
         let mut v = vec![self.initial_time];
         v.extend(self.initial_inputs.to_vec());
         v.extend(self.inputs.to_vec());
+        v.push(self.time);
+        v.extend(&self.state);
         v.extend(self.integrator.snapshot().to_f64_vec());
         v
     }
@@ -287,20 +309,31 @@ impl Simulation {
     /// reproduces the original run bit for bit.
     pub fn restore(settings: &Settings, data: &[f64]) -> Result<Simulation, String> {
         let n = Inputs::FLAT_LEN;
-        if data.len() < 1 + 2 * n {
+        if data.len() < 2 + 2 * n {
             return Err("simulation state is truncated".into());
         }
         let initial_time = data[0];
         let initial_inputs = Inputs::from_slice(&data[1..1 + n])?;
         let inputs = Inputs::from_slice(&data[1 + n..1 + 2 * n])?;
-        let snapshot =
-            BdfSnapshot::from_f64_slice(&data[1 + 2 * n..]).map_err(|e| e.to_string())?;
+        let time = data[1 + 2 * n];
         let mut sim = Simulation::new(settings, initial_time, &initial_inputs)?;
+        let states = sim.state.len();
+        let start = 2 + 2 * n;
+        let state = data
+            .get(start..start + states)
+            .ok_or("simulation state is truncated")?;
+        if !time.is_finite() || state.iter().any(|v| !v.is_finite()) {
+            return Err("simulation state holds a non-finite time or state".into());
+        }
+        let snapshot =
+            BdfSnapshot::from_f64_slice(&data[start + states..]).map_err(|e| e.to_string())?;
         sim.integrator
             .restore(&snapshot)
             .map_err(|e| e.to_string())?;
         sim.scene.set_inputs(&inputs)?;
         sim.inputs = inputs;
+        sim.time = time;
+        sim.state.copy_from_slice(state);
         Ok(sim)
     }
 }

@@ -400,6 +400,30 @@ impl Bdf {
         Ok(())
     }
 
+    /// Restarts at order 1 from state `y` at time `t`, which may lie behind the current time
+    /// (the integrator stepped past an output time at which the inputs then jumped). On error
+    /// the integrator is left as it was.
+    pub fn restart_at<P: OdeProblem>(
+        &mut self,
+        problem: &mut P,
+        t: f64,
+        y: &[f64],
+    ) -> Result<(), BdfError> {
+        if !t.is_finite() {
+            return Err(BdfError::InvalidInput {
+                field: "t",
+                message: format!("must be finite, got {t}"),
+            });
+        }
+        let tn = self.s.tn;
+        self.s.tn = t;
+        let result = self.restart(problem, Some(y));
+        if result.is_err() {
+            self.s.tn = tn;
+        }
+        result
+    }
+
     /// Sets `zn[0] = y0`, `zn[1] = y'(t) = M^{-1} f` and marks the first step size as pending.
     fn load_initial_derivative<P: OdeProblem>(
         &mut self,
@@ -448,22 +472,7 @@ impl Bdf {
         problem: &mut P,
         t_stop: f64,
     ) -> Result<(), BdfError> {
-        if !t_stop.is_finite() {
-            return Err(BdfError::InvalidInput {
-                field: "t_stop",
-                message: format!("must be finite, got {t_stop}"),
-            });
-        }
-        if problem.dim() != self.s.n {
-            return Err(BdfError::InvalidInput {
-                field: "problem",
-                message: format!(
-                    "has {} states, the integrator was built for {}",
-                    problem.dim(),
-                    self.s.n
-                ),
-            });
-        }
+        self.check_target(problem, t_stop, "t_stop")?;
         let tn = self.s.tn;
         let jitter = 100.0 * f64::EPSILON * tn.abs().max(t_stop.abs()).max(f64::MIN_POSITIVE);
         if (t_stop - tn).abs() <= jitter {
@@ -477,9 +486,78 @@ impl Bdf {
                 ),
             });
         }
-        self.s.tstop = t_stop;
+        self.step_until(problem, t_stop, true)
+    }
+
+    /// Steps freely until the internal time reaches or passes `t_out` (CVODE's normal mode) and
+    /// writes the interpolated `y(t_out)` into `y_out`. The steps do not bend to land on `t_out`,
+    /// so closely spaced output times cost no extra steps or refactorisations; `t_out` may lie
+    /// anywhere in the last step taken.
+    pub fn advance_past<P: OdeProblem>(
+        &mut self,
+        problem: &mut P,
+        t_out: f64,
+        y_out: &mut [f64],
+    ) -> Result<(), BdfError> {
+        self.check_target(problem, t_out, "t_out")?;
+        if y_out.len() != self.s.n {
+            return Err(BdfError::InvalidInput {
+                field: "y_out",
+                message: format!(
+                    "has {} entries, the problem has {} states",
+                    y_out.len(),
+                    self.s.n
+                ),
+            });
+        }
+        if t_out > self.s.tn {
+            self.step_until(problem, t_out, false)?;
+        }
+        if t_out == self.s.tn {
+            y_out.copy_from_slice(&self.s.zn.zn[0]);
+            return Ok(());
+        }
+        self.interpolate(t_out, 0, y_out)
+    }
+
+    fn check_target<P: OdeProblem>(
+        &self,
+        problem: &P,
+        t: f64,
+        field: &'static str,
+    ) -> Result<(), BdfError> {
+        if !t.is_finite() {
+            return Err(BdfError::InvalidInput {
+                field,
+                message: format!("must be finite, got {t}"),
+            });
+        }
+        if problem.dim() != self.s.n {
+            return Err(BdfError::InvalidInput {
+                field: "problem",
+                message: format!(
+                    "has {} states, the integrator was built for {}",
+                    problem.dim(),
+                    self.s.n
+                ),
+            });
+        }
+        Ok(())
+    }
+
+    /// Takes steps until `t_target` is reached (`land`: exactly, the last step shortened) or
+    /// passed (`!land`).
+    fn step_until<P: OdeProblem>(
+        &mut self,
+        problem: &mut P,
+        t_target: f64,
+        land: bool,
+    ) -> Result<(), BdfError> {
+        // Without landing there is no stop time: no step is clipped or snapped to the target,
+        // which only bounds the first step's estimate.
+        self.s.tstop = if land { t_target } else { f64::INFINITY };
         if self.s.pending_h0 {
-            self.initial_step(problem, t_stop)?;
+            self.initial_step(problem, t_target)?;
         }
         let mut steps = 0usize;
         loop {
@@ -497,10 +575,12 @@ impl Bdf {
                     factor: 2.0 * tolsf,
                 });
             }
-            self.clip_to_stop_time();
+            if land {
+                self.clip_to_stop_time();
+            }
             self.step(problem)?;
             steps += 1;
-            if self.s.tn == self.s.tstop {
+            if (land && self.s.tn == self.s.tstop) || (!land && self.s.tn >= t_target) {
                 return Ok(());
             }
         }
@@ -801,13 +881,10 @@ impl Bdf {
     fn predict(&mut self) {
         let s = &mut self.s;
         let t_new = s.tn + s.h;
-        s.tn = if (t_new - s.tstop).abs() <= 4.0 * f64::EPSILON * s.tstop.abs().max(s.h.abs())
-            || t_new > s.tstop
-        {
-            s.tstop
-        } else {
-            t_new
-        };
+        let landing = s.tstop.is_finite()
+            && ((t_new - s.tstop).abs() <= 4.0 * f64::EPSILON * s.tstop.abs().max(s.h.abs())
+                || t_new > s.tstop);
+        s.tn = if landing { s.tstop } else { t_new };
         s.zn.predict(s.q);
     }
 
