@@ -24,7 +24,7 @@ def family(knob: str) -> str:
     if knob.startswith("comm"):
         return "comm step, inputs held"
     if knob.startswith("chassis cut-off"):
-        return "chassis cut-off (vs 400 Hz reference)"
+        return "chassis cut-off (vs 2 kHz reference)"
     return "other (rtol 1e-5)"
 
 
