@@ -5,21 +5,12 @@
 //! and speed: CPU seconds per simulated second, the real-time factor and the integrator's work
 //! per simulated second.
 //!
-//! `cargo run --release --example realtime -- [--window SECONDS] [--scene N] [--cutoff HZ] [--rtol R]
+//! `cargo run --release --example realtime -- [--window SECONDS] [--scene N] [--cutoff HZ] [--rtol R] [--atol A]
 //! [--without gas,mass,balance,gyro,ring,nonlinear,flex]`
 
 use std::time::Instant;
 
-use engine_mount_chassis::cosim::{Inputs, Settings, Signal, Simulation, RPM_TO_RAD_PER_S};
-
-fn inputs(rpm: f64) -> Inputs {
-    Inputs {
-        crank_speed: Signal::constant(rpm * RPM_TO_RAD_PER_S),
-        load_torque: Signal::constant(0.0),
-        stiffness_scale: [Signal::constant(1.0); 4],
-        damping_scale: [Signal::constant(1.0); 4],
-    }
-}
+use engine_mount_chassis::cosim::{Inputs, Settings, Simulation};
 
 fn main() -> Result<(), String> {
     let args: Vec<String> = std::env::args().collect();
@@ -69,10 +60,13 @@ fn main() -> Result<(), String> {
                 settings.rel_tol = r;
                 settings.abs_tol = r * 1e-3;
             }
+            if let Some(a) = value("--atol") {
+                settings.abs_tol = a;
+            }
             if let Some(c) = value("--cutoff") {
                 settings.chassis.mode_cutoff_hz = c;
             }
-            let mut sim = Simulation::new(&settings, 0.0, &inputs(rpm))?;
+            let mut sim = Simulation::new(&settings, 0.0, &Inputs::steady(rpm))?;
             let n_settle = (settle / h).round() as usize;
             let n_window = (window / h).round() as usize;
             for k in 1..=n_settle {

@@ -1,18 +1,7 @@
 //! Scene 2 through the co-simulation runtime: the reduced chassis from the cache, statics,
 //! stepping, outputs and exact restore.
 
-use engine_mount_chassis::cosim::{
-    CacheSetting, Inputs, Settings, Signal, Simulation, RPM_TO_RAD_PER_S,
-};
-
-fn inputs(rpm: f64) -> Inputs {
-    Inputs {
-        crank_speed: Signal::constant(rpm * RPM_TO_RAD_PER_S),
-        load_torque: Signal::constant(0.0),
-        stiffness_scale: [Signal::constant(1.0); 4],
-        damping_scale: [Signal::constant(1.0); 4],
-    }
-}
+use engine_mount_chassis::cosim::{CacheSetting, Inputs, Settings, Simulation};
 
 fn settings(cache: &std::path::Path) -> Settings {
     let mut s = Settings {
@@ -31,7 +20,7 @@ fn temp_cache(tag: &str) -> std::path::PathBuf {
 fn scene_2_starts_at_the_coupled_equilibrium_and_runs() {
     let dir = temp_cache("run");
     let settings = settings(&dir);
-    let mut sim = Simulation::new(&settings, 0.0, &inputs(1800.0)).unwrap();
+    let mut sim = Simulation::new(&settings, 0.0, &Inputs::steady(1800.0)).unwrap();
     let log = sim.describe().join("\n");
     assert!(log.contains("reduced and cached at"), "{log}");
     let o = sim.outputs().unwrap();
@@ -50,7 +39,7 @@ fn scene_2_starts_at_the_coupled_equilibrium_and_runs() {
     assert!(amp > 1e-4 && amp < 50.0, "steering wheel |a| = {amp}");
 
     // A second simulation reads the cache and gets the same model: same outputs bit for bit.
-    let mut again = Simulation::new(&settings, 0.0, &inputs(1800.0)).unwrap();
+    let mut again = Simulation::new(&settings, 0.0, &Inputs::steady(1800.0)).unwrap();
     let log = again.describe().join("\n");
     assert!(log.contains("read from cache"), "{log}");
     for k in 1..=40 {
@@ -64,7 +53,7 @@ fn scene_2_starts_at_the_coupled_equilibrium_and_runs() {
 fn restored_scene_2_state_continues_bit_for_bit() {
     let dir = temp_cache("restore");
     let settings = settings(&dir);
-    let mut a = Simulation::new(&settings, 0.0, &inputs(1200.0)).unwrap();
+    let mut a = Simulation::new(&settings, 0.0, &Inputs::steady(1200.0)).unwrap();
     for k in 1..=20 {
         a.advance_to(k as f64 * 1e-3).unwrap();
     }
@@ -85,11 +74,15 @@ fn bad_chassis_settings_are_errors_naming_the_value() {
     let dir = temp_cache("bad");
     let mut s = settings(&dir);
     s.chassis.max_modes = -1;
-    let err = Simulation::new(&s, 0.0, &inputs(800.0)).err().unwrap();
+    let err = Simulation::new(&s, 0.0, &Inputs::steady(800.0))
+        .err()
+        .unwrap();
     assert!(err.contains("chassis.maxModes = -1"), "{err}");
     let mut s = settings(&dir);
     s.chassis.mode_cutoff_hz = f64::NAN;
-    let err = Simulation::new(&s, 0.0, &inputs(800.0)).err().unwrap();
+    let err = Simulation::new(&s, 0.0, &Inputs::steady(800.0))
+        .err()
+        .unwrap();
     assert!(err.contains("chassis.modeCutoff = NaN"), "{err}");
     let _ = std::fs::remove_dir_all(&dir);
 }
@@ -107,7 +100,7 @@ fn improved_vehicle_three_mounts_and_stiffening_bar() {
     s.config_file = Some(config);
     s.chassis.stiffening_bar = true;
     s.chassis.mode_cutoff_hz = 100.0;
-    let mut sim = Simulation::new(&s, 0.0, &inputs(1500.0)).unwrap();
+    let mut sim = Simulation::new(&s, 0.0, &Inputs::steady(1500.0)).unwrap();
     let log = sim.describe().join("\n");
     assert!(
         log.contains("stiffening bar on") && log.contains("3 of 4 mounts active"),

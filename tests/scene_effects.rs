@@ -1,21 +1,12 @@
 //! Scene-level effect switches: the automatic chassis cut-off and the rigid chassis.
 
 use engine_mount_chassis::cosim::{
-    ChassisSettings, EffectSwitches, Inputs, Settings, Signal, Simulation, RPM_TO_RAD_PER_S,
+    ChassisSettings, EffectSwitches, Inputs, Settings, Simulation, RPM_TO_RAD_PER_S,
 };
-
-fn inputs(rpm: f64) -> Inputs {
-    Inputs {
-        crank_speed: Signal::constant(rpm * RPM_TO_RAD_PER_S),
-        load_torque: Signal::constant(0.0),
-        stiffness_scale: [Signal::constant(1.0); 4],
-        damping_scale: [Signal::constant(1.0); 4],
-    }
-}
 
 /// RMS of the vertical steering-wheel acceleration over 0.3–0.5 s, and the number of states.
 fn steering_wheel_rms(settings: &Settings) -> (f64, usize, Vec<String>) {
-    let mut sim = Simulation::new(settings, 0.0, &inputs(1900.0)).unwrap();
+    let mut sim = Simulation::new(settings, 0.0, &Inputs::steady(1900.0)).unwrap();
     let describe = sim.describe();
     let mut sum = 0.0;
     let mut n = 0;
@@ -57,7 +48,7 @@ fn automatic_cutoff_follows_the_scene() {
         },
         ..Settings::default()
     };
-    let sim = Simulation::new(&settings, 0.0, &inputs(1000.0)).unwrap();
+    let sim = Simulation::new(&settings, 0.0, &Inputs::steady(1000.0)).unwrap();
     let text = sim.describe().join("\n");
     assert!(text.contains("automatic cut-off 48 Hz"), "{text}");
 }
@@ -101,7 +92,7 @@ fn a_rigid_chassis_removes_the_body_resonances_and_costs_less() {
 /// Amplitude of the 1.5 order of mount 1's vertical force over 8 revolutions at 2000 rpm.
 fn one_and_a_half_order(settings: &Settings) -> f64 {
     let rpm = 2000.0;
-    let mut sim = Simulation::new(settings, 0.0, &inputs(rpm)).unwrap();
+    let mut sim = Simulation::new(settings, 0.0, &Inputs::steady(rpm)).unwrap();
     let t_rev = 60.0 / rpm;
     let steps = 72;
     let h = t_rev / steps as f64;
@@ -136,7 +127,7 @@ fn full_load_combustion_raises_the_gas_order() {
         gas_load: 1.5,
         ..Settings::default()
     };
-    let Err(err) = Simulation::new(&bad, 0.0, &inputs(2000.0)) else {
+    let Err(err) = Simulation::new(&bad, 0.0, &Inputs::steady(2000.0)) else {
         panic!("a load above 1 was accepted");
     };
     assert!(err.contains("load"), "{err}");

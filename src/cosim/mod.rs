@@ -342,19 +342,10 @@ impl Simulation {
 mod tests {
     use super::*;
 
-    fn inputs(rpm: f64) -> Inputs {
-        Inputs {
-            crank_speed: Signal::constant(rpm * RPM_TO_RAD_PER_S),
-            load_torque: Signal::constant(0.0),
-            stiffness_scale: [Signal::constant(1.0); 4],
-            damping_scale: [Signal::constant(1.0); 4],
-        }
-    }
-
     #[test]
     fn restored_dynamic_state_continues_bit_for_bit() {
         let settings = Settings::default();
-        let mut a = Simulation::new(&settings, 0.0, &inputs(1200.0)).unwrap();
+        let mut a = Simulation::new(&settings, 0.0, &Inputs::steady(1200.0)).unwrap();
         for k in 1..=20 {
             a.advance_to(k as f64 * 1e-3).unwrap();
         }

@@ -44,6 +44,17 @@ pub struct Inputs {
 }
 
 impl Inputs {
+    /// Constant engine speed `rpm`, no load torque, every mount at its nominal stiffness and
+    /// damping.
+    pub fn steady(rpm: f64) -> Inputs {
+        Inputs {
+            crank_speed: Signal::constant(rpm * super::RPM_TO_RAD_PER_S),
+            load_torque: Signal::constant(0.0),
+            stiffness_scale: [Signal::constant(1.0); 4],
+            damping_scale: [Signal::constant(1.0); 4],
+        }
+    }
+
     /// Physical admissibility of the input values (finite values are checked by the caller).
     pub fn validate(&self) -> Result<(), String> {
         if self.crank_speed.value < 0.0 {
