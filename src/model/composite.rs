@@ -13,7 +13,7 @@
 //! spinning shafts and an effective mass matrix that is symmetric — so free vibration with the
 //! crank at rest conserves energy.
 
-use nalgebra::{Matrix3, Matrix6, SMatrix, Vector3, Vector6};
+use nalgebra::{Matrix3, Matrix6, Vector3, Vector6};
 
 use super::parts::Part;
 use super::rotation::skew;
@@ -130,12 +130,9 @@ pub fn add_parts(
         let r = body.rotation * path.rho;
         let d = body.rotation * path.d_rho;
         let dd = body.rotation * path.dd_rho;
-        // Partial velocities: linear Jp = [I, −[r]× − d eᵀ], angular Jw = [0, I − n e eᵀ].
-        let mut jp = SMatrix::<f64, 3, 6>::zeros();
-        jp.fixed_view_mut::<3, 3>(0, 0)
-            .copy_from(&Matrix3::identity());
-        jp.fixed_view_mut::<3, 3>(0, 3)
-            .copy_from(&(-skew(&r) - d * e.transpose()));
+        // Partial velocities: linear Jp = [I, A] with A = −[r]× − d eᵀ, angular
+        // Jw = [0, I − n e eᵀ]. Jpᵀ Jp = [[I, A], [Aᵀ, AᵀA]] is accumulated block by block.
+        let a = -skew(&r) - d * e.transpose();
         let n = part.spin_ratio;
         let jw_rot = Matrix3::identity() - e_outer * n;
         let a_bias = w.cross(&w.cross(&r))
@@ -143,8 +140,20 @@ pub fn add_parts(
             + rel_speed * rel_speed * dd
             + rel_accel * d;
         let lin = gravity * part.mass - a_bias * part.mass;
-        out.mass += jp.transpose() * jp * part.mass;
-        out.force += jp.transpose() * lin;
+        let m = part.mass;
+        let a_m = a * m;
+        let ata_m = a.transpose() * a_m;
+        let a_t_lin = a.transpose() * lin;
+        for i in 0..3 {
+            out.mass[(i, i)] += m;
+            out.force[i] += lin[i];
+            out.force[3 + i] += a_t_lin[i];
+            for j in 0..3 {
+                out.mass[(i, 3 + j)] += a_m[(i, j)];
+                out.mass[(3 + j, i)] += a_m[(i, j)];
+                out.mass[(3 + i, 3 + j)] += ata_m[(i, j)];
+            }
+        }
         if part.inertia != Matrix3::zeros() {
             let j_world = body.rotation * part.inertia * body.rotation.transpose();
             let omega_part = w + e * (n * spin_speed);
