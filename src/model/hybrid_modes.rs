@@ -16,7 +16,7 @@ use faer::Mat;
 use nalgebra::{Matrix6, Vector3};
 
 use super::hybrid_scene::HybridScene;
-use super::modes::{Direction, ModeKind};
+use super::modes::{oscillatory_eigenpairs, Direction, ModeKind, C};
 use crate::ode::OdeProblem;
 
 const DIRECTIONS: [Direction; 6] = [
@@ -55,8 +55,6 @@ pub struct HybridMode {
     /// powertrain's kinetic energy.
     pub engine_directions: [f64; 6],
 }
-
-type C = (f64, f64);
 
 fn abs2(a: C) -> f64 {
     a.0 * a.0 + a.1 * a.1
@@ -117,22 +115,10 @@ impl HybridScene {
         }
         // The right-hand side is already explicit (engine rows are accelerations): A = ∂f/∂y.
         let masses: Vec<Matrix6<f64>> = engine.body_mass(engine.fade_start(), &y_eq[..ne]);
-        let a = jac;
-        let eig = a
-            .eigen()
-            .map_err(|e| format!("eigen solver failed: {e:?}"))?;
-        let s = eig.S();
-        let u = eig.U();
-        let mut modes = Vec::new();
-        for k in 0..n {
-            let (re, im) = (s[k].re, s[k].im);
-            let mag = re.hypot(im);
-            if im <= 1e-6 * mag.max(1.0) || mag < 1e-3 {
-                continue;
-            }
-            let x: Vec<C> = (0..n).map(|i| (u[(i, k)].re, u[(i, k)].im)).collect();
-            modes.push(self.describe_mode(y_eq, &x, (re, im), &masses));
-        }
+        let mut modes: Vec<HybridMode> = oscillatory_eigenpairs(&jac)?
+            .into_iter()
+            .map(|(lam, x)| self.describe_mode(y_eq, &x, lam, &masses))
+            .collect();
         modes.sort_by(|a, b| a.frequency_hz.total_cmp(&b.frequency_hz));
         Ok(modes)
     }

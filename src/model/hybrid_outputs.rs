@@ -5,7 +5,7 @@
 use nalgebra::Vector3;
 
 use super::hybrid_scene::HybridScene;
-use super::outputs::{BodyMotion, EngineOutputs};
+use super::outputs::EngineOutputs;
 use crate::ode::ProblemError;
 
 /// All outputs of the hybrid scene at one time.
@@ -28,54 +28,17 @@ impl HybridScene {
     /// Outputs at `(t, y)`.
     pub fn outputs(&self, t: f64, y: &[f64]) -> Result<HybridOutputs, ProblemError> {
         self.check_state(y)?;
-        let engine = self.engine();
-        let nb = engine.body_count();
         let ne = self.engine_dim();
         let m = self.modes_count();
         let ev = self.evaluate(t, y);
-        let acc = engine.accelerations(&ev.engine)?;
+        let engine = self.engine().outputs_from(t, &y[..ne], &ev.engine)?;
         let mut f = vec![0.0; y.len()];
         self.write_rhs(y, &ev, &mut f)?;
         let eta_acc = &f[self.eta_rate_index()..];
-        let motion = |b: usize| {
-            let q = &y[6 * b..6 * b + 6];
-            let k = &ev.engine.kinematics[b];
-            BodyMotion {
-                displacement: [q[0], q[1], q[2]],
-                rotation: [q[3], q[4], q[5]],
-                velocity: arr(&k.velocity),
-                angular_velocity: arr(&k.omega),
-                acceleration: [acc[b][0], acc[b][1], acc[b][2]],
-                angular_acceleration: [acc[b][3], acc[b][4], acc[b][5]],
-            }
-        };
-        let mut mount_forces = Vec::with_capacity(ev.engine.mounts.len());
-        let mut mount_deflections = Vec::with_capacity(ev.engine.mounts.len());
-        for r in &ev.engine.mounts {
-            match r {
-                Some(r) => {
-                    mount_forces.push(arr(&(-r.force)));
-                    mount_deflections.push(arr(&r.deflection));
-                }
-                None => {
-                    mount_forces.push([0.0; 3]);
-                    mount_deflections.push([0.0; 3]);
-                }
-            }
-        }
         let (wheel, seat) = self.output_points();
         let eta = &y[ne..ne + m];
         Ok(HybridOutputs {
-            engine: EngineOutputs {
-                time: t,
-                mount_forces,
-                mount_deflections,
-                housing: motion(nb - 1),
-                monoblock: motion(0),
-                crank_angle: y[engine.crank_index()],
-                crank_speed: engine.inputs().crank_speed.at(t),
-                excitation: engine.excitation(t),
-            },
+            engine,
             steering_wheel_acceleration: arr(&self.point_translation(wheel, eta_acc)),
             seat_acceleration: arr(&self.point_translation(seat, eta_acc)),
             chassis_displacements: self

@@ -100,7 +100,31 @@ fn describe(kind: &ModeKind) -> String {
     }
 }
 
-type C = (f64, f64);
+pub(crate) type C = (f64, f64);
+
+/// Eigenpairs `(λ, x)` of the state matrix `a` with `Im λ > 0`: one per oscillatory mode (its
+/// conjugate and the real, non-oscillating eigenvalues are dropped, as are rigid-body zeros).
+pub(crate) fn oscillatory_eigenpairs(a: &Mat<f64>) -> Result<Vec<(C, Vec<C>)>, String> {
+    let n = a.nrows();
+    let eig = a
+        .eigen()
+        .map_err(|e| format!("eigen solver failed: {e:?}"))?;
+    let s = eig.S();
+    let u = eig.U();
+    let mut pairs = Vec::new();
+    for k in 0..n {
+        let (re, im) = (s[k].re, s[k].im);
+        let mag = re.hypot(im);
+        if im <= 1e-6 * mag.max(1.0) || mag < 1e-3 {
+            continue;
+        }
+        pairs.push((
+            (re, im),
+            (0..n).map(|i| (u[(i, k)].re, u[(i, k)].im)).collect(),
+        ));
+    }
+    Ok(pairs)
+}
 
 fn cmul(a: C, b: C) -> C {
     (a.0 * b.0 - a.1 * b.1, a.0 * b.1 + a.1 * b.0)
@@ -164,22 +188,10 @@ impl GroundScene {
             }
         }
         let a = mass.partial_piv_lu().solve(&jac);
-        let eig = a
-            .eigen()
-            .map_err(|e| format!("eigen solver failed: {e:?}"))?;
-        let s = eig.S();
-        let u = eig.U();
-        let mut modes = Vec::new();
-        for k in 0..n {
-            let lam = s[k];
-            let (re, im) = (lam.re, lam.im);
-            let mag = re.hypot(im);
-            if im <= 1e-6 * mag.max(1.0) || mag < 1e-3 {
-                continue;
-            }
-            let x: Vec<C> = (0..n).map(|i| (u[(i, k)].re, u[(i, k)].im)).collect();
-            modes.push(self.describe_mode(y_eq, &x, (re, im), &masses));
-        }
+        let mut modes: Vec<Mode> = oscillatory_eigenpairs(&a)?
+            .into_iter()
+            .map(|(lam, x)| self.describe_mode(y_eq, &x, lam, &masses))
+            .collect();
         modes.sort_by(|a, b| a.frequency_hz.total_cmp(&b.frequency_hz));
         Ok(modes)
     }

@@ -3,7 +3,7 @@
 
 use nalgebra::Vector3;
 
-use super::ground_scene::GroundScene;
+use super::ground_scene::{Evaluation, GroundScene};
 use crate::ode::ProblemError;
 
 /// Motion of one body's reference point (its centre of mass in the reference configuration).
@@ -50,7 +50,18 @@ impl GroundScene {
     pub fn outputs(&self, t: f64, y: &[f64]) -> Result<EngineOutputs, ProblemError> {
         self.check_state(y)?;
         let ev = self.evaluate(t, y);
-        let acc = self.accelerations(&ev)?;
+        self.outputs_from(t, y, &ev)
+    }
+
+    /// Outputs from an evaluation `ev` of the engine at `(t, y)`, `y` the engine states (the
+    /// hybrid scene passes one whose mount forces act against the moving chassis).
+    pub(crate) fn outputs_from(
+        &self,
+        t: f64,
+        y: &[f64],
+        ev: &Evaluation,
+    ) -> Result<EngineOutputs, ProblemError> {
+        let acc = self.accelerations(ev)?;
         let nb = self.body_count();
         let motion = |b: usize| {
             let q = &y[6 * b..6 * b + 6];
