@@ -5,7 +5,7 @@
 //! and speed: CPU seconds per simulated second, the real-time factor and the integrator's work
 //! per simulated second.
 //!
-//! `cargo run --release --example realtime -- [--window SECONDS] [--scene N] [--cutoff HZ] [--rtol R] [--atol A]
+//! `cargo run --release --example realtime -- [--window SECONDS] [--scene N] [--cutoff HZ] [--rtol R] [--atol A] [--max-order Q]
 //! [--without gas,mass,balance,gyro,ring,nonlinear,flex]`
 
 use std::time::Instant;
@@ -59,6 +59,9 @@ fn main() -> Result<(), String> {
             if let Some(r) = value("--rtol") {
                 settings.rel_tol = r;
                 settings.abs_tol = r * 1e-3;
+            }
+            if let Some(q) = value("--max-order") {
+                settings.max_order = q as i32;
             }
             if let Some(a) = value("--atol") {
                 settings.abs_tol = a;
