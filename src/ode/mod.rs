@@ -3,6 +3,14 @@
 //! The integrator knows nothing about the model: it integrates any [`OdeProblem`] in linearly
 //! implicit form `M(t, y) y' = f(t, y)`. See [`Bdf`] for the driver API.
 //!
+//! - Output times: [`Bdf::advance_to`] lands exactly on a stop time (the last step is
+//!   shortened); [`Bdf::advance_past`] steps freely and interpolates, so dense output times cost
+//!   no extra steps. [`Bdf::restart_at`] restarts from an interpolated state after an input jump.
+//! - Newton matrix `M − γ J`: dense (faer LU; analytic or finite-difference `J`) by default. A
+//!   problem whose Jacobian is block-diagonal plus low rank (a modal body coupled through a few
+//!   forces) declares it with [`OdeProblem::jacobian_structure`]; the integrator then solves by
+//!   the Woodbury identity ([`BlockLowRankLu`]) and never forms an `n × n` matrix.
+//!
 //! ```
 //! use engine_mount_chassis::ode::{Bdf, BdfOptions, OdeProblem, ProblemError, Tolerance};
 //!
