@@ -21,16 +21,6 @@ use super::hybrid_scene::HybridScene;
 use crate::ode::{BlockLowRankJacobian, BlockLowRankShape, ProblemError};
 
 impl HybridScene {
-    /// Number of connected mounts (each contributes rank 6 to the coupling).
-    fn connected_mounts(&self) -> usize {
-        self.engine()
-            .mounts()
-            .iter()
-            .zip(self.links())
-            .filter(|(m, l)| m.is_some() && l.is_some())
-            .count()
-    }
-
     /// The shape of [`Self::coupled_jacobian`]: the engine block, one 2×2 block per mode.
     pub fn coupled_jacobian_shape(&self) -> BlockLowRankShape {
         let ne = self.engine_dim();
@@ -39,7 +29,7 @@ impl HybridScene {
         blocks.extend((0..m).map(|k| vec![ne + k, ne + m + k]));
         BlockLowRankShape {
             blocks,
-            rank: 6 * self.connected_mounts(),
+            rank: 6 * self.connected_mounts().count(),
         }
     }
 
@@ -59,15 +49,7 @@ impl HybridScene {
         let ne = self.engine_dim();
         let m = self.modes_count();
         let (eta_row, rate_row) = (self.eta_index(), self.eta_rate_index());
-        let n_links = self.connected_mounts();
-        let connected: Vec<(usize, usize)> = self
-            .engine()
-            .mounts()
-            .iter()
-            .zip(self.links())
-            .enumerate()
-            .filter_map(|(i, (mount, link))| mount.as_ref().and(*link).map(|p| (i, p)))
-            .collect();
+        let n_links = self.connected_mounts().count();
         let mount_force = |ev: &super::hybrid_scene::HybridEvaluation, i: usize| {
             ev.engine.mounts[i]
                 .map(|r| r.force)
@@ -93,7 +75,7 @@ impl HybridScene {
                 block[(r, c)] = (fp[r] - f0[r]) / h;
             }
             let mut v = j.v_mut();
-            for (a, &(i, _)) in connected.iter().enumerate() {
+            for (a, (i, _, _)) in self.connected_mounts().enumerate() {
                 let df = (mount_force(&ev_p, i) - mount_force(&ev, i)) / h;
                 for d in 0..3 {
                     v[(c, 3 * n_links + 3 * a + d)] = df[d];
@@ -117,10 +99,7 @@ impl HybridScene {
         let h = &ev.engine.kinematics[hb];
         let housing_mass = ev.engine.dynamics[hb].mass.lu();
         let reference = self.engine().bodies()[hb].reference;
-        for (a, &(i, p)) in connected.iter().enumerate() {
-            let Some(mount) = &self.engine().mounts()[i] else {
-                continue;
-            };
+        for (a, (i, mount, p)) in self.connected_mounts().enumerate() {
             let Some(r) = ev.engine.mounts[i] else {
                 continue;
             };

@@ -229,13 +229,10 @@ impl HybridScene {
         let (uh, th_h) = disp(hb);
         let chassis = self.chassis();
         let mut mount_strain = 0.0;
-        for (i, (mount, link)) in engine.mounts().iter().zip(self.links()).enumerate() {
-            let (Some(mount), Some(p)) = (mount, link) else {
-                continue;
-            };
+        for (i, mount, p) in self.connected_mounts() {
             let r = kin_h.rotation * (mount.bracket - engine.bodies()[hb].reference);
             let mut attach = [(0.0, 0.0); 3];
-            for (s, e) in chassis.points[*p].shape.iter().zip(eta_shape) {
+            for (s, e) in chassis.points[p].shape.iter().zip(eta_shape) {
                 for a in 0..3 {
                     attach[a].0 += s[a] * e.0;
                     attach[a].1 += s[a] * e.1;

@@ -23,6 +23,7 @@ use faer::MatMut;
 use nalgebra::Vector3;
 
 use super::ground_scene::{Evaluation, GroundScene, Mode, StaticsError};
+use super::mount::Mount;
 use super::statics::{damped_newton, NewtonFailure};
 use crate::cms::ReducedChassis;
 use crate::fe::chassis::{SEAT_RAIL, STEERING_WHEEL};
@@ -205,6 +206,16 @@ impl HybridScene {
         &self.links
     }
 
+    /// The connected mounts: (index among the configured mounts, the mount, its chassis point).
+    pub fn connected_mounts(&self) -> impl Iterator<Item = (usize, &Mount, usize)> + '_ {
+        self.engine
+            .mounts()
+            .iter()
+            .zip(&self.links)
+            .enumerate()
+            .filter_map(|(i, (mount, link))| Some((i, mount.as_ref()?, (*link)?)))
+    }
+
     /// Number of engine states (the first block of the state vector).
     pub fn engine_dim(&self) -> usize {
         self.engine.dim()
@@ -258,16 +269,13 @@ impl HybridScene {
         let nonlinear = mode.nonlinear_mounts || self.engine.effects().mount_nonlinearity;
         let inputs = self.engine.inputs();
         let mut modal_force = vec![0.0; m];
-        for (i, (mount, link)) in self.engine.mounts().iter().zip(&self.links).enumerate() {
-            let (Some(mount), Some(p)) = (mount, link) else {
-                continue;
-            };
+        for (i, mount, p) in self.connected_mounts() {
             let h = &ev.kinematics[hb];
             let local = mount.bracket - reference;
             let x = h.point(&local);
             let xv = h.point_velocity(&local);
-            let a = self.point_translation(*p, eta);
-            let av = self.point_translation(*p, eta_rate);
+            let a = self.point_translation(p, eta);
+            let av = self.point_translation(p, eta_rate);
             let r = mount.response(
                 &(x - mount.attachment - a),
                 &(xv - av),
@@ -280,7 +288,7 @@ impl HybridScene {
             let h = ev.kinematics[hb];
             ev.dynamics[hb].add_point_force(&h, &x, &(r.force - on_ground));
             ev.mounts[i] = Some(r);
-            for (g, s) in modal_force.iter_mut().zip(&self.chassis.points[*p].shape) {
+            for (g, s) in modal_force.iter_mut().zip(&self.chassis.points[p].shape) {
                 *g -= s[0] * r.force.x + s[1] * r.force.y + s[2] * r.force.z;
             }
         }

@@ -513,10 +513,6 @@ impl Bdf {
         if t_out > self.s.tn {
             self.step_until(problem, t_out, false)?;
         }
-        if t_out == self.s.tn {
-            y_out.copy_from_slice(&self.s.zn.zn[0]);
-            return Ok(());
-        }
         self.interpolate(t_out, 0, y_out)
     }
 
