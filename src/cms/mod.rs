@@ -18,7 +18,7 @@
 //!
 //! Damping: modal, per [`DampingTable`]; with [`ReductionSpec::discrete_dampers`] the FE model's
 //! suspension dampers are added as `φ_kᵀ C φ_k / (2 ω_k)` (about 21–28 % in the rigid-body modes
-//! on the suspension, within 7 % of a full damped solve in `tests/cms_damping.rs`).
+//! on the suspension, within 7 % of a full damped solve in `tests/cms/damping.rs`).
 //!
 //! Mode selection ([`ModeSelection`]) applies to the fixed-interface modes; all constraint modes
 //! are always kept, so the reduced chassis has `n_fixed + 3 × mounts` (or `6 ×`) modes, the

@@ -1,6 +1,6 @@
 //! The FMU's C ABI driven through the built library (dlopen), as a simulation tool drives it.
 
-mod common;
+use crate::common;
 
 use common::*;
 use fmi_sys::fmi2::{fmi2StatusKind_fmi2LastSuccessfulTime, fmi2StatusKind_fmi2Terminated};

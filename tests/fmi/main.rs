@@ -1,0 +1,4 @@
+//! End-to-end tests of the FMI 2.0 C ABI: the built cdylib loaded with libloading.
+
+mod abi;
+mod common;

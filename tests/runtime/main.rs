@@ -1,0 +1,4 @@
+//! Integration tests of the co-simulation runtime (`src/cosim`): scene 2 stepping and the hard cases.
+
+mod hard_cases;
+mod hybrid_cosim;
