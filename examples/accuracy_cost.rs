@@ -16,8 +16,7 @@
 use std::time::Instant;
 
 use engine_mount_chassis::cosim::{
-    ChassisSettings, Counters, EffectSwitches, Inputs, Settings, Signal, Simulation,
-    RPM_TO_RAD_PER_S,
+    BodyOptions, Counters, Effects, Inputs, Settings, Signal, Simulation, RPM_TO_RAD_PER_S,
 };
 
 /// One run's samples: every mount force component at each communication point in the window.
@@ -210,7 +209,7 @@ fn main() {
         // most complete model; accuracy knobs against the reference of the default model.
         let complete = if scene == 2 {
             let s = Settings {
-                chassis: ChassisSettings {
+                chassis: BodyOptions {
                     mode_cutoff_hz: COMPLETE_CUTOFF_HZ,
                     ..base.chassis.clone()
                 },
@@ -263,7 +262,7 @@ fn main() {
             (
                 "without gyroscopic terms".to_owned(),
                 Settings {
-                    effects: EffectSwitches {
+                    effects: Effects {
                         gyroscopic: false,
                         ..base.effects
                     },
@@ -273,8 +272,8 @@ fn main() {
             (
                 "rigid ring carriers".to_owned(),
                 Settings {
-                    effects: EffectSwitches {
-                        ring_carrier: false,
+                    effects: Effects {
+                        ring_carrier_elasticity: false,
                         ..base.effects
                     },
                     ..base.clone()
@@ -286,7 +285,7 @@ fn main() {
                 model_knobs.push((
                     format!("chassis cut-off {cutoff:.0} Hz"),
                     Settings {
-                        chassis: ChassisSettings {
+                        chassis: BodyOptions {
                             mode_cutoff_hz: cutoff,
                             ..base.chassis.clone()
                         },
@@ -297,7 +296,7 @@ fn main() {
             model_knobs.push((
                 "rigid chassis".to_owned(),
                 Settings {
-                    effects: EffectSwitches {
+                    effects: Effects {
                         chassis_flexibility: false,
                         ..base.effects
                     },

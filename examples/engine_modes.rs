@@ -1,17 +1,16 @@
 //! Prints the eigenmodes of the engine supported by ground next to the paper's Table 1.
 //!
-//! `cargo run --release --example engine_modes [config.json]`
+//! `cargo run --release --example engine_modes [vehicle.json]`
 
-use engine_mount_chassis::model::{
-    mode_table, EngineConfig, GroundScene, TABLE1_RIGID, TABLE1_RING_CARRIER,
-};
+use engine_mount_chassis::model::{mode_table, CoupledModel, VehicleConfig};
+use engine_mount_chassis::paper::{TABLE1_RIGID, TABLE1_RING_CARRIER};
 
 fn main() -> Result<(), Box<dyn std::error::Error>> {
     let cfg = match std::env::args().nth(1) {
-        Some(path) => EngineConfig::from_json(&std::fs::read_to_string(path)?)?,
-        None => EngineConfig::default(),
+        Some(path) => VehicleConfig::from_file(path.as_ref())?,
+        None => VehicleConfig::default(),
     };
-    let mut scene = GroundScene::new(cfg)?;
+    let mut scene = CoupledModel::on_ground(&cfg)?;
     let y = scene.static_equilibrium(0.0)?;
     let modes = scene.modes(&y)?;
     println!("Engine supported by ground, linearised at the static equilibrium");

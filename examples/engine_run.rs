@@ -6,7 +6,7 @@
 use std::time::Instant;
 
 use engine_mount_chassis::model::orders::order_amplitude;
-use engine_mount_chassis::model::{EngineConfig, GroundScene};
+use engine_mount_chassis::model::{CoupledModel, VehicleConfig};
 use engine_mount_chassis::ode::{Bdf, BdfOptions, Tolerance};
 
 fn arg(i: usize, default: f64) -> f64 {
@@ -23,13 +23,13 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         arg(3, 40.0) as usize,
         arg(4, 1e-6),
     );
-    let mut cfg = EngineConfig::default();
-    cfg.gas.load = load;
-    cfg.excitation_fade_in = arg(5, 0.1);
-    let mut scene = GroundScene::new(cfg)?;
-    let y0 = scene.static_equilibrium(0.0)?;
+    let mut cfg = VehicleConfig::default();
+    cfg.engine.gas.load = load;
+    cfg.engine.excitation_fade_in = arg(5, 0.1);
+    let mut scene = CoupledModel::on_ground(&cfg)?;
     let w = rpm * std::f64::consts::PI / 30.0;
     scene.set_crank_speed(0.0, w, 0.0)?;
+    let y0 = scene.static_equilibrium(0.0)?;
     let opts = BdfOptions {
         rtol,
         atol: Tolerance::Scalar(rtol * 1e-3),
@@ -42,12 +42,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     let window = (revs / 2).max(2) & !1;
     let settle = (revs - window) as f64 * t_rev;
     bdf.advance_to(&mut scene, settle)?;
-    let names: Vec<String> = scene
-        .config()
-        .mounts
-        .iter()
-        .map(|m| m.name.clone())
-        .collect();
+    let names: Vec<String> = cfg.mounts.iter().map(|m| m.name.clone()).collect();
     let mut samples = vec![Vec::new(); names.len()];
     for k in 1..=window * spr {
         let t = settle + t_rev * k as f64 / spr as f64;

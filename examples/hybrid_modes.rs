@@ -6,17 +6,9 @@
 //! them; engine modes are matched to the ground modes by the direction of their engine motion.
 
 use engine_mount_chassis::cms::reduce_detailed;
-use engine_mount_chassis::model::hybrid_chassis::{describe_modes, reduction_spec};
-use engine_mount_chassis::model::hybrid_modes::{hybrid_mode_table, HybridModeKind};
-use engine_mount_chassis::model::{
-    mode_table, Direction, EngineConfig, GroundScene, HybridScene, ModeKind,
-};
-
-/// Paper Table 1, middle column (Hz).
-const TABLE1_HYBRID: [f64; 17] = [
-    3.13, 3.49, 4.53, 7.38, 10.38, 10.76, 12.00, 31.50, 32.07, 42.95, 46.20, 52.00, 66.53, 95.07,
-    101.42, 128.17, 142.33,
-];
+use engine_mount_chassis::model::scene::{reduction_spec, BodyOptions};
+use engine_mount_chassis::model::{mode_table, CoupledModel, Direction, ModeKind, VehicleConfig};
+use engine_mount_chassis::paper::TABLE1_HYBRID;
 
 fn main() -> Result<(), Box<dyn std::error::Error>> {
     let args: Vec<String> = std::env::args().skip(1).collect();
@@ -34,10 +26,17 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         .map(|f| f.parse())
         .transpose()?
         .unwrap_or(200.0);
-    let spec = reduction_spec(cutoff, max_modes, args.iter().any(|a| a == "--bar"));
+    let cfg = VehicleConfig::default();
+    let options = BodyOptions {
+        mode_cutoff_hz: cutoff,
+        max_modes,
+        stiffening_bar: args.iter().any(|a| a == "--bar"),
+        ..BodyOptions::default()
+    };
+    let (spec, _) = reduction_spec(&cfg, &options)?;
     let started = std::time::Instant::now();
     let reduction = reduce_detailed(&spec)?;
-    let labels = describe_modes(&reduction)?;
+    let labels = reduction.describe_modes()?;
     let chassis = reduction.reduced;
     println!(
         "chassis (Craig-Bampton, {:?}): {} modes, {:.2}..{:.2} Hz, reduced in {:.2} s",
@@ -48,8 +47,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         started.elapsed().as_secs_f64()
     );
 
-    let cfg = EngineConfig::default();
-    let mut ground = GroundScene::new(cfg.clone())?;
+    let mut ground = CoupledModel::on_ground(&cfg)?;
     let y_ground = ground.static_equilibrium(0.0)?;
     let alone = ground.modes(&y_ground)?;
     println!(
@@ -57,18 +55,18 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         mode_table(&alone)
     );
 
-    let mut hybrid = HybridScene::new(GroundScene::new(cfg)?, chassis)?;
+    let mut hybrid = CoupledModel::with_body(&cfg, chassis)?;
     let started = std::time::Instant::now();
     let y = hybrid.static_equilibrium(0.0)?;
     let modes = hybrid.modes(&y)?;
     println!(
         "engine in the elastic chassis (statics + modes in {:.2} s):\n{}",
         started.elapsed().as_secs_f64(),
-        hybrid_mode_table(&modes)
+        mode_table(&modes)
     );
     println!("chassis-dominated coupled modes below 60 Hz, by their uncoupled FE mode:");
     for m in &modes {
-        if let HybridModeKind::Chassis { mode, .. } = &m.kind {
+        if let ModeKind::Body { mode, .. } = &m.kind {
             if m.frequency_hz < 60.0 {
                 println!("  {:7.2} Hz  {}", m.frequency_hz, labels[*mode].summary());
             }
@@ -77,7 +75,6 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     let fz: f64 = hybrid
         .outputs(0.0, &y)
         .map_err(|e| format!("{e:?}"))?
-        .engine
         .mount_forces
         .iter()
         .map(|f| f[2])
@@ -107,16 +104,17 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
                 .unwrap_or(0);
                 modes
                     .iter()
-                    .filter(|h| !matches!(&h.kind, HybridModeKind::Engine(ModeKind::RingCarrier { .. })))
+                    .filter(|h| !matches!(&h.kind, ModeKind::RingCarrier { .. }))
                     .max_by(|a, b| {
-                    (a.engine_kinetic_fraction * a.engine_directions[i])
-                        .total_cmp(&(b.engine_kinetic_fraction * b.engine_directions[i]))
-                })
+                        (a.powertrain_fraction * a.powertrain_directions[i])
+                            .total_cmp(&(b.powertrain_fraction * b.powertrain_directions[i]))
+                    })
             }
+            ModeKind::Body { .. } => None,
             ModeKind::RingCarrier { direction, .. } => modes
                 .iter()
                 .filter(|h| {
-                    matches!(&h.kind, HybridModeKind::Engine(ModeKind::RingCarrier { direction: e, .. }) if e == direction)
+                    matches!(&h.kind, ModeKind::RingCarrier { direction: e, .. } if e == direction)
                 })
                 .min_by(|a, b| {
                     (a.frequency_hz - g.frequency_hz)
@@ -129,6 +127,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
             ModeKind::RingCarrier { bushing, direction } => {
                 format!("ring carrier {bushing} {direction:?}")
             }
+            ModeKind::Body { .. } => continue,
         };
         match best {
             Some(h) => println!(

@@ -7,9 +7,9 @@
 use std::time::Instant;
 
 use engine_mount_chassis::cms::{reduce, ModeSelection};
-use engine_mount_chassis::model::hybrid_chassis::reduction_spec;
 use engine_mount_chassis::model::orders::order_amplitude;
-use engine_mount_chassis::model::{EngineConfig, GroundScene, HybridScene};
+use engine_mount_chassis::model::scene::{reduction_spec, BodyOptions};
+use engine_mount_chassis::model::{CoupledModel, VehicleConfig};
 use engine_mount_chassis::ode::{Bdf, BdfOptions, OdeProblem, Tolerance};
 
 fn arg(i: usize, default: f64) -> f64 {
@@ -69,9 +69,10 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         "scene", "states", "reduce s", "cpu s", "cpu/sim", "steps", "rhs", "jacobians", "factoris."
     );
 
-    let mut ground = GroundScene::new(EngineConfig::default())?;
-    let y0 = ground.static_equilibrium(0.0)?;
+    let cfg = VehicleConfig::default();
+    let mut ground = CoupledModel::on_ground(&cfg)?;
     ground.set_crank_speed(0.0, w, 0.0)?;
+    let y0 = ground.static_equilibrium(0.0)?;
     let (cpu, n, _) = run(&mut ground, &y0, rpm, revs, rtol, |_, _, _| 0.0)?;
     println!(
         "{:<34} {:>6} {:>9} {:>7.3} {:>8.2} {:>6} {:>6} {:>9} {:>10}",
@@ -87,7 +88,11 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     );
 
     for cutoff_hz in [60.0, 200.0, 400.0] {
-        let spec = reduction_spec(cutoff_hz, 0, false);
+        let options = BodyOptions {
+            mode_cutoff_hz: cutoff_hz,
+            ..BodyOptions::default()
+        };
+        let (spec, _) = reduction_spec(&cfg, &options)?;
         let started = Instant::now();
         let chassis = reduce(&spec)?;
         let reduce_s = started.elapsed().as_secs_f64();
@@ -95,12 +100,13 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
             unreachable!("selected by cut-off");
         };
         let label = format!("2: CB < {cut:.0} Hz: {} modes", chassis.n_modes());
-        let mut hybrid = HybridScene::new(GroundScene::new(EngineConfig::default())?, chassis)?;
+        let mut hybrid = CoupledModel::with_body(&cfg, chassis)?;
+        hybrid.set_crank_speed(0.0, w, 0.0)?;
         let y0 = hybrid.static_equilibrium(0.0)?;
-        hybrid.engine_mut().set_crank_speed(0.0, w, 0.0)?;
         let (cpu, n, samples) = run(&mut hybrid, &y0, rpm, revs, rtol, |h, t, y| {
             h.outputs(t, y)
-                .map(|o| o.steering_wheel_acceleration[2])
+                .ok()
+                .and_then(|o| o.point("steering_wheel").map(|p| p.acceleration[2]))
                 .unwrap_or(f64::NAN)
         })?;
         let orders: Vec<String> = ORDERS

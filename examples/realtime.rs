@@ -50,7 +50,7 @@ fn main() -> Result<(), String> {
                     "mass" => e.mass_forces = false,
                     "balance" => e.balance_shaft = false,
                     "gyro" => e.gyroscopic = false,
-                    "ring" => e.ring_carrier = false,
+                    "ring" => e.ring_carrier_elasticity = false,
                     "nonlinear" => e.mount_nonlinearity = false,
                     "flex" => e.chassis_flexibility = false,
                     other => return Err(format!("unknown effect {other}")),

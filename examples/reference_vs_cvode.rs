@@ -22,7 +22,7 @@ mod cvode {
     use std::time::Instant;
 
     use engine_mount_chassis::cosim::{
-        ChassisSettings, Inputs, Outputs, Scene, Settings, Signal, RPM_TO_RAD_PER_S,
+        BodyOptions, Inputs, Outputs, Scene, Settings, Signal, RPM_TO_RAD_PER_S,
     };
     use engine_mount_chassis::ode::{Bdf, BdfOptions, OdeProblem, Tolerance};
     use faer::linalg::solvers::Solve;
@@ -36,9 +36,9 @@ mod cvode {
     fn scene(number: i32) -> (Scene, Vec<f64>) {
         let settings = Settings {
             scene: number,
-            chassis: ChassisSettings {
+            chassis: BodyOptions {
                 mode_cutoff_hz: 100.0,
-                ..ChassisSettings::default()
+                ..BodyOptions::default()
             },
             ..Settings::default()
         };

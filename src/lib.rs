@@ -15,3 +15,4 @@ pub mod fe;
 pub mod fmi2;
 pub mod model;
 pub mod ode;
+pub mod paper;

@@ -105,7 +105,7 @@ def cmd_runup(args) -> int:
 
 STUDY_CASES = {
     "4 mounts": {"scene": 2},
-    "3 mounts + stiffening bar": {"scene": 2, "configFile": "engine_three_mounts.json",
+    "3 mounts + stiffening bar": {"scene": 2, "configFile": "vehicle_three_mounts.json",
                                   "chassis.stiffeningBar": True},
 }
 

@@ -44,7 +44,7 @@ def test_package_layout(fmu_path):
     with zipfile.ZipFile(fmu_path) as z:
         names = set(z.namelist())
     assert {"modelDescription.xml", "binaries/linux64/EngineMountChassis.so",
-            "documentation/index.html", "resources/engine.json"} <= names
+            "documentation/index.html", "resources/vehicle.json"} <= names
     md = read_model_description(str(fmu_path))
     assert md.coSimulation.canGetAndSetFMUstate and md.coSimulation.canSerializeFMUstate
     assert md.coSimulation.canInterpolateInputs
@@ -61,7 +61,7 @@ POWERTRAIN_MASS = 180.0
 
 
 def config_gravity() -> float:
-    return json.loads((ROOT / "resources" / "engine.json").read_text())["gravity"]
+    return json.loads((ROOT / "resources" / "vehicle.json").read_text())["gravity"]
 
 
 def test_simulate_rpm_ramp_ground_scene(fmu_path):

@@ -1,5 +1,6 @@
 //! The chassis reduction: body description → FE model → Craig-Bampton → recovery rows and
-//! modal damping of the named points the coupled model needs.
+//! modal damping of the named points the coupled model needs (the interface nodes, by name, then
+//! the output points).
 
 use super::craig_bampton::{craig_bampton, CraigBampton};
 use super::error::CmsError;
@@ -8,6 +9,8 @@ use super::spec::ReductionSpec;
 use crate::fe::assembly::{assemble, mat_vec, Assembled, SparseMat};
 use crate::fe::chassis::Chassis;
 use crate::fe::dof::{DofMap, DOF_PER_NODE};
+use crate::fe::eigen::Modes;
+use crate::fe::modal::{describe, ModeDescription};
 
 /// A reduction together with the full model it came from, for verification and tools. The
 /// coupled model needs only [`Reduction::reduced`]; use [`reduce`] to drop the rest.
@@ -25,6 +28,18 @@ pub struct Reduction {
     pub reduced: ReducedChassis,
 }
 
+impl Reduction {
+    /// The FE description (torsion, steering wheel, front end, …) of every reduced mode, in the
+    /// order of [`ReducedChassis::omega`].
+    pub fn describe_modes(&self) -> Result<Vec<ModeDescription>, CmsError> {
+        let modes = Modes {
+            eigenvalues: self.modes.omega.iter().map(|w| w * w).collect(),
+            shapes: self.modes.shapes.clone(),
+        };
+        Ok(describe(&self.chassis.mesh, &self.assembled, &modes)?)
+    }
+}
+
 /// The reduced chassis described by `spec` (only recovery rows are kept).
 pub fn reduce(spec: &ReductionSpec) -> Result<ReducedChassis, CmsError> {
     Ok(reduce_detailed(spec)?.reduced)
@@ -35,7 +50,11 @@ pub fn reduce_detailed(spec: &ReductionSpec) -> Result<Reduction, CmsError> {
     spec.validate()?;
     let chassis = Chassis::build(&spec.chassis)?;
     let assembled = assemble(&chassis.mesh)?;
-    let mounts = chassis.mount_nodes(spec.layout)?;
+    let mounts = spec
+        .interface
+        .iter()
+        .map(|name| Ok((name.clone(), chassis.node(name)?)))
+        .collect::<Result<Vec<_>, CmsError>>()?;
     let mount_ids: Vec<usize> = mounts.iter().map(|(_, id)| *id).collect();
     let interface = assembled
         .dofs

@@ -32,6 +32,15 @@ impl ReducedChassis {
         self.omega.len()
     }
 
+    /// Rigid ground: a body without modes or points (mounts on ground attach at fixed points).
+    pub fn rigid_ground() -> ReducedChassis {
+        ReducedChassis {
+            omega: Vec::new(),
+            zeta: Vec::new(),
+            points: Vec::new(),
+        }
+    }
+
     pub fn point(&self, name: &str) -> Option<&RecoveryPoint> {
         self.points.iter().find(|p| p.name == name)
     }

@@ -5,16 +5,8 @@ use serde::{Deserialize, Serialize};
 
 use super::damping::DampingTable;
 use super::error::CmsError;
-use crate::fe::chassis::{MountLayout, SEAT_RAIL, STEERING_WHEEL};
+use crate::fe::chassis::{MOUNT_NAMES, SEAT_RAIL, STEERING_WHEEL};
 use crate::fe::chassis_config::ChassisConfig;
-
-/// Serde mirror of [`MountLayout`] (the FE type carries no serde derive).
-#[derive(Serialize, Deserialize)]
-#[serde(remote = "MountLayout", rename_all = "snake_case")]
-enum MountLayoutDef {
-    Four,
-    Three,
-}
 
 /// Which DOFs of each mount node form the Craig-Bampton interface.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
@@ -53,9 +45,8 @@ pub enum ModeSelection {
 pub struct ReductionSpec {
     /// The body description.
     pub chassis: ChassisConfig,
-    /// Engine-mount layout: its mount nodes form the interface.
-    #[serde(with = "MountLayoutDef")]
-    pub layout: MountLayout,
+    /// Named body nodes the engine mounts attach to: they form the interface, in this order.
+    pub interface: Vec<String>,
     /// Interface DOFs per mount node.
     pub interface_dofs: InterfaceDofs,
     /// Fixed-interface normal modes to keep.
@@ -72,12 +63,12 @@ pub struct ReductionSpec {
 }
 
 impl Default for ReductionSpec {
-    /// The default body, four mounts with translational interface DOFs, the 40 lowest
+    /// The default body, its four mount nodes with translational interface DOFs, the 40 lowest
     /// fixed-interface modes, ADAMS damping, steering wheel and seat rail recovered.
     fn default() -> Self {
         Self {
             chassis: ChassisConfig::default(),
-            layout: MountLayout::Four,
+            interface: MOUNT_NAMES.iter().map(|n| format!("mount_{n}")).collect(),
             interface_dofs: InterfaceDofs::Translations,
             selection: ModeSelection::Count(40),
             damping: DampingTable::default(),
@@ -98,6 +89,23 @@ impl ReductionSpec {
             }
         }
         self.damping.validate()?;
+        if self.interface.is_empty() {
+            return Err(CmsError::InvalidInput(
+                "interface: no node; the mounts must attach somewhere".into(),
+            ));
+        }
+        for (i, name) in self.interface.iter().enumerate() {
+            if name.is_empty() {
+                return Err(CmsError::InvalidInput(format!(
+                    "interface[{i}] is an empty node name"
+                )));
+            }
+            if self.interface[..i].contains(name) {
+                return Err(CmsError::InvalidInput(format!(
+                    "interface[{i}] = '{name}' is listed twice"
+                )));
+            }
+        }
         if let Some(i) = self.outputs.iter().position(|o| o.is_empty()) {
             return Err(CmsError::InvalidInput(format!(
                 "outputs[{i}] is an empty node name"
@@ -127,7 +135,7 @@ mod tests {
     #[test]
     fn json_round_trip_is_exact_and_canonical() {
         let mut spec = ReductionSpec {
-            layout: MountLayout::Three,
+            interface: vec!["mount_front_left".into(), "mount_rear_left".into()],
             selection: ModeSelection::Count(17),
             ..ReductionSpec::default()
         };
@@ -136,7 +144,10 @@ mod tests {
         let back = ReductionSpec::from_json(&text).unwrap();
         assert_eq!(back, spec);
         assert_eq!(back.canonical_json().unwrap(), text);
-        assert!(text.contains("\"layout\":\"three\""), "{text}");
+        assert!(
+            text.contains("\"interface\":[\"mount_front_left\",\"mount_rear_left\"]"),
+            "{text}"
+        );
     }
 
     #[test]

@@ -6,101 +6,25 @@
 //! The integrator keeps its history across communication points and lands exactly on each one
 //! (a stop time, not a restart); it restarts at order 1 only where an input really jumps.
 
-mod scene;
+pub mod scene;
 mod signals;
 
 pub use crate::cms::CacheSetting;
-pub use scene::{Scene, FMU_MOUNTS};
+pub use crate::model::scene::{BodyOptions, AUTO_CUTOFF_MARGIN};
+pub use crate::model::Effects;
+pub use scene::FMU_MOUNTS;
 pub use signals::{Inputs, Signal};
 
 use std::path::PathBuf;
 
+use crate::model::CoupledModel;
 use crate::ode::{Bdf, BdfOptions, BdfSnapshot, OdeProblem, Tolerance};
 
 /// Name of the default configuration in the FMU's resources folder.
-pub const DEFAULT_CONFIG_NAME: &str = "engine.json";
+pub const DEFAULT_CONFIG_NAME: &str = "vehicle.json";
 
 /// rpm → rad/s.
 pub const RPM_TO_RAD_PER_S: f64 = std::f64::consts::PI / 30.0;
-
-/// Which physical effects a scene includes (a switched-off effect costs nothing).
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
-pub struct EffectSwitches {
-    pub gas_forces: bool,
-    pub mass_forces: bool,
-    pub balance_shaft: bool,
-    pub gyroscopic: bool,
-    pub ring_carrier: bool,
-    pub mount_nonlinearity: bool,
-    /// Scene 2: elastic chassis; off: only its rigid-body modes on the suspension.
-    pub chassis_flexibility: bool,
-}
-
-impl Default for EffectSwitches {
-    fn default() -> Self {
-        EffectSwitches {
-            gas_forces: true,
-            mass_forces: true,
-            balance_shaft: true,
-            gyroscopic: true,
-            ring_carrier: true,
-            mount_nonlinearity: true,
-            chassis_flexibility: true,
-        }
-    }
-}
-
-/// The elastic chassis of scene 2.
-#[derive(Debug, Clone, PartialEq)]
-pub struct ChassisSettings {
-    /// Keep the fixed-interface chassis modes below this frequency, Hz; 0 = automatic, from the
-    /// highest excitation frequency the scene needs (see [`ChassisSettings::cutoff_hz`]).
-    pub mode_cutoff_hz: f64,
-    /// Interface DOFs of the mount nodes: translations (the mounts transmit forces only) or all
-    /// six (adds the rotational constraint modes, up to several kHz, as a stiffness test).
-    pub interface_rotations: bool,
-    /// Factor on every chassis modal damping ratio (1 = the ADAMS table; 0 = undamped).
-    pub modal_damping_scale: f64,
-    /// Highest engine speed (rpm) and engine order the automatic cut-off must cover.
-    pub max_rpm: f64,
-    pub max_engine_order: f64,
-    /// If positive: keep exactly this many fixed-interface modes instead (the cut-off is unused).
-    pub max_modes: i32,
-    /// Transverse stiffening bar between the front girders (paper §7.1).
-    pub stiffening_bar: bool,
-    /// Where the reduced chassis is cached.
-    pub cache: CacheSetting,
-}
-
-/// Margin of the automatic cut-off over the highest excitation frequency: the mode nearest to it
-/// must respond dynamically, not only quasi-statically.
-pub const AUTO_CUTOFF_MARGIN: f64 = 1.2;
-
-impl ChassisSettings {
-    /// The cut-off in use: the explicit one, or max rpm × max order × margin.
-    pub fn cutoff_hz(&self) -> f64 {
-        if self.mode_cutoff_hz > 0.0 {
-            self.mode_cutoff_hz
-        } else {
-            self.max_rpm / 60.0 * self.max_engine_order * AUTO_CUTOFF_MARGIN
-        }
-    }
-}
-
-impl Default for ChassisSettings {
-    fn default() -> Self {
-        ChassisSettings {
-            mode_cutoff_hz: 0.0,
-            modal_damping_scale: 1.0,
-            interface_rotations: false,
-            max_rpm: 2500.0,
-            max_engine_order: 4.5,
-            max_modes: 0,
-            stiffening_bar: false,
-            cache: CacheSetting::Default,
-        }
-    }
-}
 
 /// Everything fixed at initialisation.
 #[derive(Debug, Clone, PartialEq)]
@@ -109,7 +33,7 @@ pub struct Settings {
     pub scene: i32,
     /// Engine configuration JSON; `None` = built-in defaults.
     pub config_file: Option<PathBuf>,
-    pub effects: EffectSwitches,
+    pub effects: Effects,
     /// Combustion load, 0 = idle … 1 = full load (blends the Wiebe pressure curves).
     pub gas_load: f64,
     /// Smooth fade-in of the engine excitation, s (0 = instantly).
@@ -121,7 +45,7 @@ pub struct Settings {
     pub max_order: i32,
     pub stability_limit_detection: bool,
     /// Used by scene 2 only.
-    pub chassis: ChassisSettings,
+    pub chassis: BodyOptions,
 }
 
 impl Default for Settings {
@@ -129,7 +53,7 @@ impl Default for Settings {
         Settings {
             scene: 1,
             config_file: None,
-            effects: EffectSwitches::default(),
+            effects: Effects::default(),
             gas_load: 0.0,
             fade_in_time: 0.1,
             crank_start_angle: 0.0,
@@ -137,7 +61,7 @@ impl Default for Settings {
             abs_tol: 1e-8,
             max_order: 5,
             stability_limit_detection: true,
-            chassis: ChassisSettings::default(),
+            chassis: BodyOptions::default(),
         }
     }
 }
@@ -180,7 +104,9 @@ pub struct StepFailure {
 /// A scene with its integrator, ready to step.
 #[derive(Clone)]
 pub struct Simulation {
-    scene: Scene,
+    scene: CoupledModel,
+    /// How the model was built (for the log).
+    notes: Vec<String>,
     integrator: Bdf,
     /// Communication time and the state there. The integrator steps past communication points
     /// and interpolates, so its own time is usually a little ahead.
@@ -205,13 +131,14 @@ impl Simulation {
             stability_limit_detection: settings.stability_limit_detection,
             ..BdfOptions::default()
         };
-        let mut scene = Scene::build(settings)?;
-        scene.set_inputs(inputs)?;
+        let (mut scene, notes) = scene::build_model(settings)?;
+        scene::apply_inputs(&mut scene, inputs)?;
         options.magnitude_cap = Some(scene.magnitude_caps());
-        let y0 = scene.initial_state(t0)?;
+        let y0 = scene.static_equilibrium(t0).map_err(|e| e.to_string())?;
         let integrator = Bdf::new(&mut scene, t0, &y0, options).map_err(|e| e.to_string())?;
         Ok(Simulation {
             scene,
+            notes,
             integrator,
             time: t0,
             state: y0,
@@ -223,7 +150,12 @@ impl Simulation {
 
     /// Lines for the log describing the scene.
     pub fn describe(&self) -> Vec<String> {
-        self.scene.describe()
+        self.notes.clone()
+    }
+
+    /// The coupled model being integrated.
+    pub fn model(&self) -> &CoupledModel {
+        &self.scene
     }
 
     /// Number of integrator states (what a switched-off effect saves).
@@ -242,19 +174,45 @@ impl Simulation {
     pub fn set_inputs(&mut self, inputs: &Inputs) -> Result<bool, String> {
         inputs.validate()?;
         let t = self.time;
-        let jumped = !self.inputs.continue_into(inputs, t);
+        // With the speed follower the crank speed is a state: a set-point jump bends its
+        // trajectory but does not break it. It only needs a restart when the kink it puts into
+        // the crank acceleration would fail the error test of the next step anyway.
+        let mut compared = *inputs;
+        let mut sharp_kink = false;
+        if self.scene.layout().has_follower() {
+            compared.crank_speed = self.inputs.crank_speed;
+            sharp_kink = self.follower_kink_is_sharp(inputs, t);
+        }
+        let jumped = sharp_kink || !self.inputs.continue_into(&compared, t);
         let previous = self.inputs;
-        self.scene.set_inputs(inputs)?;
+        scene::apply_inputs(&mut self.scene, inputs)?;
         self.inputs = *inputs;
         if jumped {
             if let Err(e) = self.integrator.restart_at(&mut self.scene, t, &self.state) {
                 // Leave everything as it was: the old inputs still describe the integrator.
-                self.scene.set_inputs(&previous)?;
+                scene::apply_inputs(&mut self.scene, &previous)?;
                 self.inputs = previous;
                 return Err(e.to_string());
             }
         }
         Ok(jumped)
+    }
+
+    /// Whether the crank-speed set-point change at `t` bends the follower's acceleration so
+    /// sharply that the next step, at the step size the integrator plans, would fail its error
+    /// test: the jump `Δα' = Δs/τ² + 2Δṡ/τ` in the acceleration's derivative makes a local error
+    /// of about `Δα'·h`, compared with the acceleration's error weight.
+    fn follower_kink_is_sharp(&self, inputs: &Inputs, t: f64) -> bool {
+        let Some((_, acceleration)) = self.scene.layout().follower_states() else {
+            return false;
+        };
+        let tau = self.scene.follower().time_constant;
+        let (old, new) = (&self.inputs.crank_speed, &inputs.crank_speed);
+        let kink = (new.at(t) - old.at(t)).abs() / (tau * tau)
+            + 2.0 * (new.derivative - old.derivative).abs() / tau;
+        let options = self.integrator.options();
+        let weight = options.atol.get(acceleration) + options.rtol * self.state[acceleration].abs();
+        kink * self.integrator.stats().h_next > weight
     }
 
     /// Integrates to `t`, keeping the history for the next call. The integrator takes the
@@ -280,7 +238,7 @@ impl Simulation {
     /// Outputs at the communication time, with accelerations from one evaluation of the
     /// equations of motion.
     pub fn outputs(&mut self) -> Result<Outputs, String> {
-        self.scene.outputs(self.time, &self.state)
+        scene::outputs(&self.scene, self.time, &self.state)
     }
 
     pub fn counters(&self) -> Counters {
@@ -330,7 +288,7 @@ impl Simulation {
         sim.integrator
             .restore(&snapshot)
             .map_err(|e| e.to_string())?;
-        sim.scene.set_inputs(&inputs)?;
+        scene::apply_inputs(&mut sim.scene, &inputs)?;
         sim.inputs = inputs;
         sim.time = time;
         sim.state.copy_from_slice(state);

@@ -251,12 +251,12 @@ impl Instance {
         Ok(cosim::Settings {
             scene: v.integers[integer::SCENE as usize],
             config_file,
-            effects: cosim::EffectSwitches {
+            effects: cosim::Effects {
                 gas_forces: v.booleans[boolean::EFFECT_GAS_FORCES as usize],
                 mass_forces: v.booleans[boolean::EFFECT_MASS_FORCES as usize],
                 balance_shaft: v.booleans[boolean::EFFECT_BALANCE_SHAFT as usize],
                 gyroscopic: v.booleans[boolean::EFFECT_GYROSCOPIC as usize],
-                ring_carrier: v.booleans[boolean::EFFECT_RING_CARRIER as usize],
+                ring_carrier_elasticity: v.booleans[boolean::EFFECT_RING_CARRIER as usize],
                 mount_nonlinearity: v.booleans[boolean::EFFECT_MOUNT_NONLINEARITY as usize],
                 chassis_flexibility: v.booleans[boolean::EFFECT_CHASSIS_FLEXIBILITY as usize],
             },
@@ -268,13 +268,16 @@ impl Instance {
             max_order: v.integers[integer::SOLVER_MAX_ORDER as usize],
             stability_limit_detection: v.booleans
                 [boolean::SOLVER_STABILITY_LIMIT_DETECTION as usize],
-            chassis: cosim::ChassisSettings {
+            chassis: cosim::BodyOptions {
                 mode_cutoff_hz: v.reals[real::CHASSIS_MODE_CUTOFF as usize],
                 modal_damping_scale: v.reals[real::CHASSIS_MODAL_DAMPING_SCALE as usize],
                 interface_rotations: v.booleans[boolean::CHASSIS_INTERFACE_ROTATIONS as usize],
                 max_rpm: v.reals[real::SCENE_MAX_RPM as usize],
                 max_engine_order: v.reals[real::SCENE_MAX_ENGINE_ORDER as usize],
-                max_modes: v.integers[integer::CHASSIS_MAX_MODES as usize],
+                max_modes: usize::try_from(v.integers[integer::CHASSIS_MAX_MODES as usize])
+                    .map_err(|_| {
+                        "chassis.maxModes must be >= 0 (0: select by chassis.modeCutoff)"
+                    })?,
                 stiffening_bar: v.booleans[boolean::CHASSIS_STIFFENING_BAR as usize],
                 cache: if !v.booleans[boolean::CHASSIS_CACHE_ENABLED as usize] {
                     cosim::CacheSetting::Disabled

@@ -2,10 +2,10 @@
 
 use serde::{Deserialize, Serialize};
 
-/// Which physical effects the engine model includes. A switched-off effect costs nothing: its
-/// terms are not evaluated and, for the ring carriers, the states disappear.
+/// Which physical effects the model includes. A switched-off effect costs nothing: its terms are
+/// not evaluated and, for the ring carriers and the body's elastic modes, the states disappear.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
-#[serde(default)]
+#[serde(deny_unknown_fields)]
 pub struct Effects {
     /// Piston side-force pairs from the cylinder pressure.
     pub gas_forces: bool,
@@ -19,6 +19,8 @@ pub struct Effects {
     pub ring_carrier_elasticity: bool,
     /// Nonlinear mount curves; off: the tangent at the static operating point.
     pub mount_nonlinearity: bool,
+    /// Elastic body; off: only the body's rigid-body modes on its suspension (a rigid body).
+    pub chassis_flexibility: bool,
 }
 
 impl Default for Effects {
@@ -30,6 +32,7 @@ impl Default for Effects {
             gyroscopic: true,
             ring_carrier_elasticity: true,
             mount_nonlinearity: true,
+            chassis_flexibility: true,
         }
     }
 }

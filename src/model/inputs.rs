@@ -1,8 +1,10 @@
-//! Inputs of the engine model, settable at any time (FMI: at communication points, with
-//! derivatives for `canInterpolateInputs`).
+//! Inputs of the coupled model, settable at any time (FMI: at communication points, with
+//! derivatives for `canInterpolateInputs`). Every input is a ramp, `value + rate · (t − since)`.
+
+use serde::{Deserialize, Serialize};
 
 /// A real input that varies linearly between settings: `value + rate · (t − since)`.
-#[derive(Debug, Clone, Copy, PartialEq)]
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
 pub struct RampInput {
     pub value: f64,
     pub rate: f64,
@@ -21,39 +23,84 @@ impl RampInput {
     pub fn at(&self, t: f64) -> f64 {
         self.value + self.rate * (t - self.since)
     }
+
+    fn is_finite(&self) -> bool {
+        self.value.is_finite() && self.rate.is_finite() && self.since.is_finite()
+    }
 }
 
-/// All inputs of the engine model.
-#[derive(Debug, Clone, PartialEq)]
-pub struct EngineInputs {
-    /// Crank spin about its axis (rad/s) and its time derivative.
+/// All inputs of the coupled model.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct ModelInputs {
+    /// Crank speed set-point (rad/s, the crank's spin about its axis in inertial space) and its
+    /// slope; the crank follows it directly or through the speed follower.
     pub crank_speed: RampInput,
     /// Load torque on the housing about the crank axis +y (N m): the drivetrain reaction.
     pub load_torque: RampInput,
     /// Per configured mount (index as in the configuration): stiffness and damping scale factors.
-    pub stiffness_scale: Vec<f64>,
-    pub damping_scale: Vec<f64>,
+    /// A ramp that reaches below zero is held at zero.
+    pub stiffness_scale: Vec<RampInput>,
+    pub damping_scale: Vec<RampInput>,
 }
 
-impl EngineInputs {
+impl ModelInputs {
     pub fn new(mounts: usize) -> Self {
         Self {
             crank_speed: RampInput::constant(0.0),
             load_torque: RampInput::constant(0.0),
-            stiffness_scale: vec![1.0; mounts],
-            damping_scale: vec![1.0; mounts],
+            stiffness_scale: vec![RampInput::constant(1.0); mounts],
+            damping_scale: vec![RampInput::constant(1.0); mounts],
         }
+    }
+
+    /// Stiffness and damping scales of mount `i` at `t` (never negative).
+    pub fn mount_scales(&self, i: usize, t: f64) -> (f64, f64) {
+        (
+            self.stiffness_scale[i].at(t).max(0.0),
+            self.damping_scale[i].at(t).max(0.0),
+        )
+    }
+
+    /// Finite values, non-negative mount scales, one scale pair per configured mount.
+    pub fn validate(&self, mounts: usize) -> Result<(), InputError> {
+        for (name, r) in [
+            ("crank speed", &self.crank_speed),
+            ("load torque", &self.load_torque),
+        ] {
+            if !r.is_finite() {
+                return Err(InputError(format!(
+                    "{name} {} (rate {}, since {}) must be finite",
+                    r.value, r.rate, r.since
+                )));
+            }
+        }
+        if self.stiffness_scale.len() != mounts || self.damping_scale.len() != mounts {
+            return Err(InputError(format!(
+                "{} stiffness and {} damping scales for {mounts} mounts",
+                self.stiffness_scale.len(),
+                self.damping_scale.len()
+            )));
+        }
+        for (i, (k, c)) in self
+            .stiffness_scale
+            .iter()
+            .zip(&self.damping_scale)
+            .enumerate()
+        {
+            for (what, r) in [("stiffness", k), ("damping", c)] {
+                if !(r.is_finite() && r.value >= 0.0) {
+                    return Err(InputError(format!(
+                        "mounts[{i}] {what} scale {} (rate {}) must be finite and >= 0",
+                        r.value, r.rate
+                    )));
+                }
+            }
+        }
+        Ok(())
     }
 }
 
 /// An input value the model rejects.
-#[derive(Debug, Clone, PartialEq)]
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+#[error("{0}")]
 pub struct InputError(pub String);
-
-impl std::fmt::Display for InputError {
-    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
-        f.write_str(&self.0)
-    }
-}
-
-impl std::error::Error for InputError {}

@@ -14,7 +14,7 @@ pub enum Tolerance {
 impl Tolerance {
     /// Absolute tolerance of component `i` (the caller has validated the length).
     #[inline]
-    pub(crate) fn get(&self, i: usize) -> f64 {
+    pub fn get(&self, i: usize) -> f64 {
         match self {
             Tolerance::Scalar(a) => *a,
             Tolerance::Vector(v) => v[i],

@@ -374,10 +374,14 @@ fn input_derivatives_make_a_ramp_continuous() {
         s.logs()
     );
     // the input speed is absolute; the crank angle output is relative to the monoblock, so
-    // angle + block rotation about the crank axis integrates the ramp: ∫ ω dt = 0.1 (800 + 100) rpm s
+    // angle + block rotation about the crank axis integrates the ramp: ∫ ω dt = 0.1 (800 + 100) rpm s,
+    // less the lag of the crank that follows the set-point critically damped (time constant τ):
+    // it starts with zero acceleration, so it falls behind by ∫ a t e^(−t/τ) dt = a τ² in angle.
     let out = s.reals(&[real::CRANK_ANGLE, real::POWERTRAIN_PHI[1]]);
     let absolute = out[0] + out[1];
-    let expected = (800.0 * 0.1 + 1000.0 * 0.01) * std::f64::consts::PI / 30.0;
+    let tau = engine_mount_chassis::model::SpeedFollower::default().time_constant;
+    let rate = 2000.0 * std::f64::consts::PI / 30.0;
+    let expected = (800.0 * 0.1 + 1000.0 * 0.01) * std::f64::consts::PI / 30.0 - rate * tau * tau;
     assert!(
         (absolute - expected).abs() < 1e-6 * expected,
         "{absolute} vs {expected} (block {})",
@@ -404,6 +408,9 @@ fn parameters_strings_and_debug_logging() {
     let s = fmu.instantiate("params-2");
     assert_eq!(s.set_integer(&[integer::SOLVER_MAX_ORDER], &[7]), ERROR);
     assert_eq!(s.set_integer(&[integer::SOLVER_MAX_ORDER], &[2]), OK);
+    // A negative mode count is out of the declared range: rejected when set, naming the variable.
+    assert_eq!(s.set_integer(&[integer::CHASSIS_MAX_MODES], &[-1]), ERROR);
+    assert_logged(&s, "chassis.maxModes");
     assert_eq!(s.set_boolean(&[boolean::EFFECT_GAS_FORCES], &[false]), OK);
     let cats = [c"logEvents".as_ptr(), c"noSuchCategory".as_ptr()];
     // SAFETY: an array of two valid C strings.

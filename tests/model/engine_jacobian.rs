@@ -1,12 +1,12 @@
-//! The assembled Jacobian of the ground scene agrees with a central finite difference of the full nonlinear
-//! right-hand side.
+//! The Jacobian of the engine on rigid ground agrees with a central finite difference of the full
+//! nonlinear right-hand side.
 
-use engine_mount_chassis::model::{EngineConfig, GroundScene};
+use engine_mount_chassis::model::{CoupledModel, VehicleConfig};
 use engine_mount_chassis::ode::OdeProblem;
 use faer::Mat;
 
-fn check(cfg: EngineConfig) {
-    let mut scene = GroundScene::new(cfg).expect("scene");
+fn check(cfg: VehicleConfig) {
+    let mut scene = CoupledModel::on_ground(&cfg).expect("scene");
     let mut y = scene.static_equilibrium(0.0).expect("equilibrium");
     scene
         .set_crank_speed(0.0, 2000.0 * std::f64::consts::PI / 30.0, 150.0)
@@ -14,11 +14,13 @@ fn check(cfg: EngineConfig) {
     scene.set_load_torque(0.0, 80.0, -20.0).expect("torque");
     scene.set_mount_scales(2, 1.4, 0.6).expect("scales");
     let n = scene.dim();
+    let l = *scene.layout();
     // A state away from equilibrium: displaced, rotating, crank at 37°.
-    for (i, v) in y.iter_mut().enumerate().take(n - 1) {
-        *v += 1e-3 * (((i * 7919) % 13) as f64 / 13.0 - 0.4) * if i >= n / 2 { 20.0 } else { 1.0 };
+    for (i, v) in y.iter_mut().enumerate().take(l.crank_angle()) {
+        let scale = if i >= l.positions().end { 20.0 } else { 1.0 };
+        *v += 1e-3 * (((i * 7919) % 13) as f64 / 13.0 - 0.4) * scale;
     }
-    y[n - 1] = 37f64.to_radians();
+    y[l.crank_angle()] = 37f64.to_radians();
     let t = 0.3;
     let mut j = Mat::<f64>::zeros(n, n);
     assert!(scene.jacobian(t, &y, j.as_mut()).expect("jacobian"));
@@ -50,8 +52,8 @@ fn check(cfg: EngineConfig) {
 
 #[test]
 fn assembled_jacobian_matches_finite_differences_two_bodies() {
-    let mut cfg = EngineConfig::default();
-    cfg.gas.load = 1.0;
+    let mut cfg = VehicleConfig::default();
+    cfg.engine.gas.load = 1.0;
     // No preload: mounts sit in their progressive range, where the curves bend.
     for m in &mut cfg.mounts {
         m.preload = [0.0; 3];
@@ -61,7 +63,7 @@ fn assembled_jacobian_matches_finite_differences_two_bodies() {
 
 #[test]
 fn assembled_jacobian_matches_finite_differences_rigid_powertrain_linear_mounts() {
-    let mut cfg = EngineConfig::default();
+    let mut cfg = VehicleConfig::default();
     cfg.effects.ring_carrier_elasticity = false;
     cfg.effects.mount_nonlinearity = false;
     let rot = nalgebra::Rotation3::from_euler_angles(0.1, 0.2, -0.3).into_inner();

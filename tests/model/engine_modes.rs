@@ -1,12 +1,11 @@
 //! Paper Table 1, column "engine supported by ground": modes of the linearised engine at its
 //! static equilibrium, frequencies within 5 % and matching descriptions.
 
-use engine_mount_chassis::model::{
-    Direction, EngineConfig, GroundScene, Mode, ModeKind, TABLE1_RIGID, TABLE1_RING_CARRIER,
-};
+use engine_mount_chassis::model::{CoupledModel, Direction, Mode, ModeKind, VehicleConfig};
+use engine_mount_chassis::paper::{TABLE1_RIGID, TABLE1_RING_CARRIER};
 
-fn modes(cfg: EngineConfig) -> Vec<Mode> {
-    let mut scene = GroundScene::new(cfg).expect("scene");
+fn modes(cfg: VehicleConfig) -> Vec<Mode> {
+    let mut scene = CoupledModel::on_ground(&cfg).expect("scene");
     let y = scene.static_equilibrium(0.0).expect("equilibrium");
     scene.modes(&y).expect("modes")
 }
@@ -22,7 +21,7 @@ fn check(mode: &Mode, target: f64, what: &str) {
 
 #[test]
 fn table1_engine_on_ground() {
-    let m = modes(EngineConfig::default());
+    let m = modes(VehicleConfig::default());
     assert_eq!(m.len(), 12, "{m:#?}");
     let rigid = [
         Direction::Axial,
@@ -68,7 +67,7 @@ fn table1_engine_on_ground() {
 
 #[test]
 fn rigid_powertrain_has_six_modes_near_the_rigid_targets() {
-    let mut cfg = EngineConfig::default();
+    let mut cfg = VehicleConfig::default();
     cfg.effects.ring_carrier_elasticity = false;
     let m = modes(cfg);
     assert_eq!(m.len(), 6);
@@ -81,7 +80,7 @@ fn rigid_powertrain_has_six_modes_near_the_rigid_targets() {
 fn rigid_modes_match_the_analytic_decoupled_formulas() {
     // Independent truth: with rigid ring carriers, the decoupled layout gives
     // f = √(k/m)/2π per direction with the summed mount rates and the effective inertias.
-    let mut cfg = EngineConfig::default();
+    let mut cfg = VehicleConfig::default();
     cfg.effects.ring_carrier_elasticity = false;
     let m = modes(cfg);
     let two_pi = 2.0 * std::f64::consts::PI;

@@ -3,12 +3,12 @@
 //! inline-3 crank drive; the model computes the reactions from the composite-body kinematics.
 
 use engine_mount_chassis::model::orders::order_amplitude;
-use engine_mount_chassis::model::{EngineConfig, GroundScene};
+use engine_mount_chassis::model::{Powertrain, VehicleConfig};
 
 const SPR: usize = 720;
 
 struct Setup {
-    scene: GroundScene,
+    scene: Powertrain,
     m: f64,
     r: f64,
     a: f64,
@@ -16,11 +16,11 @@ struct Setup {
 }
 
 fn setup(gas: bool, mass: bool, balance: bool) -> Setup {
-    let mut cfg = EngineConfig::default();
+    let mut cfg = VehicleConfig::default();
     cfg.effects.gas_forces = gas;
     cfg.effects.mass_forces = mass;
     cfg.effects.balance_shaft = balance;
-    let c = &cfg.crank_drive;
+    let c = &cfg.engine.crank_drive;
     let (m, r, a, lambda) = (
         c.oscillating_mass,
         c.crank_radius,
@@ -28,7 +28,7 @@ fn setup(gas: bool, mass: bool, balance: bool) -> Setup {
         c.crank_radius / c.conrod_length,
     );
     Setup {
-        scene: GroundScene::new(cfg).expect("scene"),
+        scene: Powertrain::new(cfg.engine, cfg.effects, cfg.gravity).expect("powertrain"),
         m,
         r,
         a,
@@ -37,7 +37,7 @@ fn setup(gas: bool, mass: bool, balance: bool) -> Setup {
 }
 
 /// Force and moment components over `revs` revolutions at constant speed `w`.
-fn sample(s: &GroundScene, w: f64, revs: usize) -> Vec<[f64; 6]> {
+fn sample(s: &Powertrain, w: f64, revs: usize) -> Vec<[f64; 6]> {
     (0..revs * SPR)
         .map(|k| {
             let phi = 2.0 * std::f64::consts::PI * k as f64 / SPR as f64;
@@ -178,7 +178,7 @@ fn fact4_gas_torque_has_only_multiples_of_order_one_and_a_half() {
         let phi0 = 4.0 * std::f64::consts::PI * k as f64 / n as f64;
         let phi1 = 4.0 * std::f64::consts::PI * (k + 1) as f64 / n as f64;
         let vol = |phi: f64| {
-            let (sp, _, _) = engine_mount_chassis::model::parts::slider_crank(
+            let (sp, _, _) = engine_mount_chassis::model::powertrain::parts::slider_crank(
                 phi,
                 c.crank_radius,
                 c.conrod_length,

@@ -1,17 +1,17 @@
 //! Static equilibrium (fact 6) and configuration handling of the engine model.
 
-use engine_mount_chassis::model::{EngineConfig, GroundScene, POWERTRAIN_MASS};
+use engine_mount_chassis::model::{CoupledModel, VehicleConfig, POWERTRAIN_MASS};
 
-fn vertical_sum(scene: &GroundScene, y: &[f64]) -> f64 {
+fn vertical_sum(scene: &CoupledModel, y: &[f64]) -> f64 {
     let out = scene.outputs(0.0, y).expect("outputs");
     out.mount_forces.iter().map(|f| f[2]).sum()
 }
 
 #[test]
 fn default_config_is_valid_and_statics_carry_the_weight() {
-    let cfg = EngineConfig::default();
+    let cfg = VehicleConfig::default();
     cfg.validate().expect("default config valid");
-    let mut scene = GroundScene::new(cfg.clone()).expect("scene");
+    let mut scene = CoupledModel::on_ground(&cfg).expect("scene");
     let y = scene.static_equilibrium(0.0).expect("equilibrium");
     let weight = POWERTRAIN_MASS * cfg.gravity;
     // Force on the ground side: the powertrain pushes the ground down.
@@ -26,13 +26,13 @@ fn default_config_is_valid_and_statics_carry_the_weight() {
 fn weight_is_carried_without_preload_and_with_load_torque_and_three_mounts() {
     // Fact 6 where the answer is not built into the preloads: no preload at all (the weight
     // deflects the progressive mounts by several mm), a 150 N m load torque, one mount removed.
-    let mut cfg = EngineConfig::default();
+    let mut cfg = VehicleConfig::default();
     for m in &mut cfg.mounts {
         m.preload = [0.0; 3];
     }
     cfg.mounts[1].active = false;
     let weight = POWERTRAIN_MASS * cfg.gravity;
-    let mut scene = GroundScene::new(cfg).expect("scene");
+    let mut scene = CoupledModel::on_ground(&cfg).expect("scene");
     scene.set_load_torque(0.0, 150.0, 0.0).expect("torque");
     let y = scene.static_equilibrium(0.0).expect("equilibrium");
     let out = scene.outputs(0.0, &y).expect("outputs");
@@ -43,8 +43,7 @@ fn weight_is_carried_without_preload_and_with_load_torque_and_three_mounts() {
     );
     // The moment about y of the mount forces (ground side) balances the load torque.
     let cg = engine_mount_chassis::model::POWERTRAIN_CG;
-    let my: f64 = scene
-        .config()
+    let my: f64 = cfg
         .mounts
         .iter()
         .zip(&out.mount_forces)
@@ -68,15 +67,15 @@ fn weight_is_carried_without_preload_and_with_load_torque_and_three_mounts() {
 
 #[test]
 fn too_soft_mounts_give_a_clear_error() {
-    let mut scene = GroundScene::new(EngineConfig::default()).expect("scene");
+    let mut scene = CoupledModel::on_ground(&VehicleConfig::default()).expect("scene");
     for i in 0..4 {
         scene.set_mount_scales(i, 0.02, 1.0).expect("scale");
     }
-    let mut cfg = scene.config().clone();
+    let mut cfg = VehicleConfig::default();
     for m in &mut cfg.mounts {
         m.preload = [0.0; 3];
     }
-    let mut soft = GroundScene::new(cfg).expect("scene");
+    let mut soft = CoupledModel::on_ground(&cfg).expect("scene");
     for i in 0..4 {
         soft.set_mount_scales(i, 0.02, 1.0).expect("scale");
     }
@@ -86,69 +85,79 @@ fn too_soft_mounts_give_a_clear_error() {
 
 #[test]
 fn invalid_values_are_rejected_naming_field_and_value() {
-    type Mutation = Box<dyn Fn(&mut EngineConfig)>;
+    type Mutation = Box<dyn Fn(&mut VehicleConfig)>;
     let cases: Vec<(Mutation, &str)> = vec![
-        (Box::new(|c| c.monoblock.mass = -3.0), "monoblock.mass = -3"),
         (
-            Box::new(|c| c.housing.inertia[0][0] = -1.0),
+            Box::new(|c| c.engine.monoblock.mass = -3.0),
+            "monoblock.mass = -3",
+        ),
+        (
+            Box::new(|c| c.engine.housing.inertia[0][0] = -1.0),
             "housing.inertia",
         ),
-        (Box::new(|c| c.crank_drive.conrod_length = 0.04), "lambda"),
+        (
+            Box::new(|c| c.engine.crank_drive.conrod_length = 0.04),
+            "lambda",
+        ),
         (
             Box::new(|c| c.mounts[2].curves[1].knots[3].stiffness = 0.0),
             "mounts[2].curves[1].knots[3].stiffness = 0",
         ),
-        (Box::new(|c| c.gas.load = 1.5), "gas.load = 1.5"),
+        (Box::new(|c| c.engine.gas.load = 1.5), "gas.load = 1.5"),
         (
-            Box::new(|c| c.crank_drive.cylinders[1].firing_tdc_deg = 100.0),
+            Box::new(|c| c.engine.crank_drive.cylinders[1].firing_tdc_deg = 100.0),
             "crank_drive.cylinders[1].firing_tdc_deg = 100",
         ),
         (Box::new(|c| c.mounts.truncate(2)), "2 active mounts"),
         (
-            Box::new(|c| c.crank_drive.oscillating_mass = f64::NAN),
+            Box::new(|c| c.engine.crank_drive.oscillating_mass = f64::NAN),
             "crank_drive.oscillating_mass = NaN",
         ),
     ];
     for (mutate, expect) in cases {
-        let mut c = EngineConfig::default();
+        let mut c = VehicleConfig::default();
         mutate(&mut c);
         let e = c.validate().expect_err(expect).to_string();
         assert!(
             e.contains(expect),
             "message {e:?} should contain {expect:?}"
         );
-        assert!(GroundScene::new(c).is_err());
+        assert!(CoupledModel::on_ground(&c).is_err());
     }
 }
 
 #[test]
-fn json_round_trip_and_partial_json_takes_defaults() {
-    let d = EngineConfig::default();
-    let back = EngineConfig::from_json(&d.to_json()).expect("round trip");
+fn json_round_trip_and_partial_json_only_by_extending_the_default() {
+    let d = VehicleConfig::default();
+    let back = VehicleConfig::from_json(&d.to_json()).expect("round trip");
     assert_eq!(back, d);
-    let partial =
-        EngineConfig::from_json(r#"{"gravity": 9.80665, "effects": {"gas_forces": false}}"#)
-            .expect("partial");
+    let partial = VehicleConfig::from_json(
+        r#"{"extends": "default", "gravity": 9.80665, "effects": {"gas_forces": false}}"#,
+    )
+    .expect("partial");
     assert_eq!(partial.gravity, 9.80665);
     assert!(!partial.effects.gas_forces);
     assert!(partial.effects.mass_forces);
     assert_eq!(partial.mounts, d.mounts);
-    let e = EngineConfig::from_json(r#"{"gravity": "x"}"#).expect_err("bad json");
-    assert!(e.to_string().contains("json"));
+    // Without `extends` a partial file is an error naming what is missing.
+    let e = VehicleConfig::from_json(r#"{"gravity": 9.80665}"#).expect_err("missing fields");
+    assert!(e.to_string().contains("missing field"), "{e}");
+    let e = VehicleConfig::from_json(r#"{"gravity": "x"}"#).expect_err("bad json");
+    assert!(e.to_string().contains("gravity"), "{e}");
 }
 
 #[test]
 fn resource_file_equals_the_defaults() {
     let text = std::fs::read_to_string(concat!(
         env!("CARGO_MANIFEST_DIR"),
-        "/resources/engine.json"
+        "/resources/vehicle.json"
     ))
-    .expect("resources/engine.json");
-    let cfg = EngineConfig::from_json(&text).expect("resource parses");
+    .expect("resources/vehicle.json");
+    let cfg = VehicleConfig::from_json(&text).expect("resource parses");
     assert_eq!(
         cfg,
-        EngineConfig::default(),
-        "regenerate with `cargo run --release --example engine_default_config`"
+        VehicleConfig::default(),
+        "regenerate with `cargo run --release --example vehicle_configs`"
     );
 }
 
@@ -156,10 +165,10 @@ fn resource_file_equals_the_defaults() {
 fn three_mount_resource_carries_the_weight_at_the_design_position() {
     let text = std::fs::read_to_string(concat!(
         env!("CARGO_MANIFEST_DIR"),
-        "/resources/engine_three_mounts.json"
+        "/resources/vehicle_three_mounts.json"
     ))
-    .expect("resources/engine_three_mounts.json");
-    let cfg = EngineConfig::from_json(&text).expect("resource parses");
+    .expect("resources/vehicle_three_mounts.json");
+    let cfg = VehicleConfig::from_json(&text).expect("resource parses");
     let names: Vec<&str> = cfg
         .mounts
         .iter()
@@ -167,16 +176,16 @@ fn three_mount_resource_carries_the_weight_at_the_design_position() {
         .map(|m| m.name.as_str())
         .collect();
     assert_eq!(names, ["front_left", "front_right", "rear_left"]);
-    let rest = EngineConfig {
+    let rest = VehicleConfig {
         mounts: cfg.mounts.clone(),
-        ..EngineConfig::default()
+        ..VehicleConfig::default()
     };
     assert_eq!(rest, cfg, "only the mounts differ from the default");
-    let mut scene = GroundScene::new(cfg).expect("valid");
+    let mut scene = CoupledModel::on_ground(&cfg).expect("valid");
     let y = scene.static_equilibrium(0.0).expect("equilibrium");
     let out = scene.outputs(0.0, &y).expect("outputs");
     let vertical: f64 = out.mount_forces.iter().map(|f| f[2]).sum();
-    let weight = 180.0 * scene.config().gravity;
+    let weight = 180.0 * cfg.gravity;
     assert!((vertical + weight).abs() < 1e-3 * weight, "{vertical}");
     // the preloads balance the weight at the design position: the operating points stay linear
     for d in out.housing.displacement {

@@ -1,13 +1,13 @@
 //! Time-domain behaviour of the engine on ground, integrated with the BDF solver.
 
 use engine_mount_chassis::model::orders::order_amplitude;
-use engine_mount_chassis::model::{EngineConfig, GroundScene};
+use engine_mount_chassis::model::{CoupledModel, VehicleConfig};
 use engine_mount_chassis::ode::{Bdf, BdfOptions, Tolerance};
 
-fn undamped_config() -> EngineConfig {
-    let mut cfg = EngineConfig::default();
+fn undamped_config() -> VehicleConfig {
+    let mut cfg = VehicleConfig::default();
     cfg.effects.gas_forces = false;
-    for rc in &mut cfg.ring_carriers {
+    for rc in &mut cfg.engine.ring_carriers {
         rc.damping = [0.0; 6];
     }
     for m in &mut cfg.mounts {
@@ -20,12 +20,12 @@ fn undamped_config() -> EngineConfig {
 fn energy_drift(rtol: f64, rigid_ring_carriers: bool) -> f64 {
     let mut cfg = undamped_config();
     cfg.effects.ring_carrier_elasticity = !rigid_ring_carriers;
-    let mut scene = GroundScene::new(cfg).expect("scene");
+    let mut scene = CoupledModel::on_ground(&cfg).expect("scene");
     let y_eq = scene.static_equilibrium(0.0).expect("equilibrium");
     let e_eq = scene.energy(0.0, &y_eq).expect("energy");
     // Kick: housing displaced 2 mm / 10 mrad (against the monoblock when elastic), the
     // monoblock rotating; crank at rest, so the pistons move only with the block.
-    let nb = scene.body_count();
+    let nb = scene.layout().bodies();
     let hb = 6 * (nb - 1);
     let mut y0 = y_eq.clone();
     y0[hb] += 0.002;
@@ -70,8 +70,8 @@ fn free_vibration_without_damping_keeps_the_energy() {
 }
 
 /// Mount force samples over `revs` revolutions after `settle` seconds at `rpm`.
-fn run(cfg: EngineConfig, rpm: f64, settle: f64, revs: usize, spr: usize) -> Vec<[f64; 3]> {
-    let mut scene = GroundScene::new(cfg).expect("scene");
+fn run(cfg: VehicleConfig, rpm: f64, settle: f64, revs: usize, spr: usize) -> Vec<[f64; 3]> {
+    let mut scene = CoupledModel::on_ground(&cfg).expect("scene");
     let y0 = scene.static_equilibrium(0.0).expect("equilibrium");
     let w = rpm * std::f64::consts::PI / 30.0;
     scene.set_crank_speed(0.0, w, 0.0).expect("speed");
@@ -96,9 +96,9 @@ fn run(cfg: EngineConfig, rpm: f64, settle: f64, revs: usize, spr: usize) -> Vec
 #[test]
 fn gas_forces_make_order_one_and_a_half_dominant_in_the_mount_forces() {
     // Fact 4 in the mount forces: full load, 2000 rpm, stationary window of 4 revolutions.
-    let mut cfg = EngineConfig::default();
-    cfg.gas.load = 1.0;
-    cfg.excitation_fade_in = 0.05;
+    let mut cfg = VehicleConfig::default();
+    cfg.engine.gas.load = 1.0;
+    cfg.engine.excitation_fade_in = 0.05;
     let spr = 90;
     let f = run(cfg, 2000.0, 0.6, 4, spr);
     let vertical: Vec<f64> = f.iter().map(|v| v[2]).collect();

@@ -3,9 +3,8 @@
 
 use engine_mount_chassis::cms::reduce_detailed;
 use engine_mount_chassis::fe::modal::{steering_wheel_pair, ModeKind as ChassisMode};
-use engine_mount_chassis::model::hybrid_chassis::{describe_modes, reduction_spec};
-use engine_mount_chassis::model::hybrid_modes::{HybridMode, HybridModeKind};
-use engine_mount_chassis::model::{Direction, EngineConfig, GroundScene, HybridScene, ModeKind};
+use engine_mount_chassis::model::scene::{reduction_spec, BodyOptions};
+use engine_mount_chassis::model::{CoupledModel, Direction, Mode, ModeKind, VehicleConfig};
 
 const DIRECTIONS: [Direction; 6] = [
     Direction::Lateral,
@@ -18,14 +17,14 @@ const DIRECTIONS: [Direction; 6] = [
 
 /// The coupled mode with the most powertrain kinetic energy in direction `d` (ring-carrier modes
 /// excluded): the engine's rigid-body mode in that direction, wherever the chassis moved it.
-fn engine_mode(modes: &[HybridMode], d: Direction) -> &HybridMode {
+fn engine_mode(modes: &[Mode], d: Direction) -> &Mode {
     let i = DIRECTIONS.iter().position(|x| *x == d).unwrap();
     modes
         .iter()
-        .filter(|m| !matches!(m.kind, HybridModeKind::Engine(ModeKind::RingCarrier { .. })))
+        .filter(|m| !matches!(m.kind, ModeKind::RingCarrier { .. }))
         .max_by(|a, b| {
-            (a.engine_kinetic_fraction * a.engine_directions[i])
-                .total_cmp(&(b.engine_kinetic_fraction * b.engine_directions[i]))
+            (a.powertrain_fraction * a.powertrain_directions[i])
+                .total_cmp(&(b.powertrain_fraction * b.powertrain_directions[i]))
         })
         .unwrap()
 }
@@ -33,14 +32,19 @@ fn engine_mode(modes: &[HybridMode], d: Direction) -> &HybridMode {
 #[test]
 fn hybrid_modes_reproduce_paper_section_6_2() {
     // The FMU's default chassis: Craig-Bampton with the fixed-interface modes below 200 Hz.
-    let reduction = reduce_detailed(&reduction_spec(200.0, 0, false)).unwrap();
-    let labels = describe_modes(&reduction).unwrap();
+    let cfg = VehicleConfig::default();
+    let options = BodyOptions {
+        mode_cutoff_hz: 200.0,
+        ..BodyOptions::default()
+    };
+    let (spec, _) = reduction_spec(&cfg, &options).unwrap();
+    let reduction = reduce_detailed(&spec).unwrap();
+    let labels = reduction.describe_modes().unwrap();
     let chassis = reduction.reduced;
-    let cfg = EngineConfig::default();
-    let mut ground = GroundScene::new(cfg.clone()).unwrap();
+    let mut ground = CoupledModel::on_ground(&cfg).unwrap();
     let y_ground = ground.static_equilibrium(0.0).unwrap();
     let alone = ground.modes(&y_ground).unwrap();
-    let mut hybrid = HybridScene::new(GroundScene::new(cfg).unwrap(), chassis).unwrap();
+    let mut hybrid = CoupledModel::with_body(&cfg, chassis).unwrap();
     let y = hybrid.static_equilibrium(0.0).unwrap();
     let modes = hybrid.modes(&y).unwrap();
 
@@ -69,7 +73,7 @@ fn hybrid_modes_reproduce_paper_section_6_2() {
     {
         let nearest = modes
             .iter()
-            .filter(|m| matches!(m.kind, HybridModeKind::Engine(ModeKind::RingCarrier { .. })))
+            .filter(|m| matches!(m.kind, ModeKind::RingCarrier { .. }))
             .map(|m| (m.frequency_hz / g.frequency_hz - 1.0).abs())
             .fold(f64::INFINITY, f64::min);
         assert!(
@@ -83,14 +87,16 @@ fn hybrid_modes_reproduce_paper_section_6_2() {
     let by_chassis_kind = |kind: ChassisMode| -> Vec<f64> {
         modes
             .iter()
-            .filter(|m| matches!(&m.kind, HybridModeKind::Chassis { mode, .. } if labels[*mode].kind == kind))
+            .filter(
+                |m| matches!(&m.kind, ModeKind::Body { mode, .. } if labels[*mode].kind == kind),
+            )
             .map(|m| m.frequency_hz)
             .collect()
     };
     let (vertical, lateral) = steering_wheel_pair(&labels).unwrap();
     let wheel: Vec<f64> = modes
         .iter()
-        .filter(|m| matches!(&m.kind, HybridModeKind::Chassis { mode, .. } if *mode == vertical || *mode == lateral))
+        .filter(|m| matches!(&m.kind, ModeKind::Body { mode, .. } if *mode == vertical || *mode == lateral))
         .map(|m| m.frequency_hz)
         .collect();
     assert_eq!(wheel.len(), 2, "steering wheel modes {wheel:?}");

@@ -1,7 +1,7 @@
 //! Scene-level effect switches: the automatic chassis cut-off and the rigid chassis.
 
 use engine_mount_chassis::cosim::{
-    ChassisSettings, EffectSwitches, Inputs, Settings, Simulation, RPM_TO_RAD_PER_S,
+    BodyOptions, Effects, Inputs, Settings, Simulation, RPM_TO_RAD_PER_S,
 };
 
 /// RMS of the vertical steering-wheel acceleration over 0.3–0.5 s, and the number of states.
@@ -24,16 +24,16 @@ fn steering_wheel_rms(settings: &Settings) -> (f64, usize, Vec<String>) {
 
 #[test]
 fn automatic_cutoff_follows_the_scene() {
-    let c = ChassisSettings::default();
+    let c = BodyOptions::default();
     assert_eq!(c.mode_cutoff_hz, 0.0);
     assert!((c.cutoff_hz() - 2500.0 / 60.0 * 4.5 * 1.2).abs() < 1e-9);
-    let low = ChassisSettings {
+    let low = BodyOptions {
         max_rpm: 1200.0,
         max_engine_order: 2.0,
         ..c.clone()
     };
     assert!((low.cutoff_hz() - 48.0).abs() < 1e-9);
-    let explicit = ChassisSettings {
+    let explicit = BodyOptions {
         mode_cutoff_hz: 80.0,
         ..c
     };
@@ -41,10 +41,10 @@ fn automatic_cutoff_follows_the_scene() {
 
     let settings = Settings {
         scene: 2,
-        chassis: ChassisSettings {
+        chassis: BodyOptions {
             max_rpm: 1200.0,
             max_engine_order: 2.0,
-            ..ChassisSettings::default()
+            ..BodyOptions::default()
         },
         ..Settings::default()
     };
@@ -58,18 +58,18 @@ fn a_rigid_chassis_removes_the_body_resonances_and_costs_less() {
     // 1900 rpm: the 1st order (31.7 Hz) sits on the steering-wheel modes of the elastic body.
     let elastic = Settings {
         scene: 2,
-        effects: EffectSwitches {
+        effects: Effects {
             balance_shaft: false,
-            ..EffectSwitches::default()
+            ..Effects::default()
         },
-        chassis: ChassisSettings {
+        chassis: BodyOptions {
             mode_cutoff_hz: 100.0,
-            ..ChassisSettings::default()
+            ..BodyOptions::default()
         },
         ..Settings::default()
     };
     let rigid = Settings {
-        effects: EffectSwitches {
+        effects: Effects {
             chassis_flexibility: false,
             ..elastic.effects
         },

@@ -16,7 +16,6 @@
 use nalgebra::{Matrix3, Matrix6, Vector3, Vector6};
 
 use super::parts::Part;
-use super::rotation::skew;
 
 /// Pose and velocity of one body.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -132,7 +131,7 @@ pub fn add_parts(
         let dd = body.rotation * path.dd_rho;
         // Partial velocities: linear Jp = [I, A] with A = −[r]× − d eᵀ, angular
         // Jw = [0, I − n e eᵀ]. Jpᵀ Jp = [[I, A], [Aᵀ, AᵀA]] is accumulated block by block.
-        let a = -skew(&r) - d * e.transpose();
+        let a = -r.cross_matrix() - d * e.transpose();
         let n = part.spin_ratio;
         let jw_rot = Matrix3::identity() - e_outer * n;
         let a_bias = w.cross(&w.cross(&r))
@@ -173,8 +172,9 @@ pub fn add_parts(
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::model::assembly::build_bodies;
-    use crate::model::parts::PartMotion;
+    use crate::model::effects::Effects;
+    use crate::model::powertrain::assembly::build_bodies;
+    use crate::model::powertrain::parts::PartMotion;
     use crate::model::EngineConfig;
 
     #[test]
@@ -226,7 +226,7 @@ mod tests {
 
     #[test]
     fn composite_mass_matrix_is_symmetric_positive_definite_at_any_crank_angle() {
-        let bodies = build_bodies(&EngineConfig::default());
+        let bodies = build_bodies(&EngineConfig::default(), &Effects::default());
         let rot = nalgebra::Rotation3::from_euler_angles(0.02, -0.03, 0.01).into_inner();
         for k in 0..12 {
             let crank = CrankDriveState::at_rest(0.5 * k as f64);

@@ -3,8 +3,11 @@
 //! Every part is a rigid body whose centre of mass moves on a prescribed path `ρ(φ)` in the body
 //! frame (φ = crank angle relative to the monoblock) and which may spin about the body's y axis
 //! (the crank axis) at `n · φ'`. Pistons carry the oscillating conrod mass (two-mass split), crank
-//! points carry the rotating conrod mass, the crank pin and the counterweights, the balance shaft
-//! weights turn at `n = −1`.
+//! points carry the rotating conrod mass, the crank pin and the counterweights; balance shaft
+//! weights turn at their shaft's ratio `n` (−1 for the inline-3's shaft, ±2 for Lanchester shafts).
+//!
+//! Angles in the plane normal to the crank axis are measured from the cylinder (bore) axis `b`
+//! towards `s = e_y × b`: for an upright engine `b = z`, `s = x`.
 
 use nalgebra::{Matrix3, Vector3};
 
@@ -13,19 +16,21 @@ use nalgebra::{Matrix3, Vector3};
 pub enum PartMotion {
     /// Rigidly attached at `offset` (from the body reference point, body axes).
     Fixed { offset: Vector3<f64> },
-    /// Piston pin on a cylinder parallel to body z through `crank_centre + y·e_y`; exact
+    /// Piston pin on the cylinder through `crank_centre + y·e_y` along the bore axis `bore`; exact
     /// slider-crank `s(ψ) = r cos ψ + √(l² − r² sin² ψ)`, `ψ = φ − throw`.
     Piston {
         crank_centre: Vector3<f64>,
+        bore: Vector3<f64>,
         y: f64,
         throw: f64,
         radius: f64,
         conrod: f64,
     },
     /// Point at `radius` from an axis parallel to body y through `centre`, at `y` along it, at the
-    /// angle `ψ = ratio · φ + phase` measured from body +z towards +x.
+    /// angle `ψ = ratio · φ + phase` measured from the bore axis `bore` towards `e_y × bore`.
     Orbit {
         centre: Vector3<f64>,
+        bore: Vector3<f64>,
         y: f64,
         radius: f64,
         ratio: f64,
@@ -74,6 +79,7 @@ impl Part {
             },
             PartMotion::Piston {
                 crank_centre,
+                bore,
                 y,
                 throw,
                 radius,
@@ -81,23 +87,27 @@ impl Part {
             } => {
                 let (s, s1, s2) = slider_crank(phi - throw, *radius, *conrod);
                 PartPath {
-                    rho: crank_centre + Vector3::new(0.0, *y, s),
-                    d_rho: Vector3::new(0.0, 0.0, s1),
-                    dd_rho: Vector3::new(0.0, 0.0, s2),
+                    rho: crank_centre + Vector3::new(0.0, *y, 0.0) + bore * s,
+                    d_rho: bore * s1,
+                    dd_rho: bore * s2,
                 }
             }
             PartMotion::Orbit {
                 centre,
+                bore,
                 y,
                 radius,
                 ratio,
                 phase,
             } => {
+                let side = Vector3::y().cross(bore);
                 let (sn, cs) = (ratio * phi + phase).sin_cos();
+                let radial = side * sn + bore * cs;
+                let tangential = side * cs - bore * sn;
                 PartPath {
-                    rho: centre + Vector3::new(radius * sn, *y, radius * cs),
-                    d_rho: Vector3::new(ratio * radius * cs, 0.0, -ratio * radius * sn),
-                    dd_rho: -ratio * ratio * Vector3::new(radius * sn, 0.0, radius * cs),
+                    rho: centre + Vector3::new(0.0, *y, 0.0) + radial * *radius,
+                    d_rho: tangential * (ratio * radius),
+                    dd_rho: radial * (-ratio * ratio * radius),
                 }
             }
         }

@@ -12,7 +12,7 @@ use nalgebra::{Matrix3, Vector3};
 use super::assembly::v3;
 use super::composite::BodyKinematics;
 use super::config::BushingConfig;
-use super::rotation::{left_jacobian_inverse_transpose, rotation_vector};
+use crate::model::kinematics::{left_jacobian_inverse_transpose, rotation_vector};
 
 /// A bushing ready for evaluation.
 #[derive(Debug, Clone, PartialEq)]

@@ -1,5 +1,5 @@
-//! Default configuration: DESIGN §8 values, tuned to the paper's Table 1 ("engine supported by
-//! ground").
+//! Default powertrain: the paper's Steyr M13 inline-3, DESIGN §8 values, tuned to the paper's
+//! Table 1 ("engine supported by ground", [`crate::paper`]).
 //!
 //! Tuning rationale (documented here because the numbers are derived, not guessed):
 //! - Rigid-body modes: 180 kg with the powertrain CG at (0.20, 0, 0.55) m and the four mounts at
@@ -28,35 +28,16 @@ use nalgebra::{Matrix3, Vector3};
 use super::assembly::{balance_parts, crank_drive_parts};
 use super::composite::{add_parts, BodyDynamics, BodyKinematics, CrankDriveState};
 use super::config::{
-    BalanceShaftConfig, BushingConfig, CrankDriveConfig, CylinderConfig, EngineConfig, GasConfig,
-    MountConfig, RigidBodyConfig,
+    BalanceShaftConfig, BushingConfig, CrankDriveConfig, CylinderConfig, EccentricWeight,
+    EngineConfig, GasConfig, RigidBodyConfig,
 };
-use super::effects::Effects;
-use super::mount_curve::MountCurve;
+use super::gas::GasModel;
+use crate::paper::TABLE1_RING_CARRIER;
 
 /// Powertrain centre of mass (vehicle frame).
 pub const POWERTRAIN_CG: [f64; 3] = [0.20, 0.0, 0.55];
 /// Powertrain mass (kg).
 pub const POWERTRAIN_MASS: f64 = 180.0;
-/// Paper Table 1, engine on ground: rigid-body modes (Hz) with the paper's names.
-pub const TABLE1_RIGID: [(f64, &str); 6] = [
-    (4.54, "axial translation"),
-    (5.21, "vertical translation"),
-    (5.38, "lateral translation"),
-    (10.74, "pitching"),
-    (11.80, "rolling"),
-    (12.99, "yawing"),
-];
-/// Paper Table 1, engine on ground: ring-carrier modes (Hz).
-pub const TABLE1_RING_CARRIER: [(f64, &str); 6] = [
-    (42.89, "axial deformation of ring carriers"),
-    (66.63, "torsion deformation ring carriers"),
-    (97.77, "front ring carrier, ajar vertical"),
-    (101.42, "front ring carrier, ajar lateral"),
-    (128.15, "rear ring carrier, ajar vertical"),
-    (149.09, "rear ring carrier, ajar lateral"),
-];
-
 const MONOBLOCK_MASS: f64 = 90.0;
 const MONOBLOCK_INERTIA: [f64; 3] = [3.0, 1.35, 3.05];
 const HOUSING_INERTIA: [f64; 3] = [3.8, 1.75, 3.85];
@@ -69,6 +50,7 @@ impl Default for CrankDriveConfig {
         let cw_radius = 0.04;
         Self {
             crank_centre: [0.20, 0.0, 0.45],
+            bore_axis: [0.0, 0.0, 1.0],
             bore: 0.085,
             crank_radius: r,
             conrod_length: r / 0.3,
@@ -99,44 +81,54 @@ impl Default for CrankDriveConfig {
     }
 }
 
-impl BalanceShaftConfig {
-    /// Balance shaft and extra counterweight that cancel the 1st-order rocking moment of `crank`.
-    pub fn balancing(crank: &CrankDriveConfig) -> Self {
-        // S = Σ y_i e^{−iθ_i}: the oscillating 1st-order moment about x is m r ω² |S| cos(φ + arg S).
-        let (re, im) = crank.cylinders.iter().fold((0.0, 0.0), |(re, im), c| {
-            let t = c.throw_deg.to_radians();
-            (re + c.y_offset * t.cos(), im - c.y_offset * t.sin())
-        });
-        let magnitude = re.hypot(im);
-        let couple = 0.5 * crank.oscillating_mass * crank.crank_radius * magnitude;
-        let spacing = 0.24;
-        let eccentricity = 0.02;
-        let cw_radius = 0.04;
-        let phase = im.atan2(re) + PI;
-        Self {
-            axis_point: [
-                crank.crank_centre[0] + 0.08,
-                crank.crank_centre[1],
-                crank.crank_centre[2] - 0.03,
-            ],
-            shaft_mass: 2.0,
-            shaft_axial_inertia: 0.002,
-            weight_mass: couple / (eccentricity * spacing),
-            weight_eccentricity: eccentricity,
-            weight_spacing: spacing,
-            weight_phase_deg: (-phase).to_degrees(),
-            extra_counterweight_mass: couple / (cw_radius * spacing),
-            extra_counterweight_radius: cw_radius,
-            extra_counterweight_spacing: spacing,
-            extra_counterweight_phase_deg: phase.to_degrees(),
-        }
-    }
-}
-
-impl Default for BalanceShaftConfig {
-    fn default() -> Self {
-        Self::balancing(&CrankDriveConfig::default())
-    }
+/// The inline-3's first-order balancing (module doc): a balance shaft at −1× crank speed with two
+/// opposed eccentric weights, and the pair of extra crank counterweights.
+pub fn first_order_balancing(
+    crank: &CrankDriveConfig,
+) -> (BalanceShaftConfig, Vec<EccentricWeight>) {
+    // S = Σ y_i e^{−iθ_i}: the oscillating 1st-order moment about x is m r ω² |S| cos(φ + arg S).
+    let (re, im) = crank.cylinders.iter().fold((0.0, 0.0), |(re, im), c| {
+        let t = c.throw_deg.to_radians();
+        (re + c.y_offset * t.cos(), im - c.y_offset * t.sin())
+    });
+    let magnitude = re.hypot(im);
+    let couple = 0.5 * crank.oscillating_mass * crank.crank_radius * magnitude;
+    let spacing = 0.24;
+    let eccentricity = 0.02;
+    let cw_radius = 0.04;
+    let phase = im.atan2(re) + PI;
+    let pair = |mass: f64, radius: f64, phase_deg: f64| {
+        [(1.0, 0.0), (-1.0, 180.0)].map(|(sign, extra)| EccentricWeight {
+            mass,
+            eccentricity: radius,
+            y: sign * 0.5 * spacing,
+            phase_deg: phase_deg + extra,
+        })
+    };
+    let shaft = BalanceShaftConfig {
+        name: "balance shaft".into(),
+        axis_point: [
+            crank.crank_centre[0] + 0.08,
+            crank.crank_centre[1],
+            crank.crank_centre[2] - 0.03,
+        ],
+        ratio: -1.0,
+        shaft_mass: 2.0,
+        shaft_axial_inertia: 0.002,
+        weights: pair(
+            couple / (eccentricity * spacing),
+            eccentricity,
+            (-phase).to_degrees(),
+        )
+        .to_vec(),
+    };
+    let counterweights = pair(
+        couple / (cw_radius * spacing),
+        cw_radius,
+        phase.to_degrees(),
+    )
+    .to_vec();
+    (shaft, counterweights)
 }
 
 fn diag(d: [f64; 3]) -> [[f64; 3]; 3] {
@@ -145,14 +137,10 @@ fn diag(d: [f64; 3]) -> [[f64; 3]; 3] {
 
 /// Monoblock structure such that structure + moving parts have `MONOBLOCK_MASS`, the CG
 /// `POWERTRAIN_CG` and the effective inertia `MONOBLOCK_INERTIA` at crank angle `phi0`.
-fn monoblock_structure(
-    crank: &CrankDriveConfig,
-    balance: &BalanceShaftConfig,
-    phi0: f64,
-) -> RigidBodyConfig {
+fn monoblock_structure(engine: &EngineConfig, phi0: f64) -> RigidBodyConfig {
     let target = Vector3::from(POWERTRAIN_CG);
-    let mut parts = crank_drive_parts(crank, &target);
-    parts.extend(balance_parts(balance, crank, &target));
+    let mut parts = crank_drive_parts(&engine.crank_drive, &target);
+    parts.extend(balance_parts(engine, &target));
     let mut dynamics = BodyDynamics::zero();
     add_parts(
         &parts,
@@ -224,67 +212,42 @@ fn ring_carriers() -> Vec<BushingConfig> {
     ]
 }
 
-fn mounts(weight: f64) -> Vec<MountConfig> {
-    let (kx, ky, kz) = (51_500.0, 36_600.0, 48_300.0);
-    // Loss factor 0.15 at 10 Hz.
-    let c = |k: f64| 0.15 * k / (2.0 * PI * 10.0);
-    let corners = [
-        ("front_left", 0.30, 0.40),
-        ("front_right", 0.30, -0.40),
-        ("rear_left", -0.30, 0.40),
-        ("rear_right", -0.30, -0.40),
-    ];
-    corners
-        .iter()
-        .map(|&(name, dx, dy)| MountConfig {
-            name: name.to_string(),
-            active: true,
-            bracket: [
-                POWERTRAIN_CG[0] + dx,
-                POWERTRAIN_CG[1] + dy,
-                POWERTRAIN_CG[2],
-            ],
-            attachment: None,
-            axes: diag([1.0, 1.0, 1.0]),
-            curves: [
-                MountCurve::progressive(kx),
-                MountCurve::progressive(ky),
-                MountCurve::progressive(kz),
-            ],
-            damping: [c(kx), c(ky), c(kz)],
-            preload: [0.0, 0.0, weight / 4.0],
-        })
-        .collect()
+impl Default for GasConfig {
+    fn default() -> Self {
+        Self {
+            model: GasModel::default(),
+            load: 0.0,
+            crankcase_pressure: 1.0e5,
+        }
+    }
 }
 
 impl Default for EngineConfig {
     fn default() -> Self {
         let crank_drive = CrankDriveConfig::default();
-        let balance_shaft = BalanceShaftConfig::balancing(&crank_drive);
+        let (shaft, crank_counterweights) = first_order_balancing(&crank_drive);
         let start_crank_angle_deg = 0.0;
-        let gravity = 9.81;
-        let monoblock = monoblock_structure(
-            &crank_drive,
-            &balance_shaft,
-            f64::to_radians(start_crank_angle_deg),
-        );
-        let housing = RigidBodyConfig {
-            mass: POWERTRAIN_MASS - MONOBLOCK_MASS,
+        let placeholder = RigidBodyConfig {
+            mass: 1.0,
             centre_of_mass: POWERTRAIN_CG,
-            inertia: diag(HOUSING_INERTIA),
+            inertia: diag([1.0, 1.0, 1.0]),
         };
-        Self {
-            gravity,
+        let mut engine = Self {
             start_crank_angle_deg,
             excitation_fade_in: 0.1,
             crank_drive,
-            balance_shaft,
+            balance_shafts: vec![shaft],
+            crank_counterweights,
             gas: GasConfig::default(),
-            monoblock,
-            housing,
+            monoblock: placeholder,
+            housing: RigidBodyConfig {
+                mass: POWERTRAIN_MASS - MONOBLOCK_MASS,
+                centre_of_mass: POWERTRAIN_CG,
+                inertia: diag(HOUSING_INERTIA),
+            },
             ring_carriers: ring_carriers(),
-            mounts: mounts(POWERTRAIN_MASS * gravity),
-            effects: Effects::default(),
-        }
+        };
+        engine.monoblock = monoblock_structure(&engine, start_crank_angle_deg.to_radians());
+        engine
     }
 }

@@ -2,14 +2,14 @@
 //! assembly preload, with stiffness and damping scale factors.
 //!
 //! The law is a function of the relative displacement and velocity of the housing bracket with
-//! respect to the attachment point (ground now, a chassis interface node later), so it can be
-//! assembled into any larger system; it also returns its derivatives for Jacobians.
+//! respect to the attachment point (a ground point or a body node), so it works in any vehicle;
+//! it also returns its derivatives for Jacobians.
 
 use nalgebra::{Matrix3, Vector3};
 
-use super::assembly::{m3, v3};
 use super::config::MountConfig;
-use super::mount_curve::MountCurve;
+use super::curve::MountCurve;
+use crate::model::powertrain::assembly::{m3, v3};
 
 /// Mount force and its derivatives, in the vehicle frame.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -30,7 +30,7 @@ pub struct Mount {
     pub name: String,
     /// Bracket point in the vehicle frame, reference configuration.
     pub bracket: Vector3<f64>,
-    /// Attachment point in the vehicle frame (reference).
+    /// Attachment point in the vehicle frame (reference): the ground point or the body node.
     pub attachment: Vector3<f64>,
     /// Rows: local axes.
     pub axes: Matrix3<f64>,
@@ -43,12 +43,12 @@ pub struct Mount {
 }
 
 impl Mount {
-    pub fn from_config(c: &MountConfig) -> Self {
-        let bracket = v3(&c.bracket);
+    /// The mount of `c` attached at `attachment` (vehicle frame, reference configuration).
+    pub fn from_config(c: &MountConfig, attachment: Vector3<f64>) -> Self {
         Self {
             name: c.name.clone(),
-            bracket,
-            attachment: c.attachment.as_ref().map(v3).unwrap_or(bracket),
+            bracket: v3(&c.bracket),
+            attachment,
             axes: m3(&c.axes),
             curves: c.curves.clone(),
             damping: v3(&c.damping),
@@ -125,18 +125,18 @@ impl Mount {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::model::EngineConfig;
+    use crate::model::VehicleConfig;
 
     #[test]
     fn response_derivatives_match_finite_differences_in_a_rotated_frame() {
-        let mut cfg = EngineConfig::default().mounts[0].clone();
+        let mut cfg = VehicleConfig::default().mounts[0].clone();
         let rot = nalgebra::Rotation3::from_euler_angles(0.3, -0.2, 0.5).into_inner();
         cfg.axes = [
             [rot[(0, 0)], rot[(0, 1)], rot[(0, 2)]],
             [rot[(1, 0)], rot[(1, 1)], rot[(1, 2)]],
             [rot[(2, 0)], rot[(2, 1)], rot[(2, 2)]],
         ];
-        let mount = Mount::from_config(&cfg);
+        let mount = Mount::from_config(&cfg, v3(&cfg.bracket));
         let rel = Vector3::new(0.004, -0.006, -0.009);
         let vel = Vector3::new(0.01, 0.02, -0.03);
         let r = mount.response(&rel, &vel, 1.3, 0.7, true);

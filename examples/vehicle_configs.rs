@@ -1,20 +1,20 @@
-//! Writes the default engine configurations into `resources/`:
-//! - `engine.json`: the default (four mounts),
-//! - `engine_three_mounts.json`: the paper's improved vehicle (§7.1), the rear right mount removed
+//! Writes the vehicle configurations shipped in the FMU's `resources/`:
+//! - `vehicle.json`: the default (the M13 inline-3 on four mounts in the procedural body),
+//! - `vehicle_three_mounts.json`: the paper's improved vehicle (§7.1), the rear right mount removed
 //!   (it carried little static load but had a low vibration impedance). The three remaining
 //!   mounts get the vertical preloads that carry the weight at the design position (three
 //!   equations: vertical force and the two tilting moments about the CG), so the operating
 //!   points stay in the linear range of the curves.
 //!
-//! `cargo run --release --example engine_default_config`
+//! `cargo run --release --example vehicle_configs`
 
-use engine_mount_chassis::model::{EngineConfig, POWERTRAIN_CG, POWERTRAIN_MASS};
+use engine_mount_chassis::model::{VehicleConfig, POWERTRAIN_CG, POWERTRAIN_MASS};
 use nalgebra::{Matrix3, Vector3};
 
 fn main() -> Result<(), Box<dyn std::error::Error>> {
     let dir = concat!(env!("CARGO_MANIFEST_DIR"), "/resources");
     std::fs::create_dir_all(dir)?;
-    let default = EngineConfig::default();
+    let default = VehicleConfig::default();
     let mut three = default.clone();
     for mount in three.mounts.iter_mut().filter(|m| m.name == "rear_right") {
         mount.active = false;
@@ -41,8 +41,8 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         three.mounts[*i].preload = [0.0, 0.0, loads[col]];
     }
     for (name, config) in [
-        ("engine.json", &default),
-        ("engine_three_mounts.json", &three),
+        ("vehicle.json", &default),
+        ("vehicle_three_mounts.json", &three),
     ] {
         let path = format!("{dir}/{name}");
         std::fs::write(&path, config.to_json() + "\n")?;

@@ -2,8 +2,9 @@
 
 use nalgebra::{Matrix3, Vector3};
 
-use super::config::{BalanceShaftConfig, CrankDriveConfig, EngineConfig, RigidBodyConfig};
+use super::config::{CrankDriveConfig, EccentricWeight, EngineConfig, RigidBodyConfig};
 use super::parts::{Part, PartMotion};
+use crate::model::effects::Effects;
 
 /// One free rigid body (6 coordinates) with the parts it carries.
 #[derive(Debug, Clone, PartialEq)]
@@ -42,6 +43,7 @@ pub fn structure_part(name: &str, body: &RigidBodyConfig, reference: &Vector3<f6
 /// Crank drive parts (pistons, crank points, crank rotor), relative to `reference`.
 pub fn crank_drive_parts(c: &CrankDriveConfig, reference: &Vector3<f64>) -> Vec<Part> {
     let centre = v3(&c.crank_centre) - reference;
+    let bore = v3(&c.bore_axis);
     let mut parts = Vec::new();
     for (i, cyl) in c.cylinders.iter().enumerate() {
         let throw = cyl.throw_deg.to_radians();
@@ -51,6 +53,7 @@ pub fn crank_drive_parts(c: &CrankDriveConfig, reference: &Vector3<f64>) -> Vec<
             inertia: Matrix3::zeros(),
             motion: PartMotion::Piston {
                 crank_centre: centre,
+                bore,
                 y: cyl.y_offset,
                 throw,
                 radius: c.crank_radius,
@@ -65,6 +68,7 @@ pub fn crank_drive_parts(c: &CrankDriveConfig, reference: &Vector3<f64>) -> Vec<
                 inertia: Matrix3::zeros(),
                 motion: PartMotion::Orbit {
                     centre,
+                    bore,
                     y: cyl.y_offset,
                     radius: c.crank_radius,
                     ratio: 1.0,
@@ -80,6 +84,7 @@ pub fn crank_drive_parts(c: &CrankDriveConfig, reference: &Vector3<f64>) -> Vec<
                 inertia: Matrix3::zeros(),
                 motion: PartMotion::Orbit {
                     centre,
+                    bore,
                     y: cyl.y_offset,
                     radius: c.counterweight_radius,
                     ratio: 1.0,
@@ -99,68 +104,68 @@ pub fn crank_drive_parts(c: &CrankDriveConfig, reference: &Vector3<f64>) -> Vec<
     parts
 }
 
-/// Balance shaft and extra crank counterweight parts, relative to `reference`.
-pub fn balance_parts(
-    b: &BalanceShaftConfig,
-    c: &CrankDriveConfig,
-    reference: &Vector3<f64>,
-) -> Vec<Part> {
-    let axis = v3(&b.axis_point) - reference;
+/// An eccentric weight turning at `ratio` about an axis through `centre` (relative to the body
+/// reference point).
+fn eccentric(
+    name: String,
+    w: &EccentricWeight,
+    centre: Vector3<f64>,
+    bore: Vector3<f64>,
+    ratio: f64,
+) -> Part {
+    Part {
+        name,
+        mass: w.mass,
+        inertia: Matrix3::zeros(),
+        motion: PartMotion::Orbit {
+            centre,
+            bore,
+            y: w.y,
+            radius: w.eccentricity,
+            ratio,
+            phase: w.phase_deg.to_radians(),
+        },
+        spin_ratio: ratio,
+    }
+}
+
+/// Balance shafts with their weights and the extra crank counterweights, relative to `reference`.
+pub fn balance_parts(cfg: &EngineConfig, reference: &Vector3<f64>) -> Vec<Part> {
+    let c = &cfg.crank_drive;
+    let bore = v3(&c.bore_axis);
     let crank = v3(&c.crank_centre) - reference;
-    let pi = std::f64::consts::PI;
-    let mut parts = vec![Part {
-        name: "balance shaft".into(),
-        mass: b.shaft_mass,
-        inertia: spin_inertia(b.shaft_axial_inertia),
-        motion: PartMotion::Fixed { offset: axis },
-        spin_ratio: -1.0,
-    }];
-    let wp = b.weight_phase_deg.to_radians();
-    let cp = b.extra_counterweight_phase_deg.to_radians();
-    for (sign, extra) in [(1.0, 0.0), (-1.0, pi)] {
+    let mut parts = Vec::new();
+    for shaft in &cfg.balance_shafts {
+        let axis = v3(&shaft.axis_point) - reference;
         parts.push(Part {
-            name: format!("balance weight {}", if sign > 0.0 { "+y" } else { "-y" }),
-            mass: b.weight_mass,
-            inertia: Matrix3::zeros(),
-            motion: PartMotion::Orbit {
-                centre: axis,
-                y: sign * 0.5 * b.weight_spacing,
-                radius: b.weight_eccentricity,
-                ratio: -1.0,
-                phase: wp + extra,
-            },
-            spin_ratio: -1.0,
+            name: shaft.name.clone(),
+            mass: shaft.shaft_mass,
+            inertia: spin_inertia(shaft.shaft_axial_inertia),
+            motion: PartMotion::Fixed { offset: axis },
+            spin_ratio: shaft.ratio,
         });
-        parts.push(Part {
-            name: format!(
-                "extra counterweight {}",
-                if sign > 0.0 { "+y" } else { "-y" }
-            ),
-            mass: b.extra_counterweight_mass,
-            inertia: Matrix3::zeros(),
-            motion: PartMotion::Orbit {
-                centre: crank,
-                y: sign * 0.5 * b.extra_counterweight_spacing,
-                radius: b.extra_counterweight_radius,
-                ratio: 1.0,
-                phase: cp + extra,
-            },
-            spin_ratio: 1.0,
-        });
+        for (k, w) in shaft.weights.iter().enumerate() {
+            let name = format!("{} weight {}", shaft.name, k + 1);
+            parts.push(eccentric(name, w, axis, bore, shaft.ratio));
+        }
+    }
+    for (k, w) in cfg.crank_counterweights.iter().enumerate() {
+        let name = format!("extra counterweight {}", k + 1);
+        parts.push(eccentric(name, w, crank, bore, 1.0));
     }
     parts
 }
 
 /// The free bodies of the model: `[monoblock, housing]` with elastic ring carriers, otherwise one
 /// rigid `powertrain`. The monoblock (or powertrain) is always body 0 and carries the crank drive.
-pub fn build_bodies(cfg: &EngineConfig) -> Vec<Body> {
+pub fn build_bodies(cfg: &EngineConfig, effects: &Effects) -> Vec<Body> {
     let mb_ref = v3(&cfg.monoblock.centre_of_mass);
     let mut mb_parts = vec![structure_part("monoblock", &cfg.monoblock, &mb_ref)];
     mb_parts.extend(crank_drive_parts(&cfg.crank_drive, &mb_ref));
-    if cfg.effects.balance_shaft {
-        mb_parts.extend(balance_parts(&cfg.balance_shaft, &cfg.crank_drive, &mb_ref));
+    if effects.balance_shaft {
+        mb_parts.extend(balance_parts(cfg, &mb_ref));
     }
-    if cfg.effects.ring_carrier_elasticity {
+    if effects.ring_carrier_elasticity {
         let h_ref = v3(&cfg.housing.centre_of_mass);
         vec![
             Body {

@@ -6,7 +6,7 @@ use nalgebra::Vector3;
 
 use super::assembly::v3;
 use super::composite::{add_parts, BodyDynamics, BodyKinematics, CrankDriveState};
-use super::ground_scene::GroundScene;
+use super::Powertrain;
 
 /// Force and moment (vehicle frame) on the monoblock.
 #[derive(Debug, Clone, Copy, PartialEq, Default)]
@@ -16,7 +16,7 @@ pub struct Wrench {
     pub moment: [f64; 3],
 }
 
-impl GroundScene {
+impl Powertrain {
     /// Wrench the crank drive exerts on the monoblock held fixed at its reference pose, at crank
     /// angle `phi`, crank spin `speed` and spin acceleration `acceleration`; gravity excluded,
     /// effect switches honoured, no fade-in. Minus this is the reaction on rigid ground.

@@ -1,18 +1,27 @@
-//! Engine configuration (serde). Defaults: DESIGN §8, tuned to the paper's Table 1 column
-//! "engine supported by ground" (tuning rationale in `src/model/defaults.rs`).
+//! Powertrain configuration (serde): crank drive, balance shafts, gas, the monoblock and housing
+//! bodies and the ring carriers between them. Defaults: the paper's Steyr M13 inline-3
+//! ([`super::defaults`]).
 //!
 //! Frame: ISO 8855 vehicle frame, x forward, y left, z up, origin at the front axle centre on the
-//! ground. The engine is transverse: the crank axis is +y, cylinders point to +z in the monoblock.
-//! All positions are given in the reference configuration (bodies undeflected), SI units.
+//! ground. The engine is transverse: the crank axis is +y; the cylinders point along the
+//! configurable bore axis (default +z). Angles about the crank axis are measured from the bore
+//! axis `b` towards `e_y × b` (for the upright engine: from +z towards +x). All positions are
+//! given in the reference configuration (bodies undeflected), SI units.
+//!
+//! Every struct rejects unknown fields, and no field is silently defaulted: a configuration file
+//! is complete, or says `"extends": "default"` to patch the default (see
+//! [`crate::model::vehicle::VehicleConfig::from_json`]).
 
 use serde::{Deserialize, Serialize};
 
-use super::effects::Effects;
 use super::gas::GasModel;
-use super::mount_curve::MountCurve;
+use crate::model::validate::{
+    err, finite, inertia_tensor, non_negative, positive, unit_vector, ConfigError,
+};
 
 /// Mass properties of one rigid body (without the internal moving parts).
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
 pub struct RigidBodyConfig {
     /// Mass (kg).
     pub mass: f64,
@@ -24,21 +33,25 @@ pub struct RigidBodyConfig {
 
 /// One cylinder of the inline engine.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
 pub struct CylinderConfig {
     /// Cylinder axis position along the crank axis relative to the crank centre (m).
     pub y_offset: f64,
     /// Crank throw angle (deg): the cylinder's crank angle after TDC is `φ − throw`.
     pub throw_deg: f64,
-    /// Crank angle of this cylinder's firing TDC within the 720° cycle (deg).
+    /// Crank angle of this cylinder's firing TDC within the 720° cycle (deg): the firing order.
     pub firing_tdc_deg: f64,
 }
 
-/// Crank drive: geometry, reciprocating and rotating masses, firing order.
+/// Crank drive: geometry, reciprocating and rotating masses, cylinders and firing order.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
-#[serde(default)]
+#[serde(deny_unknown_fields)]
 pub struct CrankDriveConfig {
     /// Crank centre (middle of the crank axis) in the vehicle frame (m).
     pub crank_centre: [f64; 3],
+    /// Cylinder (bore) axis, a unit vector normal to the crank axis y (default +z; an inclined
+    /// engine tilts it in the x-z plane).
+    pub bore_axis: [f64; 3],
     pub bore: f64,
     pub crank_radius: f64,
     pub conrod_length: f64,
@@ -55,32 +68,39 @@ pub struct CrankDriveConfig {
     pub cylinders: Vec<CylinderConfig>,
 }
 
-/// Balance shaft (turning at −1× crank speed) and the extra crank counterweight pair.
+/// An eccentric mass on a shaft parallel to the crank axis.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
-#[serde(default)]
+#[serde(deny_unknown_fields)]
+pub struct EccentricWeight {
+    /// Mass (kg) and distance of its centre of mass from the shaft axis (m).
+    pub mass: f64,
+    pub eccentricity: f64,
+    /// Position along the shaft axis, from the shaft's reference point (m).
+    pub y: f64,
+    /// Angle at crank angle φ = 0 (deg, from the bore axis towards e_y × bore); it turns at the
+    /// shaft's ratio times φ.
+    pub phase_deg: f64,
+}
+
+/// A balance shaft: a shaft parallel to the crank axis turning at `ratio` times the crank's speed
+/// relative to the block (−1: the inline-3's counter-rotating first-order shaft; ±2: a pair of
+/// Lanchester shafts of an inline-4), carrying eccentric weights.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
 pub struct BalanceShaftConfig {
-    /// A point of the shaft axis (parallel to the crank axis) in the vehicle frame; the weights sit
-    /// at ±spacing/2 from it along y (m).
+    pub name: String,
+    /// A point of the shaft axis in the vehicle frame; the reference of the weights' `y` (m).
     pub axis_point: [f64; 3],
+    pub ratio: f64,
+    /// Shaft mass on the axis (kg) and spin inertia (kg m²).
     pub shaft_mass: f64,
     pub shaft_axial_inertia: f64,
-    /// Each of the two opposed eccentric weights (kg) and its eccentricity (m).
-    pub weight_mass: f64,
-    pub weight_eccentricity: f64,
-    pub weight_spacing: f64,
-    /// Angle of the +y weight at φ = 0 (deg from +z towards +x); it turns at −φ.
-    pub weight_phase_deg: f64,
-    /// Extra crank counterweights (two opposed, on the crank, at ±spacing/2 about the crank centre).
-    pub extra_counterweight_mass: f64,
-    pub extra_counterweight_radius: f64,
-    pub extra_counterweight_spacing: f64,
-    /// Angle of the +y extra counterweight at φ = 0 (deg); it turns at +φ.
-    pub extra_counterweight_phase_deg: f64,
+    pub weights: Vec<EccentricWeight>,
 }
 
 /// Gas pressure source and load.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
-#[serde(default)]
+#[serde(deny_unknown_fields)]
 pub struct GasConfig {
     pub model: GasModel,
     /// Load between idle (0) and full load (1) for the Wiebe model.
@@ -89,18 +109,9 @@ pub struct GasConfig {
     pub crankcase_pressure: f64,
 }
 
-impl Default for GasConfig {
-    fn default() -> Self {
-        Self {
-            model: GasModel::default(),
-            load: 0.0,
-            crankcase_pressure: 1.0e5,
-        }
-    }
-}
-
 /// Linear 6-DOF elastomer bushing (ring carrier) between monoblock and housing.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
 pub struct BushingConfig {
     pub name: String,
     /// Location in the vehicle frame (m).
@@ -111,131 +122,27 @@ pub struct BushingConfig {
     pub damping: [f64; 6],
 }
 
-/// One engine mount between a housing bracket and ground (or a chassis node).
+/// The powertrain: monoblock with its crank drive, balance shafts and gas forces, the housing
+/// (gearbox, aggregates, mount brackets), and the ring carriers between the two.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
-pub struct MountConfig {
-    pub name: String,
-    /// A removed mount (paper §7.1: 4 → 3 mounts) carries no force and costs nothing.
-    #[serde(default = "default_true")]
-    pub active: bool,
-    /// Bracket point on the housing in the vehicle frame (m).
-    pub bracket: [f64; 3],
-    /// Attachment point on ground/chassis (m); `None` means coincident with the bracket.
-    #[serde(default)]
-    pub attachment: Option<[f64; 3]>,
-    /// Local mount axes as rows (unit vectors in the vehicle frame); deflections and forces of the
-    /// curves below are along these axes.
-    pub axes: [[f64; 3]; 3],
-    /// Force–deflection curve per local axis.
-    pub curves: [MountCurve; 3],
-    /// Viscous damping per local axis (N s/m).
-    pub damping: [f64; 3],
-    /// Force the mount exerts on the bracket at zero deflection, per local axis (N): the assembly
-    /// preload that places the static operating point (DESIGN §4.1).
-    pub preload: [f64; 3],
-}
-
-fn default_true() -> bool {
-    true
-}
-
-/// Complete engine configuration.
-#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
-#[serde(default)]
+#[serde(deny_unknown_fields)]
 pub struct EngineConfig {
-    /// Gravitational acceleration (m/s², acting along −z).
-    pub gravity: f64,
     /// Crank angle at the start of a simulation (deg, relative to the monoblock).
     pub start_crank_angle_deg: f64,
     /// Excitation fade-in time (s); 0 switches the excitation on at once.
     pub excitation_fade_in: f64,
     pub crank_drive: CrankDriveConfig,
-    pub balance_shaft: BalanceShaftConfig,
+    /// Balance shafts (effect switch `balance_shaft`).
+    pub balance_shafts: Vec<BalanceShaftConfig>,
+    /// Extra counterweights on the crank that work with the balance shafts (switched with them);
+    /// `y` from the crank centre, turning with the crank.
+    pub crank_counterweights: Vec<EccentricWeight>,
     pub gas: GasConfig,
     /// Monoblock structure (cylinders, head, main bearing frame) without the moving parts.
     pub monoblock: RigidBodyConfig,
     /// Housing + gearbox + aggregates (carries the mount brackets).
     pub housing: RigidBodyConfig,
     pub ring_carriers: Vec<BushingConfig>,
-    pub mounts: Vec<MountConfig>,
-    pub effects: Effects,
-}
-
-/// A configuration value that is out of its physical range.
-#[derive(Debug, Clone, PartialEq)]
-pub struct ConfigError {
-    /// Dotted path of the offending field, e.g. `mounts[2].curves[1].knots[0].stiffness`.
-    pub field: String,
-    pub message: String,
-}
-
-impl std::fmt::Display for ConfigError {
-    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
-        write!(f, "invalid configuration: {}: {}", self.field, self.message)
-    }
-}
-
-impl std::error::Error for ConfigError {}
-
-fn err(field: impl Into<String>, message: impl Into<String>) -> ConfigError {
-    ConfigError {
-        field: field.into(),
-        message: message.into(),
-    }
-}
-
-fn positive(field: &str, v: f64) -> Result<(), ConfigError> {
-    if v.is_finite() && v > 0.0 {
-        Ok(())
-    } else {
-        Err(err(
-            field,
-            format!("{field} = {v} must be a positive finite number"),
-        ))
-    }
-}
-
-fn non_negative(field: &str, v: f64) -> Result<(), ConfigError> {
-    if v.is_finite() && v >= 0.0 {
-        Ok(())
-    } else {
-        Err(err(
-            field,
-            format!("{field} = {v} must be a non-negative finite number"),
-        ))
-    }
-}
-
-fn finite(field: &str, v: &[f64]) -> Result<(), ConfigError> {
-    match v.iter().find(|x| !x.is_finite()) {
-        Some(x) => Err(err(field, format!("{field} contains {x}, must be finite"))),
-        None => Ok(()),
-    }
-}
-
-fn inertia_tensor(field: &str, j: &[[f64; 3]; 3]) -> Result<(), ConfigError> {
-    finite(field, &j.concat())?;
-    let m = nalgebra::Matrix3::from_fn(|r, c| j[r][c]);
-    if (m - m.transpose()).abs().max() > 1e-9 * m.abs().max().max(1e-30) {
-        return Err(err(field, format!("{field} = {j:?} must be symmetric")));
-    }
-    let eig = m.symmetric_eigen().eigenvalues;
-    let (a, b, c) = (eig[0], eig[1], eig[2]);
-    if a.min(b).min(c) <= 0.0 {
-        return Err(err(
-            field,
-            format!("{field} = {j:?} must be positive definite (eigenvalues {a}, {b}, {c})"),
-        ));
-    }
-    // Triangle inequality of principal moments: otherwise no mass distribution has this tensor.
-    let tol = 1e-9 * (a + b + c);
-    if a + b < c - tol || a + c < b - tol || b + c < a - tol {
-        return Err(err(
-            field,
-            format!("{field} = {j:?} violates the triangle inequality of principal moments"),
-        ));
-    }
-    Ok(())
 }
 
 impl RigidBodyConfig {
@@ -246,27 +153,33 @@ impl RigidBodyConfig {
     }
 }
 
+impl EccentricWeight {
+    fn validate(&self, field: &str) -> Result<(), ConfigError> {
+        non_negative(&format!("{field}.mass"), self.mass)?;
+        non_negative(&format!("{field}.eccentricity"), self.eccentricity)?;
+        finite(&format!("{field}.y"), &[self.y])?;
+        finite(&format!("{field}.phase_deg"), &[self.phase_deg])
+    }
+}
+
 impl EngineConfig {
-    /// Loads a configuration from JSON; unspecified fields take their defaults. Validates it.
-    pub fn from_json(text: &str) -> Result<Self, ConfigError> {
-        let cfg: Self = serde_json::from_str(text)
-            .map_err(|e| err("json", format!("cannot parse the configuration: {e}")))?;
-        cfg.validate()?;
-        Ok(cfg)
-    }
-
-    /// Serialises the configuration as pretty JSON.
-    pub fn to_json(&self) -> String {
-        serde_json::to_string_pretty(self).unwrap_or_default()
-    }
-
-    /// Checks every physical parameter; the error names the field and its value.
+    /// Checks every physical parameter; the error names the field (prefixed by `at`) and its
+    /// value.
     pub fn validate(&self) -> Result<(), ConfigError> {
-        positive("gravity", self.gravity)?;
         finite("start_crank_angle_deg", &[self.start_crank_angle_deg])?;
         non_negative("excitation_fade_in", self.excitation_fade_in)?;
         let c = &self.crank_drive;
         finite("crank_drive.crank_centre", &c.crank_centre)?;
+        unit_vector("crank_drive.bore_axis", &c.bore_axis)?;
+        if c.bore_axis[1].abs() > 1e-6 {
+            return Err(err(
+                "crank_drive.bore_axis",
+                format!(
+                    "crank_drive.bore_axis = {:?} must be normal to the crank axis y",
+                    c.bore_axis
+                ),
+            ));
+        }
         positive("crank_drive.bore", c.bore)?;
         positive("crank_drive.crank_radius", c.crank_radius)?;
         positive("crank_drive.conrod_length", c.conrod_length)?;
@@ -290,84 +203,54 @@ impl EngineConfig {
             ));
         }
         for (i, cyl) in c.cylinders.iter().enumerate() {
-            let f = format!("crank_drive.cylinders[{i}]");
-            finite(&f, &[cyl.y_offset, cyl.throw_deg, cyl.firing_tdc_deg])?;
+            let fc = format!("crank_drive.cylinders[{i}]");
+            finite(&fc, &[cyl.y_offset, cyl.throw_deg, cyl.firing_tdc_deg])?;
             let diff = (cyl.firing_tdc_deg - cyl.throw_deg).rem_euclid(360.0);
             if diff > 1e-6 && diff < 360.0 - 1e-6 {
                 return Err(err(
-                    format!("{f}.firing_tdc_deg"),
+                    format!("{fc}.firing_tdc_deg"),
                     format!(
-                        "{f}.firing_tdc_deg = {} must be a TDC of the cylinder, i.e. equal to throw_deg = {} modulo 360",
+                        "{fc}.firing_tdc_deg = {} must be a TDC of the cylinder, i.e. equal to throw_deg = {} modulo 360",
                         cyl.firing_tdc_deg, cyl.throw_deg
                     ),
                 ));
             }
         }
-        let b = &self.balance_shaft;
-        finite("balance_shaft.axis_point", &b.axis_point)?;
-        for (name, v) in [
-            ("shaft_mass", b.shaft_mass),
-            ("shaft_axial_inertia", b.shaft_axial_inertia),
-            ("weight_mass", b.weight_mass),
-            ("weight_eccentricity", b.weight_eccentricity),
-            ("weight_spacing", b.weight_spacing),
-            ("extra_counterweight_mass", b.extra_counterweight_mass),
-            ("extra_counterweight_radius", b.extra_counterweight_radius),
-            ("extra_counterweight_spacing", b.extra_counterweight_spacing),
-        ] {
-            non_negative(&format!("balance_shaft.{name}"), v)?;
+        for (i, b) in self.balance_shafts.iter().enumerate() {
+            let fb = format!("balance_shafts[{i}]");
+            finite(&format!("{fb}.axis_point"), &b.axis_point)?;
+            if !(b.ratio.is_finite() && b.ratio != 0.0) {
+                return Err(err(
+                    format!("{fb}.ratio"),
+                    format!("{fb}.ratio = {} must be finite and non-zero", b.ratio),
+                ));
+            }
+            non_negative(&format!("{fb}.shaft_mass"), b.shaft_mass)?;
+            non_negative(&format!("{fb}.shaft_axial_inertia"), b.shaft_axial_inertia)?;
+            for (k, w) in b.weights.iter().enumerate() {
+                w.validate(&format!("{fb}.weights[{k}]"))?;
+            }
         }
-        finite(
-            "balance_shaft.weight_phase_deg",
-            &[b.weight_phase_deg, b.extra_counterweight_phase_deg],
-        )?;
+        for (k, w) in self.crank_counterweights.iter().enumerate() {
+            w.validate(&format!("crank_counterweights[{k}]"))?;
+        }
         self.validate_gas()?;
         self.monoblock.validate("monoblock")?;
         self.housing.validate("housing")?;
         for (i, r) in self.ring_carriers.iter().enumerate() {
-            let f = format!("ring_carriers[{i}]");
-            finite(&format!("{f}.position"), &r.position)?;
+            let fr = format!("ring_carriers[{i}]");
+            finite(&format!("{fr}.position"), &r.position)?;
             for k in 0..6 {
-                non_negative(&format!("{f}.stiffness[{k}]"), r.stiffness[k])?;
-                non_negative(&format!("{f}.damping[{k}]"), r.damping[k])?;
+                non_negative(&format!("{fr}.stiffness[{k}]"), r.stiffness[k])?;
+                non_negative(&format!("{fr}.damping[{k}]"), r.damping[k])?;
             }
-        }
-        if self.effects.ring_carrier_elasticity && self.ring_carriers.is_empty() {
-            return Err(err(
-                "ring_carriers",
-                "ring carrier elasticity is on but no ring carrier is configured",
-            ));
-        }
-        let active = self.mounts.iter().filter(|m| m.active).count();
-        if active < 3 {
-            return Err(err("mounts", format!("{active} active mounts cannot carry the powertrain statically; need at least 3")));
-        }
-        for (i, m) in self.mounts.iter().enumerate() {
-            let f = format!("mounts[{i}]");
-            finite(&format!("{f}.bracket"), &m.bracket)?;
-            if let Some(a) = &m.attachment {
-                finite(&format!("{f}.attachment"), a)?;
-            }
-            let axes = nalgebra::Matrix3::from_fn(|r, c| m.axes[r][c]);
-            finite(&format!("{f}.axes"), &m.axes.concat())?;
-            let dev = (axes * axes.transpose() - nalgebra::Matrix3::identity())
-                .abs()
-                .max();
-            if dev > 1e-6 || axes.determinant() < 0.0 {
-                return Err(err(
-                    format!("{f}.axes"),
-                    format!("{f}.axes = {:?} must be a right-handed orthonormal frame (rows), deviation {dev}", m.axes),
-                ));
-            }
-            for k in 0..3 {
-                m.curves[k]
-                    .validate(&format!("{f}.curves[{k}]"))
-                    .map_err(|e| err(format!("{f}.curves[{k}]"), e))?;
-                non_negative(&format!("{f}.damping[{k}]"), m.damping[k])?;
-            }
-            finite(&format!("{f}.preload"), &m.preload)?;
         }
         Ok(())
+    }
+
+    /// Crank radius over conrod length.
+    pub fn lambda(&self) -> f64 {
+        self.crank_drive.crank_radius / self.crank_drive.conrod_length
     }
 
     fn validate_gas(&self) -> Result<(), ConfigError> {

@@ -1,0 +1,323 @@
+//! One evaluation of the coupled equations of motion, and the right-hand side built from it.
+
+use faer::MatMut;
+use nalgebra::{Vector3, Vector6};
+
+use super::{CoupledModel, MountTarget};
+use crate::model::kinematics::{angle_rates, rotation_matrix};
+use crate::model::mount::MountResponse;
+use crate::model::powertrain::composite::{BodyDynamics, BodyKinematics, CrankDriveState};
+use crate::ode::{BlockLowRankJacobian, BlockLowRankShape, OdeProblem, ProblemError};
+
+/// How the model is evaluated.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub(crate) struct Mode {
+    /// Engine running (crank speed, gas, fade-in); false: crank at rest, no gas (statics, modes).
+    pub(crate) running: bool,
+    /// Force the nonlinear mount curves (statics determine the operating point with them).
+    pub(crate) nonlinear_mounts: bool,
+}
+
+impl Mode {
+    pub(crate) const RUNNING: Mode = Mode {
+        running: true,
+        nonlinear_mounts: false,
+    };
+    /// Crank standing, no gas, nonlinear mounts: the static residual.
+    pub(crate) const STATIC: Mode = Mode {
+        running: false,
+        nonlinear_mounts: true,
+    };
+    /// Crank standing, no gas, mounts linearised at the operating point: the linearisation of
+    /// the modal analysis.
+    pub(crate) const AT_REST: Mode = Mode {
+        running: false,
+        nonlinear_mounts: false,
+    };
+}
+
+/// Everything one evaluation of the equations of motion produces.
+#[derive(Debug, Clone)]
+pub struct Evaluation {
+    pub kinematics: Vec<BodyKinematics>,
+    /// Mass matrix and generalised forces per powertrain body (mount forces included).
+    pub dynamics: Vec<BodyDynamics>,
+    /// Per configured mount (None when removed).
+    pub mounts: Vec<Option<MountResponse>>,
+    /// Generalised body forces `Σ_p φ_{p,k} · (−F_p)` per mode.
+    pub modal_force: Vec<f64>,
+    /// The crank drive as the parts saw it.
+    pub crank: CrankDriveState,
+    /// Crank angle rate `φ' = ω_c − e·ω_block`.
+    pub crank_rate: f64,
+    /// Crank speed and acceleration (from the follower or the set-point).
+    pub crank_speed: f64,
+    pub crank_acceleration: f64,
+}
+
+impl CoupledModel {
+    /// Pose and velocity of powertrain body `b` in state `y`.
+    pub(crate) fn kinematics(&self, y: &[f64], b: usize) -> BodyKinematics {
+        let q = &y[self.layout.q(b)];
+        let v = &y[self.layout.v(b)];
+        BodyKinematics {
+            position: self.powertrain.bodies()[b].reference + Vector3::new(q[0], q[1], q[2]),
+            rotation: rotation_matrix(&Vector3::new(q[3], q[4], q[5])),
+            velocity: Vector3::new(v[0], v[1], v[2]),
+            omega: Vector3::new(v[3], v[4], v[5]),
+        }
+    }
+
+    /// Crank speed and acceleration at `(t, y)`: the follower's states, or the set-point.
+    fn crank_motion(&self, t: f64, y: &[f64]) -> (f64, f64) {
+        match self.layout.follower_states() {
+            Some((w, a)) => (y[w], y[a]),
+            None => (self.inputs.crank_speed.at(t), self.inputs.crank_speed.rate),
+        }
+    }
+
+    fn crank_state(
+        &self,
+        t: f64,
+        phi: f64,
+        speed: f64,
+        acceleration: f64,
+        mode: Mode,
+    ) -> CrankDriveState {
+        if !mode.running {
+            return CrankDriveState {
+                angle: phi,
+                speed: 0.0,
+                acceleration: 0.0,
+                excitation: 0.0,
+                spin: 0.0,
+            };
+        }
+        let fx = self.effects();
+        let fade = self.excitation(t);
+        CrankDriveState {
+            angle: if fx.mass_forces {
+                phi
+            } else {
+                self.powertrain.start_angle()
+            },
+            speed,
+            acceleration,
+            excitation: if fx.mass_forces { fade } else { 0.0 },
+            spin: if fx.gyroscopic { fade * speed } else { 0.0 },
+        }
+    }
+
+    pub(crate) fn evaluate_mode(&self, t: f64, y: &[f64], mode: Mode) -> Evaluation {
+        let nb = self.layout.bodies();
+        let phi = y[self.layout.crank_angle()];
+        let (speed, acceleration) = self.crank_motion(t, y);
+        let crank = self.crank_state(t, phi, speed, acceleration, mode);
+        let gas_scale = if mode.running {
+            self.excitation(t)
+        } else {
+            0.0
+        };
+        let load_torque = self.inputs.load_torque.at(t);
+        let kin: Vec<BodyKinematics> = (0..nb).map(|b| self.kinematics(y, b)).collect();
+        let mut dynamics: Vec<BodyDynamics> = (0..nb)
+            .map(|b| {
+                self.powertrain
+                    .local_dynamics(b, &kin[b], &crank, phi, gas_scale, load_torque)
+            })
+            .collect();
+        self.powertrain.add_ring_carriers(&kin, &mut dynamics);
+        let hb = self.powertrain.housing_index();
+        let (mounts, modal_force) = self.add_mounts(t, y, &kin[hb], mode, &mut dynamics[hb]);
+        let e = kin[0].rotation * Vector3::y();
+        let crank_rate = if mode.running { speed } else { 0.0 } - e.dot(&kin[0].omega);
+        Evaluation {
+            kinematics: kin,
+            dynamics,
+            mounts,
+            modal_force,
+            crank,
+            crank_rate,
+            crank_speed: speed,
+            crank_acceleration: acceleration,
+        }
+    }
+
+    /// Mount forces on the housing `h` and, as generalised forces, on the body; the responses per
+    /// configured mount.
+    fn add_mounts(
+        &self,
+        t: f64,
+        y: &[f64],
+        h: &BodyKinematics,
+        mode: Mode,
+        out: &mut BodyDynamics,
+    ) -> (Vec<Option<MountResponse>>, Vec<f64>) {
+        let hb = self.powertrain.housing_index();
+        let reference = self.powertrain.bodies()[hb].reference;
+        let nonlinear = mode.nonlinear_mounts || self.effects().mount_nonlinearity;
+        let eta = &y[self.layout.eta()];
+        let eta_rate = &y[self.layout.eta_rate()];
+        let mut modal_force = vec![0.0; self.layout.modes()];
+        let responses = self
+            .mounts
+            .iter()
+            .enumerate()
+            .map(|(i, m)| {
+                let m = m.as_ref()?;
+                let local = m.mount.bracket - reference;
+                let x = h.point(&local);
+                let xv = h.point_velocity(&local);
+                let (a, av) = match m.target {
+                    MountTarget::Ground => (Vector3::zeros(), Vector3::zeros()),
+                    MountTarget::BodyPoint(p) => (
+                        self.point_translation(p, eta),
+                        self.point_translation(p, eta_rate),
+                    ),
+                };
+                let (k_scale, c_scale) = self.inputs.mount_scales(i, t);
+                let r = m.mount.response(
+                    &(x - m.mount.attachment - a),
+                    &(xv - av),
+                    k_scale,
+                    c_scale,
+                    nonlinear,
+                );
+                out.add_point_force(h, &x, &r.force);
+                if let MountTarget::BodyPoint(p) = m.target {
+                    for (g, s) in modal_force.iter_mut().zip(&self.body.points[p].shape) {
+                        *g -= s[0] * r.force.x + s[1] * r.force.y + s[2] * r.force.z;
+                    }
+                }
+                Some(r)
+            })
+            .collect();
+        (responses, modal_force)
+    }
+
+    /// One evaluation of the equations of motion of the running engine at `(t, y)`.
+    pub fn evaluate(&self, t: f64, y: &[f64]) -> Evaluation {
+        self.evaluate_mode(t, y, Mode::RUNNING)
+    }
+
+    /// Accelerations `[u'', ω']` per powertrain body from one evaluation.
+    pub(crate) fn accelerations(&self, ev: &Evaluation) -> Result<Vec<Vector6<f64>>, ProblemError> {
+        ev.dynamics
+            .iter()
+            .map(|d| {
+                d.mass
+                    .lu()
+                    .solve(&d.force)
+                    .ok_or_else(|| ProblemError::Fatal("singular body mass matrix".into()))
+            })
+            .collect()
+    }
+
+    /// Writes `f(t, y)` from an evaluation at `(t, y)` in mode `mode`.
+    pub(crate) fn write_rhs(
+        &self,
+        t: f64,
+        y: &[f64],
+        ev: &Evaluation,
+        mode: Mode,
+        f: &mut [f64],
+    ) -> Result<(), ProblemError> {
+        let l = &self.layout;
+        for (b, acc) in self.accelerations(ev)?.iter().enumerate() {
+            let q = &y[l.q(b)];
+            let k = &ev.kinematics[b];
+            let theta = Vector3::new(q[3], q[4], q[5]);
+            let rates = angle_rates(&theta, &k.omega).ok_or_else(|| {
+                ProblemError::Recoverable(format!(
+                    "{} rotation reached the Cardan singularity",
+                    self.powertrain.bodies()[b].name
+                ))
+            })?;
+            let qr = l.q(b).start;
+            for i in 0..3 {
+                f[qr + i] = k.velocity[i];
+                f[qr + 3 + i] = rates[i];
+            }
+            f[l.v(b)].copy_from_slice(acc.as_slice());
+        }
+        f[l.crank_angle()] = ev.crank_rate;
+        if let Some((w, a)) = l.follower_states() {
+            let (dw, da) = if mode.running {
+                let s = &self.inputs.crank_speed;
+                self.follower
+                    .rates(ev.crank_speed, ev.crank_acceleration, s.at(t), s.rate)
+            } else {
+                (0.0, 0.0)
+            };
+            f[w] = dw;
+            f[a] = da;
+        }
+        let (eta, rate) = (l.eta().start, l.eta_rate().start);
+        let body = &self.body;
+        for k in 0..l.modes() {
+            let (x, v) = (y[eta + k], y[rate + k]);
+            f[eta + k] = v;
+            f[rate + k] = ev.modal_force[k]
+                - 2.0 * body.zeta[k] * body.omega[k] * v
+                - body.omega[k] * body.omega[k] * x;
+        }
+        if f.iter().any(|x| !x.is_finite()) {
+            return Err(ProblemError::NonFinite);
+        }
+        Ok(())
+    }
+
+    /// Right-hand side with the engine at rest (crank standing, no gas, linearised mounts): the
+    /// linearisation point of the modal analysis.
+    pub(crate) fn rhs_at_rest(&self, y: &[f64], f: &mut [f64]) -> Result<(), ProblemError> {
+        let t = self.fade_start;
+        let ev = self.evaluate_mode(t, y, Mode::AT_REST);
+        self.write_rhs(t, y, &ev, Mode::AT_REST, f)
+    }
+
+    /// Body-point accelerations: modal accelerations η̈ from one evaluation at `(t, y)`.
+    pub fn modal_accelerations(&self, t: f64, y: &[f64]) -> Result<Vec<f64>, ProblemError> {
+        self.check_state(y)?;
+        let mut f = vec![0.0; y.len()];
+        let ev = self.evaluate(t, y);
+        self.write_rhs(t, y, &ev, Mode::RUNNING, &mut f)?;
+        Ok(f[self.layout.eta_rate()].to_vec())
+    }
+}
+
+impl OdeProblem for CoupledModel {
+    fn dim(&self) -> usize {
+        self.layout.dim()
+    }
+
+    fn rhs(&mut self, t: f64, y: &[f64], f: &mut [f64]) -> Result<(), ProblemError> {
+        let n = self.layout.dim();
+        if y.len() != n || f.len() != n {
+            return Err(ProblemError::Fatal(format!(
+                "state/derivative lengths {}/{} differ from {n}",
+                y.len(),
+                f.len()
+            )));
+        }
+        let ev = self.evaluate(t, y);
+        self.write_rhs(t, y, &ev, Mode::RUNNING, f)
+    }
+
+    fn jacobian(&mut self, t: f64, y: &[f64], j: MatMut<'_, f64>) -> Result<bool, ProblemError> {
+        self.dense_jacobian(t, y, j)?;
+        Ok(true)
+    }
+
+    fn jacobian_structure(&self) -> Option<BlockLowRankShape> {
+        self.uses_block_low_rank().then(|| self.jacobian_shape())
+    }
+
+    fn structured_jacobian(
+        &mut self,
+        t: f64,
+        y: &[f64],
+        j: &mut BlockLowRankJacobian,
+    ) -> Result<(), ProblemError> {
+        self.structured(t, y, j)
+    }
+}

@@ -1,0 +1,284 @@
+//! The powertrain component: the monoblock with its internal parts (crank drive, balance shafts),
+//! the housing, the ring carriers between them, gas forces and gravity.
+//!
+//! It owns 1 or 2 free rigid bodies (6 coordinates each: one rigid powertrain, or monoblock and
+//! housing on elastic ring carriers) and evaluates their composite-body dynamics
+//! (`M(q, φ) v' = Q`) for a given crank-drive state; where those coordinates live in the state
+//! vector, and what the mounts attach to, is the coupled model's business
+//! ([`crate::model::coupled`]).
+
+pub mod assembly;
+pub mod composite;
+pub mod config;
+pub mod defaults;
+pub mod gas;
+pub mod parts;
+pub mod reaction;
+pub mod ring_carrier;
+
+use nalgebra::Vector3;
+
+use self::assembly::{build_bodies, v3, Body};
+use self::composite::{add_parts, BodyDynamics, BodyKinematics, CrankDriveState};
+use self::config::EngineConfig;
+use self::gas::{side_force, CylinderGeometry, GasModel, PressureCurve};
+use self::parts::slider_crank;
+use self::ring_carrier::RingCarrier;
+use super::effects::Effects;
+use super::inputs::InputError;
+use super::validate::ConfigError;
+
+/// Gas excitation prepared from the configuration.
+#[derive(Debug, Clone, PartialEq)]
+struct GasExcitation {
+    curve: PressureCurve,
+    /// Idle and full-load curves of the Wiebe model, for changing the load at run time.
+    load_points: Option<(PressureCurve, PressureCurve)>,
+    area: f64,
+    crankcase_pressure: f64,
+    radius: f64,
+    conrod: f64,
+    /// (y offset, throw, firing TDC) per cylinder, radians.
+    cylinders: Vec<(f64, f64, f64)>,
+    /// Crank centre relative to body 0's reference point, and the bore axis (body axes).
+    crank_centre: Vector3<f64>,
+    bore: Vector3<f64>,
+}
+
+impl GasExcitation {
+    fn new(config: &EngineConfig, reference: &Vector3<f64>) -> Result<Self, ConfigError> {
+        let c = &config.crank_drive;
+        let geometry = CylinderGeometry {
+            bore: c.bore,
+            crank_radius: c.crank_radius,
+            conrod: c.conrod_length,
+        };
+        let (curve, load_points) = match &config.gas.model {
+            GasModel::Wiebe(w) => {
+                let idle = PressureCurve::wiebe(w, &w.idle, &geometry);
+                let full = PressureCurve::wiebe(w, &w.full_load, &geometry);
+                (
+                    PressureCurve::blend(&idle, &full, config.gas.load),
+                    Some((idle, full)),
+                )
+            }
+            GasModel::Table(t) => (
+                PressureCurve::from_table(t).map_err(|message| ConfigError {
+                    field: "engine.gas.model".into(),
+                    message,
+                })?,
+                None,
+            ),
+        };
+        Ok(GasExcitation {
+            curve,
+            load_points,
+            area: geometry.piston_area(),
+            crankcase_pressure: config.gas.crankcase_pressure,
+            radius: c.crank_radius,
+            conrod: c.conrod_length,
+            cylinders: c
+                .cylinders
+                .iter()
+                .map(|k| {
+                    (
+                        k.y_offset,
+                        k.throw_deg.to_radians(),
+                        k.firing_tdc_deg.to_radians(),
+                    )
+                })
+                .collect(),
+            crank_centre: v3(&c.crank_centre) - reference,
+            bore: v3(&c.bore_axis),
+        })
+    }
+}
+
+/// The powertrain ready for evaluation.
+#[derive(Debug, Clone)]
+pub struct Powertrain {
+    config: EngineConfig,
+    effects: Effects,
+    bodies: Vec<Body>,
+    ring_carriers: Vec<RingCarrier>,
+    gas: Option<GasExcitation>,
+    gravity: Vector3<f64>,
+}
+
+impl Powertrain {
+    /// Builds the powertrain of `config` with the effects switched as in `effects`, under gravity
+    /// `g` (m/s², along −z). The configuration is validated here.
+    pub fn new(config: EngineConfig, effects: Effects, g: f64) -> Result<Self, ConfigError> {
+        config.validate()?;
+        if effects.ring_carrier_elasticity && config.ring_carriers.is_empty() {
+            return Err(ConfigError {
+                field: "engine.ring_carriers".into(),
+                message: "ring carrier elasticity is on but no ring carrier is configured".into(),
+            });
+        }
+        let bodies = build_bodies(&config, &effects);
+        let ring_carriers = if bodies.len() == 2 {
+            config
+                .ring_carriers
+                .iter()
+                .map(|r| RingCarrier::from_config(r, &bodies[0].reference, &bodies[1].reference))
+                .collect()
+        } else {
+            Vec::new()
+        };
+        let gas = if effects.gas_forces {
+            Some(GasExcitation::new(&config, &bodies[0].reference)?)
+        } else {
+            None
+        };
+        Ok(Self {
+            config,
+            effects,
+            bodies,
+            ring_carriers,
+            gas,
+            gravity: Vector3::new(0.0, 0.0, -g),
+        })
+    }
+
+    pub fn config(&self) -> &EngineConfig {
+        &self.config
+    }
+
+    pub fn effects(&self) -> &Effects {
+        &self.effects
+    }
+
+    pub fn bodies(&self) -> &[Body] {
+        &self.bodies
+    }
+
+    pub fn ring_carriers(&self) -> &[RingCarrier] {
+        &self.ring_carriers
+    }
+
+    pub fn gravity(&self) -> &Vector3<f64> {
+        &self.gravity
+    }
+
+    /// Number of free bodies (2 with elastic ring carriers, else 1).
+    pub fn body_count(&self) -> usize {
+        self.bodies.len()
+    }
+
+    /// Index of the body carrying the mount brackets (housing or the rigid powertrain).
+    pub fn housing_index(&self) -> usize {
+        self.bodies.len() - 1
+    }
+
+    /// Reference point of the housing outputs: the housing's centre of mass in the reference
+    /// configuration (also when the powertrain is one rigid body).
+    pub fn housing_reference(&self) -> Vector3<f64> {
+        v3(&self.config.housing.centre_of_mass)
+    }
+
+    /// Total mass of every body and part (kg).
+    pub fn mass(&self) -> f64 {
+        self.bodies
+            .iter()
+            .flat_map(|b| b.parts.iter())
+            .map(|p| p.mass)
+            .sum()
+    }
+
+    /// Crank angle at the start of a simulation (rad, relative to the monoblock).
+    pub fn start_angle(&self) -> f64 {
+        self.config.start_crank_angle_deg.to_radians()
+    }
+
+    /// Engine load between idle (0) and full load (1) of the Wiebe gas model, at run time.
+    /// Ignored (Ok) when gas forces are off; an error for a user pressure table.
+    pub fn set_gas_load(&mut self, load: f64) -> Result<(), InputError> {
+        if !(load.is_finite() && (0.0..=1.0).contains(&load)) {
+            return Err(InputError(format!("gas load {load} must lie in [0, 1]")));
+        }
+        if let Some(gas) = &mut self.gas {
+            let Some((idle, full)) = &gas.load_points else {
+                return Err(InputError(
+                    "the gas pressure comes from a user table; its load cannot change".into(),
+                ));
+            };
+            gas.curve = PressureCurve::blend(idle, full, load);
+        }
+        self.config.gas.load = load;
+        Ok(())
+    }
+
+    /// Contributions that depend on one body's coordinates only (and on the crank angle): its
+    /// parts with gravity (the parts placed as `crank` says), the gas side forces at crank angle
+    /// `phi` scaled by `gas_scale` (monoblock), the load torque about the crank axis (housing).
+    pub fn local_dynamics(
+        &self,
+        b: usize,
+        kin: &BodyKinematics,
+        crank: &CrankDriveState,
+        phi: f64,
+        gas_scale: f64,
+        load_torque: f64,
+    ) -> BodyDynamics {
+        let mut d = BodyDynamics::zero();
+        add_parts(&self.bodies[b].parts, kin, crank, &self.gravity, &mut d);
+        if b == 0 && gas_scale != 0.0 {
+            self.add_gas_forces(kin, phi, gas_scale, &mut d);
+        }
+        if b == self.housing_index() {
+            d.add_wrench(
+                &Vector3::zeros(),
+                &(kin.rotation * Vector3::y() * load_torque),
+            );
+        }
+        d
+    }
+
+    /// Ring-carrier forces on monoblock and housing (nothing for a rigid powertrain).
+    pub fn add_ring_carriers(&self, kin: &[BodyKinematics], dynamics: &mut [BodyDynamics]) {
+        if kin.len() != 2 {
+            return;
+        }
+        for rc in &self.ring_carriers {
+            let w = rc.wrench(&kin[0], &kin[1]);
+            dynamics[0].add_point_force(&kin[0], &w.monoblock_point, &w.monoblock_force);
+            dynamics[0].add_wrench(&Vector3::zeros(), &w.monoblock_moment);
+            dynamics[1].add_point_force(&kin[1], &w.housing_point, &w.housing_force);
+            dynamics[1].add_wrench(&Vector3::zeros(), &w.housing_moment);
+        }
+    }
+
+    /// Piston side-force pairs (paper §4.2) on the monoblock `body`: `−F_N` at each piston pin,
+    /// `+F_N` at the main bearing on the same cylinder axis, `F_N = p A tan β` along
+    /// `e_y × bore`, scaled by `scale`.
+    pub fn add_gas_forces(
+        &self,
+        body: &BodyKinematics,
+        phi: f64,
+        scale: f64,
+        out: &mut BodyDynamics,
+    ) {
+        let Some(gas) = &self.gas else { return };
+        let side = body.rotation * Vector3::y().cross(&gas.bore);
+        for &(yo, throw, firing) in &gas.cylinders {
+            let psi = phi - throw;
+            let p = gas.curve.pressure(phi - firing);
+            let f_gas = (p - gas.crankcase_pressure) * gas.area * scale;
+            let n = side_force(f_gas, psi, gas.radius / gas.conrod);
+            let (s, _, _) = slider_crank(psi, gas.radius, gas.conrod);
+            let on_axis = gas.crank_centre + Vector3::new(0.0, yo, 0.0);
+            let pin = body.point(&(on_axis + gas.bore * s));
+            let bearing = body.point(&on_axis);
+            out.add_point_force(body, &pin, &(-n * side));
+            out.add_point_force(body, &bearing, &(n * side));
+        }
+    }
+
+    /// Cylinder pressure of cylinder `i` at crank angle `phi` (Pa), if gas forces are on.
+    pub fn cylinder_pressure(&self, i: usize, phi: f64) -> Option<f64> {
+        let gas = self.gas.as_ref()?;
+        let &(_, _, firing) = gas.cylinders.get(i)?;
+        Some(gas.curve.pressure(phi - firing))
+    }
+}

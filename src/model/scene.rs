@@ -1,0 +1,239 @@
+//! Scenes as configurations of components: the vehicle's powertrain and mounts on rigid ground
+//! (scene 1, paper Table 1 left column), or in the vehicle's elastic body reduced to the modes the
+//! scene needs (scene 2, Table 1 middle column).
+
+use crate::cms::{
+    reduce_cached, CacheOutcome, CacheSetting, InterfaceDofs, ModeSelection, ReducedChassis,
+    ReductionSpec,
+};
+
+use super::coupled::CoupledModel;
+use super::vehicle::{BodyConfig, VehicleConfig};
+
+/// With chassis flexibility off, the body modes kept: the rigid-body modes on the suspension
+/// (1–5 Hz; the first elastic mode of the default body is above 20 Hz).
+pub const RIGID_BODY_HZ: f64 = 10.0;
+
+/// Margin of the automatic cut-off over the highest excitation frequency: the mode nearest to it
+/// must respond dynamically, not only quasi-statically.
+pub const AUTO_CUTOFF_MARGIN: f64 = 1.2;
+
+/// Which structure the scene has.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum SceneKind {
+    /// Powertrain on its mounts on rigid ground.
+    Ground,
+    /// Powertrain on its mounts in the vehicle's elastic body.
+    Body,
+}
+
+/// What the scene needs of the body: mode selection, interface, damping, cache.
+#[derive(Debug, Clone, PartialEq)]
+pub struct BodyOptions {
+    /// Keep the fixed-interface modes below this frequency, Hz; 0 = automatic, from
+    /// `max_rpm / 60 × max_engine_order × AUTO_CUTOFF_MARGIN`.
+    pub mode_cutoff_hz: f64,
+    /// If positive: keep exactly this many fixed-interface modes instead.
+    pub max_modes: usize,
+    pub max_rpm: f64,
+    pub max_engine_order: f64,
+    /// All six DOFs of the mount nodes as interface (rotational constraint modes, kHz), instead
+    /// of the translations (the mounts transmit forces only).
+    pub interface_rotations: bool,
+    /// Factor on every modal damping ratio (1 = the ADAMS table; 0 = undamped).
+    pub modal_damping_scale: f64,
+    /// Procedural body only: the transverse stiffening bar between the front girders.
+    pub stiffening_bar: bool,
+    pub cache: CacheSetting,
+}
+
+impl Default for BodyOptions {
+    fn default() -> Self {
+        Self {
+            mode_cutoff_hz: 0.0,
+            max_modes: 0,
+            max_rpm: 2500.0,
+            max_engine_order: 4.5,
+            interface_rotations: false,
+            modal_damping_scale: 1.0,
+            stiffening_bar: false,
+            cache: CacheSetting::Default,
+        }
+    }
+}
+
+impl BodyOptions {
+    /// The cut-off in use: the explicit one, or max rpm × max order × margin.
+    pub fn cutoff_hz(&self) -> f64 {
+        if self.mode_cutoff_hz > 0.0 {
+            self.mode_cutoff_hz
+        } else {
+            self.max_rpm / 60.0 * self.max_engine_order * AUTO_CUTOFF_MARGIN
+        }
+    }
+
+    fn validate(&self) -> Result<(), String> {
+        if !(self.mode_cutoff_hz.is_finite() && self.mode_cutoff_hz >= 0.0) {
+            return Err(format!(
+                "chassis.modeCutoff = {} Hz must be >= 0 and finite (0: automatic)",
+                self.mode_cutoff_hz
+            ));
+        }
+        if !(self.max_rpm > 0.0 && self.max_engine_order > 0.0 && self.cutoff_hz().is_finite()) {
+            return Err(format!(
+                "scene.maxRpm = {} and scene.maxEngineOrder = {} must be positive",
+                self.max_rpm, self.max_engine_order
+            ));
+        }
+        if !(self.modal_damping_scale.is_finite() && self.modal_damping_scale >= 0.0) {
+            return Err(format!(
+                "chassis.modalDampingScale = {} must be >= 0 and finite",
+                self.modal_damping_scale
+            ));
+        }
+        Ok(())
+    }
+}
+
+/// A model built for a scene, with log lines on how its body was obtained.
+pub struct Built {
+    pub model: CoupledModel,
+    pub notes: Vec<String>,
+}
+
+/// Builds the coupled model of `vehicle` for `scene`.
+pub fn build(
+    vehicle: &VehicleConfig,
+    scene: SceneKind,
+    options: &BodyOptions,
+) -> Result<Built, String> {
+    vehicle.validate().map_err(|e| e.to_string())?;
+    let (body, notes) = match scene {
+        SceneKind::Ground => (ReducedChassis::rigid_ground(), Vec::new()),
+        SceneKind::Body => {
+            let (body, note) = body(vehicle, options)?;
+            (body, vec![note])
+        }
+    };
+    let model = CoupledModel::with_body(vehicle, body).map_err(|e| e.to_string())?;
+    Ok(Built { model, notes })
+}
+
+/// What the procedural body's reduction depends on for this vehicle and these options, and a
+/// description of the mode selection for the log.
+pub fn reduction_spec(
+    vehicle: &VehicleConfig,
+    options: &BodyOptions,
+) -> Result<(ReductionSpec, String), String> {
+    options.validate()?;
+    let BodyConfig::Procedural { chassis } = &vehicle.body else {
+        return Err("the vehicle's body is not the procedural one".into());
+    };
+    let interface = vehicle.interface_nodes().map_err(|e| e.to_string())?;
+    // A rigid body needs no fixed-interface modes: the constraint modes alone contain its
+    // rigid-body motion on the suspension, the only part kept later.
+    let (selection, origin) = if !vehicle.effects.chassis_flexibility {
+        (
+            ModeSelection::Count(0),
+            "rigid chassis: rigid-body modes on the suspension only".to_owned(),
+        )
+    } else if options.max_modes > 0 {
+        (
+            ModeSelection::Count(options.max_modes),
+            format!("{} fixed-interface modes", options.max_modes),
+        )
+    } else {
+        let cutoff = options.cutoff_hz();
+        let origin = if options.mode_cutoff_hz > 0.0 {
+            format!("cut-off {cutoff:.0} Hz (chassis.modeCutoff)")
+        } else {
+            format!(
+                "automatic cut-off {cutoff:.0} Hz = {} rpm / 60 x order {} x margin {AUTO_CUTOFF_MARGIN}",
+                options.max_rpm, options.max_engine_order
+            )
+        };
+        (ModeSelection::CutoffHz(cutoff), origin)
+    };
+    let mut chassis = chassis.clone();
+    chassis.options.stiffening_bar |= options.stiffening_bar;
+    let spec = ReductionSpec {
+        chassis: *chassis,
+        interface,
+        interface_dofs: if options.interface_rotations {
+            InterfaceDofs::All
+        } else {
+            InterfaceDofs::Translations
+        },
+        selection,
+        outputs: vehicle.outputs.clone(),
+        ..ReductionSpec::default()
+    };
+    Ok((spec, origin))
+}
+
+/// The reduced body the scene asks for, from the cache or freshly reduced (timed for the log).
+pub fn body(
+    vehicle: &VehicleConfig,
+    options: &BodyOptions,
+) -> Result<(ReducedChassis, String), String> {
+    options.validate()?;
+    let flexible = vehicle.effects.chassis_flexibility;
+    let started = std::time::Instant::now();
+    let (body, origin) = match &vehicle.body {
+        BodyConfig::Procedural { .. } => {
+            let (spec, origin) = reduction_spec(vehicle, options)?;
+            let (body, outcome) = reduce_cached(&spec, &options.cache)
+                .map_err(|e| format!("chassis reduction: {e}"))?;
+            let source = match outcome {
+                CacheOutcome::Hit(path) => format!("read from cache {}", path.display()),
+                CacheOutcome::Stored(path) => format!("reduced and cached at {}", path.display()),
+                CacheOutcome::Replaced { path, reason } => format!(
+                    "reduced and cached at {} (old entry: {reason})",
+                    path.display()
+                ),
+                CacheOutcome::NotStored { reason } => format!("reduced (not cached: {reason})"),
+                CacheOutcome::Disabled => "reduced (caching disabled)".to_owned(),
+            };
+            let bar = if spec.chassis.options.stiffening_bar {
+                "on"
+            } else {
+                "off"
+            };
+            (
+                body,
+                format!(
+                    "procedural chassis (Craig-Bampton, {origin}, stiffening bar {bar}), {source}"
+                ),
+            )
+        }
+        BodyConfig::Reduced { path } => {
+            if options.stiffening_bar {
+                return Err(
+                    "chassis.stiffeningBar applies to the procedural body only; this vehicle's body is a reduced model from a file".into(),
+                );
+            }
+            let text = std::fs::read_to_string(path)
+                .map_err(|e| format!("cannot read the reduced body {}: {e}", path.display()))?;
+            let body: ReducedChassis = serde_json::from_str(&text)
+                .map_err(|e| format!("reduced body {}: {e}", path.display()))?;
+            (body, format!("reduced body read from {}", path.display()))
+        }
+    };
+    let seconds = started.elapsed().as_secs_f64();
+    let mut body = if flexible {
+        body
+    } else {
+        body.keep_below(RIGID_BODY_HZ)
+    };
+    for z in &mut body.zeta {
+        *z *= options.modal_damping_scale;
+    }
+    let note = format!(
+        "{origin}, modal damping x{}: {} modes, {:.1}..{:.1} Hz, in {seconds:.2} s",
+        options.modal_damping_scale,
+        body.n_modes(),
+        body.omega.first().copied().unwrap_or(0.0) / (2.0 * std::f64::consts::PI),
+        body.omega.last().copied().unwrap_or(0.0) / (2.0 * std::f64::consts::PI),
+    );
+    Ok((body, note))
+}
