@@ -40,6 +40,8 @@ pub struct Settings {
     pub fade_in_time: f64,
     /// Crank angle at the start time, rad.
     pub crank_start_angle: f64,
+    /// Time constant with which the crank speed follows the set-point, s (0 = directly).
+    pub speed_time_constant: f64,
     pub rel_tol: f64,
     pub abs_tol: f64,
     pub max_order: i32,
@@ -57,6 +59,7 @@ impl Default for Settings {
             gas_load: 0.0,
             fade_in_time: 0.1,
             crank_start_angle: 0.0,
+            speed_time_constant: crate::model::SpeedFollower::default().time_constant,
             rel_tol: 1e-5,
             abs_tol: 1e-8,
             max_order: 5,
@@ -92,6 +95,9 @@ pub struct Counters {
     pub rhs_evaluations: u64,
     pub jacobian_evaluations: u64,
     pub factorizations: u64,
+    /// Integrator restarts at order 1 for input discontinuities since this simulation was built
+    /// or restored.
+    pub restarts: u64,
 }
 
 /// A step that could not be completed; the simulation stays at `reached`.
@@ -108,6 +114,7 @@ pub struct Simulation {
     /// How the model was built (for the log).
     notes: Vec<String>,
     integrator: Bdf,
+    restarts: u64,
     /// Communication time and the state there. The integrator steps past communication points
     /// and interpolates, so its own time is usually a little ahead.
     time: f64,
@@ -145,6 +152,7 @@ impl Simulation {
             inputs: *inputs,
             initial_time: t0,
             initial_inputs: *inputs,
+            restarts: 0,
         })
     }
 
@@ -194,6 +202,7 @@ impl Simulation {
                 self.inputs = previous;
                 return Err(e.to_string());
             }
+            self.restarts += 1;
         }
         Ok(jumped)
     }
@@ -248,6 +257,7 @@ impl Simulation {
             rhs_evaluations: s.rhs_evals,
             jacobian_evaluations: s.jac_evals,
             factorizations: s.factorizations,
+            restarts: self.restarts,
         }
     }
 

@@ -24,6 +24,7 @@ pub fn vehicle_config(settings: &Settings) -> Result<VehicleConfig, String> {
     config.engine.gas.load = settings.gas_load;
     config.engine.excitation_fade_in = settings.fade_in_time;
     config.engine.start_crank_angle_deg = settings.crank_start_angle.to_degrees();
+    config.speed_follower.time_constant = settings.speed_time_constant;
     if config.mounts.len() > FMU_MOUNTS {
         return Err(format!(
             "the configuration has {} mounts; the FMU exposes {FMU_MOUNTS} (deactivate one with \"active\": false)",

@@ -37,7 +37,7 @@ pub struct Inputs {
     pub crank_speed: Signal,
     /// Drivetrain reaction torque on the housing about the crank axis, N m.
     pub load_torque: Signal,
-    /// Scale on each mount's force-deflection curve (> 0).
+    /// Scale on each mount's force-deflection curve (>= 0).
     pub stiffness_scale: [Signal; 4],
     /// Scale on each mount's damping (>= 0).
     pub damping_scale: [Signal; 4],
@@ -64,23 +64,11 @@ impl Inputs {
             ));
         }
         for (i, s) in self.stiffness_scale.iter().enumerate() {
-            if s.value.is_nan() || s.value <= 0.0 {
+            if s.value.is_nan() || s.value < 0.0 {
                 return Err(format!(
-                    "mount[{}].stiffnessScale = {} must be > 0 (remove a mount in the configuration instead)",
+                    "mount[{}].stiffnessScale = {} must be >= 0 (0: the mount carries nothing)",
                     i + 1,
                     s.value
-                ));
-            }
-        }
-        for (name, signals) in [
-            ("stiffnessScale", &self.stiffness_scale),
-            ("dampingScale", &self.damping_scale),
-        ] {
-            if let Some(i) = signals.iter().position(|s| s.derivative != 0.0) {
-                return Err(format!(
-                    "mount[{}].{name} has a time derivative; mount scales are held constant over a \
-                     communication step (set a new value at the next communication point)",
-                    i + 1
                 ));
             }
         }

@@ -268,8 +268,8 @@ const _: fmi2SetDebugLoggingTYPE = Some(fmi2SetDebugLogging);
 #[no_mangle]
 pub extern "C" fn fmi2SetupExperiment(
     c: fmi2Component,
-    _toleranceDefined: fmi2Boolean,
-    _tolerance: fmi2Real,
+    toleranceDefined: fmi2Boolean,
+    tolerance: fmi2Real,
     startTime: fmi2Real,
     stopTimeDefined: fmi2Boolean,
     stopTime: fmi2Real,
@@ -279,9 +279,11 @@ pub extern "C" fn fmi2SetupExperiment(
         if let Err(s) = inst.allowed("fmi2SetupExperiment", state::SETUP_EXPERIMENT) {
             return s;
         }
-        // The solver tolerance is the parameter solver.relTol: a master's generic tolerance is not
-        // applied silently to a model whose accuracy/cost trade-off the user tuned.
-        inst.setup_experiment(startTime, (stopTimeDefined != 0).then_some(stopTime))
+        inst.setup_experiment(
+            startTime,
+            (stopTimeDefined != 0).then_some(stopTime),
+            (toleranceDefined != 0).then_some(tolerance),
+        )
     })
 }
 const _: fmi2SetupExperimentTYPE = Some(fmi2SetupExperiment);

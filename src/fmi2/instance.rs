@@ -6,6 +6,7 @@
 
 use std::path::PathBuf;
 
+use super::input_track::InputTrack;
 use super::logger::{Level, Logger};
 use super::state::{self, Mask, Phase};
 use super::variables::{
@@ -49,10 +50,15 @@ impl Values {
 pub struct Core {
     pub phase: Phase,
     pub values: Values,
-    /// First time derivatives of the Real inputs (`fmi2SetRealInputDerivatives`), by value reference.
-    pub input_derivatives: Vec<f64>,
+    /// The signal of each Real input (indexed by value reference; unused for non-inputs).
+    pub inputs: Vec<InputTrack>,
     pub start_time: f64,
     pub stop_time: Option<f64>,
+    /// The tolerance of `fmi2SetupExperiment`, if the master defined one.
+    pub experiment_tolerance: Option<f64>,
+    /// Whether the master set `solver.relTol` itself (it then wins over the experiment's
+    /// tolerance).
+    pub rel_tol_set: bool,
     pub time: f64,
     pub terminated: bool,
     pub simulation: Option<Simulation>,
@@ -63,9 +69,14 @@ impl Core {
         Core {
             phase: Phase::Instantiated,
             values: Values::start(),
-            input_derivatives: vec![0.0; REALS.len()],
+            inputs: REALS
+                .iter()
+                .map(|v| InputTrack::constant(v.start, 0.0))
+                .collect(),
             start_time: 0.0,
             stop_time: None,
+            experiment_tolerance: None,
+            rel_tol_set: false,
             time: 0.0,
             terminated: false,
             simulation: None,
@@ -150,7 +161,23 @@ impl Instance {
         Status::Ok
     }
 
-    pub fn setup_experiment(&mut self, start: f64, stop: Option<f64>) -> Status {
+    /// `fmi2SetupExperiment`. A defined tolerance becomes the integrator's relative tolerance
+    /// unless the master set `solver.relTol` itself (which then wins); either way it is logged.
+    pub fn setup_experiment(
+        &mut self,
+        start: f64,
+        stop: Option<f64>,
+        tolerance: Option<f64>,
+    ) -> Status {
+        if let Some(tol) = tolerance {
+            let range = &REALS[real::SOLVER_REL_TOL as usize];
+            let (lo, hi) = (range.min.unwrap_or(0.0), range.max.unwrap_or(f64::INFINITY));
+            if !(tol.is_finite() && tol >= lo && tol <= hi) {
+                return self.error(&format!(
+                    "fmi2SetupExperiment: tolerance {tol} is outside [{lo}, {hi}] (solver.relTol's range)"
+                ));
+            }
+        }
         if !start.is_finite() {
             return self.error(&format!(
                 "fmi2SetupExperiment: start time {start} is not finite"
@@ -166,6 +193,7 @@ impl Instance {
         self.core.start_time = start;
         self.core.stop_time = stop;
         self.core.time = start;
+        self.core.experiment_tolerance = tolerance;
         Status::Ok
     }
 
@@ -193,6 +221,7 @@ impl Instance {
         if self.core.simulation.is_some() {
             return Ok(());
         }
+        self.commit_inputs(0.0);
         let mut simulation = self.build_simulation().map_err(|m| self.error(&m))?;
         for line in simulation.describe() {
             self.event(&line);
@@ -207,6 +236,14 @@ impl Instance {
     pub fn build_simulation(&self) -> Result<Simulation, String> {
         let settings = self.settings()?;
         let inputs = self.inputs_at_time();
+        self.event(&match (self.core.experiment_tolerance, self.core.rel_tol_set) {
+            (Some(t), false) => format!("relative tolerance {t} from fmi2SetupExperiment"),
+            (Some(t), true) => format!(
+                "relative tolerance {} from solver.relTol (set explicitly; fmi2SetupExperiment's {t} not used)",
+                settings.rel_tol
+            ),
+            (None, _) => format!("relative tolerance {} (solver.relTol)", settings.rel_tol),
+        });
         self.event(&format!(
             "building scene {} at t = {} s (config: {})",
             settings.scene,
@@ -223,15 +260,16 @@ impl Instance {
 
     /// A simulation for a deserialized FMU state, rebuilt from that state's own parameters.
     pub fn restore_simulation(&self, core: &Core, dynamic: &[f64]) -> Result<Simulation, String> {
-        Simulation::restore(&self.settings_for(&core.values)?, dynamic)
+        Simulation::restore(&self.settings_for(core)?, dynamic)
     }
 
     fn settings(&self) -> Result<cosim::Settings, String> {
-        self.settings_for(&self.core.values)
+        self.settings_for(&self.core)
     }
 
     /// The model settings the parameters in `v` describe.
-    fn settings_for(&self, v: &Values) -> Result<cosim::Settings, String> {
+    fn settings_for(&self, core: &Core) -> Result<cosim::Settings, String> {
+        let v = &core.values;
         let config_file = {
             let given = v.strings[string::CONFIG_FILE as usize].trim();
             if !given.is_empty() {
@@ -263,7 +301,11 @@ impl Instance {
             gas_load: v.reals[real::ENGINE_LOAD as usize],
             fade_in_time: v.reals[real::FADE_IN_TIME as usize],
             crank_start_angle: v.reals[real::CRANK_START_ANGLE as usize],
-            rel_tol: v.reals[real::SOLVER_REL_TOL as usize],
+            speed_time_constant: v.reals[real::CRANK_SPEED_TIME_CONSTANT as usize],
+            rel_tol: match (core.experiment_tolerance, core.rel_tol_set) {
+                (Some(tolerance), false) => tolerance,
+                _ => v.reals[real::SOLVER_REL_TOL as usize],
+            },
             abs_tol: v.reals[real::SOLVER_ABS_TOL as usize],
             max_order: v.integers[integer::SOLVER_MAX_ORDER as usize],
             stability_limit_detection: v.booleans
@@ -291,13 +333,43 @@ impl Instance {
         })
     }
 
-    /// The inputs as signals referenced to the current time.
+    /// The inputs as signals from the current time on (what the master set, not yet committed).
     fn inputs_at_time(&self) -> cosim::Inputs {
-        inputs_from(
-            &self.core.values.reals,
-            &self.core.input_derivatives,
-            self.core.time,
-        )
+        inputs_from(&self.core.inputs, self.core.time)
+    }
+
+    /// Starts the step `[t, t + step]` for every input ([`InputTrack::commit`]): the signals in
+    /// force from now on. The input values the master reads back are the signals' values at `t`.
+    /// Returns whether a ramp had to be bent onto a declared bound (logged as a warning).
+    fn commit_inputs(&mut self, step: f64) -> bool {
+        let t = self.core.time;
+        let mut clipped = false;
+        for v in REALS.iter().filter(|v| v.causality == Causality::Input) {
+            let i = v.vr as usize;
+            let track = &mut self.core.inputs[i];
+            let commit = track.commit(
+                t,
+                step,
+                v.min.unwrap_or(f64::NEG_INFINITY),
+                v.max.unwrap_or(f64::INFINITY),
+            );
+            self.core.values.reals[i] = track.value;
+            if let Some(bound) = commit.clipped {
+                clipped = true;
+                self.logger.log(
+                    Level::Warning,
+                    "logStatusWarning",
+                    &format!(
+                        "{}: the ramp from {} with slope {} per s would leave the declared range within the step from {t} s; it ends on {bound} at {} s",
+                        v.name,
+                        track.value,
+                        track.slope,
+                        t + step
+                    ),
+                );
+            }
+        }
+        clipped
     }
 
     fn write_outputs(&mut self, o: &cosim::Outputs, c: &cosim::Counters) {
@@ -505,18 +577,18 @@ impl Instance {
             Ok(c) => c,
             Err(s) => return s,
         };
-        let inputs = inputs_from(&candidate, &self.core.input_derivatives, self.core.time);
-        if let Err(m) = inputs.validate() {
-            return self.error(&format!("{F}: {m}"));
-        }
-        // A new input value starts a new linear segment: its derivative is reset until the
-        // master sets it again with fmi2SetRealInputDerivatives.
+        let mut tracks = self.core.inputs.clone();
         for vr in vrs {
             if REALS[*vr as usize].causality == Causality::Input {
-                self.core.input_derivatives[*vr as usize] = 0.0;
+                tracks[*vr as usize].set_value(candidate[*vr as usize]);
             }
         }
+        if let Err(m) = inputs_from(&tracks, self.core.time).validate() {
+            return self.error(&format!("{F}: {m}"));
+        }
+        self.core.inputs = tracks;
         self.core.values.reals = candidate;
+        self.core.rel_tol_set |= vrs.contains(&real::SOLVER_REL_TOL);
         self.after_set(true);
         Status::Ok
     }
@@ -594,7 +666,7 @@ impl Instance {
         if let Err(s) = self.allowed("fmi2SetRealInputDerivatives", state::SET_INPUT_DERIVATIVES) {
             return s;
         }
-        let mut candidate = self.core.input_derivatives.clone();
+        let mut candidate = self.core.inputs.clone();
         for ((vr, order), value) in vrs.iter().zip(orders).zip(values) {
             let Some(v) = REALS.get(*vr as usize) else {
                 return self.error(&format!(
@@ -619,13 +691,12 @@ impl Instance {
                     v.name
                 ));
             }
-            candidate[*vr as usize] = *value;
+            candidate[*vr as usize].set_slope(*value);
         }
-        let inputs = inputs_from(&self.core.values.reals, &candidate, self.core.time);
-        if let Err(m) = inputs.validate() {
+        if let Err(m) = inputs_from(&candidate, self.core.time).validate() {
             return self.error(&format!("fmi2SetRealInputDerivatives: {m}"));
         }
-        self.core.input_derivatives = candidate;
+        self.core.inputs = candidate;
         Status::Ok
     }
 
@@ -655,9 +726,15 @@ impl Instance {
                 ));
             }
         }
+        if self.core.simulation.is_none() {
+            return self.error("fmi2DoStep: the model was not initialised");
+        }
+        let (tracks_before, reals_before) =
+            (self.core.inputs.clone(), self.core.values.reals.clone());
+        let clipped = self.commit_inputs(target - current);
         let inputs = self.inputs_at_time();
         let Some(simulation) = self.core.simulation.as_mut() else {
-            return self.error("fmi2DoStep: the model was not initialised");
+            return Status::Error;
         };
         match simulation.set_inputs(&inputs) {
             Ok(true) => self.event(&format!(
@@ -665,7 +742,11 @@ impl Instance {
                 self.core.time
             )),
             Ok(false) => {}
-            Err(m) => return self.error(&format!("fmi2DoStep: {m}")),
+            Err(m) => {
+                self.core.inputs = tracks_before;
+                self.core.values.reals = reals_before;
+                return self.error(&format!("fmi2DoStep: {m}"));
+            }
         }
         let Some(simulation) = self.core.simulation.as_mut() else {
             return Status::Error;
@@ -678,6 +759,11 @@ impl Instance {
                     Ok(o) => {
                         self.write_outputs(&o, &counters);
                         self.core.time = target;
+                        // Inputs read back as the values their signals have reached.
+                        for v in REALS.iter().filter(|v| v.causality == Causality::Input) {
+                            let i = v.vr as usize;
+                            self.core.values.reals[i] = self.core.inputs[i].at(target);
+                        }
                         self.logger.log(
                             Level::Info,
                             "logSolver",
@@ -689,7 +775,11 @@ impl Instance {
                                 counters.factorizations
                             ),
                         );
-                        Status::Ok
+                        if clipped {
+                            Status::Warning
+                        } else {
+                            Status::Ok
+                        }
                     }
                     Err(m) => {
                         self.core.phase = Phase::Error;
@@ -725,17 +815,21 @@ impl Instance {
     }
 }
 
-/// Input signals from the Real values and their derivatives, referenced to `time`.
-fn inputs_from(reals: &[f64], derivatives: &[f64], time: f64) -> cosim::Inputs {
-    let signal = |vr: u32| cosim::Signal {
-        value: reals[vr as usize],
-        derivative: derivatives[vr as usize],
-        reference_time: time,
+/// The input signals the tracks will give from `time` on (SI units).
+fn inputs_from(tracks: &[InputTrack], time: f64) -> cosim::Inputs {
+    let signal = |vr: u32| {
+        let (value, derivative) = tracks[vr as usize].preview(time);
+        cosim::Signal {
+            value,
+            derivative,
+            reference_time: time,
+        }
     };
+    let rpm = signal(real::RPM);
     cosim::Inputs {
         crank_speed: cosim::Signal {
-            value: reals[real::RPM as usize] * cosim::RPM_TO_RAD_PER_S,
-            derivative: derivatives[real::RPM as usize] * cosim::RPM_TO_RAD_PER_S,
+            value: rpm.value * cosim::RPM_TO_RAD_PER_S,
+            derivative: rpm.derivative * cosim::RPM_TO_RAD_PER_S,
             reference_time: time,
         },
         load_torque: signal(real::LOAD_TORQUE),
@@ -753,7 +847,7 @@ mod tests {
         let logger = Logger::new(None, std::ptr::null_mut(), "t", false);
         let resources = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("resources");
         let mut inst = Instance::new("t", logger, Some(resources));
-        assert_eq!(inst.setup_experiment(0.0, None), Status::Ok);
+        assert_eq!(inst.setup_experiment(0.0, None, None), Status::Ok);
         inst.enter_initialization();
         assert_eq!(inst.exit_initialization(), Status::Ok);
         let mut t = 0.0;

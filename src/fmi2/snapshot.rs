@@ -1,16 +1,17 @@
 //! The serialized FMU state: a versioned, length-checked byte layout of [`Core`].
 //!
 //! Layout (little endian): magic, format version, GUID, phase, times, the variable values, the
-//! input derivatives, and the simulation's dynamic state. The model itself is not stored: it is
+//! input signals, and the simulation's dynamic state. The model itself is not stored: it is
 //! rebuilt from the stored parameters, so a buffer stays small and cannot smuggle in a model.
 
+use super::input_track::InputTrack;
 use super::instance::{Core, Values};
 use super::state::Phase;
 use super::variables::{BOOLEANS, GUID, INTEGERS, REALS, STRINGS};
 use crate::cosim::Simulation;
 
 const MAGIC: &[u8; 8] = b"EMCSTATE";
-const FORMAT_VERSION: u32 = 1;
+const FORMAT_VERSION: u32 = 2;
 
 /// Serializes a state captured by `fmi2GetFMUstate`.
 pub fn serialize(core: &Core) -> Vec<u8> {
@@ -24,6 +25,8 @@ pub fn serialize(core: &Core) -> Vec<u8> {
     w.f64(core.stop_time.unwrap_or(0.0));
     w.f64(core.time);
     w.u8(u8::from(core.terminated));
+    w.optional(core.experiment_tolerance);
+    w.u8(u8::from(core.rel_tol_set));
     w.u32(core.values.reals.len() as u32);
     core.values.reals.iter().for_each(|x| w.f64(*x));
     w.u32(core.values.integers.len() as u32);
@@ -32,8 +35,8 @@ pub fn serialize(core: &Core) -> Vec<u8> {
     core.values.booleans.iter().for_each(|x| w.u8(u8::from(*x)));
     w.u32(core.values.strings.len() as u32);
     core.values.strings.iter().for_each(|x| w.str(x));
-    w.u32(core.input_derivatives.len() as u32);
-    core.input_derivatives.iter().for_each(|x| w.f64(*x));
+    w.u32(core.inputs.len() as u32);
+    core.inputs.iter().for_each(|track| w.track(track));
     match &core.simulation {
         Some(sim) => {
             let dynamic = sim.dynamic_state();
@@ -77,13 +80,15 @@ pub fn deserialize(
     let stop = r.f64()?;
     let time = r.f64()?;
     let terminated = r.u8()? != 0;
+    let experiment_tolerance = r.optional()?;
+    let rel_tol_set = r.u8()? != 0;
     let reals = r.counted(REALS.len(), "Real values", |r| r.f64())?;
     let integers = r.counted(INTEGERS.len(), "Integer values", |r| {
         r.u32().map(|x| x as i32)
     })?;
     let booleans = r.counted(BOOLEANS.len(), "Boolean values", |r| r.u8().map(|x| x != 0))?;
     let strings = r.counted(STRINGS.len(), "String values", |r| r.str())?;
-    let input_derivatives = r.counted(REALS.len(), "input derivatives", |r| r.f64())?;
+    let inputs = r.counted(REALS.len(), "input signals", |r| r.track())?;
     let has_simulation = r.u8()? != 0;
     let dynamic = if has_simulation {
         let n = r.u32()? as usize;
@@ -108,9 +113,11 @@ pub fn deserialize(
             booleans,
             strings,
         },
-        input_derivatives,
+        inputs,
         start_time,
         stop_time: has_stop.then_some(stop),
+        experiment_tolerance,
+        rel_tol_set,
         time,
         terminated,
         simulation: None,
@@ -139,6 +146,20 @@ impl Writer {
     fn str(&mut self, s: &str) {
         self.u32(s.len() as u32);
         self.bytes(s.as_bytes());
+    }
+    fn optional(&mut self, x: Option<f64>) {
+        self.u8(u8::from(x.is_some()));
+        self.f64(x.unwrap_or(0.0));
+    }
+    fn track(&mut self, t: &InputTrack) {
+        self.f64(t.value);
+        self.f64(t.slope);
+        self.f64(t.since);
+        self.optional(t.pending_value);
+        self.optional(t.pending_slope);
+        self.optional(t.last_set.map(|(time, _)| time));
+        self.f64(t.last_set.map_or(0.0, |(_, value)| value));
+        self.optional(t.last_slope);
     }
 }
 
@@ -179,6 +200,30 @@ impl Reader<'_> {
         let n = self.u32()? as usize;
         let b = self.take(n)?;
         String::from_utf8(b.to_vec()).map_err(|_| "string in FMU state is not UTF-8".to_owned())
+    }
+    fn optional(&mut self) -> Result<Option<f64>, String> {
+        let present = self.u8()? != 0;
+        let x = self.f64()?;
+        Ok(present.then_some(x))
+    }
+    fn track(&mut self) -> Result<InputTrack, String> {
+        let value = self.f64()?;
+        let slope = self.f64()?;
+        let since = self.f64()?;
+        let pending_value = self.optional()?;
+        let pending_slope = self.optional()?;
+        let last_time = self.optional()?;
+        let last_value = self.f64()?;
+        let last_slope = self.optional()?;
+        Ok(InputTrack {
+            value,
+            slope,
+            since,
+            pending_value,
+            pending_slope,
+            last_set: last_time.map(|t| (t, last_value)),
+            last_slope,
+        })
     }
     fn counted<T>(
         &mut self,

@@ -2,3 +2,5 @@
 
 mod abi;
 mod common;
+mod inputs;
+mod tolerance;

@@ -271,6 +271,17 @@ impl Slave<'_> {
             )
         }
     }
+    /// Switches debug logging on for every category.
+    pub fn log_everything(&self) {
+        // SAFETY: c is a live instance; zero categories with a null array is allowed.
+        let status = unsafe { (self.f().fmi2SetDebugLogging)(self.c, 1, 0, std::ptr::null()) };
+        assert_eq!(status, OK);
+    }
+    /// `fmi2SetupExperiment` at t = 0 with a defined tolerance.
+    pub fn setup_with_tolerance(&self, tolerance: f64) -> fmi2Status {
+        // SAFETY: c is a live instance.
+        unsafe { (self.f().fmi2SetupExperiment)(self.c, 1, tolerance, 0.0, 0, 0.0) }
+    }
     pub fn enter_init(&self) -> fmi2Status {
         // SAFETY: c is a live instance.
         unsafe { (self.f().fmi2EnterInitializationMode)(self.c) }

@@ -1,0 +1,77 @@
+//! `fmi2SetupExperiment`'s tolerance: the integrator's relative tolerance unless the master set
+//! `solver.relTol` itself.
+
+use crate::common::*;
+use engine_mount_chassis::fmi2::variables::{integer, real};
+
+/// Integrator steps for 50 ms at 2000 rpm after setting up with `tolerance` (and `rel_tol`).
+fn steps(
+    fmu: &Fmu,
+    name: &str,
+    tolerance: Option<f64>,
+    rel_tol: Option<f64>,
+) -> (i32, Vec<String>) {
+    let s = fmu.instantiate(name);
+    s.log_everything();
+    assert_eq!(s.set_real(&[real::RPM], &[2000.0]), OK);
+    if let Some(r) = rel_tol {
+        assert_eq!(s.set_real(&[real::SOLVER_REL_TOL], &[r]), OK);
+    }
+    let status = match tolerance {
+        Some(t) => s.setup_with_tolerance(t),
+        None => s.setup(0.0, None),
+    };
+    assert_eq!(status, OK);
+    assert_eq!(s.enter_init(), OK);
+    assert_eq!(s.exit_init(), OK, "{:?}", s.logs());
+    for k in 0..50 {
+        assert_eq!(s.do_step(k as f64 * 1e-3, 1e-3), OK);
+    }
+    let (_, n) = s.get_integer(&[integer::SOLVER_STEPS]);
+    (n[0], s.logs())
+}
+
+#[test]
+fn the_experiment_tolerance_is_used_unless_rel_tol_was_set() {
+    let fmu = Fmu::load();
+    let (default, log) = steps(&fmu, "tol-default", None, None);
+    assert!(
+        log.iter()
+            .any(|l| l.contains("relative tolerance 0.00001 (solver.relTol)")
+                || l.contains("relative tolerance 1e-5 (solver.relTol)")),
+        "{log:?}"
+    );
+    let (loose, log) = steps(&fmu, "tol-experiment", Some(1e-3), None);
+    assert!(
+        log.iter()
+            .any(|l| l.contains("relative tolerance 0.001 from fmi2SetupExperiment")),
+        "{log:?}"
+    );
+    assert!(
+        loose < default / 2,
+        "{loose} steps at 1e-3 vs {default} at 1e-5"
+    );
+    let (explicit, log) = steps(&fmu, "tol-explicit", Some(1e-3), Some(1e-5));
+    assert!(
+        log.iter()
+            .any(|l| l.contains("from solver.relTol (set explicitly")),
+        "{log:?}"
+    );
+    assert_eq!(explicit, default);
+}
+
+#[test]
+fn a_tolerance_outside_the_range_is_an_error() {
+    let fmu = Fmu::load();
+    let s = fmu.instantiate("tol-bad");
+    assert_eq!(s.setup_with_tolerance(f64::NAN), ERROR);
+    assert_eq!(s.setup_with_tolerance(2.0), ERROR);
+    assert!(
+        s.logs()
+            .iter()
+            .any(|l| l.contains("tolerance 2 is outside")),
+        "{:?}",
+        s.logs()
+    );
+    assert_eq!(s.setup_with_tolerance(1e-4), OK);
+}
