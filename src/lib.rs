@@ -16,3 +16,4 @@ pub mod fmi2;
 pub mod model;
 pub mod ode;
 pub mod paper;
+pub mod text_file;

@@ -13,20 +13,19 @@
 use std::fs;
 use std::io::Write;
 use std::path::{Path, PathBuf};
-use std::sync::atomic::{AtomicU64, Ordering};
 use std::sync::OnceLock;
 
 use serde::{Deserialize, Serialize};
 
 use super::error::CmsError;
-use super::hash::fnv1a64;
+use super::hash::sha256_hex;
 use super::reduce::reduce;
 use super::reduced::ReducedChassis;
 use super::spec::ReductionSpec;
 
 /// Version of the entry layout and of the reduction algorithm; bump it whenever the entry
 /// format, the reduction or the FE generator changes results for the same spec.
-pub const FORMAT_VERSION: u32 = 1;
+pub const FORMAT_VERSION: u32 = 2;
 
 const CACHE_SUBDIR: &str = "engine_mount_chassis";
 
@@ -70,7 +69,25 @@ pub enum CacheOutcome {
 struct Entry {
     format: u32,
     key: String,
+    /// SHA-256 of the reduction's JSON: an entry edited after it was written is not served.
+    checksum: String,
     reduced: ReducedChassis,
+}
+
+impl Entry {
+    fn new(key: String, reduced: ReducedChassis) -> Result<Self, String> {
+        Ok(Self {
+            format: FORMAT_VERSION,
+            key,
+            checksum: checksum(&reduced)?,
+            reduced,
+        })
+    }
+}
+
+fn checksum(reduced: &ReducedChassis) -> Result<String, String> {
+    let json = serde_json::to_string(reduced).map_err(|e| format!("serialising: {e}"))?;
+    Ok(sha256_hex(json.as_bytes()))
 }
 
 /// The source of every file whose code turns a spec into a reduction (FE generator, elements,
@@ -99,35 +116,26 @@ const ALGORITHM_SOURCES: [&str; 18] = [
 ];
 
 /// Fingerprint of [`ALGORITHM_SOURCES`], computed once per process.
-fn algorithm_fingerprint() -> u64 {
-    static FINGERPRINT: OnceLock<u64> = OnceLock::new();
-    *FINGERPRINT.get_or_init(|| fnv1a64(ALGORITHM_SOURCES.concat().as_bytes()))
+fn algorithm_fingerprint() -> &'static str {
+    static FINGERPRINT: OnceLock<String> = OnceLock::new();
+    FINGERPRINT.get_or_init(|| sha256_hex(ALGORITHM_SOURCES.concat().as_bytes()))
 }
 
 /// The full cache key of `spec`: the format version, the fingerprint of the code and every
 /// input of the reduction.
 fn key_text(spec: &ReductionSpec) -> Result<String, CmsError> {
     Ok(format!(
-        "engine_mount_chassis cms format {FORMAT_VERSION} crate {} code {:016x}\n{}",
+        "engine_mount_chassis cms format {FORMAT_VERSION} crate {} code {}\n{}",
         env!("CARGO_PKG_VERSION"),
         algorithm_fingerprint(),
         spec.canonical_json()?
     ))
 }
 
+/// The user's cache folder for this crate: `$XDG_CACHE_HOME` or `~/.cache` on Linux,
+/// `%LOCALAPPDATA%` on Windows (the `directories` crate's convention).
 fn default_dir() -> Option<PathBuf> {
-    let absolute = |v: std::ffi::OsString| {
-        let p = PathBuf::from(v);
-        p.is_absolute().then_some(p)
-    };
-    std::env::var_os("XDG_CACHE_HOME")
-        .and_then(absolute)
-        .or_else(|| {
-            std::env::var_os("HOME")
-                .and_then(absolute)
-                .map(|h| h.join(".cache"))
-        })
-        .map(|base| base.join(CACHE_SUBDIR))
+    directories::BaseDirs::new().map(|d| d.cache_dir().join(CACHE_SUBDIR))
 }
 
 /// Checks that a loaded reduction is complete and finite.
@@ -172,7 +180,8 @@ fn check_consistent(r: &ReducedChassis) -> Result<(), String> {
 
 /// Reads the entry at `path` if it holds a valid reduction for `key`.
 fn load(path: &Path, key: &str) -> Result<ReducedChassis, String> {
-    let text = fs::read_to_string(path).map_err(|e| format!("unreadable: {e}"))?;
+    let text = crate::text_file::read_limited(path, crate::text_file::DATA_LIMIT)
+        .map_err(|e| format!("unreadable: {e}"))?;
     let entry: Entry = serde_json::from_str(&text).map_err(|e| format!("corrupt: {e}"))?;
     if entry.format != FORMAT_VERSION {
         return Err(format!(
@@ -183,6 +192,9 @@ fn load(path: &Path, key: &str) -> Result<ReducedChassis, String> {
     if entry.key != key {
         return Err("written for different inputs".into());
     }
+    if checksum(&entry.reduced)? != entry.checksum {
+        return Err("altered after it was written (checksum mismatch)".into());
+    }
     check_consistent(&entry.reduced).map_err(|e| format!("inconsistent: {e}"))?;
     Ok(entry.reduced)
 }
@@ -190,34 +202,20 @@ fn load(path: &Path, key: &str) -> Result<ReducedChassis, String> {
 /// Writes `entry` to `path` atomically: a unique temporary file in the same directory, then a
 /// rename over the target.
 fn store(path: &Path, entry: &Entry) -> Result<(), String> {
-    static COUNTER: AtomicU64 = AtomicU64::new(0);
     let dir = path
         .parent()
         .ok_or_else(|| format!("{} has no parent directory", path.display()))?;
     fs::create_dir_all(dir).map_err(|e| format!("creating {}: {e}", dir.display()))?;
     let text = serde_json::to_string(entry).map_err(|e| format!("serialising: {e}"))?;
-    let nanos = std::time::SystemTime::now()
-        .duration_since(std::time::UNIX_EPOCH)
-        .map_or(0, |d| d.subsec_nanos());
-    let file_name = path
-        .file_name()
-        .map(|n| n.to_string_lossy().into_owned())
-        .unwrap_or_default();
-    let tmp = dir.join(format!(
-        ".{file_name}.{}.{nanos}.{}.tmp",
-        std::process::id(),
-        COUNTER.fetch_add(1, Ordering::Relaxed)
-    ));
     let written = (|| {
-        let mut f = fs::File::create(&tmp)?;
+        // The temporary file is removed by tempfile if anything below fails.
+        let mut f = tempfile::NamedTempFile::new_in(dir)?;
         f.write_all(text.as_bytes())?;
-        f.sync_all()?;
-        fs::rename(&tmp, path)
+        f.as_file().sync_all()?;
+        f.persist(path).map_err(|e| e.error)?;
+        Ok::<_, std::io::Error>(())
     })();
-    written.map_err(|e| {
-        let _ = fs::remove_file(&tmp);
-        format!("writing {}: {e}", path.display())
-    })
+    written.map_err(|e| format!("writing {}: {e}", path.display()))
 }
 
 /// [`reduce`] through the cache selected by `cache`.
@@ -242,7 +240,7 @@ pub fn reduce_cached(
             },
         ));
     };
-    let path = dir.join(format!("cms-{:016x}.json", fnv1a64(key.as_bytes())));
+    let path = dir.join(format!("cms-{}.json", &sha256_hex(key.as_bytes())[..16]));
     let rejected = if path.exists() {
         match load(&path, &key) {
             Ok(reduced) => return Ok((reduced, CacheOutcome::Hit(path))),
@@ -252,10 +250,9 @@ pub fn reduce_cached(
         None
     };
     let reduced = reduce(spec)?;
-    let entry = Entry {
-        format: FORMAT_VERSION,
-        key,
-        reduced,
+    let entry = match Entry::new(key, reduced.clone()) {
+        Ok(entry) => entry,
+        Err(reason) => return Ok((reduced, CacheOutcome::NotStored { reason })),
     };
     let outcome = match (store(&path, &entry), rejected) {
         (Ok(()), None) => CacheOutcome::Stored(path),
@@ -306,14 +303,15 @@ mod tests {
     fn store_then_load_round_trips_and_rejects_other_keys() {
         let dir = std::env::temp_dir().join(format!("cms-cache-unit-{}", std::process::id()));
         let path = dir.join("entry.json");
-        let entry = Entry {
-            format: FORMAT_VERSION,
-            key: "k1".into(),
-            reduced: tiny(),
-        };
+        let entry = Entry::new("k1".into(), tiny()).unwrap();
         store(&path, &entry).unwrap();
         assert_eq!(load(&path, "k1").unwrap(), tiny());
         assert!(load(&path, "k2").unwrap_err().contains("different inputs"));
+        // a reduction edited in place (still valid JSON, still consistent) is refused
+        let mut altered = Entry::new("k1".into(), tiny()).unwrap();
+        altered.reduced.omega[0] *= 1.01;
+        store(&path, &altered).unwrap();
+        assert!(load(&path, "k1").unwrap_err().contains("checksum"));
         fs::write(&path, "{\"format\": 1, \"key\": \"k1\", \"reduced\": {").unwrap();
         assert!(load(&path, "k1").unwrap_err().contains("corrupt"));
         let old = Entry {

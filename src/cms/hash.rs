@@ -1,15 +1,15 @@
-//! FNV-1a (64 bit), written out: a stable, dependency-free hash for cache file names. It only
-//! names the entry; the entry itself stores the full canonical spec and is compared on load, so
-//! a hash collision can never serve a stale reduction.
+//! Content hashes for the reduction cache: SHA-256 (the `sha2` crate) names an entry by its
+//! inputs and guards its content. The entry also stores the full canonical spec and compares it
+//! on load, so even a collision of the name could never serve a stale reduction.
 
-const OFFSET_BASIS: u64 = 0xcbf2_9ce4_8422_2325;
-const PRIME: u64 = 0x0000_0100_0000_01b3;
+use sha2::{Digest, Sha256};
 
-/// FNV-1a of `bytes`.
-pub(crate) fn fnv1a64(bytes: &[u8]) -> u64 {
-    bytes
+/// SHA-256 of `bytes` as lower-case hex.
+pub(crate) fn sha256_hex(bytes: &[u8]) -> String {
+    Sha256::digest(bytes)
         .iter()
-        .fold(OFFSET_BASIS, |h, &b| (h ^ u64::from(b)).wrapping_mul(PRIME))
+        .map(|b| format!("{b:02x}"))
+        .collect()
 }
 
 #[cfg(test)]
@@ -18,9 +18,14 @@ mod tests {
 
     #[test]
     fn published_test_vectors() {
-        // From the FNV reference test suite (Fowler/Noll/Vo).
-        assert_eq!(fnv1a64(b""), 0xcbf2_9ce4_8422_2325);
-        assert_eq!(fnv1a64(b"a"), 0xaf63_dc4c_8601_ec8c);
-        assert_eq!(fnv1a64(b"foobar"), 0x8594_4171_f739_67e8);
+        // FIPS 180-2 examples.
+        assert_eq!(
+            sha256_hex(b"abc"),
+            "ba7816bf8f01cfea414140de5dae2223b00361a396177a9cb410ff61f20015ad"
+        );
+        assert_eq!(
+            sha256_hex(b""),
+            "e3b0c44298fc1c149afbf4c8996fb92427ae41e4649b934ca495991b7852b855"
+        );
     }
 }

@@ -284,6 +284,10 @@ impl Simulation {
         let initial_inputs = Inputs::from_slice(&data[1..1 + n])?;
         let inputs = Inputs::from_slice(&data[1 + n..1 + 2 * n])?;
         let time = data[1 + 2 * n];
+        if data[..1 + 2 * n].iter().any(|x| !x.is_finite()) {
+            return Err("simulation state holds a non-finite input or start time".into());
+        }
+        inputs.validate()?;
         let mut sim = Simulation::new(settings, initial_time, &initial_inputs)?;
         let states = sim.state.len();
         let start = 2 + 2 * n;

@@ -503,8 +503,8 @@ impl ChassisConfig {
 
     /// Reads and parses a JSON description file.
     pub fn from_file(path: &std::path::Path) -> Result<Self, FeError> {
-        let text = std::fs::read_to_string(path)
-            .map_err(|e| FeError::Io(format!("{}: {e}", path.display())))?;
+        let text = crate::text_file::read_limited(path, crate::text_file::CONFIG_LIMIT)
+            .map_err(FeError::Io)?;
         Self::from_json(&text)
     }
 

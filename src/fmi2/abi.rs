@@ -26,12 +26,33 @@ struct Handle {
     instance: Instance,
     /// Strings returned by fmi2GetString stay valid until the next call on this instance.
     returned_strings: Vec<CString>,
+    /// The FMU states this instance handed out (fmi2GetFMUstate, fmi2DeSerializeFMUstate) and
+    /// that are not freed yet: they belong to it and are freed with it. A state pointer is
+    /// recognised by its address among these, never dereferenced on trust. Boxed so that a
+    /// state keeps its address, which the master holds, when the vector grows.
+    #[allow(clippy::vec_box)]
+    states: Vec<Box<StateHandle>>,
 }
 
 /// An FMU state handed out by `fmi2GetFMUstate`.
 struct StateHandle {
-    live: u64,
     core: Core,
+}
+
+/// Index of the state behind `state` among an instance's `states`.
+fn state_index(states: &[Box<StateHandle>], state: fmi2FMUstate) -> Option<usize> {
+    states
+        .iter()
+        .position(|s| std::ptr::eq(&**s, state as *const StateHandle))
+}
+
+/// Keeps `core` as a new state among `states` and returns its handle.
+#[allow(clippy::vec_box)] // the box gives the state the stable address the master holds
+fn new_state(states: &mut Vec<Box<StateHandle>>, core: Core) -> fmi2FMUstate {
+    let mut boxed = Box::new(StateHandle { core });
+    let ptr: *mut StateHandle = &mut *boxed;
+    states.push(boxed);
+    ptr as fmi2FMUstate
 }
 
 fn status(s: Status) -> fmi2Status {
@@ -192,16 +213,31 @@ pub extern "C" fn fmi2Instantiate(
         }
         // SAFETY: as above.
         let resource_dir = match unsafe { text(fmuResourceLocation) } {
-            None => None,
+            None => {
+                logger.log(
+                    Level::Warning,
+                    "logStatusWarning",
+                    "fmi2Instantiate: no resource location given; the built-in vehicle is used unless configFile names an absolute path",
+                );
+                None
+            }
             Some(uri) => match resource_path(&uri) {
-                Ok(p) => Some(p),
+                Ok(p) if p.is_dir() => Some(p),
+                Ok(p) => {
+                    logger.log(
+                        Level::Error,
+                        "logStatusError",
+                        &format!("fmi2Instantiate: the resource location {uri} names {}, which is not a directory", p.display()),
+                    );
+                    return std::ptr::null_mut();
+                }
                 Err(m) => {
                     logger.log(
-                        Level::Warning,
-                        "logStatusWarning",
-                        &format!("fmi2Instantiate: {m}; using built-in defaults unless configFile is absolute"),
+                        Level::Error,
+                        "logStatusError",
+                        &format!("fmi2Instantiate: {m}"),
                     );
-                    None
+                    return std::ptr::null_mut();
                 }
             },
         };
@@ -209,6 +245,7 @@ pub extern "C" fn fmi2Instantiate(
             live: LIVE,
             instance: Instance::new(&name, logger, resource_dir),
             returned_strings: Vec::new(),
+            states: Vec::new(),
         });
         Box::into_raw(handle) as fmi2Component
     }));
@@ -482,6 +519,11 @@ pub extern "C" fn fmi2SetBoolean(
         else {
             return null_argument(inst, "fmi2SetBoolean");
         };
+        if let Some((vr, b)) = vrs.iter().zip(vals).find(|(_, b)| **b != 0 && **b != 1) {
+            return inst.error(&format!(
+                "fmi2SetBoolean: value {b} for value reference {vr} is neither fmi2True (1) nor fmi2False (0)"
+            ));
+        }
         let vals: Vec<bool> = vals.iter().map(|b| *b != 0).collect();
         inst.set_boolean(vrs, &vals)
     })
@@ -526,37 +568,19 @@ pub extern "C" fn fmi2GetFMUstate(c: fmi2Component, FMUstate: *mut fmi2FMUstate)
         }
         // SAFETY: FMUstate points to a writable fmi2FMUstate slot (FMI 2.0 §2.1.8).
         let slot = unsafe { &mut *FMUstate };
-        if !slot.is_null() {
-            let existing = *slot as *mut StateHandle;
-            // SAFETY: a non-null slot holds a state this FMU handed out earlier and not freed.
-            let existing = unsafe { &mut *existing };
-            if existing.live != LIVE {
-                return inst.error("fmi2GetFMUstate: the given FMU state is not one of this FMU's");
-            }
-            existing.core = inst.core.clone();
+        let core = inst.core.clone();
+        if slot.is_null() {
+            *slot = new_state(&mut h.states, core);
+        } else if let Some(i) = state_index(&h.states, *slot) {
+            h.states[i].core = core;
         } else {
-            *slot = Box::into_raw(Box::new(StateHandle {
-                live: LIVE,
-                core: inst.core.clone(),
-            })) as fmi2FMUstate;
+            return inst
+                .error("fmi2GetFMUstate: the given FMU state is not one of this instance's");
         }
         Status::Ok
     })
 }
 const _: fmi2GetFMUstateTYPE = Some(fmi2GetFMUstate);
-
-/// The state behind an fmi2FMUstate pointer, if it is one of ours.
-///
-/// # Safety
-/// `state` is null or a pointer returned by fmi2GetFMUstate/fmi2DeSerializeFMUstate and not freed.
-unsafe fn state_ref<'a>(state: fmi2FMUstate) -> Option<&'a StateHandle> {
-    if state.is_null() {
-        return None;
-    }
-    // SAFETY: by the caller's contract.
-    let s = unsafe { &*(state as *const StateHandle) };
-    (s.live == LIVE).then_some(s)
-}
 
 #[no_mangle]
 pub extern "C" fn fmi2SetFMUstate(c: fmi2Component, FMUstate: fmi2FMUstate) -> fmi2Status {
@@ -565,11 +589,13 @@ pub extern "C" fn fmi2SetFMUstate(c: fmi2Component, FMUstate: fmi2FMUstate) -> f
         if let Err(s) = inst.allowed("fmi2SetFMUstate", state::FMU_STATE) {
             return s;
         }
-        // SAFETY: FMUstate was produced by this FMU (checked by the live marker).
-        let Some(s) = (unsafe { state_ref(FMUstate) }) else {
-            return inst.error("fmi2SetFMUstate: not a valid FMU state of this FMU");
+        let Some(i) = state_index(&h.states, FMUstate) else {
+            return inst.error("fmi2SetFMUstate: not an FMU state of this instance");
         };
-        inst.core = s.core.clone();
+        if let Err(m) = inst.check_state_fits(&h.states[i].core) {
+            return inst.error(&format!("fmi2SetFMUstate: {m}"));
+        }
+        inst.core = h.states[i].core.clone();
         Status::Ok
     })
 }
@@ -587,16 +613,10 @@ pub extern "C" fn fmi2FreeFMUstate(c: fmi2Component, FMUstate: *mut fmi2FMUstate
         if slot.is_null() {
             return Status::Ok;
         }
-        let ptr = *slot as *mut StateHandle;
-        // SAFETY: the slot holds a Box<StateHandle> from fmi2GetFMUstate; the live marker catches a
-        // double free before ownership is taken back.
-        unsafe {
-            if (*ptr).live != LIVE {
-                return inst.error("fmi2FreeFMUstate: not a valid FMU state of this FMU");
-            }
-            (*ptr).live = 0;
-            drop(Box::from_raw(ptr));
-        }
+        let Some(i) = state_index(&h.states, *slot) else {
+            return inst.error("fmi2FreeFMUstate: not an FMU state of this instance");
+        };
+        h.states.swap_remove(i);
         *slot = std::ptr::null_mut();
         Status::Ok
     })
@@ -611,10 +631,10 @@ pub extern "C" fn fmi2SerializedFMUstateSize(
 ) -> fmi2Status {
     with_handle(c, |h| {
         let inst = &mut h.instance;
-        // SAFETY: as in fmi2SetFMUstate.
-        let Some(s) = (unsafe { state_ref(FMUstate) }) else {
-            return inst.error("fmi2SerializedFMUstateSize: not a valid FMU state of this FMU");
+        let Some(i) = state_index(&h.states, FMUstate) else {
+            return inst.error("fmi2SerializedFMUstateSize: not an FMU state of this instance");
         };
+        let s = &h.states[i];
         if size.is_null() {
             return null_argument(inst, "fmi2SerializedFMUstateSize");
         }
@@ -634,10 +654,10 @@ pub extern "C" fn fmi2SerializeFMUstate(
 ) -> fmi2Status {
     with_handle(c, |h| {
         let inst = &mut h.instance;
-        // SAFETY: as in fmi2SetFMUstate.
-        let Some(s) = (unsafe { state_ref(FMUstate) }) else {
-            return inst.error("fmi2SerializeFMUstate: not a valid FMU state of this FMU");
+        let Some(i) = state_index(&h.states, FMUstate) else {
+            return inst.error("fmi2SerializeFMUstate: not an FMU state of this instance");
         };
+        let s = &h.states[i];
         let bytes = snapshot::serialize(&s.core);
         if bytes.len() != size {
             return inst.error(&format!(
@@ -682,19 +702,15 @@ pub extern "C" fn fmi2DeSerializeFMUstate(
         };
         // SAFETY: FMUstate points to a writable slot.
         let slot = unsafe { &mut *FMUstate };
-        if !slot.is_null() {
-            // SAFETY: a non-null slot holds a state this FMU handed out.
-            if let Some(existing) = unsafe { state_ref(*slot) } {
-                let existing = existing as *const StateHandle as *mut StateHandle;
-                // SAFETY: we own that state (handed out by us, not freed); replace its content.
-                unsafe { (*existing).core = core };
-                return Status::Ok;
-            }
+        if slot.is_null() {
+            *slot = new_state(&mut h.states, core);
+        } else if let Some(i) = state_index(&h.states, *slot) {
+            h.states[i].core = core;
+        } else {
             return inst.error(
-                "fmi2DeSerializeFMUstate: the given FMU state slot holds a foreign pointer",
+                "fmi2DeSerializeFMUstate: the given FMU state slot holds a state of another instance",
             );
         }
-        *slot = Box::into_raw(Box::new(StateHandle { live: LIVE, core })) as fmi2FMUstate;
         Status::Ok
     })
 }

@@ -280,10 +280,22 @@ impl Instance {
                     p
                 })
             } else {
-                self.resource_dir
-                    .as_ref()
-                    .map(|r| r.join(cosim::DEFAULT_CONFIG_NAME))
-                    .filter(|p| p.is_file())
+                // The FMU's own vehicle: missing from an unpacked FMU is an error, not a silent
+                // switch to the built-in data.
+                match &self.resource_dir {
+                    Some(r) => {
+                        let p = r.join(cosim::DEFAULT_CONFIG_NAME);
+                        if !p.is_file() {
+                            return Err(format!(
+                                "the FMU's resources {} have no {} (configFile is empty)",
+                                r.display(),
+                                cosim::DEFAULT_CONFIG_NAME
+                            ));
+                        }
+                        Some(p)
+                    }
+                    None => None,
+                }
             }
         };
         Ok(cosim::Settings {
@@ -527,6 +539,60 @@ impl Instance {
             // Parameters or initial inputs changed before the model started: rebuild lazily.
             self.core.simulation = None;
         }
+    }
+
+    /// Whether `core` (from `fmi2SetFMUstate`) can become this instance's state: its values are
+    /// admissible and, once this instance has built its model, it was taken with the same
+    /// parameters (a state of another scene or configuration would silently change the model).
+    pub fn check_state_fits(&self, core: &Core) -> Result<(), String> {
+        check_values(&core.values, &core.inputs)?;
+        if self.core.simulation.is_none() || core.simulation.is_none() {
+            return Ok(());
+        }
+        let differs = |name: &str, theirs: String, ours: String| {
+            Err(format!(
+                "the state was taken with {name} = {theirs}, this instance runs with {ours}"
+            ))
+        };
+        let (a, b) = (&core.values, &self.core.values);
+        for v in REALS.iter().filter(|v| v.causality == Causality::Parameter) {
+            let i = v.vr as usize;
+            if a.reals[i].to_bits() != b.reals[i].to_bits() {
+                return differs(v.name, a.reals[i].to_string(), b.reals[i].to_string());
+            }
+        }
+        for v in INTEGERS
+            .iter()
+            .filter(|v| v.causality == Causality::Parameter)
+        {
+            let i = v.vr as usize;
+            if a.integers[i] != b.integers[i] {
+                return differs(v.name, a.integers[i].to_string(), b.integers[i].to_string());
+            }
+        }
+        for v in BOOLEANS
+            .iter()
+            .filter(|v| v.causality == Causality::Parameter)
+        {
+            let i = v.vr as usize;
+            if a.booleans[i] != b.booleans[i] {
+                return differs(v.name, a.booleans[i].to_string(), b.booleans[i].to_string());
+            }
+        }
+        for v in STRINGS
+            .iter()
+            .filter(|v| v.causality == Causality::Parameter)
+        {
+            let i = v.vr as usize;
+            if a.strings[i] != b.strings[i] {
+                return differs(
+                    v.name,
+                    format!("{:?}", a.strings[i]),
+                    format!("{:?}", b.strings[i]),
+                );
+            }
+        }
+        Ok(())
     }
 
     /// The values after `vrs := values`, if every reference is known, settable now and passes
@@ -813,6 +879,48 @@ impl Instance {
     pub fn last_successful_time(&self) -> f64 {
         self.core.time
     }
+}
+
+/// Whether stored values (an FMU state) are admissible: every Real finite, inputs and
+/// parameters within their declared ranges, input signals finite.
+pub fn check_values(values: &Values, tracks: &[InputTrack]) -> Result<(), String> {
+    for v in REALS {
+        let x = values.reals[v.vr as usize];
+        if !x.is_finite() {
+            return Err(format!("{} = {x} is not finite", v.name));
+        }
+        let ranged = matches!(v.causality, Causality::Input | Causality::Parameter);
+        if ranged && (v.min.is_some_and(|m| x < m) || v.max.is_some_and(|m| x > m)) {
+            return Err(format!(
+                "{} = {x} is outside [{}, {}]",
+                v.name,
+                v.min.unwrap_or(f64::NEG_INFINITY),
+                v.max.unwrap_or(f64::INFINITY)
+            ));
+        }
+    }
+    for v in INTEGERS
+        .iter()
+        .filter(|v| v.causality == Causality::Parameter)
+    {
+        let x = values.integers[v.vr as usize];
+        if v.min.is_some_and(|m| x < m) || v.max.is_some_and(|m| x > m) {
+            return Err(format!("{} = {x} is outside its range", v.name));
+        }
+    }
+    for v in REALS.iter().filter(|v| v.causality == Causality::Input) {
+        let t = &tracks[v.vr as usize];
+        let numbers = [t.value, t.slope, t.since];
+        if numbers.iter().any(|x| !x.is_finite())
+            || [t.pending_value, t.pending_slope, t.last_slope]
+                .iter()
+                .flatten()
+                .any(|x| !x.is_finite())
+        {
+            return Err(format!("the signal of {} is not finite", v.name));
+        }
+    }
+    Ok(())
 }
 
 /// The input signals the tracks will give from `time` on (SI units).

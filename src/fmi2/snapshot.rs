@@ -122,6 +122,7 @@ pub fn deserialize(
         terminated,
         simulation: None,
     };
+    super::instance::check_values(&core.values, &core.inputs)?;
     if has_simulation {
         core.simulation = Some(rebuild(&core, &dynamic)?);
     }

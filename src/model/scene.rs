@@ -212,8 +212,8 @@ pub fn body(
                     "chassis.stiffeningBar applies to the procedural body only; this vehicle's body is a reduced model from a file".into(),
                 );
             }
-            let text = std::fs::read_to_string(path)
-                .map_err(|e| format!("cannot read the reduced body {}: {e}", path.display()))?;
+            let text = crate::text_file::read_limited(path, crate::text_file::DATA_LIMIT)
+                .map_err(|e| format!("reduced body: {e}"))?;
             let body: ReducedChassis = serde_json::from_str(&text)
                 .map_err(|e| format!("reduced body {}: {e}", path.display()))?;
             (body, format!("reduced body read from {}", path.display()))

@@ -160,8 +160,8 @@ impl VehicleConfig {
     /// Reads and parses a configuration file; a relative `reduced` body path is resolved against
     /// the file's folder.
     pub fn from_file(path: &std::path::Path) -> Result<Self, ConfigError> {
-        let text = std::fs::read_to_string(path)
-            .map_err(|e| err("file", format!("cannot read {}: {e}", path.display())))?;
+        let text = crate::text_file::read_limited(path, crate::text_file::CONFIG_LIMIT)
+            .map_err(|e| err("file", e))?;
         let mut config = Self::from_json(&text)?;
         if let BodyConfig::Reduced { path: body } = &mut config.body {
             if body.is_relative() {

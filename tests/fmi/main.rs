@@ -1,6 +1,7 @@
 //! End-to-end tests of the FMI 2.0 C ABI: the built cdylib loaded with libloading.
 
 mod abi;
+mod bad_inputs;
 mod common;
 mod inputs;
 mod tolerance;
