@@ -8,4 +8,5 @@ mod engine_statics;
 mod engine_time_domain;
 mod hybrid_coupling;
 mod hybrid_paper;
+mod inline_four;
 mod scene_effects;
