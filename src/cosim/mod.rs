@@ -48,6 +48,12 @@ pub struct Settings {
     pub stability_limit_detection: bool,
     /// Used by scene 2 only.
     pub chassis: BodyOptions,
+    /// Which of the vehicle settings above (by FMU parameter name: `engine.load`,
+    /// `excitation.fadeInTime`, `crank.startAngle`, `crank.speedTimeConstant`, `effects.*`)
+    /// replace the vehicle configuration's values. `None`: all of them (the Rust API's default:
+    /// these settings are the whole truth). The FMU passes the parameters the master set
+    /// explicitly, so a configuration file keeps its own values for the others.
+    pub explicit: Option<std::collections::BTreeSet<String>>,
 }
 
 impl Default for Settings {
@@ -65,6 +71,7 @@ impl Default for Settings {
             max_order: 5,
             stability_limit_detection: true,
             chassis: BodyOptions::default(),
+            explicit: None,
         }
     }
 }

@@ -13,25 +13,102 @@ pub const STEERING_WHEEL_POINT: &str = "steering_wheel";
 pub const SEAT_POINT: &str = "seat_rail";
 
 /// The vehicle the settings name (configuration file or built-in default), with the FMU
-/// parameters applied on top.
+/// parameters applied on top by the precedence rule of [`Settings::explicit`].
 pub fn vehicle_config(settings: &Settings) -> Result<VehicleConfig, String> {
+    vehicle_config_with_notes(settings).map(|(config, _)| config)
+}
+
+/// [`vehicle_config`] and a log line per configuration value an FMU parameter replaced.
+pub fn vehicle_config_with_notes(
+    settings: &Settings,
+) -> Result<(VehicleConfig, Vec<String>), String> {
     let mut config = match &settings.config_file {
         Some(path) => VehicleConfig::from_file(path)
             .map_err(|e| format!("configuration {}: {e}", path.display()))?,
         None => VehicleConfig::default(),
     };
-    config.effects = settings.effects;
-    config.engine.gas.load = settings.gas_load;
-    config.engine.excitation_fade_in = settings.fade_in_time;
-    config.engine.start_crank_angle_deg = settings.crank_start_angle.to_degrees();
-    config.speed_follower.time_constant = settings.speed_time_constant;
+    let mut notes = Vec::new();
+    let applies = |name: &str| {
+        settings
+            .explicit
+            .as_ref()
+            .is_none_or(|set| set.contains(name))
+    };
+    let mut apply = |name: &str, slot: &mut f64, value: f64| {
+        if applies(name) {
+            if settings.config_file.is_some() && *slot != value {
+                notes.push(format!(
+                    "{name} = {value} (FMU parameter) replaces the configuration's {}",
+                    *slot
+                ));
+            }
+            *slot = value;
+        }
+    };
+    apply(
+        "engine.load",
+        &mut config.engine.gas.load,
+        settings.gas_load,
+    );
+    apply(
+        "excitation.fadeInTime",
+        &mut config.engine.excitation_fade_in,
+        settings.fade_in_time,
+    );
+    apply(
+        "crank.startAngle",
+        &mut config.engine.start_crank_angle_deg,
+        settings.crank_start_angle.to_degrees(),
+    );
+    apply(
+        "crank.speedTimeConstant",
+        &mut config.speed_follower.time_constant,
+        settings.speed_time_constant,
+    );
+    let e = &settings.effects;
+    let c = &mut config.effects;
+    for (name, slot, value) in [
+        ("effects.gasForces", &mut c.gas_forces, e.gas_forces),
+        ("effects.massForces", &mut c.mass_forces, e.mass_forces),
+        (
+            "effects.balanceShaft",
+            &mut c.balance_shaft,
+            e.balance_shaft,
+        ),
+        ("effects.gyroscopic", &mut c.gyroscopic, e.gyroscopic),
+        (
+            "effects.ringCarrier",
+            &mut c.ring_carrier_elasticity,
+            e.ring_carrier_elasticity,
+        ),
+        (
+            "effects.mountNonlinearity",
+            &mut c.mount_nonlinearity,
+            e.mount_nonlinearity,
+        ),
+        (
+            "effects.chassisFlexibility",
+            &mut c.chassis_flexibility,
+            e.chassis_flexibility,
+        ),
+    ] {
+        if applies(name) {
+            if settings.config_file.is_some() && *slot != value {
+                notes.push(format!(
+                    "{name} = {value} (FMU parameter) replaces the configuration's {}",
+                    *slot
+                ));
+            }
+            *slot = value;
+        }
+    }
     if config.mounts.len() > FMU_MOUNTS {
         return Err(format!(
             "the configuration has {} mounts; the FMU exposes {FMU_MOUNTS} (deactivate one with \"active\": false)",
             config.mounts.len()
         ));
     }
-    Ok(config)
+    Ok((config, notes))
 }
 
 /// The coupled model the settings describe, with log lines on how it was built.
@@ -45,9 +122,9 @@ pub fn build_model(settings: &Settings) -> Result<(CoupledModel, Vec<String>), S
             ))
         }
     };
-    let vehicle = vehicle_config(settings)?;
+    let (vehicle, mut notes) = vehicle_config_with_notes(settings)?;
     let built = build(&vehicle, kind, &settings.chassis)?;
-    let mut notes = built.notes;
+    notes.extend(built.notes);
     notes.push(format!(
         "scene {} ({}): {}",
         settings.scene,

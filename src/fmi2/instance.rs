@@ -4,6 +4,7 @@
 //! rejected call leaves the instance exactly as it was: values are validated as a whole before
 //! any is applied.
 
+use std::collections::BTreeSet;
 use std::path::PathBuf;
 
 use super::input_track::InputTrack;
@@ -56,9 +57,9 @@ pub struct Core {
     pub stop_time: Option<f64>,
     /// The tolerance of `fmi2SetupExperiment`, if the master defined one.
     pub experiment_tolerance: Option<f64>,
-    /// Whether the master set `solver.relTol` itself (it then wins over the experiment's
-    /// tolerance).
-    pub rel_tol_set: bool,
+    /// Parameters the master set itself (by name): they win over the configuration file and
+    /// (`solver.relTol`) over the experiment's tolerance.
+    pub explicit: BTreeSet<String>,
     pub time: f64,
     pub terminated: bool,
     pub simulation: Option<Simulation>,
@@ -76,7 +77,7 @@ impl Core {
             start_time: 0.0,
             stop_time: None,
             experiment_tolerance: None,
-            rel_tol_set: false,
+            explicit: BTreeSet::new(),
             time: 0.0,
             terminated: false,
             simulation: None,
@@ -228,15 +229,37 @@ impl Instance {
         }
         let outputs = simulation.outputs().map_err(|m| self.error(&m))?;
         self.write_outputs(&outputs, &simulation.counters());
+        self.write_effective_parameters(&simulation);
         self.core.simulation = Some(simulation);
         Ok(())
+    }
+
+    /// The vehicle parameters as the model uses them (a configuration file's values where the
+    /// master did not set the parameter), so that reading a parameter tells the truth.
+    fn write_effective_parameters(&mut self, simulation: &Simulation) {
+        let model = simulation.model();
+        let engine = model.powertrain().config();
+        let r = &mut self.core.values.reals;
+        r[real::ENGINE_LOAD as usize] = engine.gas.load;
+        r[real::FADE_IN_TIME as usize] = engine.excitation_fade_in;
+        r[real::CRANK_START_ANGLE as usize] = engine.start_crank_angle_deg.to_radians();
+        r[real::CRANK_SPEED_TIME_CONSTANT as usize] = model.follower().time_constant;
+        let e = model.effects();
+        let b = &mut self.core.values.booleans;
+        b[boolean::EFFECT_GAS_FORCES as usize] = e.gas_forces;
+        b[boolean::EFFECT_MASS_FORCES as usize] = e.mass_forces;
+        b[boolean::EFFECT_BALANCE_SHAFT as usize] = e.balance_shaft;
+        b[boolean::EFFECT_GYROSCOPIC as usize] = e.gyroscopic;
+        b[boolean::EFFECT_RING_CARRIER as usize] = e.ring_carrier_elasticity;
+        b[boolean::EFFECT_MOUNT_NONLINEARITY as usize] = e.mount_nonlinearity;
+        b[boolean::EFFECT_CHASSIS_FLEXIBILITY as usize] = e.chassis_flexibility;
     }
 
     /// A simulation built from the current parameters and inputs, at its static equilibrium.
     pub fn build_simulation(&self) -> Result<Simulation, String> {
         let settings = self.settings()?;
         let inputs = self.inputs_at_time();
-        self.event(&match (self.core.experiment_tolerance, self.core.rel_tol_set) {
+        self.event(&match (self.core.experiment_tolerance, self.core.explicit.contains("solver.relTol")) {
             (Some(t), false) => format!("relative tolerance {t} from fmi2SetupExperiment"),
             (Some(t), true) => format!(
                 "relative tolerance {} from solver.relTol (set explicitly; fmi2SetupExperiment's {t} not used)",
@@ -314,7 +337,10 @@ impl Instance {
             fade_in_time: v.reals[real::FADE_IN_TIME as usize],
             crank_start_angle: v.reals[real::CRANK_START_ANGLE as usize],
             speed_time_constant: v.reals[real::CRANK_SPEED_TIME_CONSTANT as usize],
-            rel_tol: match (core.experiment_tolerance, core.rel_tol_set) {
+            rel_tol: match (
+                core.experiment_tolerance,
+                core.explicit.contains("solver.relTol"),
+            ) {
                 (Some(tolerance), false) => tolerance,
                 _ => v.reals[real::SOLVER_REL_TOL as usize],
             },
@@ -342,6 +368,7 @@ impl Instance {
                     }
                 },
             },
+            explicit: Some(core.explicit.clone()),
         })
     }
 
@@ -597,6 +624,15 @@ impl Instance {
 
     /// The values after `vrs := values`, if every reference is known, settable now and passes
     /// `check`; otherwise the logged refusal. Nothing is applied here.
+    fn mark_explicit<S: 'static>(&mut self, table: &[Variable<S>], vrs: &[u32]) {
+        for vr in vrs {
+            let v = &table[*vr as usize];
+            if v.causality == Causality::Parameter {
+                self.core.explicit.insert(v.name.to_owned());
+            }
+        }
+    }
+
     fn candidate<T: Clone, S: 'static>(
         &self,
         function: &str,
@@ -654,7 +690,7 @@ impl Instance {
         }
         self.core.inputs = tracks;
         self.core.values.reals = candidate;
-        self.core.rel_tol_set |= vrs.contains(&real::SOLVER_REL_TOL);
+        self.mark_explicit(REALS, vrs);
         self.after_set(true);
         Status::Ok
     }
@@ -679,6 +715,7 @@ impl Instance {
             Ok(c) => self.core.values.integers = c,
             Err(s) => return s,
         }
+        self.mark_explicit(INTEGERS, vrs);
         self.after_set(true);
         Status::Ok
     }
@@ -699,6 +736,7 @@ impl Instance {
             Ok(c) => self.core.values.booleans = c,
             Err(s) => return s,
         }
+        self.mark_explicit(BOOLEANS, vrs);
         self.after_set(true);
         Status::Ok
     }
@@ -719,6 +757,7 @@ impl Instance {
             Ok(c) => self.core.values.strings = c,
             Err(s) => return s,
         }
+        self.mark_explicit(STRINGS, vrs);
         self.after_set(true);
         Status::Ok
     }
@@ -949,6 +988,45 @@ fn inputs_from(tracks: &[InputTrack], time: f64) -> cosim::Inputs {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// The vehicle parameters' start values are the built-in vehicle's: one set of defaults.
+    #[test]
+    fn parameter_start_values_are_the_built_in_vehicle() {
+        let v = crate::model::VehicleConfig::default();
+        let start = Values::start();
+        let r = &start.reals;
+        assert_eq!(r[real::ENGINE_LOAD as usize], v.engine.gas.load);
+        assert_eq!(r[real::FADE_IN_TIME as usize], v.engine.excitation_fade_in);
+        assert_eq!(
+            r[real::CRANK_START_ANGLE as usize],
+            v.engine.start_crank_angle_deg.to_radians()
+        );
+        assert_eq!(
+            r[real::CRANK_SPEED_TIME_CONSTANT as usize],
+            v.speed_follower.time_constant
+        );
+        let b = &start.booleans;
+        let e = v.effects;
+        assert_eq!(b[boolean::EFFECT_GAS_FORCES as usize], e.gas_forces);
+        assert_eq!(b[boolean::EFFECT_MASS_FORCES as usize], e.mass_forces);
+        assert_eq!(b[boolean::EFFECT_BALANCE_SHAFT as usize], e.balance_shaft);
+        assert_eq!(b[boolean::EFFECT_GYROSCOPIC as usize], e.gyroscopic);
+        assert_eq!(
+            b[boolean::EFFECT_RING_CARRIER as usize],
+            e.ring_carrier_elasticity
+        );
+        assert_eq!(
+            b[boolean::EFFECT_MOUNT_NONLINEARITY as usize],
+            e.mount_nonlinearity
+        );
+        assert_eq!(
+            b[boolean::EFFECT_CHASSIS_FLEXIBILITY as usize],
+            e.chassis_flexibility
+        );
+        let settings = crate::cosim::Settings::default();
+        assert_eq!(r[real::SOLVER_REL_TOL as usize], settings.rel_tol);
+        assert_eq!(r[real::SOLVER_ABS_TOL as usize], settings.abs_tol);
+    }
 
     #[test]
     fn deserialized_state_continues_bit_for_bit() {

@@ -26,7 +26,8 @@ pub fn serialize(core: &Core) -> Vec<u8> {
     w.f64(core.time);
     w.u8(u8::from(core.terminated));
     w.optional(core.experiment_tolerance);
-    w.u8(u8::from(core.rel_tol_set));
+    w.u32(core.explicit.len() as u32);
+    core.explicit.iter().for_each(|name| w.str(name));
     w.u32(core.values.reals.len() as u32);
     core.values.reals.iter().for_each(|x| w.f64(*x));
     w.u32(core.values.integers.len() as u32);
@@ -81,7 +82,15 @@ pub fn deserialize(
     let time = r.f64()?;
     let terminated = r.u8()? != 0;
     let experiment_tolerance = r.optional()?;
-    let rel_tol_set = r.u8()? != 0;
+    let explicit_count = r.u32()? as usize;
+    if explicit_count > REALS.len() + INTEGERS.len() + BOOLEANS.len() + STRINGS.len() {
+        return Err(format!(
+            "FMU state names {explicit_count} explicitly set parameters"
+        ));
+    }
+    let explicit = (0..explicit_count)
+        .map(|_| r.str())
+        .collect::<Result<std::collections::BTreeSet<_>, _>>()?;
     let reals = r.counted(REALS.len(), "Real values", |r| r.f64())?;
     let integers = r.counted(INTEGERS.len(), "Integer values", |r| {
         r.u32().map(|x| x as i32)
@@ -117,7 +126,7 @@ pub fn deserialize(
         start_time,
         stop_time: has_stop.then_some(stop),
         experiment_tolerance,
-        rel_tol_set,
+        explicit,
         time,
         terminated,
         simulation: None,

@@ -3,51 +3,39 @@
 use std::path::PathBuf;
 
 /// Parses a `file:` URI as FMI tools pass it: `file:///abs/path`, `file:/abs/path`,
-/// `file://localhost/abs/path`, with percent-encoded bytes. Other schemes and hosts are refused.
+/// `file://localhost/abs/path`, with percent-encoded bytes (the `url` crate, which also knows
+/// Windows drive letters). Other schemes, remote hosts, relative paths and malformed escapes are
+/// refused.
 pub fn resource_path(uri: &str) -> Result<PathBuf, String> {
-    let rest = uri
+    let after_scheme = uri
         .strip_prefix("file:")
         .ok_or_else(|| format!("resource location \"{uri}\" is not a file: URI"))?;
-    let path = if let Some(after) = rest.strip_prefix("//") {
-        let slash = after.find('/').unwrap_or(after.len());
-        let host = &after[..slash];
-        if !(host.is_empty() || host.eq_ignore_ascii_case("localhost")) {
-            return Err(format!(
-                "resource location \"{uri}\" names a remote host \"{host}\""
-            ));
-        }
-        &after[slash..]
-    } else {
-        rest
-    };
-    if !path.starts_with('/') {
+    // A URL parser makes `file:relative` absolute; FMI tools never mean that.
+    if !after_scheme.starts_with('/') {
         return Err(format!(
             "resource location \"{uri}\" is not an absolute path"
         ));
     }
-    let bytes = percent_decode(path)
-        .ok_or_else(|| format!("resource location \"{uri}\" has a bad %-escape"))?;
-    let text = String::from_utf8(bytes)
-        .map_err(|_| format!("resource location \"{uri}\" is not UTF-8"))?;
-    Ok(PathBuf::from(text))
-}
-
-fn percent_decode(s: &str) -> Option<Vec<u8>> {
-    let bytes = s.as_bytes();
-    let mut out = Vec::with_capacity(bytes.len());
-    let mut i = 0;
-    while i < bytes.len() {
-        if bytes[i] == b'%' {
-            let hex = bytes.get(i + 1..i + 3)?;
-            let text = std::str::from_utf8(hex).ok()?;
-            out.push(u8::from_str_radix(text, 16).ok()?);
-            i += 3;
-        } else {
-            out.push(bytes[i]);
-            i += 1;
-        }
+    // The url crate keeps a malformed escape as literal text; a tool never sends one.
+    let escapes_ok = after_scheme
+        .split('%')
+        .skip(1)
+        .all(|rest| rest.len() >= 2 && rest.as_bytes()[..2].iter().all(u8::is_ascii_hexdigit));
+    if !escapes_ok {
+        return Err(format!("resource location \"{uri}\" has a bad %-escape"));
     }
-    Some(out)
+    let url = url::Url::parse(uri).map_err(|e| format!("resource location \"{uri}\": {e}"))?;
+    if url
+        .host_str()
+        .is_some_and(|h| !h.is_empty() && !h.eq_ignore_ascii_case("localhost"))
+    {
+        return Err(format!(
+            "resource location \"{uri}\" names a remote host \"{}\"",
+            url.host_str().unwrap_or_default()
+        ));
+    }
+    url.to_file_path()
+        .map_err(|()| format!("resource location \"{uri}\" is not a local path"))
 }
 
 #[cfg(test)]

@@ -4,4 +4,4 @@ mod abi;
 mod bad_inputs;
 mod common;
 mod inputs;
-mod tolerance;
+mod precedence;

@@ -1,8 +1,10 @@
-//! `fmi2SetupExperiment`'s tolerance: the integrator's relative tolerance unless the master set
-//! `solver.relTol` itself.
+//! Which value wins where two sources give one: `fmi2SetupExperiment`'s tolerance is the
+//! integrator's relative tolerance unless the master set `solver.relTol` itself; a configuration
+//! file's vehicle values hold unless the master set the matching FMU parameter, and the
+//! parameters read back what the model uses.
 
 use crate::common::*;
-use engine_mount_chassis::fmi2::variables::{integer, real};
+use engine_mount_chassis::fmi2::variables::{boolean, integer, real, string};
 
 /// Integrator steps for 50 ms at 2000 rpm after setting up with `tolerance` (and `rel_tol`).
 fn steps(
@@ -74,4 +76,45 @@ fn a_tolerance_outside_the_range_is_an_error() {
         s.logs()
     );
     assert_eq!(s.setup_with_tolerance(1e-4), OK);
+}
+
+#[test]
+fn a_configuration_file_keeps_its_values_unless_the_master_sets_the_parameter() {
+    let fmu = Fmu::load();
+    let dir = std::env::temp_dir().join(format!("emc-precedence-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let config = dir.join("loaded.json");
+    std::fs::write(
+        &config,
+        r#"{"extends": "default", "engine": {"gas": {"load": 0.7}}, "effects": {"balance_shaft": false}}"#,
+    )
+    .unwrap();
+    let path = config.display().to_string();
+
+    // Not set by the master: the file's values are used, and the parameters say so.
+    let s = fmu.instantiate("file-values");
+    assert_eq!(s.set_string(&[string::CONFIG_FILE], &[&path]), OK);
+    s.initialize();
+    assert_eq!(s.reals(&[real::ENGINE_LOAD]), vec![0.7]);
+    let (_, b) = s.get_boolean(&[boolean::EFFECT_BALANCE_SHAFT]);
+    assert_eq!(b, vec![false]);
+
+    // Set by the master: the parameter wins, with a log line naming both values.
+    let s = fmu.instantiate("parameter-wins");
+    s.log_everything();
+    assert_eq!(s.set_string(&[string::CONFIG_FILE], &[&path]), OK);
+    assert_eq!(s.set_real(&[real::ENGINE_LOAD], &[0.2]), OK);
+    s.initialize();
+    assert_eq!(s.reals(&[real::ENGINE_LOAD]), vec![0.2]);
+    assert!(
+        s.logs()
+            .iter()
+            .any(|l| l
+                .contains("engine.load = 0.2 (FMU parameter) replaces the configuration's 0.7")),
+        "{:?}",
+        s.logs()
+    );
+    let (_, b) = s.get_boolean(&[boolean::EFFECT_BALANCE_SHAFT]);
+    assert_eq!(b, vec![false], "not set: still the file's");
+    let _ = std::fs::remove_dir_all(&dir);
 }
