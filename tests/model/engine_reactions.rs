@@ -17,6 +17,10 @@ struct Setup {
 
 fn setup(gas: bool, mass: bool, balance: bool) -> Setup {
     let mut cfg = VehicleConfig::default();
+    // The ideal crank drive of the analytic order formulas: no residual unbalance, identical
+    // cylinders (both are checked on their own in tests/model/engine_imperfections.rs).
+    cfg.engine.residual_unbalance.clear();
+    cfg.engine.gas.cylinder_heat_spread.clear();
     cfg.effects.gas_forces = gas;
     cfg.effects.mass_forces = mass;
     cfg.effects.balance_shaft = balance;

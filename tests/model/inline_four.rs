@@ -21,6 +21,10 @@ fn powertrain(file: &str, gas: bool) -> (Powertrain, f64, f64, f64) {
         .join("resources")
         .join(file);
     let mut cfg = VehicleConfig::from_file(&path).expect("configuration");
+    // The ideal crank drive of the analytic order formulas: no residual unbalance, identical
+    // cylinders (both are checked on their own in tests/model/engine_imperfections.rs).
+    cfg.engine.residual_unbalance.clear();
+    cfg.engine.gas.cylinder_heat_spread.clear();
     cfg.effects.gas_forces = gas;
     cfg.effects.mass_forces = !gas;
     let c = &cfg.engine.crank_drive;

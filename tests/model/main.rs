@@ -1,5 +1,6 @@
 //! Integration tests of the coupled engine–mount–body model (`src/model`): statics, modes, orders, Jacobians, time domain.
 
+mod engine_imperfections;
 mod engine_inputs_outputs;
 mod engine_jacobian;
 mod engine_modes;

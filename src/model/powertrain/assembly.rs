@@ -2,7 +2,9 @@
 
 use nalgebra::{Matrix3, Vector3};
 
-use super::config::{CrankDriveConfig, EccentricWeight, EngineConfig, RigidBodyConfig};
+use super::config::{
+    CrankDriveConfig, EccentricWeight, EngineConfig, RigidBodyConfig, UNBALANCE_RADIUS,
+};
 use super::parts::{Part, PartMotion};
 use crate::model::effects::Effects;
 
@@ -129,8 +131,47 @@ fn eccentric(
     }
 }
 
+/// Residual unbalances ([`super::config::ResidualUnbalance`]) as point masses on the crank and the shafts.
+pub fn unbalance_parts(cfg: &EngineConfig, reference: &Vector3<f64>) -> Vec<Part> {
+    let c = &cfg.crank_drive;
+    let bore = v3(&c.bore_axis);
+    let crank = v3(&c.crank_centre) - reference;
+    cfg.residual_unbalance
+        .iter()
+        .filter_map(|u| {
+            let (mass, centre, ratio) = if u.part == "crank" {
+                (c.crank_mass, crank, 1.0)
+            } else {
+                let shaft = cfg.balance_shafts.iter().find(|b| b.name == u.part)?;
+                let weights: f64 = shaft.weights.iter().map(|w| w.mass).sum();
+                (
+                    shaft.shaft_mass + weights,
+                    v3(&shaft.axis_point) - reference,
+                    shaft.ratio,
+                )
+            };
+            let omega = u.service_rpm * std::f64::consts::PI / 30.0 * ratio.abs();
+            let unbalance = mass * u.grade_mm_per_s * 1e-3 / omega;
+            let weight = EccentricWeight {
+                mass: unbalance / UNBALANCE_RADIUS,
+                eccentricity: UNBALANCE_RADIUS,
+                y: u.y,
+                phase_deg: u.phase_deg,
+            };
+            Some(eccentric(
+                format!("{} residual unbalance", u.part),
+                &weight,
+                centre,
+                bore,
+                ratio,
+            ))
+        })
+        .collect()
+}
+
 /// Balance shafts with their weights and the extra crank counterweights, relative to `reference`.
-pub fn balance_parts(cfg: &EngineConfig, reference: &Vector3<f64>) -> Vec<Part> {
+/// With `balancing` off the weights sit on their axes: the masses stay, the balancing goes.
+pub fn balance_parts(cfg: &EngineConfig, reference: &Vector3<f64>, balancing: bool) -> Vec<Part> {
     let c = &cfg.crank_drive;
     let bore = v3(&c.bore_axis);
     let crank = v3(&c.crank_centre) - reference;
@@ -146,14 +187,29 @@ pub fn balance_parts(cfg: &EngineConfig, reference: &Vector3<f64>) -> Vec<Part> 
         });
         for (k, w) in shaft.weights.iter().enumerate() {
             let name = format!("{} weight {}", shaft.name, k + 1);
-            parts.push(eccentric(name, w, axis, bore, shaft.ratio));
+            parts.push(eccentric(
+                name,
+                &switched(w, balancing),
+                axis,
+                bore,
+                shaft.ratio,
+            ));
         }
     }
     for (k, w) in cfg.crank_counterweights.iter().enumerate() {
         let name = format!("extra counterweight {}", k + 1);
-        parts.push(eccentric(name, w, crank, bore, 1.0));
+        parts.push(eccentric(name, &switched(w, balancing), crank, bore, 1.0));
     }
+    parts.extend(unbalance_parts(cfg, reference));
     parts
+}
+
+/// A balancing weight as it is with balancing on, or moved onto its axis with balancing off.
+fn switched(w: &EccentricWeight, balancing: bool) -> EccentricWeight {
+    EccentricWeight {
+        eccentricity: if balancing { w.eccentricity } else { 0.0 },
+        ..w.clone()
+    }
 }
 
 /// The free bodies of the model: `[monoblock, housing]` with elastic ring carriers, otherwise one
@@ -162,9 +218,7 @@ pub fn build_bodies(cfg: &EngineConfig, effects: &Effects) -> Vec<Body> {
     let mb_ref = v3(&cfg.monoblock.centre_of_mass);
     let mut mb_parts = vec![structure_part("monoblock", &cfg.monoblock, &mb_ref)];
     mb_parts.extend(crank_drive_parts(&cfg.crank_drive, &mb_ref));
-    if effects.balance_shaft {
-        mb_parts.extend(balance_parts(cfg, &mb_ref));
-    }
+    mb_parts.extend(balance_parts(cfg, &mb_ref, effects.balance_shaft));
     if effects.ring_carrier_elasticity {
         let h_ref = v3(&cfg.housing.centre_of_mass);
         vec![

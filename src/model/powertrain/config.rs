@@ -85,6 +85,28 @@ pub struct EccentricWeight {
 /// A balance shaft: a shaft parallel to the crank axis turning at `ratio` times the crank's speed
 /// relative to the block (−1: the inline-3's counter-rotating first-order shaft; ±2: a pair of
 /// Lanchester shafts of an inline-4), carrying eccentric weights.
+/// Residual unbalance of a rotating part after balancing, by its balance grade (ISO 21940-11,
+/// formerly ISO 1940-1): the permissible specific unbalance `e = G / Ω` at the maximum service
+/// speed `Ω`, so `U = m G / Ω` for a part of mass `m`. It acts as a point mass `U / r` at radius
+/// [`UNBALANCE_RADIUS`] on the part, turning with it.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct ResidualUnbalance {
+    /// `crank`, or the name of a balance shaft.
+    pub part: String,
+    /// Balance grade G (mm/s), e.g. 16 for G 16.
+    pub grade_mm_per_s: f64,
+    /// Maximum service speed of the engine (rpm) the grade refers to.
+    pub service_rpm: f64,
+    /// Axial position (m) from the crank centre plane (y = 0).
+    pub y: f64,
+    /// Angle of the unbalance (deg) in the part's frame, as for eccentric weights.
+    pub phase_deg: f64,
+}
+
+/// Radius at which a residual unbalance is placed as a point mass (m).
+pub const UNBALANCE_RADIUS: f64 = 0.05;
+
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct BalanceShaftConfig {
@@ -107,6 +129,11 @@ pub struct GasConfig {
     pub load: f64,
     /// Crankcase pressure acting under the piston (Pa).
     pub crankcase_pressure: f64,
+    /// Cylinder-to-cylinder variation: relative deviation of each cylinder's heat release from
+    /// the mean (Wiebe model), one per cylinder, or empty for identical cylinders. The pressure
+    /// equation is linear in the heat released, so cylinder `i` sees
+    /// `p_motored + (1 + δ_i)(p − p_motored)` and its IMEP scales by `1 + δ_i`.
+    pub cylinder_heat_spread: Vec<f64>,
 }
 
 /// Linear 6-DOF elastomer bushing (ring carrier) between monoblock and housing.
@@ -137,6 +164,9 @@ pub struct EngineConfig {
     /// Extra counterweights on the crank that work with the balance shafts (switched with them);
     /// `y` from the crank centre, turning with the crank.
     pub crank_counterweights: Vec<EccentricWeight>,
+    /// Residual unbalance of the crank and the balance shafts (present whatever the effect
+    /// switches say: balancing never removes it completely).
+    pub residual_unbalance: Vec<ResidualUnbalance>,
     pub gas: GasConfig,
     /// Monoblock structure (cylinders, head, main bearing frame) without the moving parts.
     pub monoblock: RigidBodyConfig,
@@ -231,6 +261,21 @@ impl EngineConfig {
                 w.validate(&format!("{fb}.weights[{k}]"))?;
             }
         }
+        for (k, u) in self.residual_unbalance.iter().enumerate() {
+            let f = format!("residual_unbalance[{k}]");
+            if u.part != "crank" && !self.balance_shafts.iter().any(|b| b.name == u.part) {
+                return Err(err(
+                    format!("{f}.part"),
+                    format!(
+                        "{f}.part = {:?} is neither \"crank\" nor a balance shaft's name",
+                        u.part
+                    ),
+                ));
+            }
+            non_negative(&format!("{f}.grade_mm_per_s"), u.grade_mm_per_s)?;
+            positive(&format!("{f}.service_rpm"), u.service_rpm)?;
+            finite(&format!("{f}.y"), &[u.y, u.phase_deg])?;
+        }
         for (k, w) in self.crank_counterweights.iter().enumerate() {
             w.validate(&format!("crank_counterweights[{k}]"))?;
         }
@@ -263,6 +308,30 @@ impl EngineConfig {
             ));
         }
         positive("gas.crankcase_pressure", g.crankcase_pressure)?;
+        let n = self.crank_drive.cylinders.len();
+        if !(g.cylinder_heat_spread.is_empty() || g.cylinder_heat_spread.len() == n) {
+            return Err(err(
+                "gas.cylinder_heat_spread",
+                format!(
+                    "gas.cylinder_heat_spread has {} entries for {n} cylinders (give one per cylinder, or none)",
+                    g.cylinder_heat_spread.len()
+                ),
+            ));
+        }
+        for (i, d) in g.cylinder_heat_spread.iter().enumerate() {
+            if !(d.is_finite() && *d > -1.0) {
+                return Err(err(
+                    "gas.cylinder_heat_spread",
+                    format!("gas.cylinder_heat_spread[{i}] = {d} must be finite and > -1"),
+                ));
+            }
+        }
+        if !g.cylinder_heat_spread.is_empty() && matches!(g.model, GasModel::Table(_)) {
+            return Err(err(
+                "gas.cylinder_heat_spread",
+                "a cylinder-to-cylinder spread needs the Wiebe model (a pressure table has no heat release to vary)".to_owned(),
+            ));
+        }
         match &g.model {
             GasModel::Wiebe(w) => {
                 if !(w.compression_ratio.is_finite() && w.compression_ratio > 1.0) {

@@ -363,6 +363,40 @@ mod tests {
         }
     }
 
+    /// The single-zone pressure equation is linear in the heat released, so scaling a cylinder's
+    /// heat by 1 + δ is the blend of the motored and the fired curve with weight 1 + δ: what
+    /// the powertrain uses for cylinder-to-cylinder variation.
+    #[test]
+    fn scaling_the_heat_scales_the_pressure_rise_over_the_motored_curve() {
+        let model = WiebeModel::default();
+        let point = &model.full_load;
+        let fired = PressureCurve::wiebe(&model, point, &geometry());
+        let motored = PressureCurve::wiebe(
+            &model,
+            &CombustionPoint {
+                heat: 0.0,
+                ..point.clone()
+            },
+            &geometry(),
+        );
+        for delta in [0.05, -0.1] {
+            let direct = PressureCurve::wiebe(
+                &model,
+                &CombustionPoint {
+                    heat: point.heat * (1.0 + delta),
+                    ..point.clone()
+                },
+                &geometry(),
+            );
+            let blended = PressureCurve::blend(&motored, &fired, 1.0 + delta);
+            for deg in [-100.0, -5.0, 0.0, 7.5, 20.0, 90.0, 200.0] {
+                let th = f64::to_radians(deg);
+                let (a, b) = (direct.pressure(th), blended.pressure(th));
+                assert!((a - b).abs() < 1e-9 * a, "{deg}°: {a} vs {b}");
+            }
+        }
+    }
+
     #[test]
     fn motored_cycle_follows_the_polytropic_law() {
         // No heat release, constant exponent: p V^κ = const between IVC and EVO (independent truth).

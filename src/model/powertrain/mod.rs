@@ -16,6 +16,8 @@ pub mod parts;
 pub mod reaction;
 pub mod ring_carrier;
 
+use std::sync::Arc;
+
 use nalgebra::Vector3;
 
 use self::assembly::{build_bodies, v3, Body};
@@ -28,12 +30,43 @@ use super::effects::Effects;
 use super::inputs::InputError;
 use super::validate::ConfigError;
 
+/// The Wiebe model's fired and motored curves at idle and full load, for changing the load at
+/// run time.
+#[derive(Debug, Clone, PartialEq)]
+struct LoadPoints {
+    idle: PressureCurve,
+    full: PressureCurve,
+    idle_motored: PressureCurve,
+    full_motored: PressureCurve,
+}
+
+impl LoadPoints {
+    /// Per-cylinder curves at `load` with the heat-release spread `spread` (shared when the
+    /// cylinders are identical).
+    fn curves(&self, load: f64, spread: &[f64], cylinders: usize) -> Vec<Arc<PressureCurve>> {
+        let fired = PressureCurve::blend(&self.idle, &self.full, load);
+        if spread.iter().all(|d| *d == 0.0) {
+            let shared = Arc::new(fired);
+            return (0..cylinders).map(|_| Arc::clone(&shared)).collect();
+        }
+        // The pressure equation is linear in the heat released: scaling the heat by 1 + δ
+        // scales the pressure rise over the motored curve by the same factor.
+        let motored = PressureCurve::blend(&self.idle_motored, &self.full_motored, load);
+        spread
+            .iter()
+            .map(|d| Arc::new(PressureCurve::blend(&motored, &fired, 1.0 + d)))
+            .collect()
+    }
+}
+
 /// Gas excitation prepared from the configuration.
 #[derive(Debug, Clone, PartialEq)]
 struct GasExcitation {
-    curve: PressureCurve,
-    /// Idle and full-load curves of the Wiebe model, for changing the load at run time.
-    load_points: Option<(PressureCurve, PressureCurve)>,
+    /// Pressure curve of each cylinder (shared when they are alike).
+    curves: Vec<Arc<PressureCurve>>,
+    load_points: Option<LoadPoints>,
+    /// Relative heat-release deviation per cylinder (empty: identical cylinders).
+    spread: Vec<f64>,
     area: f64,
     crankcase_pressure: f64,
     radius: f64,
@@ -53,26 +86,35 @@ impl GasExcitation {
             crank_radius: c.crank_radius,
             conrod: c.conrod_length,
         };
-        let (curve, load_points) = match &config.gas.model {
+        let n = c.cylinders.len();
+        let spread = config.gas.cylinder_heat_spread.clone();
+        let (curves, load_points) = match &config.gas.model {
             GasModel::Wiebe(w) => {
-                let idle = PressureCurve::wiebe(w, &w.idle, &geometry);
-                let full = PressureCurve::wiebe(w, &w.full_load, &geometry);
-                (
-                    PressureCurve::blend(&idle, &full, config.gas.load),
-                    Some((idle, full)),
-                )
+                let motored = |point: &gas::CombustionPoint| gas::CombustionPoint {
+                    heat: 0.0,
+                    ..point.clone()
+                };
+                let points = LoadPoints {
+                    idle: PressureCurve::wiebe(w, &w.idle, &geometry),
+                    full: PressureCurve::wiebe(w, &w.full_load, &geometry),
+                    idle_motored: PressureCurve::wiebe(w, &motored(&w.idle), &geometry),
+                    full_motored: PressureCurve::wiebe(w, &motored(&w.full_load), &geometry),
+                };
+                (points.curves(config.gas.load, &spread, n), Some(points))
             }
-            GasModel::Table(t) => (
-                PressureCurve::from_table(t).map_err(|message| ConfigError {
+            GasModel::Table(t) => {
+                let curve = PressureCurve::from_table(t).map_err(|message| ConfigError {
                     field: "engine.gas.model".into(),
                     message,
-                })?,
-                None,
-            ),
+                })?;
+                let shared = Arc::new(curve);
+                ((0..n).map(|_| Arc::clone(&shared)).collect(), None)
+            }
         };
         Ok(GasExcitation {
-            curve,
+            curves,
             load_points,
+            spread,
             area: geometry.piston_area(),
             crankcase_pressure: config.gas.crankcase_pressure,
             radius: c.crank_radius,
@@ -198,12 +240,12 @@ impl Powertrain {
             return Err(InputError(format!("gas load {load} must lie in [0, 1]")));
         }
         if let Some(gas) = &mut self.gas {
-            let Some((idle, full)) = &gas.load_points else {
+            let Some(points) = &gas.load_points else {
                 return Err(InputError(
                     "the gas pressure comes from a user table; its load cannot change".into(),
                 ));
             };
-            gas.curve = PressureCurve::blend(idle, full, load);
+            gas.curves = points.curves(load, &gas.spread, gas.cylinders.len());
         }
         self.config.gas.load = load;
         Ok(())
@@ -261,9 +303,9 @@ impl Powertrain {
     ) {
         let Some(gas) = &self.gas else { return };
         let side = body.rotation * Vector3::y().cross(&gas.bore);
-        for &(yo, throw, firing) in &gas.cylinders {
+        for (&(yo, throw, firing), curve) in gas.cylinders.iter().zip(&gas.curves) {
             let psi = phi - throw;
-            let p = gas.curve.pressure(phi - firing);
+            let p = curve.pressure(phi - firing);
             let f_gas = (p - gas.crankcase_pressure) * gas.area * scale;
             let n = side_force(f_gas, psi, gas.radius / gas.conrod);
             let (s, _, _) = slider_crank(psi, gas.radius, gas.conrod);
@@ -279,6 +321,6 @@ impl Powertrain {
     pub fn cylinder_pressure(&self, i: usize, phi: f64) -> Option<f64> {
         let gas = self.gas.as_ref()?;
         let &(_, _, firing) = gas.cylinders.get(i)?;
-        Some(gas.curve.pressure(phi - firing))
+        Some(gas.curves[i].pressure(phi - firing))
     }
 }
