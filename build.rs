@@ -111,10 +111,25 @@ fn main() {
     map.push_str("  local:\n    callback_log;\n    *;\n};\n");
     let map_path = out.join("exports.map");
     write(&map_path, &map);
-    println!(
-        "cargo:rustc-cdylib-link-arg=-Wl,--version-script={}",
-        map_path.display()
-    );
+    if std::env::var("CARGO_CFG_TARGET_OS").as_deref() == Ok("windows") {
+        // The PE linker would export what rustc lists in its own .def file (every #[no_mangle]
+        // function, fmi-sys' callback_log included); this .def file names the 34 alone.
+        let mut def = String::from("EXPORTS\n");
+        for f in FMI2_FUNCTIONS {
+            let _ = writeln!(def, "    {f}");
+        }
+        let def_path = out.join("exports.def");
+        write(&def_path, &def);
+        println!("cargo:rustc-cdylib-link-arg={}", def_path.display());
+        // No DLLs beyond the system's: the GCC runtime and winpthread are linked in.
+        println!("cargo:rustc-cdylib-link-arg=-static-libgcc");
+        println!("cargo:rustc-cdylib-link-arg=-static");
+    } else {
+        println!(
+            "cargo:rustc-cdylib-link-arg=-Wl,--version-script={}",
+            map_path.display()
+        );
+    }
 }
 
 fn env(key: &str) -> String {

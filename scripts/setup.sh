@@ -4,8 +4,9 @@
 set -euo pipefail
 root=$(cd "$(dirname "$0")/.." && pwd)
 
-# System packages: clang/libclang for fmi-sys' bindgen; zip for packaging the FMU.
-apt_packages=(clang libclang-dev zip)
+# System packages: clang/libclang for fmi-sys' bindgen; zip for packaging the FMU; mingw-w64 to
+# cross-build the FMU's win64 binary and wine to test it.
+apt_packages=(clang libclang-dev zip gcc-mingw-w64-x86-64 wine wine64)
 missing=()
 for p in "${apt_packages[@]}"; do
   dpkg -s "$p" >/dev/null 2>&1 || missing+=("$p")
@@ -16,6 +17,12 @@ if [ ${#missing[@]} -gt 0 ]; then
   [ "$(id -u)" -eq 0 ] || sudo_cmd="sudo"
   $sudo_cmd apt-get update -qq
   DEBIAN_FRONTEND=noninteractive $sudo_cmd apt-get install -y -qq "${missing[@]}" >/dev/null
+fi
+
+# The Rust target of the win64 binary.
+if ! rustup target list --installed | grep -qx x86_64-pc-windows-gnu; then
+  echo "setup: adding the Rust target x86_64-pc-windows-gnu"
+  rustup target add x86_64-pc-windows-gnu
 fi
 
 # Python environment from the pinned requirements; reinstalled only when they change.

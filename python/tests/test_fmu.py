@@ -2,6 +2,8 @@
 
 import json
 import pathlib
+import re
+import shutil
 import subprocess
 import tempfile
 import zipfile
@@ -40,10 +42,28 @@ def test_library_exports_exactly_the_fmi2_functions(fmu_path):
     assert exported == FMI2_FUNCTIONS
 
 
+def test_windows_dll_exports_exactly_the_fmi2_functions_and_needs_system_dlls_only(fmu_path):
+    objdump = shutil.which("x86_64-w64-mingw32-objdump")
+    if objdump is None:
+        pytest.skip("mingw-w64 binutils are not installed (scripts/setup.sh installs them)")
+    with tempfile.TemporaryDirectory() as tmp, zipfile.ZipFile(fmu_path) as z:
+        dll = z.extract("binaries/win64/EngineMountChassis.dll", tmp)
+        out = subprocess.run([objdump, "-p", dll], capture_output=True, text=True, check=True).stdout
+    table = out.split("[Ordinal/Name Pointer] Table", 1)[1]
+    exported = set(re.findall(r"^\s*\[\s*\d+\]\s+(\S+)$", table, re.MULTILINE))
+    assert exported == FMI2_FUNCTIONS
+    imported = {name.lower() for name in re.findall(r"DLL Name: (\S+)", out)}
+    system = {"kernel32.dll", "ntdll.dll", "msvcrt.dll", "ws2_32.dll", "userenv.dll", "bcrypt.dll",
+              "bcryptprimitives.dll", "advapi32.dll", "ole32.dll", "combase.dll", "shell32.dll",
+              "dbghelp.dll", "api-ms-win-core-synch-l1-2-0.dll"}
+    assert imported <= system, imported - system
+
+
 def test_package_layout(fmu_path):
     with zipfile.ZipFile(fmu_path) as z:
         names = set(z.namelist())
     assert {"modelDescription.xml", "binaries/linux64/EngineMountChassis.so",
+            "binaries/win64/EngineMountChassis.dll",
             "documentation/index.html", "resources/vehicle.json"} <= names
     md = read_model_description(str(fmu_path))
     assert md.coSimulation.canGetAndSetFMUstate and md.coSimulation.canSerializeFMUstate
