@@ -51,6 +51,15 @@ const FMI2_FUNCTIONS: [&str; 34] = [
 
 const TYPES: [&str; 4] = ["Real", "Integer", "Boolean", "String"];
 
+/// Value references are unique across types (some masters, PyFMI among them, key variables by
+/// value reference alone): the XML's value reference of a variable is its index among the
+/// variables of its type plus the type's base.
+const VR_BASE: [usize; 4] = [0, 1000, 2000, 3000];
+
+fn vr_base(ty: &str) -> usize {
+    VR_BASE[TYPES.iter().position(|t| *t == ty).unwrap_or(0)]
+}
+
 /// One scalar variable after expanding `{i}`/`{j}` families.
 struct Scalar {
     name: String,
@@ -64,6 +73,8 @@ struct Scalar {
     display_unit: Option<String>,
     min: Option<f64>,
     max: Option<f64>,
+    /// An input the static equilibrium at initialisation depends on (`"statics": true`).
+    statics: bool,
 }
 
 /// A table entry as written: a scalar or a family with `dims`, named for Rust by `rust`.
@@ -237,8 +248,14 @@ fn expand(table: &Value) -> (Vec<Scalar>, Vec<Family>) {
                 display_unit: opt_str(e, "displayUnit"),
                 min: e.get("min").and_then(Value::as_f64),
                 max: e.get("max").and_then(Value::as_f64),
+                statics: e.get("statics").and_then(Value::as_bool).unwrap_or(false),
             });
         }
+    }
+    if let Some((ty, n)) = next_vr.iter().find(|(_, n)| **n >= VR_BASE[1]) {
+        fail(&format!(
+            "{n} {ty} variables do not fit below the next type's value-reference base"
+        ));
     }
     (scalars, families)
 }
@@ -376,7 +393,7 @@ fn model_description(table: &Value, scalars: &[Scalar], guid: &str) -> String {
             x,
             r#"    <ScalarVariable name="{}" valueReference="{}" causality="{}" variability="{}" description="{}">"#,
             xml_escape(&s.name),
-            s.vr,
+            s.vr + vr_base(s.ty),
             s.causality,
             s.variability,
             xml_escape(&s.description)
@@ -407,12 +424,25 @@ fn model_description(table: &Value, scalars: &[Scalar], guid: &str) -> String {
         .filter(|(_, s)| s.causality == "output")
         .map(|(i, _)| i + 1)
         .collect();
+    // Outputs are computed from the integrator's state at the communication point, in
+    // fmi2DoStep (and at initialisation): an input set at a communication point acts from there
+    // on and changes no output before the next step, so no output depends on an input directly.
     for i in &outputs {
-        let _ = writeln!(x, r#"      <Unknown index="{i}"/>"#);
+        let _ = writeln!(x, r#"      <Unknown index="{i}" dependencies=""/>"#);
     }
     x.push_str("    </Outputs>\n    <InitialUnknowns>\n");
+    // At the end of initialisation the outputs describe the static equilibrium: it depends on
+    // every parameter and on the inputs marked "statics" (load torque, mount stiffness scales),
+    // not on rpm or the damping scales (a test checks each input).
+    let knowns: Vec<String> = scalars
+        .iter()
+        .enumerate()
+        .filter(|(_, s)| s.causality == "parameter" || (s.causality == "input" && s.statics))
+        .map(|(i, _)| (i + 1).to_string())
+        .collect();
+    let knowns = knowns.join(" ");
     for i in &outputs {
-        let _ = writeln!(x, r#"      <Unknown index="{i}"/>"#);
+        let _ = writeln!(x, r#"      <Unknown index="{i}" dependencies="{knowns}"/>"#);
     }
     x.push_str("    </InitialUnknowns>\n  </ModelStructure>\n</fmiModelDescription>\n");
     x
@@ -458,6 +488,10 @@ fn rust_table(table: &Value, scalars: &[Scalar], families: &[Family], guid: &str
         str_field(table, "modelIdentifier")
     );
     let _ = writeln!(r, "/// The GUID of `modelDescription.xml` (a hash of the variable table).\npub const GUID: &str = {guid:?};");
+    let _ = writeln!(
+        r,
+        "/// What the XML adds to a variable's index among its type ([`real`], [`integer`], …) to\n/// make its value reference, per type Real, Integer, Boolean, String: value references are\n/// unique across types.\npub const VR_BASE: [u32; 4] = {VR_BASE:?};"
+    );
     let _ = writeln!(
         r,
         "/// Log categories declared in `modelDescription.xml`.\npub const LOG_CATEGORIES: &[&str] = &{:?};",

@@ -194,3 +194,37 @@ def test_inline_three_and_inline_four_through_the_fmu(fmu_path, config):
         assert amp[2.0] > 20 * amp[1.5], amp
     else:
         assert amp[1.5] > 5 * amp[2.0], amp
+
+
+def test_libcosim_run_up_with_rpm_set_at_every_step(fmu_path):
+    """libcosim has no input derivatives: a master that computes the engine speed sets rpm at
+    every communication step. The FMU holds the first two values and then continues their slope
+    (README, "Inputs between communication points"): the crank angle integrates the ramp up to
+    the analytic lag of those two held steps and of the speed follower, a (h² + 4 h τ + τ²)."""
+    from libcosimpy.CosimExecution import CosimExecution
+    from libcosimpy.CosimManipulator import CosimManipulator
+    from libcosimpy.CosimObserver import CosimObserver
+    from libcosimpy.CosimSlave import CosimLocalSlave
+
+    md = read_model_description(str(fmu_path))
+    vr = {v.name: v.valueReference for v in md.modelVariables}
+    tau = next(float(v.start) for v in md.modelVariables if v.name == "crank.speedTimeConstant")
+    h, steps = 1e-3, 500
+    rpm0, slope = 800.0, 2000.0  # rpm, rpm/s
+    execution = CosimExecution.from_step_size(step_size=int(h * 1e9))
+    index = execution.add_local_slave(local_slave=CosimLocalSlave(fmu_path=str(fmu_path), instance_name="engine"))
+    manipulator = CosimManipulator.create_override()
+    execution.add_manipulator(manipulator=manipulator)
+    observer = CosimObserver.create_last_value()
+    execution.add_observer(observer=observer)
+    execution.real_initial_value(slave_index=index, variable_reference=vr["rpm"], value=rpm0)
+    execution.boolean_initial_value(slave_index=index, variable_reference=vr["effects.ringCarrier"], value=False)
+    for k in range(steps):
+        manipulator.slave_real_values(index, [vr["rpm"]], [rpm0 + slope * k * h])
+        assert execution.step()
+    angle, roll = observer.last_real_values(slave_index=index,
+                                            variable_references=[vr["crankAngle"], vr["powertrain.phi[2]"]])
+    t = steps * h
+    a = slope * np.pi / 30
+    expected = (rpm0 * t + 0.5 * slope * t * t) * np.pi / 30 - a * (h * h + 4 * h * tau + tau * tau)
+    assert angle + roll == pytest.approx(expected, rel=1e-6)

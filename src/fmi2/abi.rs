@@ -15,7 +15,7 @@ use super::logger::{Level, Logger};
 use super::snapshot;
 use super::state::{self, Phase};
 use super::uri::resource_path;
-use super::variables::GUID;
+use super::variables::{BOOLEANS, GUID, INTEGERS, REALS, STRINGS, VR_BASE};
 
 /// Marks a live instance allocated by `fmi2Instantiate`; cleared when freed, so a stale or
 /// foreign pointer is recognised with high probability instead of being used.
@@ -375,8 +375,28 @@ const _: fmi2ResetTYPE = Some(fmi2Reset);
 
 // ----- getting and setting values --------------------------------------------------------------
 
+/// The FMU's variables are indexed per type inside; their value references are unique across
+/// types ([`VR_BASE`]). Maps the master's value references of one type to indices, or logs the
+/// first unknown one.
+fn indices(
+    inst: &Instance,
+    function: &str,
+    type_index: usize,
+    count: usize,
+    vrs: &[fmi2ValueReference],
+) -> Result<Vec<u32>, Status> {
+    let base = VR_BASE[type_index];
+    vrs.iter()
+        .map(|&vr| {
+            vr.checked_sub(base)
+                .filter(|i| (*i as usize) < count)
+                .ok_or_else(|| inst.error(&format!("{function}: unknown value reference {vr}")))
+        })
+        .collect()
+}
+
 macro_rules! get_values {
-    ($fn_name:ident, $ty:ty, $check:ident, $method:ident, $zero:expr, $conv:expr) => {
+    ($fn_name:ident, $ty:ty, $check:ident, $method:ident, $zero:expr, $conv:expr, $type_index:expr, $table:ident) => {
         #[no_mangle]
         pub extern "C" fn $fn_name(
             c: fmi2Component,
@@ -392,8 +412,13 @@ macro_rules! get_values {
                 else {
                     return null_argument(inst, stringify!($fn_name));
                 };
+                let vrs = match indices(inst, stringify!($fn_name), $type_index, $table.len(), vrs)
+                {
+                    Ok(v) => v,
+                    Err(s) => return s,
+                };
                 let mut tmp = vec![$zero; nvr];
-                let s = inst.$method(vrs, &mut tmp);
+                let s = inst.$method(&vrs, &mut tmp);
                 if s == Status::Ok {
                     for (o, t) in out.iter_mut().zip(tmp) {
                         *o = $conv(t);
@@ -412,7 +437,9 @@ get_values!(
     fmi2GetRealTYPE,
     get_real,
     0.0f64,
-    |x: f64| x
+    |x: f64| x,
+    0,
+    REALS
 );
 get_values!(
     fmi2GetInteger,
@@ -420,7 +447,9 @@ get_values!(
     fmi2GetIntegerTYPE,
     get_integer,
     0i32,
-    |x: i32| x
+    |x: i32| x,
+    1,
+    INTEGERS
 );
 get_values!(
     fmi2GetBoolean,
@@ -434,7 +463,9 @@ get_values!(
         } else {
             fmi2False as fmi2Boolean
         }
-    }
+    },
+    2,
+    BOOLEANS
 );
 
 #[no_mangle]
@@ -450,8 +481,12 @@ pub extern "C" fn fmi2GetString(
         else {
             return null_argument(&h.instance, "fmi2GetString");
         };
+        let vrs = match indices(&h.instance, "fmi2GetString", 3, STRINGS.len(), vrs) {
+            Ok(v) => v,
+            Err(s) => return s,
+        };
         let mut strings = Vec::new();
-        let s = h.instance.get_string(vrs, &mut strings);
+        let s = h.instance.get_string(&vrs, &mut strings);
         if s != Status::Ok {
             return s;
         }
@@ -500,7 +535,10 @@ pub extern "C" fn fmi2SetInteger(
         else {
             return null_argument(inst, "fmi2SetInteger");
         };
-        inst.set_integer(vrs, vals)
+        match indices(inst, "fmi2SetInteger", 1, INTEGERS.len(), vrs) {
+            Ok(vrs) => inst.set_integer(&vrs, vals),
+            Err(s) => s,
+        }
     })
 }
 const _: fmi2SetIntegerTYPE = Some(fmi2SetInteger);
@@ -525,7 +563,10 @@ pub extern "C" fn fmi2SetBoolean(
             ));
         }
         let vals: Vec<bool> = vals.iter().map(|b| *b != 0).collect();
-        inst.set_boolean(vrs, &vals)
+        match indices(inst, "fmi2SetBoolean", 2, BOOLEANS.len(), vrs) {
+            Ok(vrs) => inst.set_boolean(&vrs, &vals),
+            Err(s) => s,
+        }
     })
 }
 const _: fmi2SetBooleanTYPE = Some(fmi2SetBoolean);
@@ -549,7 +590,10 @@ pub extern "C" fn fmi2SetString(
         let Some(strings) = strings else {
             return inst.error("fmi2SetString: a value is NULL or not UTF-8");
         };
-        inst.set_string(vrs, &strings)
+        match indices(inst, "fmi2SetString", 3, STRINGS.len(), vrs) {
+            Ok(vrs) => inst.set_string(&vrs, &strings),
+            Err(s) => s,
+        }
     })
 }
 const _: fmi2SetStringTYPE = Some(fmi2SetString);

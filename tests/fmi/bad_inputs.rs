@@ -99,7 +99,7 @@ fn booleans_other_than_true_and_false_are_refused() {
         let st = unsafe {
             (s.f().fmi2SetBoolean)(
                 s.c,
-                [boolean::EFFECT_GAS_FORCES].as_ptr(),
+                value_references(2, &[boolean::EFFECT_GAS_FORCES]).as_ptr(),
                 1,
                 [value].as_ptr(),
             )

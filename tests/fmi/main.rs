@@ -4,4 +4,5 @@ mod abi;
 mod bad_inputs;
 mod common;
 mod inputs;
+mod model_structure;
 mod precedence;

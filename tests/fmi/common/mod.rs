@@ -225,6 +225,13 @@ impl Fmu {
     }
 }
 
+/// The tests name variables by the generated per-type indices (`integer::SCENE`, …); the C API
+/// takes the XML's value references, unique across types (`VR_BASE`).
+pub fn value_references(type_index: usize, indices: &[u32]) -> Vec<u32> {
+    let base = engine_mount_chassis::fmi2::variables::VR_BASE[type_index];
+    indices.iter().map(|i| i + base).collect()
+}
+
 pub fn logs(name: &str) -> Vec<String> {
     capture()
         .0
@@ -314,15 +321,18 @@ impl Slave<'_> {
         unsafe { (self.f().fmi2SetReal)(self.c, vrs.as_ptr(), vrs.len(), values.as_ptr()) }
     }
     pub fn set_integer(&self, vrs: &[u32], values: &[i32]) -> fmi2Status {
+        let vrs = &value_references(1, vrs);
         // SAFETY: arrays of equal length nvr.
         unsafe { (self.f().fmi2SetInteger)(self.c, vrs.as_ptr(), vrs.len(), values.as_ptr()) }
     }
     pub fn set_boolean(&self, vrs: &[u32], values: &[bool]) -> fmi2Status {
+        let vrs = &value_references(2, vrs);
         let v: Vec<i32> = values.iter().map(|b| *b as i32).collect();
         // SAFETY: arrays of equal length nvr.
         unsafe { (self.f().fmi2SetBoolean)(self.c, vrs.as_ptr(), vrs.len(), v.as_ptr()) }
     }
     pub fn set_string(&self, vrs: &[u32], values: &[&str]) -> fmi2Status {
+        let vrs = &value_references(3, vrs);
         let owned: Vec<CString> = values.iter().map(|s| CString::new(*s).unwrap()).collect();
         let ptrs: Vec<*const c_char> = owned.iter().map(|s| s.as_ptr()).collect();
         // SAFETY: arrays of equal length nvr of valid C strings.
@@ -341,6 +351,7 @@ impl Slave<'_> {
         v
     }
     pub fn get_integer(&self, vrs: &[u32]) -> (fmi2Status, Vec<i32>) {
+        let vrs = &value_references(1, vrs);
         let mut out = vec![0; vrs.len()];
         // SAFETY: arrays of equal length nvr.
         let s =
@@ -348,6 +359,7 @@ impl Slave<'_> {
         (s, out)
     }
     pub fn get_boolean(&self, vrs: &[u32]) -> (fmi2Status, Vec<bool>) {
+        let vrs = &value_references(2, vrs);
         let mut out = vec![0; vrs.len()];
         // SAFETY: arrays of equal length nvr.
         let s =
@@ -355,6 +367,7 @@ impl Slave<'_> {
         (s, out.iter().map(|b| *b != 0).collect())
     }
     pub fn get_string(&self, vrs: &[u32]) -> (fmi2Status, Vec<String>) {
+        let vrs = &value_references(3, vrs);
         let mut out = vec![std::ptr::null(); vrs.len()];
         // SAFETY: arrays of equal length nvr; returned strings are valid until the next call.
         let s =
