@@ -43,6 +43,7 @@ pub mod export;
 pub mod mass;
 pub mod mesh;
 pub mod modal;
+pub mod nastran;
 pub mod shell;
 pub mod spring;
 
