@@ -5,9 +5,11 @@
 use super::craig_bampton::{craig_bampton, CraigBampton};
 use super::error::CmsError;
 use super::reduced::{RecoveryPoint, ReducedChassis};
+use super::spec::BulkDeckBody;
 use super::spec::ReductionSpec;
 use crate::fe::assembly::{assemble, mat_vec, Assembled, SparseMat};
 use crate::fe::chassis::Chassis;
+use crate::fe::chassis_config::ChassisConfig;
 use crate::fe::dof::{DofMap, DOF_PER_NODE};
 use crate::fe::eigen::Modes;
 use crate::fe::modal::{describe, ModeDescription};
@@ -48,7 +50,10 @@ pub fn reduce(spec: &ReductionSpec) -> Result<ReducedChassis, CmsError> {
 /// The reduction of `spec` with the full model and full mode shapes kept.
 pub fn reduce_detailed(spec: &ReductionSpec) -> Result<Reduction, CmsError> {
     spec.validate()?;
-    let chassis = Chassis::build(&spec.chassis)?;
+    let chassis = match &spec.deck {
+        None => Chassis::build(&spec.chassis)?,
+        Some(deck) => deck_body(deck)?,
+    };
     let assembled = assemble(&chassis.mesh)?;
     let mounts = spec
         .interface
@@ -92,6 +97,31 @@ pub fn reduce_detailed(spec: &ReductionSpec) -> Result<Reduction, CmsError> {
         interface,
         modes,
         reduced,
+    })
+}
+
+/// The body of a bulk data deck, its points named; the content must still be what the spec's
+/// checksum says (the cache key was made from it).
+fn deck_body(deck: &BulkDeckBody) -> Result<Chassis, CmsError> {
+    let text = crate::text_file::read_limited(&deck.path, crate::text_file::DATA_LIMIT)
+        .map_err(|e| CmsError::InvalidInput(format!("bulk data deck: {e}")))?;
+    if super::hash::sha256_hex(text.as_bytes()) != deck.sha256 {
+        return Err(CmsError::InvalidInput(format!(
+            "bulk data deck {} changed after its checksum was taken",
+            deck.path.display()
+        )));
+    }
+    let mut body = crate::fe::nastran::parse_str(&text).map_err(|e| {
+        CmsError::InvalidInput(format!("bulk data deck {}: {e}", deck.path.display()))
+    })?;
+    for (name, grid) in &deck.points {
+        let node = body.node(*grid)?;
+        body.mesh.named_nodes.insert(name.clone(), node);
+    }
+    crate::fe::checks::check_mesh(&body.mesh, &crate::fe::checks::CheckLimits::default())?;
+    Ok(Chassis {
+        mesh: body.mesh,
+        config: ChassisConfig::default(),
     })
 }
 

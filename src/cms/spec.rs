@@ -39,12 +39,26 @@ pub enum ModeSelection {
     CutoffHz(f64),
 }
 
+/// A body from a Nastran bulk data deck ([`crate::fe::nastran`]): the file, the SHA-256 of its
+/// content (so the cache key changes with the content), and the GRID ids of the named points
+/// (mounts, outputs).
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct BulkDeckBody {
+    pub path: std::path::PathBuf,
+    pub sha256: String,
+    pub points: std::collections::BTreeMap<String, u32>,
+}
+
 /// Everything the reduction depends on.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct ReductionSpec {
-    /// The body description.
+    /// The body description (the procedural chassis), unless `deck` is given.
     pub chassis: ChassisConfig,
+    /// A user's body from a bulk data deck instead of the procedural chassis.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub deck: Option<BulkDeckBody>,
     /// Named body nodes the engine mounts attach to: they form the interface, in this order.
     pub interface: Vec<String>,
     /// Interface DOFs per mount node.
@@ -68,6 +82,7 @@ impl Default for ReductionSpec {
     fn default() -> Self {
         Self {
             chassis: ChassisConfig::default(),
+            deck: None,
             interface: MOUNT_NAMES.iter().map(|n| format!("mount_{n}")).collect(),
             interface_dofs: InterfaceDofs::Translations,
             selection: ModeSelection::Count(40),

@@ -3,9 +3,10 @@
 //! scene needs (scene 2, Table 1 middle column).
 
 use crate::cms::{
-    reduce_cached, CacheOutcome, CacheSetting, InterfaceDofs, ModeSelection, ReducedChassis,
-    ReductionSpec,
+    reduce_cached, BulkDeckBody, CacheOutcome, CacheSetting, InterfaceDofs, ModeSelection,
+    ReducedChassis, ReductionSpec,
 };
+use crate::fe::chassis_config::ChassisConfig;
 
 use super::coupled::CoupledModel;
 use super::vehicle::{BodyConfig, VehicleConfig};
@@ -126,8 +127,24 @@ pub fn reduction_spec(
     options: &BodyOptions,
 ) -> Result<(ReductionSpec, String), String> {
     options.validate()?;
-    let BodyConfig::Procedural { chassis } = &vehicle.body else {
-        return Err("the vehicle's body is not the procedural one".into());
+    let (chassis, deck) = match &vehicle.body {
+        BodyConfig::Procedural { chassis } => (chassis.as_ref().clone(), None),
+        BodyConfig::Nastran { path, points } => {
+            if options.stiffening_bar {
+                return Err("chassis.stiffeningBar applies to the procedural body only; this vehicle's body is a bulk data deck".into());
+            }
+            let text = crate::text_file::read_limited(path, crate::text_file::DATA_LIMIT)
+                .map_err(|e| format!("bulk data deck: {e}"))?;
+            let deck = BulkDeckBody {
+                path: path.clone(),
+                sha256: crate::cms::sha256_hex(text.as_bytes()),
+                points: points.clone(),
+            };
+            (ChassisConfig::default(), Some(deck))
+        }
+        BodyConfig::Reduced { .. } => {
+            return Err("the vehicle's body is already reduced".into());
+        }
     };
     let interface = vehicle.interface_nodes().map_err(|e| e.to_string())?;
     // A rigid body needs no fixed-interface modes: the constraint modes alone contain its
@@ -154,10 +171,11 @@ pub fn reduction_spec(
         };
         (ModeSelection::CutoffHz(cutoff), origin)
     };
-    let mut chassis = chassis.clone();
+    let mut chassis = chassis;
     chassis.options.stiffening_bar |= options.stiffening_bar;
     let spec = ReductionSpec {
-        chassis: *chassis,
+        chassis,
+        deck,
         interface,
         interface_dofs: if options.interface_rotations {
             InterfaceDofs::All
@@ -180,7 +198,7 @@ pub fn body(
     let flexible = vehicle.effects.chassis_flexibility;
     let started = std::time::Instant::now();
     let (body, origin) = match &vehicle.body {
-        BodyConfig::Procedural { .. } => {
+        BodyConfig::Procedural { .. } | BodyConfig::Nastran { .. } => {
             let (spec, origin) = reduction_spec(vehicle, options)?;
             let (body, outcome) = reduce_cached(&spec, &options.cache)
                 .map_err(|e| format!("chassis reduction: {e}"))?;
@@ -194,17 +212,21 @@ pub fn body(
                 CacheOutcome::NotStored { reason } => format!("reduced (not cached: {reason})"),
                 CacheOutcome::Disabled => "reduced (caching disabled)".to_owned(),
             };
-            let bar = if spec.chassis.options.stiffening_bar {
-                "on"
-            } else {
-                "off"
-            };
-            (
-                body,
-                format!(
-                    "procedural chassis (Craig-Bampton, {origin}, stiffening bar {bar}), {source}"
+            let what = match &spec.deck {
+                Some(deck) => format!(
+                    "bulk data deck {} (Craig-Bampton, {origin})",
+                    deck.path.display()
                 ),
-            )
+                None => format!(
+                    "procedural chassis (Craig-Bampton, {origin}, stiffening bar {})",
+                    if spec.chassis.options.stiffening_bar {
+                        "on"
+                    } else {
+                        "off"
+                    }
+                ),
+            };
+            (body, format!("{what}, {source}"))
         }
         BodyConfig::Reduced { path } => {
             if options.stiffening_bar {

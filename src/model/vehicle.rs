@@ -4,7 +4,8 @@
 //!
 //! JSON: every struct rejects unknown fields, and nothing is silently defaulted. A file is either
 //! complete, or declares `"extends": "default"` and is then a JSON merge patch (RFC 7386) on the
-//! default vehicle: objects merge key by key, arrays and values replace. Errors name the field's
+//! default vehicle: objects merge key by key, arrays and values replace; an object whose `kind`
+//! changes (the body's) replaces the default's. Errors name the field's
 //! path.
 
 use std::path::PathBuf;
@@ -28,6 +29,14 @@ pub enum BodyConfig {
     /// `mount_front_right`, `mount_rear_left`, `mount_rear_right`; other named nodes include
     /// `steering_wheel` and `seat_rail`.
     Procedural { chassis: Box<ChassisConfig> },
+    /// A user's body from a Nastran bulk data deck ([`crate::fe::nastran`]), reduced by
+    /// Craig-Bampton like the procedural one; `points` names the GRID ids the mounts
+    /// (`body_node`) and the outputs refer to. A relative path is taken from the configuration
+    /// file's folder.
+    Nastran {
+        path: PathBuf,
+        points: std::collections::BTreeMap<String, u32>,
+    },
     /// Modal data of an already reduced body: the JSON of a [`crate::cms::ReducedChassis`]
     /// (frequencies, damping ratios, named points with their mode-shape rows). A relative path is
     /// taken from the configuration file's folder.
@@ -115,7 +124,12 @@ fn merge_patch(target: &mut serde_json::Value, patch: &serde_json::Value) {
     use serde_json::Value;
     match patch {
         Value::Object(p) => {
-            if !target.is_object() {
+            // A tagged variant that changes its kind (a body from "procedural" to "nastran") is
+            // a new object: merging the old variant's fields into it would make no sense.
+            let kind_changes = p
+                .get("kind")
+                .is_some_and(|k| target.get("kind").is_some_and(|old| old != k));
+            if !target.is_object() || kind_changes {
                 *target = Value::Object(Default::default());
             }
             if let Value::Object(t) = target {
@@ -163,7 +177,9 @@ impl VehicleConfig {
         let text = crate::text_file::read_limited(path, crate::text_file::CONFIG_LIMIT)
             .map_err(|e| err("file", e))?;
         let mut config = Self::from_json(&text)?;
-        if let BodyConfig::Reduced { path: body } = &mut config.body {
+        if let BodyConfig::Reduced { path: body } | BodyConfig::Nastran { path: body, .. } =
+            &mut config.body
+        {
             if body.is_relative() {
                 if let Some(dir) = path.parent() {
                     *body = dir.join(&*body);

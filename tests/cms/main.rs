@@ -1,5 +1,6 @@
 //! Integration tests of the Craig-Bampton reduction and its cache (`src/cms`).
 
+mod bulk_deck;
 mod cache;
 mod damping;
 mod reduction;
