@@ -109,14 +109,31 @@ STUDY_CASES = {
                                   "chassis.stiffeningBar": True},
 }
 
+# The M13 inline-3 against the inline-4 it replaced (paper §1), in the same body on the same mounts.
+ENGINE_CASES = {
+    "inline-3 (M13)": {"scene": 2},
+    "inline-4": {"scene": 2, "configFile": "vehicle_i4.json"},
+    "inline-4 + Lanchester shafts": {"scene": 2, "configFile": "vehicle_i4_lanchester.json"},
+}
+
 
 def cmd_study_mounts(args) -> int:
     """Paper §7.1: the original vehicle against the improved one, from one command."""
+    return run_study(args, STUDY_CASES)
+
+
+def cmd_study_engines(args) -> int:
+    """The inline-3 against the inline-4 (with and without Lanchester shafts), side by side."""
+    return run_study(args, ENGINE_CASES)
+
+
+def run_study(args, cases: dict) -> int:
+    """Sweeps each case and writes side-by-side waterfalls and order cuts on common scales."""
     out = pathlib.Path(args.out)
     out.mkdir(parents=True, exist_ok=True)
     tables = []
     started = time.perf_counter()
-    for case, params in STUDY_CASES.items():
+    for case, params in cases.items():
         points = speed_points(args.rpm[0], args.rpm[1], args.count, revolutions=args.revolutions,
                               settle_revolutions=args.settle,
                               parameters=tuple(params.items()) + parse_settings(args.set))
@@ -130,9 +147,9 @@ def cmd_study_mounts(args) -> int:
     save(spectra, str(out / f"spectra{suffix}"))
     for signal in args.signal or STUDY_SIGNALS:
         name = safe_name(signal)
-        plots.side_by_side(spectra, orders, signal, list(STUDY_CASES),
+        plots.side_by_side(spectra, orders, signal, list(cases),
                            str(out / f"study_waterfall_{name}.png"), str(out / f"study_order_cuts_{name}.png"))
-    summary = (orders[orders.order.isin([1.0, 1.5, 2.0])]
+    summary = (orders[orders.order.isin([1.0, 1.5, 2.0, 4.0])]
                .groupby(["signal", "case", "order"]).amplitude.max().unstack("order"))
     print(summary.to_string(float_format=lambda v: f"{v:.4g}"))
     print(f"study in {time.perf_counter() - started:.1f} s -> {out}")
@@ -200,6 +217,18 @@ def main(argv: list[str] | None = None) -> int:
     m.add_argument("--scheduler", help="address of a running Dask scheduler")
     m.add_argument("--quiet", action="store_true")
     m.set_defaults(func=cmd_study_mounts)
+
+    e = sub.add_parser("study-engines", help="inline-3 (M13) vs the inline-4 it replaced, with and without "
+                                             "Lanchester shafts (scene 2)")
+    common(e)
+    e.add_argument("--count", type=int, default=18)
+    e.add_argument("--revolutions", type=int, default=40, help="stationary window (even)")
+    e.add_argument("--settle", type=int, default=20, help="revolutions before the window")
+    e.add_argument("--serial", action="store_true", help="no Dask")
+    e.add_argument("--workers", type=int, default=2)
+    e.add_argument("--scheduler", help="address of a running Dask scheduler")
+    e.add_argument("--quiet", action="store_true")
+    e.set_defaults(func=cmd_study_engines)
 
     b = sub.add_parser("bench-effects", help="CPU time per simulated second for each scene and effect set")
     b.add_argument("--fmu", default="dist/EngineMountChassis.fmu")

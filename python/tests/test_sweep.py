@@ -43,3 +43,19 @@ def test_dask_sweep_equals_serial_sweep(fmu_path):
     main = orders[(orders.signal == "mount[1].F[3]") & (orders.order == 1.5)].amplitude
     other = orders[(orders.signal == "mount[1].F[3]") & (orders.order.isin([2.5, 3.5]))].amplitude
     assert main.min() > 10 * other.max()
+
+
+def test_study_engines_compares_the_inline_three_with_the_inline_four(fmu_path, tmp_path):
+    """emc study-engines: in the same body, the inline-3's mount force carries the 1.5 order, the
+    inline-4's the 2nd and 4th; every case gets its side-by-side plots."""
+    from emc.cli import main
+
+    assert main(["study-engines", "--fmu", str(fmu_path), "--rpm", "1500", "2000", "--count", "2",
+                 "--revolutions", "4", "--settle", "6", "--serial", "--quiet",
+                 "--signal", "mount[1].F[3]", "--out", str(tmp_path)]) == 0
+    orders = pd.read_csv(tmp_path / "orders.csv")
+    force = orders[orders.signal == "mount[1].F[3]"]
+    peak = force.groupby(["case", "order"]).amplitude.max().unstack("order")
+    assert peak.loc["inline-3 (M13)", 1.5] > 3 * peak.loc["inline-3 (M13)", 2.0]
+    assert peak.loc["inline-4", 2.0] > 10 * peak.loc["inline-4", 1.5]
+    assert (tmp_path / "study_waterfall_mount1.F3.png").exists()
