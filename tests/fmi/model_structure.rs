@@ -58,6 +58,15 @@ fn outputs_do_not_change_when_an_input_is_set_without_a_step() {
     );
 }
 
+/// The value reference of a `<ScalarVariable` line of the XML.
+fn value_reference(line: &str) -> u32 {
+    line.split("valueReference=\"")
+        .nth(1)
+        .and_then(|r| r.split('"').next())
+        .and_then(|v| v.parse().ok())
+        .expect("valueReference")
+}
+
 /// Index (1-based, as in `<ModelStructure>`) of each ScalarVariable by value reference, Reals.
 fn real_index() -> std::collections::BTreeMap<u32, usize> {
     let mut map = std::collections::BTreeMap::new();
@@ -65,13 +74,7 @@ fn real_index() -> std::collections::BTreeMap<u32, usize> {
     for line in MODEL_DESCRIPTION_XML.lines() {
         if line.contains("<ScalarVariable") {
             index += 1;
-            let vr: u32 = line
-                .split("valueReference=\"")
-                .nth(1)
-                .and_then(|r| r.split('"').next())
-                .and_then(|v| v.parse().ok())
-                .expect("valueReference");
-            map.entry(vr).or_insert(index);
+            map.entry(value_reference(line)).or_insert(index);
         }
     }
     map
@@ -130,12 +133,7 @@ fn value_references_are_unique_across_types() {
         .lines()
         .filter(|l| l.contains("<ScalarVariable"))
     {
-        let vr: u32 = line
-            .split("valueReference=\"")
-            .nth(1)
-            .and_then(|r| r.split('"').next())
-            .and_then(|v| v.parse().ok())
-            .expect("valueReference");
+        let vr = value_reference(line);
         assert!(seen.insert(vr), "value reference {vr} used twice");
     }
     assert!(seen.len() > 50, "{} variables", seen.len());

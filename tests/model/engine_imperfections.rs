@@ -1,34 +1,10 @@
 //! The two imperfections of a real engine (issue 18): residual unbalance after balancing and
 //! cylinder-to-cylinder variation of the heat release, against their analytic consequences.
 
-use engine_mount_chassis::model::orders::order_amplitude;
+use crate::wrench_orders::{amp, sample};
 use engine_mount_chassis::model::powertrain::config::ResidualUnbalance;
 use engine_mount_chassis::model::{Powertrain, VehicleConfig};
 use std::f64::consts::PI;
-
-const SPR: usize = 720;
-
-fn wrench_samples(p: &Powertrain, w: f64, revs: usize) -> Vec<[f64; 6]> {
-    (0..revs * SPR)
-        .map(|k| {
-            let phi = 2.0 * PI * k as f64 / SPR as f64;
-            let wr = p.crank_drive_wrench(phi, w, 0.0);
-            [
-                wr.force[0],
-                wr.force[1],
-                wr.force[2],
-                wr.moment[0],
-                wr.moment[1],
-                wr.moment[2],
-            ]
-        })
-        .collect()
-}
-
-fn amp(x: &[[f64; 6]], comp: usize, order: f64) -> f64 {
-    let v: Vec<f64> = x.iter().map(|s| s[comp]).collect();
-    order_amplitude(&v, SPR, order).expect("whole periods")
-}
 
 /// The default vehicle with mass forces only and the given residual unbalances.
 fn with_unbalance(unbalance: Vec<ResidualUnbalance>) -> (Powertrain, f64) {
@@ -56,8 +32,8 @@ fn a_crank_unbalance_of_grade_g_adds_a_first_order_force_u_omega_squared() {
     let u = crank_mass * grade * 1e-3 / (service_rpm * PI / 30.0);
     for rpm in [1000.0, 2500.0] {
         let w = rpm * PI / 30.0;
-        let a = wrench_samples(&ideal, w, 1);
-        let b = wrench_samples(&unbalanced, w, 1);
+        let a = sample(&ideal, w, 1);
+        let b = sample(&unbalanced, w, 1);
         let diff: Vec<[f64; 6]> = a
             .iter()
             .zip(&b)
@@ -106,9 +82,9 @@ fn with_spread(spread: Vec<f64>) -> Powertrain {
 #[test]
 fn a_heat_release_spread_brings_the_half_order_by_the_phasor_sum_of_the_spread() {
     let w = 2000.0 * PI / 30.0;
-    let ideal = wrench_samples(&with_spread(Vec::new()), w, 2);
-    let one = wrench_samples(&with_spread(vec![0.02, 0.0, 0.0]), w, 2);
-    let default = wrench_samples(&with_spread(vec![0.02, -0.01, -0.01]), w, 2);
+    let ideal = sample(&with_spread(Vec::new()), w, 2);
+    let one = sample(&with_spread(vec![0.02, 0.0, 0.0]), w, 2);
+    let default = sample(&with_spread(vec![0.02, -0.01, -0.01]), w, 2);
     // Identical cylinders firing 240° apart: the 0.5 order cancels (phasors 120° apart).
     let t15 = amp(&ideal, 4, 1.5);
     assert!(amp(&ideal, 4, 0.5) < 1e-9 * t15);

@@ -2,10 +2,8 @@
 //! order amplitudes by a DFT over whole cycles. The truth is the analytic order formulas of the
 //! inline-3 crank drive; the model computes the reactions from the composite-body kinematics.
 
-use engine_mount_chassis::model::orders::order_amplitude;
+use crate::wrench_orders::{amp, sample, vamp, SPR};
 use engine_mount_chassis::model::{Powertrain, VehicleConfig};
-
-const SPR: usize = 720;
 
 struct Setup {
     scene: Powertrain,
@@ -38,39 +36,6 @@ fn setup(gas: bool, mass: bool, balance: bool) -> Setup {
         a,
         lambda,
     }
-}
-
-/// Force and moment components over `revs` revolutions at constant speed `w`.
-fn sample(s: &Powertrain, w: f64, revs: usize) -> Vec<[f64; 6]> {
-    (0..revs * SPR)
-        .map(|k| {
-            let phi = 2.0 * std::f64::consts::PI * k as f64 / SPR as f64;
-            let wr = s.crank_drive_wrench(phi, w, 0.0);
-            [
-                wr.force[0],
-                wr.force[1],
-                wr.force[2],
-                wr.moment[0],
-                wr.moment[1],
-                wr.moment[2],
-            ]
-        })
-        .collect()
-}
-
-fn amp(x: &[[f64; 6]], comp: usize, order: f64) -> f64 {
-    let v: Vec<f64> = x.iter().map(|s| s[comp]).collect();
-    order_amplitude(&v, SPR, order).expect("whole periods")
-}
-
-/// Amplitude of a rotating or oscillating vector quantity of components `comps` (root of the sum
-/// of squared component amplitudes).
-fn vamp(x: &[[f64; 6]], comps: &[usize], order: f64) -> f64 {
-    comps
-        .iter()
-        .map(|&c| amp(x, c, order).powi(2))
-        .sum::<f64>()
-        .sqrt()
 }
 
 #[test]

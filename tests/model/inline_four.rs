@@ -9,12 +9,10 @@
 //! crank, in moment; the 2nd orders of the four cylinders add: `4 m r ω² A₂` along the bore
 //! axis. Two shafts at ±2 ω with `m_e e = m r λ / 2` each cancel the `λ` term of it.
 
-use engine_mount_chassis::model::orders::order_amplitude;
+use crate::wrench_orders::{amp, sample, vamp};
 use engine_mount_chassis::model::{Powertrain, VehicleConfig};
 use std::f64::consts::PI;
 use std::path::PathBuf;
-
-const SPR: usize = 720;
 
 fn powertrain(file: &str, gas: bool) -> (Powertrain, f64, f64, f64) {
     let path = PathBuf::from(env!("CARGO_MANIFEST_DIR"))
@@ -35,37 +33,6 @@ fn powertrain(file: &str, gas: bool) -> (Powertrain, f64, f64, f64) {
     );
     let p = Powertrain::new(cfg.engine, cfg.effects, cfg.gravity).expect("powertrain");
     (p, m, r, lambda)
-}
-
-/// Force and moment components over `revs` revolutions at constant speed `w`.
-fn sample(p: &Powertrain, w: f64, revs: usize) -> Vec<[f64; 6]> {
-    (0..revs * SPR)
-        .map(|k| {
-            let phi = 2.0 * PI * k as f64 / SPR as f64;
-            let wr = p.crank_drive_wrench(phi, w, 0.0);
-            [
-                wr.force[0],
-                wr.force[1],
-                wr.force[2],
-                wr.moment[0],
-                wr.moment[1],
-                wr.moment[2],
-            ]
-        })
-        .collect()
-}
-
-fn amp(x: &[[f64; 6]], comp: usize, order: f64) -> f64 {
-    let v: Vec<f64> = x.iter().map(|s| s[comp]).collect();
-    order_amplitude(&v, SPR, order).expect("whole periods")
-}
-
-fn vamp(x: &[[f64; 6]], comps: &[usize], order: f64) -> f64 {
-    comps
-        .iter()
-        .map(|&c| amp(x, c, order).powi(2))
-        .sum::<f64>()
-        .sqrt()
 }
 
 #[test]

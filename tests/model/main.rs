@@ -11,3 +11,4 @@ mod hybrid_coupling;
 mod hybrid_paper;
 mod inline_four;
 mod scene_effects;
+mod wrench_orders;

@@ -90,6 +90,22 @@ struct Pbar {
     nsm: f64,
 }
 
+/// A PBAR or (constant-section) PBEAM: MID, A, I1, I2 in fields 3 to 6 of both; J and NSM
+/// where the card has them. Nastran's plane 1 holds the axis and the orientation vector (our
+/// local y): I1 resists bending in it (our `iz`), I2 in plane 2 (our `iy`).
+fn bar_property(c: &Card, j_field: usize, nsm_field: usize) -> Result<Pbar, FeError> {
+    Ok(Pbar {
+        material: id(c, 1)?,
+        section: BeamSection {
+            area: c.real(2, None)?,
+            iz: c.real(3, None)?,
+            iy: c.real(4, None)?,
+            j: c.real(j_field, Some(0.0))?,
+        },
+        nsm: c.real(nsm_field, Some(0.0))?,
+    })
+}
+
 /// Builds the body from the deck's cards.
 pub fn build(cards: &[Card]) -> Result<NastranBody, FeError> {
     // First pass: coordinate systems, materials and properties.
@@ -165,39 +181,13 @@ pub fn build(cards: &[Card]) -> Result<NastranBody, FeError> {
                 );
             }
             "PBAR" => {
-                pbars.insert(
-                    id(c, 0)?,
-                    Pbar {
-                        material: id(c, 1)?,
-                        // Nastran's plane 1 holds the axis and the orientation vector (our local y):
-                        // I1 resists bending in it (our iz), I2 in plane 2 (our iy).
-                        section: BeamSection {
-                            area: c.real(2, None)?,
-                            iz: c.real(3, None)?,
-                            iy: c.real(4, None)?,
-                            j: c.real(5, Some(0.0))?,
-                        },
-                        nsm: c.real(6, Some(0.0))?,
-                    },
-                );
+                pbars.insert(id(c, 0)?, bar_property(c, 5, 6)?);
             }
             "PBEAM" => {
                 if !c.blank(5) && c.real(5, None)? != 0.0 {
                     return Err(c.invalid("I12 must be 0 (principal axes)"));
                 }
-                pbars.insert(
-                    id(c, 0)?,
-                    Pbar {
-                        material: id(c, 1)?,
-                        section: BeamSection {
-                            area: c.real(2, None)?,
-                            iz: c.real(3, None)?,
-                            iy: c.real(4, None)?,
-                            j: c.real(6, Some(0.0))?,
-                        },
-                        nsm: c.real(7, Some(0.0))?,
-                    },
-                );
+                pbars.insert(id(c, 0)?, bar_property(c, 6, 7)?);
             }
             "PELAS" => {
                 pelas.insert(id(c, 0)?, c.real(1, None)?);
