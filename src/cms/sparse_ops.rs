@@ -97,23 +97,9 @@ impl Partition {
     }
 }
 
-/// `A X` for a sparse `a` and a dense block `x`.
+/// `A X` for a sparse `a` and a dense block `x` (faer's sparse-dense product).
 pub(crate) fn sparse_times_dense(a: &SparseMat, x: MatRef<'_, f64>) -> Mat<f64> {
-    let (cp, ri, val) = (a.symbolic().col_ptr(), a.symbolic().row_idx(), a.val());
-    let mut y = Mat::<f64>::zeros(a.nrows(), x.ncols());
-    for c in 0..x.ncols() {
-        let mut yc = y.col_mut(c);
-        for j in 0..a.ncols() {
-            let xj = x[(j, c)];
-            if xj == 0.0 {
-                continue;
-            }
-            for p in cp[j]..cp[j + 1] {
-                yc[ri[p]] += val[p] * xj;
-            }
-        }
-    }
-    y
+    a.as_ref() * x
 }
 
 #[cfg(test)]

@@ -131,16 +131,10 @@ pub fn assemble(mesh: &Mesh) -> Result<Assembled, FeError> {
     })
 }
 
-/// y = A x for a sparse `a` and a dense vector `x`.
+/// y = A x for a sparse `a` and a dense vector `x` (faer's sparse-dense product).
 pub fn mat_vec(a: &SparseMat, x: &[f64]) -> Vec<f64> {
-    let mut y = vec![0.0; a.nrows()];
-    let (col_ptr, row_idx, val) = (a.symbolic().col_ptr(), a.symbolic().row_idx(), a.val());
-    for (j, xj) in x.iter().enumerate().take(a.ncols()) {
-        for p in col_ptr[j]..col_ptr[j + 1] {
-            y[row_idx[p]] += val[p] * xj;
-        }
-    }
-    y
+    let y = a.as_ref() * faer::ColRef::from_slice(x);
+    y.iter().copied().collect()
 }
 
 /// Sum of all entries of the diagonal of `a` belonging to translational DOFs in direction
