@@ -147,6 +147,20 @@ pub fn check_mesh(mesh: &Mesh, limits: &CheckLimits) -> Result<(), FeError> {
             }
         }
     }
+    // A node tied by a rigid or interpolation link is held by the link (or holds it): count it
+    // as structurally connected; a link on a node without any real stiffness shows up as a
+    // singular DOF in `check_assembled`.
+    for (what, nodes) in link_node_sets(mesh) {
+        for k in nodes {
+            match connected.get_mut(k) {
+                Some(c) => {
+                    *c = true;
+                    has_stiffness[k] = true;
+                }
+                None => problems.push(format!("{what}: node {k} does not exist")),
+            }
+        }
+    }
     let mut constrained_count = vec![0usize; n];
     let mut seen = std::collections::HashSet::new();
     for &(k, d) in &mesh.constraints {
@@ -173,6 +187,21 @@ pub fn check_mesh(mesh: &Mesh, limits: &CheckLimits) -> Result<(), FeError> {
         }
     }
     report(problems)
+}
+
+/// The nodes of every rigid and interpolation link, named for messages.
+fn link_node_sets(mesh: &Mesh) -> Vec<(String, Vec<usize>)> {
+    let rigid = mesh.rigid_links.iter().enumerate().map(|(i, l)| {
+        let mut nodes = vec![l.independent];
+        nodes.extend(&l.dependent);
+        (format!("rigid link {i}"), nodes)
+    });
+    let interpolation = mesh.interpolation_links.iter().enumerate().map(|(i, l)| {
+        let mut nodes = vec![l.reference];
+        nodes.extend(l.sources.iter().flat_map(|s| s.nodes.iter().copied()));
+        (format!("interpolation link {i}"), nodes)
+    });
+    rigid.chain(interpolation).collect()
 }
 
 fn find(parent: &mut [usize], mut i: usize) -> usize {
@@ -203,7 +232,8 @@ fn disconnected_parts(
         .iter()
         .map(|b| b.nodes.to_vec())
         .chain(mesh.shells.iter().map(|s| s.nodes.to_vec()))
-        .chain(mesh.springs.iter().map(|s| s.nodes.to_vec()));
+        .chain(mesh.springs.iter().map(|s| s.nodes.to_vec()))
+        .chain(link_node_sets(mesh).into_iter().map(|(_, nodes)| nodes));
     for nodes in links {
         for w in nodes.windows(2) {
             join(w[0], w[1]);

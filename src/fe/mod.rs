@@ -40,6 +40,7 @@ pub mod dof;
 pub mod eigen;
 pub mod error;
 pub mod export;
+pub mod links;
 pub mod mass;
 pub mod mesh;
 pub mod modal;
