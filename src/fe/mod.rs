@@ -44,6 +44,7 @@ pub mod links;
 pub mod mass;
 pub mod mesh;
 pub mod modal;
+pub mod nastran;
 pub mod shell;
 pub mod spring;
 

@@ -1,0 +1,143 @@
+//! Nastran bulk data input and output: a user's car body as a [`Mesh`].
+//!
+//! Reading: [`read_bulk_deck`] / [`parse_str`] → [`NastranBody`] (mesh + GRID id → node index).
+//! Formats: small field, large field (`*`), free field (commas), continuations (`+`, `*`,
+//! blank first field), `$` comments, optional executive and case control before `BEGIN BULK`
+//! (only `SPC = n` is read from it), `ENDDATA`. Units are taken as given (use SI: m, kg, s, N).
+//!
+//! Cards and how they map:
+//! - GRID (CP → CORD2R, coordinates converted to basic; CD must be 0/blank; PS → supports),
+//!   CORD2R (RID chains).
+//! - MAT1: two of E, G, NU given, the third by E = 2(1+ν)G (Nastran's rule); all three given:
+//!   beams keep E and G, shells need G within 1 % of E/2(1+ν). RHO; GE/A/TREF ignored
+//!   (structural damping is added modally by the caller).
+//! - PSHELL (MID1 = MID2, MID3 blank or MID1, T, 12I/T³ → bending thickness T·(12I/T³)^⅓, NSM):
+//!   the element is the QM6 + MITC4 shell with transverse shear (k = 5/6) always included;
+//!   Nastran omits transverse shear for MID3 blank, which differs by O((t/L)²) for thin sheets.
+//!   CQUAD4 (no offsets, no corner thicknesses). CTRIA3 is rejected: there is no 3-node shell.
+//! - PBAR (A, I1, I2, J, NSM; I12 must be 0), PBEAM (constant section only), CBAR/CBEAM with
+//!   X1..X3 or G0, no pins or offsets. The element is Euler-Bernoulli: shear flexibility (PBAR/
+//!   PBEAM K1, K2) is not modelled. I1 bends in Nastran's plane 1 (element x-y) → `iz`,
+//!   I2 → `iy`.
+//! - CONM2 (CID −1, 0 or a CORD2R; offset masses sit on an extra node rigidly linked to the
+//!   grid, so the translation–rotation coupling is exact; products of inertia as in the QRG).
+//! - CELAS1/PELAS, CELAS2, CDAMP1/PDAMP, CDAMP2: one component, to ground or between two grids
+//!   along the same component. Merged per node / node pair.
+//! - RBE2 → [`crate::fe::mesh::RigidLink`], RBE3 (no UM) → [`crate::fe::mesh::InterpolationLink`],
+//!   both eliminated exactly in assembly.
+//! - SPC1 (with THRU), SPC (zero displacement) of the set chosen by case control, or of the only
+//!   set in the file.
+//! - PARAM WTMASS (scales all mass), PARAM POST/GRDPNT/… (output only) and EIGRL/EIGR
+//!   (extraction requests) are accepted; any other card is an error naming card and line.
+//!
+//! Writing: [`write_bulk_deck`] emits large-field cards for a mesh of the supported elements.
+
+mod cards;
+mod lexer;
+mod to_mesh;
+mod writer;
+
+use std::collections::BTreeMap;
+use std::path::Path;
+
+pub use lexer::{classify, parse_real, Value};
+pub use writer::write_bulk_deck;
+
+use super::error::FeError;
+use super::mesh::Mesh;
+
+/// Largest bulk data file read (bytes).
+pub const MAX_FILE_BYTES: u64 = 256 * 1024 * 1024;
+
+/// Nastran ids of the mesh entities, in mesh order (`beams[i]` is the CBAR/CBEAM id of
+/// `mesh.beams[i]`, …). A CONM2 with an offset appears in `masses` and in `rigid_links`.
+#[derive(Debug, Clone, Default, PartialEq)]
+pub struct ElementIds {
+    /// CBAR / CBEAM ids.
+    pub beams: Vec<u32>,
+    /// CQUAD4 ids.
+    pub shells: Vec<u32>,
+    /// CONM2 ids.
+    pub masses: Vec<u32>,
+    /// RBE2 ids (and CONM2 ids of offset masses).
+    pub rigid_links: Vec<u32>,
+    /// RBE3 ids.
+    pub interpolation_links: Vec<u32>,
+}
+
+/// A body read from bulk data.
+#[derive(Debug, Clone, PartialEq)]
+pub struct NastranBody {
+    /// The mesh (no named nodes or regions: name points with [`NastranBody::name_points`]).
+    pub mesh: Mesh,
+    /// GRID id → node index. Nodes are numbered in ascending GRID id; nodes beyond the GRIDs
+    /// are the centres of gravity of offset CONM2 masses.
+    pub grid_index: BTreeMap<u32, usize>,
+    /// Element ids per mesh entity.
+    pub element_ids: ElementIds,
+    /// The SPC set applied, if any.
+    pub spc_set: Option<u32>,
+}
+
+impl NastranBody {
+    /// Node index of GRID `grid`.
+    pub fn node_of_grid(&self, grid: u32) -> Result<usize, FeError> {
+        self.grid_index
+            .get(&grid)
+            .copied()
+            .ok_or_else(|| FeError::InvalidInput(format!("GRID {grid} is not in the bulk data")))
+    }
+
+    /// Adds `name → GRID id` pairs (e.g. `"mount_front_left": 1001`) to `mesh.named_nodes`.
+    pub fn name_points(&mut self, points: &BTreeMap<String, u32>) -> Result<(), FeError> {
+        for (name, &grid) in points {
+            let node = self
+                .node_of_grid(grid)
+                .map_err(|e| FeError::InvalidInput(format!("point '{name}': {e}")))?;
+            self.mesh.named_nodes.insert(name.clone(), node);
+        }
+        Ok(())
+    }
+}
+
+/// Parses bulk data text (see the module documentation for what is accepted).
+pub fn parse_str(text: &str) -> Result<NastranBody, FeError> {
+    to_mesh::build(&lexer::lex(text)?)
+}
+
+/// Reads a bulk data file: a regular file of at most [`MAX_FILE_BYTES`], UTF-8/ASCII text.
+pub fn read_bulk_deck(path: &Path) -> Result<NastranBody, FeError> {
+    let shown = path.display();
+    let meta =
+        std::fs::metadata(path).map_err(|e| FeError::Io(format!("bulk data file {shown}: {e}")))?;
+    if !meta.is_file() {
+        return Err(FeError::Io(format!(
+            "bulk data file {shown} is not a regular file"
+        )));
+    }
+    if meta.len() > MAX_FILE_BYTES {
+        return Err(FeError::Io(format!(
+            "bulk data file {shown} has {} bytes, more than the limit of {MAX_FILE_BYTES}",
+            meta.len()
+        )));
+    }
+    let file = std::fs::File::open(path)
+        .map_err(|e| FeError::Io(format!("bulk data file {shown}: {e}")))?;
+    // The size is checked again while reading: the file may grow after the metadata call.
+    let mut bytes = Vec::with_capacity(meta.len() as usize);
+    use std::io::Read;
+    file.take(MAX_FILE_BYTES + 1)
+        .read_to_end(&mut bytes)
+        .map_err(|e| FeError::Io(format!("bulk data file {shown}: {e}")))?;
+    if bytes.len() as u64 > MAX_FILE_BYTES {
+        return Err(FeError::Io(format!(
+            "bulk data file {shown} grew beyond the limit of {MAX_FILE_BYTES} bytes while read"
+        )));
+    }
+    let text = String::from_utf8(bytes)
+        .map_err(|e| FeError::Io(format!("bulk data file {shown} is not text: {e}")))?;
+    parse_str(&text).map_err(|e| match e {
+        FeError::InvalidInput(m) => FeError::InvalidInput(format!("{shown}: {m}")),
+        other => other,
+    })
+}
