@@ -3,3 +3,4 @@
 mod chassis;
 mod eigen;
 mod elements;
+mod nastran;

@@ -169,11 +169,9 @@ fn split_line(line: &str, lineno: usize) -> Result<(String, Vec<(String, usize)>
                 ),
             ));
         }
-        let fields = data
-            .iter()
-            .take(per_line)
-            .enumerate()
-            .map(|(k, t)| (t.clone(), k + 2))
+        // A short line still stands for all its fields: the next line continues at field 2.
+        let fields = (0..per_line)
+            .map(|k| (data.get(k).cloned().unwrap_or_default(), k + 2))
             .collect();
         return Ok((first, fields));
     }
