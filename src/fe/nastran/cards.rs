@@ -154,8 +154,7 @@ impl<'a> Reader<'a> {
     pub(crate) fn require_blank(&self, i: usize, name: &str, why: &str) -> Result<(), FeError> {
         match self.value(i, name)? {
             Value::Blank => Ok(()),
-            Value::Int(0) => Ok(()),
-            Value::Real(v) if v == 0.0 => Ok(()),
+            Value::Int(0) | Value::Real(0.0) => Ok(()),
             other => Err(self.error(i, name, format!("{other:?} is not supported: {why}"))),
         }
     }

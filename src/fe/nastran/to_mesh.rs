@@ -250,7 +250,7 @@ impl Systems {
                 let (a, b, c) = (to_basic(d.a), to_basic(d.b), to_basic(d.c));
                 let z = b - a;
                 let x = (c - a) - z * (z.dot(&(c - a)) / z.norm_squared());
-                if !(z.norm() > 0.0 && x.norm() > 1e-12 * z.norm()) || !x.norm().is_finite() {
+                if !(z.norm() > 0.0 && x.norm() > 1e-12 * z.norm() && x.norm().is_finite()) {
                     return Err(mesh_error(
                         d.line,
                         format!("CORD2R {cid}: points A, B, C are coincident or collinear"),
@@ -652,7 +652,7 @@ fn add_links(c: &Cards, body: &mut NastranBody) -> Result<(), FeError> {
         let reference = node_of(body, e.reference, e.line, &user)?;
         let mut sources = Vec::new();
         for (weight, components, grids) in &e.groups {
-            if !(*weight > 0.0) {
+            if weight.is_nan() || *weight <= 0.0 {
                 return Err(mesh_error(
                     e.line,
                     format!("{user}: weight {weight} must be > 0"),
