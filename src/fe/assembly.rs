@@ -6,7 +6,7 @@ use nalgebra::{Dim, Matrix, RawStorage, Vector3};
 use super::dof::{DofMap, Expansion, DOF_PER_NODE};
 use super::error::FeError;
 use super::mesh::Mesh;
-use super::{beam, links, mass, shell, spring};
+use super::{beam, links, mass, shell, shell3, spring};
 
 /// Sparse symmetric matrix type of the FE model (both triangles stored).
 pub type SparseMat = SparseColMat<usize, f64>;
@@ -137,6 +137,16 @@ pub fn assemble(mesh: &Mesh) -> Result<Assembled, FeError> {
         ];
         k.scatter(&s.nodes, &shell::stiffness(i, s, &p)?);
         m.scatter(&s.nodes, &shell::lumped_mass(i, s, &p)?);
+    }
+    for (i, t) in mesh.triangles.iter().enumerate() {
+        let what = format!("triangle {i}");
+        let p = [
+            node_of(mesh, &what, t.nodes[0])?,
+            node_of(mesh, &what, t.nodes[1])?,
+            node_of(mesh, &what, t.nodes[2])?,
+        ];
+        k.scatter(&t.nodes, &shell3::stiffness(i, t, &p)?);
+        m.scatter(&t.nodes, &shell3::lumped_mass(i, t, &p)?);
     }
     for (i, pm) in mesh.masses.iter().enumerate() {
         node_of(mesh, &format!("point mass {i}"), pm.node)?;

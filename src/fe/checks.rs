@@ -6,7 +6,7 @@ use nalgebra::Vector3;
 use super::assembly::Assembled;
 use super::error::FeError;
 use super::mesh::Mesh;
-use super::shell;
+use super::{shell, shell3};
 
 /// Limits of the geometric checks.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -127,6 +127,24 @@ pub fn check_mesh(mesh: &Mesh, limits: &CheckLimits) -> Result<(), FeError> {
             has_stiffness[k] = true;
         }
     }
+    for (i, t) in mesh.triangles.iter().enumerate() {
+        let pts: Option<Vec<Vector3<f64>>> = t.nodes.iter().map(|&k| node(mesh, k)).collect();
+        let Some(pts) = pts else {
+            problems.push(format!("triangle {i}: node {:?} does not exist", t.nodes));
+            continue;
+        };
+        match shell3::geometry(i, &[pts[0], pts[1], pts[2]]) {
+            Err(e) => problems.push(e.to_string()),
+            Ok(g) if g.area < limits.min_shell_area => {
+                problems.push(format!("triangle {i}: degenerate (area {:.3e} m²)", g.area))
+            }
+            Ok(_) => {}
+        }
+        for &k in &t.nodes {
+            connected[k] = true;
+            has_stiffness[k] = true;
+        }
+    }
     for (i, m) in mesh.masses.iter().enumerate() {
         match connected.get_mut(m.node) {
             Some(c) => *c = true,
@@ -232,6 +250,7 @@ fn disconnected_parts(
         .iter()
         .map(|b| b.nodes.to_vec())
         .chain(mesh.shells.iter().map(|s| s.nodes.to_vec()))
+        .chain(mesh.triangles.iter().map(|t| t.nodes.to_vec()))
         .chain(mesh.springs.iter().map(|s| s.nodes.to_vec()))
         .chain(link_node_sets(mesh).into_iter().map(|(_, nodes)| nodes));
     for nodes in links {

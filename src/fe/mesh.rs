@@ -101,6 +101,22 @@ pub struct Shell {
     pub extra_mass_per_area: f64,
 }
 
+/// Three-node flat shell (CST membrane with drilling rotation + DKT plate, lumped mass); the
+/// fields mean what they mean for [`Shell`].
+#[derive(Debug, Clone, PartialEq)]
+pub struct TriShell {
+    /// Corner nodes, counter-clockwise seen from the side the normal points to.
+    pub nodes: [usize; 3],
+    /// Material.
+    pub material: Material,
+    /// Thickness (m) (membrane stiffness and mass).
+    pub thickness: f64,
+    /// Effective thickness for plate bending (m).
+    pub bending_thickness: f64,
+    /// Non-structural mass per area (kg/m²).
+    pub extra_mass_per_area: f64,
+}
+
 /// Point mass with rotary inertia (global axes) at a node.
 #[derive(Debug, Clone, PartialEq)]
 pub struct PointMass {
@@ -180,6 +196,8 @@ pub struct Mesh {
     pub beams: Vec<Beam>,
     /// Shell elements.
     pub shells: Vec<Shell>,
+    /// Three-node shell elements.
+    pub triangles: Vec<TriShell>,
     /// Point masses.
     pub masses: Vec<PointMass>,
     /// Springs to ground.

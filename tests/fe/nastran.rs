@@ -46,8 +46,9 @@ const STEEL: &str = "MAT1,1,2.1+11,,0.3,7850.\n";
 // ---------------------------------------------------------------------------------------------
 // (a) Cantilever plate (CQUAD4, SPC1 clamped edge) against Leissa.
 
-/// Square cantilever plate a × a, thickness h, clamped along x = 0, n × n CQUAD4 (free field).
-fn cantilever_plate_deck(n: usize, a: f64, h: f64) -> String {
+/// Square cantilever plate a × a, thickness h, clamped along x = 0, n × n CQUAD4 or 2 n²
+/// CTRIA3 (each square cut along alternating diagonals), free field.
+fn cantilever_plate_deck(n: usize, a: f64, h: f64, triangles: bool) -> String {
     let mut deck = String::from("BEGIN BULK\n");
     deck.push_str(STEEL);
     let _ = writeln!(deck, "PSHELL,7,1,{h:e},1,,1");
@@ -60,15 +61,17 @@ fn cantilever_plate_deck(n: usize, a: f64, h: f64) -> String {
     }
     for i in 0..n {
         for j in 0..n {
-            let _ = writeln!(
-                deck,
-                "CQUAD4,{},7,{},{},{},{}",
-                1 + i * n + j,
-                id(i, j),
-                id(i + 1, j),
-                id(i + 1, j + 1),
-                id(i, j + 1)
-            );
+            let c = [id(i, j), id(i + 1, j), id(i + 1, j + 1), id(i, j + 1)];
+            let e = 1 + 2 * (i * n + j);
+            if !triangles {
+                let _ = writeln!(deck, "CQUAD4,{e},7,{},{},{},{}", c[0], c[1], c[2], c[3]);
+            } else if (i + j) % 2 == 0 {
+                let _ = writeln!(deck, "CTRIA3,{e},7,{},{},{}", c[0], c[1], c[2]);
+                let _ = writeln!(deck, "CTRIA3,{},7,{},{},{}", e + 1, c[0], c[2], c[3]);
+            } else {
+                let _ = writeln!(deck, "CTRIA3,{e},7,{},{},{}", c[0], c[1], c[3]);
+                let _ = writeln!(deck, "CTRIA3,{},7,{},{},{}", e + 1, c[1], c[2], c[3]);
+            }
         }
     }
     let _ = writeln!(deck, "SPC1,3,123456,{},THRU,{}", id(0, 0), id(0, n));
@@ -76,44 +79,57 @@ fn cantilever_plate_deck(n: usize, a: f64, h: f64) -> String {
     deck
 }
 
-#[test]
-fn cantilever_plate_converges_to_leissa_bending_and_torsion() {
-    // Leissa (1969), square cantilever plate, ν = 0.3: λ = ω a² √(ρh/D) = 3.492 (first
-    // bending), 8.525 (first torsion). These Ritz values are upper bounds; converged values
-    // are about 0.6 % lower (3.471, 8.507), so a converging mesh approaches them from either
-    // side within that band.
+/// λ1 (first bending), λ2 (first torsion) of the cantilever plate on n × n meshes.
+fn cantilever_plate_history(triangles: bool) -> Vec<(f64, f64)> {
     let (a, h): (f64, f64) = (0.5, 0.002);
     let d = 2.1e11 * h.powi(3) / (12.0 * (1.0 - 0.09));
     let scale = (7850.0 * h / d).sqrt() * a * a;
     let mut history = Vec::new();
     for n in [4, 8, 16] {
-        let body = parse_str(&cantilever_plate_deck(n, a, h)).unwrap();
+        let body = parse_str(&cantilever_plate_deck(n, a, h, triangles)).unwrap();
         assert_eq!(body.spc_set, Some(3));
         let (asm, m) = modes(&body, 3);
         let lambda: Vec<f64> = m.eigenvalues.iter().map(|l| l.sqrt() * scale).collect();
-        // Bending: transverse motion symmetric; torsion second. Both are out-of-plane modes.
         for mode in 0..2 {
             assert!(
                 dof_share(&asm, &m, mode, 2) > 0.9,
                 "mode {mode} is not transverse"
             );
         }
+        let kind = if triangles { "CTRIA3" } else { "CQUAD4" };
         println!(
-            "cantilever plate {n}×{n}: λ1 = {:.4}, λ2 = {:.4}",
+            "cantilever plate {kind} {n}×{n}: λ1 = {:.4}, λ2 = {:.4}",
             lambda[0], lambda[1]
         );
         history.push((lambda[0], lambda[1]));
     }
+    history
+}
+
+/// Leissa (1969), square cantilever plate, ν = 0.3: λ = ω a² √(ρh/D) = 3.492 (first bending),
+/// 8.525 (first torsion). These Ritz values are upper bounds; converged values are about 0.6 %
+/// lower (3.471, 8.507), so the finest mesh must lie within 1.5 % of Leissa, and each
+/// refinement must at least halve the change (an O(h²) element converging).
+fn assert_converges_to_leissa(history: &[(f64, f64)]) {
     let (l1, l2) = history[2];
     assert!((l1 / 3.492 - 1.0).abs() < 0.015, "λ1 = {l1}");
     assert!((l2 / 8.525 - 1.0).abs() < 0.015, "λ2 = {l2}");
-    // Convergence: each refinement at least halves the change (O(h²) elements).
     for k in [0, 1] {
         let pick = |s: (f64, f64)| if k == 0 { s.0 } else { s.1 };
         let d1 = (pick(history[1]) - pick(history[0])).abs();
         let d2 = (pick(history[2]) - pick(history[1])).abs();
         assert!(d2 < 0.5 * d1, "mode {k}: changes {d1} then {d2}");
     }
+}
+
+#[test]
+fn cantilever_plate_of_cquad4_converges_to_leissa_bending_and_torsion() {
+    assert_converges_to_leissa(&cantilever_plate_history(false));
+}
+
+#[test]
+fn cantilever_plate_of_ctria3_converges_to_leissa_bending_and_torsion() {
+    assert_converges_to_leissa(&cantilever_plate_history(true));
 }
 
 // ---------------------------------------------------------------------------------------------
@@ -406,6 +422,29 @@ fn chassis_written_as_bulk_data_and_read_back_has_the_same_lowest_20_modes() {
     }
 }
 
+#[test]
+fn triangles_links_masses_and_springs_survive_a_write_read_cycle_unchanged() {
+    let mut deck = cantilever_plate_deck(2, 0.5, 0.002, true);
+    deck = deck.replace("ENDDATA\n", "");
+    // A rigid body on grid 1 (offset CONM2 with products of inertia), a second offset CONM2,
+    // and an RBE3 reference point (grid 3) over two plate grids.
+    let rigid = rigid_body_deck(
+        2.0,
+        [0.05, 0.01, 0.07, -0.005, 0.008, 0.09],
+        [0.3, -0.2, 0.25],
+        [4.0e4, 5.0e4, 6.0e4, 900.0, 1100.0, 1300.0],
+        false,
+    );
+    let body_part = rigid.replace("BEGIN BULK\n", "")
+        + "CONM2,61,1,,1.5,0.1,0.,0.\nGRID,3,,0.1,0.2,0.\nRBE3,41,,3,123,1.,123,1002,1004\n";
+    deck.push_str(&body_part);
+    let first = parse_str(&deck).unwrap();
+    assert_eq!(first.mesh.triangles.len(), 8);
+    let second = parse_str(&write_bulk_deck(&first.mesh).unwrap()).unwrap();
+    assert_eq!(first.mesh, second.mesh);
+    assemble(&second.mesh).unwrap();
+}
+
 // ---------------------------------------------------------------------------------------------
 // (f) Errors name the card, line and field.
 
@@ -417,8 +456,8 @@ fn error_of(deck: &str) -> String {
 fn unsupported_card_names_card_and_line() {
     let err = error_of("BEGIN BULK\nGRID,1,,0.,0.,0.\nCHEXA,2,3,1,1,1,1,1,1\n+,1,1\n");
     assert!(err.contains("CHEXA") && err.contains("line 3"), "{err}");
-    let err = error_of("GRID,1,,0.,0.,0.\nCTRIA3,2,7,1,1,1\n");
-    assert!(err.contains("CTRIA3 2") && err.contains("line 2"), "{err}");
+    let err = error_of("GRID,1,,0.,0.,0.\nCQUAD8,2,7,1,1,1\n");
+    assert!(err.contains("CQUAD8") && err.contains("line 2"), "{err}");
     let err = error_of("PARAM,COUPMASS,1\n");
     assert!(err.contains("COUPMASS") && err.contains("line 1"), "{err}");
 }

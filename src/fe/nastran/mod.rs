@@ -12,9 +12,10 @@
 //!   beams keep E and G, shells need G within 1 % of E/2(1+ν). RHO; GE/A/TREF ignored
 //!   (structural damping is added modally by the caller).
 //! - PSHELL (MID1 = MID2, MID3 blank or MID1, T, 12I/T³ → bending thickness T·(12I/T³)^⅓, NSM):
-//!   the element is the QM6 + MITC4 shell with transverse shear (k = 5/6) always included;
-//!   Nastran omits transverse shear for MID3 blank, which differs by O((t/L)²) for thin sheets.
-//!   CQUAD4 (no offsets, no corner thicknesses). CTRIA3 is rejected: there is no 3-node shell.
+//!   CQUAD4 is the QM6 + MITC4 shell with transverse shear (k = 5/6) always included (Nastran
+//!   omits transverse shear for MID3 blank: a difference of O((t/L)²) for thin sheets); CTRIA3
+//!   is the CST + DKT shell ([`crate::fe::shell3`], Kirchhoff: no transverse shear). No offsets,
+//!   no corner thicknesses.
 //! - PBAR (A, I1, I2, J, NSM; I12 must be 0), PBEAM (constant section only), CBAR/CBEAM with
 //!   X1..X3 or G0, no pins or offsets. The element is Euler-Bernoulli: shear flexibility (PBAR/
 //!   PBEAM K1, K2) is not modelled. I1 bends in Nastran's plane 1 (element x-y) → `iz`,
@@ -57,6 +58,8 @@ pub struct ElementIds {
     pub beams: Vec<u32>,
     /// CQUAD4 ids.
     pub shells: Vec<u32>,
+    /// CTRIA3 ids.
+    pub triangles: Vec<u32>,
     /// CONM2 ids.
     pub masses: Vec<u32>,
     /// RBE2 ids (and CONM2 ids of offset masses).

@@ -11,7 +11,7 @@ use super::NastranBody;
 use crate::fe::error::FeError;
 use crate::fe::mesh::{
     Beam, BeamSection, GroundSpring, InterpolationLink, InterpolationSource, Material, Mesh,
-    PointMass, RigidLink, Shell, Spring,
+    PointMass, RigidLink, Shell, Spring, TriShell,
 };
 
 /// Parameters that only steer output or solution bookkeeping: accepted and ignored.
@@ -359,15 +359,6 @@ fn add_shells(c: &Cards, body: &mut NastranBody) -> Result<(), FeError> {
     for (&id, (plate, name)) in &c.plates {
         let user = format!("{name} {id}");
         let line = plate.line;
-        if *name == "CTRIA3" {
-            return Err(mesh_error(
-                line,
-                format!(
-                    "{user}: 3-node shells are not supported by this model's shell element; \
-                     mesh with CQUAD4"
-                ),
-            ));
-        }
         let p = c.shell_properties.get(&plate.pid).ok_or_else(|| {
             mesh_error(
                 line,
@@ -428,18 +419,32 @@ fn add_shells(c: &Cards, body: &mut NastranBody) -> Result<(), FeError> {
             .iter()
             .map(|&g| node_of(body, g, line, &user))
             .collect::<Result<Vec<_>, _>>()?;
-        body.mesh.shells.push(Shell {
-            nodes: [nodes[0], nodes[1], nodes[2], nodes[3]],
-            material: Material {
-                youngs_modulus: e,
-                poisson_ratio: nu,
-                density: m.rho * c.mass_scale,
-            },
-            thickness: p.t,
-            bending_thickness: p.t * p.bending_ratio.cbrt(),
-            extra_mass_per_area: p.nsm * c.mass_scale,
-        });
-        body.element_ids.shells.push(id);
+        let material = Material {
+            youngs_modulus: e,
+            poisson_ratio: nu,
+            density: m.rho * c.mass_scale,
+        };
+        let (thickness, bending_thickness) = (p.t, p.t * p.bending_ratio.cbrt());
+        let extra_mass_per_area = p.nsm * c.mass_scale;
+        if let [a, b, cc, d] = nodes[..] {
+            body.mesh.shells.push(Shell {
+                nodes: [a, b, cc, d],
+                material,
+                thickness,
+                bending_thickness,
+                extra_mass_per_area,
+            });
+            body.element_ids.shells.push(id);
+        } else if let [a, b, cc] = nodes[..] {
+            body.mesh.triangles.push(TriShell {
+                nodes: [a, b, cc],
+                material,
+                thickness,
+                bending_thickness,
+                extra_mass_per_area,
+            });
+            body.element_ids.triangles.push(id);
+        }
     }
     Ok(())
 }

@@ -1,7 +1,7 @@
 //! [`Mesh`] → Nastran bulk data in large-field format (16-column fields, so a real keeps 10 or
 //! more significant digits; most values of a generated mesh are written exactly).
 //!
-//! GRID ids are node index + 1; elements are numbered from 1 in the order CQUAD4, CBAR, CONM2,
+//! GRID ids are node index + 1; elements are numbered from 1 in the order CQUAD4, CTRIA3, CBAR, CONM2,
 //! CELAS2, CDAMP2, RBE2, RBE3. Supports are SPC1 set 1 (a Nastran run needs `SPC = 1` in its
 //! case control; [`super::parse_str`] applies the only set present). Named nodes are listed in
 //! comments.
@@ -155,6 +155,39 @@ fn material(out: &mut String, table: &mut Table, m: &Material) -> Result<u64, Fe
     Ok(id)
 }
 
+/// The PSHELL id of a shell section, written on first use (MID1 = MID2 = MID3, so Nastran also
+/// includes transverse shear, like the four-node shell).
+fn shell_property(
+    out: &mut String,
+    materials: &mut Table,
+    properties: &mut Table,
+    m: &Material,
+    thickness: f64,
+    bending_thickness: f64,
+    extra_mass_per_area: f64,
+) -> Result<u64, FeError> {
+    let mid = material(out, materials, m)?;
+    let ratio = (bending_thickness / thickness).powi(3);
+    let (pid, new) = properties.id(&[0.0, mid as f64, thickness, ratio, extra_mass_per_area]);
+    if new {
+        card(
+            out,
+            "PSHELL",
+            &[
+                Out::Int(pid),
+                Out::Int(mid),
+                Out::Real(thickness),
+                Out::Int(mid),
+                Out::Real(ratio),
+                Out::Int(mid),
+                Out::Blank,
+                Out::Real(extra_mass_per_area),
+            ],
+        )?;
+    }
+    Ok(pid)
+}
+
 /// Writes `mesh` as bulk data (BEGIN BULK … ENDDATA).
 pub fn write_bulk_deck(mesh: &Mesh) -> Result<String, FeError> {
     let mut out = String::new();
@@ -180,32 +213,38 @@ pub fn write_bulk_deck(mesh: &Mesh) -> Result<String, FeError> {
     let mut properties = Table::new();
     let mut eid = 0u64;
     for (i, s) in mesh.shells.iter().enumerate() {
-        let mid = material(&mut out, &mut materials, &s.material)?;
-        let ratio = (s.bending_thickness / s.thickness).powi(3);
-        let (pid, new) =
-            properties.id(&[0.0, mid as f64, s.thickness, ratio, s.extra_mass_per_area]);
-        if new {
-            card(
-                &mut out,
-                "PSHELL",
-                &[
-                    Out::Int(pid),
-                    Out::Int(mid),
-                    Out::Real(s.thickness),
-                    Out::Int(mid),
-                    Out::Real(ratio),
-                    Out::Int(mid),
-                    Out::Blank,
-                    Out::Real(s.extra_mass_per_area),
-                ],
-            )?;
-        }
+        let pid = shell_property(
+            &mut out,
+            &mut materials,
+            &mut properties,
+            &s.material,
+            s.thickness,
+            s.bending_thickness,
+            s.extra_mass_per_area,
+        )?;
         eid += 1;
         let mut fields = vec![Out::Int(eid), Out::Int(pid)];
         for &n in &s.nodes {
             fields.push(Out::Int(check_node(mesh, &format!("shell {i}"), n)?));
         }
         card(&mut out, "CQUAD4", &fields)?;
+    }
+    for (i, t) in mesh.triangles.iter().enumerate() {
+        let pid = shell_property(
+            &mut out,
+            &mut materials,
+            &mut properties,
+            &t.material,
+            t.thickness,
+            t.bending_thickness,
+            t.extra_mass_per_area,
+        )?;
+        eid += 1;
+        let mut fields = vec![Out::Int(eid), Out::Int(pid)];
+        for &n in &t.nodes {
+            fields.push(Out::Int(check_node(mesh, &format!("triangle {i}"), n)?));
+        }
+        card(&mut out, "CTRIA3", &fields)?;
     }
     for (i, b) in mesh.beams.iter().enumerate() {
         let mid = material(&mut out, &mut materials, &b.material)?;
