@@ -445,6 +445,55 @@ fn triangles_links_masses_and_springs_survive_a_write_read_cycle_unchanged() {
     assemble(&second.mesh).unwrap();
 }
 
+#[test]
+fn grids_and_masses_in_nested_cord2r_systems_land_in_basic() {
+    // System 5: origin (1, 2, 3), local z = basic x, local x = basic y (so local y = basic z).
+    // System 6 is defined in system 5 and is system 5 moved by 1 along basic x.
+    let deck = "BEGIN BULK\n\
+                CORD2R,5,,1.,2.,3.,2.,2.,3.\n,1.,3.,3.\n\
+                CORD2R,6,5,0.,0.,1.,0.,0.,2.\n,1.,0.,1.\n\
+                GRID,1,5,0.5,0.25,2.\nGRID,2,6,0.5,0.25,2.\n\
+                CONM2,9,1,5,4.,0.1,0.,0.\n,1.,,2.,,,3.\nENDDATA\n";
+    let body = parse_str(deck).unwrap();
+    let at = |g: u32| body.mesh.nodes[body.node_of_grid(g).unwrap()];
+    assert!(
+        (at(1) - Vector3::new(3.0, 2.5, 3.25)).norm() < 1e-14,
+        "{}",
+        at(1)
+    );
+    assert!(
+        (at(2) - Vector3::new(4.0, 2.5, 3.25)).norm() < 1e-14,
+        "{}",
+        at(2)
+    );
+    // The CONM2 offset (0.1 along local x = basic y) puts the mass on its own node, rigidly
+    // tied to grid 1; its inertia about local x, y, z is about basic y, z, x.
+    let mass = &body.mesh.masses[0];
+    assert_eq!(mass.mass, 4.0);
+    assert!((body.mesh.nodes[mass.node] - Vector3::new(3.0, 2.6, 3.25)).norm() < 1e-14);
+    let diagonal = [
+        mass.inertia[(0, 0)],
+        mass.inertia[(1, 1)],
+        mass.inertia[(2, 2)],
+    ];
+    for (got, want) in diagonal.iter().zip([3.0, 1.0, 2.0]) {
+        assert!((got - want).abs() < 1e-14, "{diagonal:?}");
+    }
+    assert_eq!(body.mesh.rigid_links.len(), 1);
+    assert_eq!(body.element_ids.rigid_links, vec![9]);
+}
+
+#[test]
+fn spc1_thru_takes_the_grids_that_exist_and_wtmass_scales_all_mass() {
+    let deck = "GRID,1,,0.,0.,0.\nGRID,2,,1.,0.,0.\nGRID,5,,2.,0.,0.\nGRID,9,,3.,0.,0.\n\
+                SPC1,1,123,2,THRU,8\nPARAM,WTMASS,0.5\nCONM2,3,9,,10.\nPARAM,POST,-1\n";
+    let body = parse_str(deck).unwrap();
+    let mut fixed: Vec<(usize, usize)> = body.mesh.constraints.clone();
+    fixed.sort_unstable();
+    assert_eq!(fixed, vec![(1, 0), (1, 1), (1, 2), (2, 0), (2, 1), (2, 2)]);
+    assert_eq!(body.mesh.masses[0].mass, 5.0);
+}
+
 // ---------------------------------------------------------------------------------------------
 // (f) Errors name the card, line and field.
 
@@ -496,6 +545,20 @@ fn missing_references_are_named() {
     assert!(err.contains("RBE2 3") && err.contains("GRID 9"), "{err}");
     let err = error_of(&format!("{base}SPC1,1,123,1\nSPC1,2,123,2\n"));
     assert!(err.contains("several SPC sets"), "{err}");
+    let err = error_of(&format!("{base}GRID,3,,5.,5.,5.\n"));
+    assert!(
+        err.contains("GRID 3 is defined twice") && err.contains("line 5"),
+        "{err}"
+    );
+    let err = error_of(
+        "CORD2R,1,2,0.,0.,0.,0.,0.,1.\n,1.,0.,0.\nCORD2R,2,1,0.,0.,0.,0.,0.,1.\n,1.,0.,0.\n",
+    );
+    assert!(err.contains("cycle"), "{err}");
+    let err = error_of(&format!("{base}GRID,7,9,0.,0.,0.\n"));
+    assert!(
+        err.contains("GRID 7 CP") && err.contains("coordinate system 9"),
+        "{err}"
+    );
 }
 
 #[test]

@@ -39,7 +39,7 @@ struct Cards {
     dampers: BTreeMap<u32, cards::Scalar>,
     rigid: BTreeMap<u32, cards::Rbe2>,
     interpolation: BTreeMap<u32, cards::Rbe3>,
-    supports: Vec<(u32, u32, [bool; 6], usize)>,
+    supports: Vec<(cards::Support, usize)>,
     element_lines: BTreeMap<u32, (usize, String)>,
     mass_scale: f64,
 }
@@ -159,8 +159,7 @@ impl Cards {
                     } else {
                         cards::spc(&r)?
                     };
-                    c.supports
-                        .extend(list.into_iter().map(|(s, g, m)| (s, g, m, line)));
+                    c.supports.extend(list.into_iter().map(|s| (s, line)));
                 }
                 "PARAM" => c.param(&r)?,
                 // Eigenvalue extraction requests: the caller chooses the modes.
@@ -683,7 +682,7 @@ fn add_links(c: &Cards, body: &mut NastranBody) -> Result<(), FeError> {
 }
 
 fn add_supports(c: &Cards, selected: Option<u32>, body: &mut NastranBody) -> Result<(), FeError> {
-    let sets: BTreeSet<u32> = c.supports.iter().map(|s| s.0).collect();
+    let sets: BTreeSet<u32> = c.supports.iter().map(|s| s.0 .0).collect();
     let set = match (selected, sets.len()) {
         (Some(s), _) => {
             if !sets.is_empty() && !sets.contains(&s) {
@@ -704,14 +703,21 @@ fn add_supports(c: &Cards, selected: Option<u32>, body: &mut NastranBody) -> Res
     };
     body.spc_set = set;
     let mut seen = BTreeSet::new();
-    for &(sid, grid, mask, line) in &c.supports {
+    for &((sid, grids, mask), line) in &c.supports {
         if Some(sid) != set {
             continue;
         }
-        let node = node_of(body, grid, line, &format!("SPC set {sid}"))?;
-        for d in mask_nodes(mask) {
-            if seen.insert((node, d)) {
-                body.mesh.constraints.push((node, d));
+        let nodes: Vec<usize> = match grids {
+            cards::Grids::One(grid) => vec![node_of(body, grid, line, &format!("SPC set {sid}"))?],
+            cards::Grids::Range(from, to) => {
+                body.grid_index.range(from..=to).map(|(_, &n)| n).collect()
+            }
+        };
+        for node in nodes {
+            for d in mask_nodes(mask) {
+                if seen.insert((node, d)) {
+                    body.mesh.constraints.push((node, d));
+                }
             }
         }
     }
