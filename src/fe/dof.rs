@@ -151,6 +151,27 @@ impl DofMap {
         }
     }
 
+    /// Motion rows of the local DOFs `local` of each node in `nodes` (node by node): the sparse
+    /// matrix R with u_points = R q. For a Craig-Bampton interface or an output point on a
+    /// dependent node (RBE2 dependent, RBE3 reference) R replaces the missing equation indices.
+    pub fn motion_rows(
+        &self,
+        nodes: &[usize],
+        local: &[usize],
+    ) -> Result<SparseColMat<usize, f64>, FeError> {
+        let mut entries = Vec::new();
+        for (n, &node) in nodes.iter().enumerate() {
+            for (k, &dof) in local.iter().enumerate() {
+                let row = n * local.len() + k;
+                for (g, c) in self.motion_row(node, dof)? {
+                    entries.push(Triplet::new(row, g, c));
+                }
+            }
+        }
+        SparseColMat::try_new_from_triplets(nodes.len() * local.len(), self.n_free, &entries)
+            .map_err(|e| FeError::Numerical(format!("building motion rows: {e:?}")))
+    }
+
     /// The transformation T (6·n_nodes × n_free) from the equations to all node DOFs, row
     /// `node * 6 + dof`; rows of constrained DOFs are empty.
     pub fn transformation(&self) -> Result<SparseColMat<usize, f64>, FeError> {
@@ -342,6 +363,10 @@ mod tests {
         assert_eq!(t[(6, 1)], 3.0);
         let err = map.indices_of(&[1], &[0]).unwrap_err().to_string();
         assert!(err.contains("dependent"), "{err}");
+        let r = map.motion_rows(&[1, 0], &[0, 2]).unwrap().to_dense();
+        assert_eq!((r.nrows(), r.ncols()), (4, 15));
+        assert_eq!((r[(0, 0)], r[(0, 1)]), (2.0, 3.0));
+        assert!((0..15).all(|g| r[(3, g)] == 0.0), "node 0 dof 2 is fixed");
     }
 
     #[test]
