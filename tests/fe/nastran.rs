@@ -546,6 +546,18 @@ fn missing_references_are_named() {
         "{base}{STEEL}PSHELL,7,1,0.001,1\nCQUAD4,10,7,1,2,3,44\n"
     ));
     assert!(err.contains("GRID 44") && err.contains("line 7"), "{err}");
+    let err = error_of(&format!(
+        "{base}RBE2,3,1,123456,2\nRBE3,4,,2,1,1.,123,3,4\n"
+    ));
+    assert!(
+        err.contains("GRID 2 component 1") && err.contains("RBE2 3 and RBE3 4"),
+        "{err}"
+    );
+    let err = error_of(&format!("{base}RBE2,3,1,123,2\nSPC1,1,3,2\n"));
+    assert!(
+        err.contains("RBE2 3") && err.contains("also constrained"),
+        "{err}"
+    );
     let err = error_of(&format!("{base}RBE2,3,1,123456,2,9\n"));
     assert!(err.contains("RBE2 3") && err.contains("GRID 9"), "{err}");
     let err = error_of(&format!("{base}SPC1,1,123,1\nSPC1,2,123,2\n"));

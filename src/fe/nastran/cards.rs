@@ -612,14 +612,18 @@ pub struct Scalar {
     pub line: usize,
 }
 
-pub(crate) fn scalar(r: &Reader, direct: bool) -> Result<Scalar, FeError> {
+pub(crate) fn scalar(r: &Reader, direct: bool, spring: bool) -> Result<Scalar, FeError> {
     let id = r.id(0, "EID")?;
     let value = if direct {
-        // CELAS2: GE (structural damping) and S (stress coefficient) follow; GE is added
-        // modally by the caller, like MAT1 GE.
-        r.opt_real(6, "GE")?;
-        r.opt_real(7, "S")?;
-        r.at_most(8)?;
+        if spring {
+            // CELAS2: GE (structural damping) and S (stress coefficient) follow; GE is added
+            // modally by the caller, like MAT1 GE.
+            r.opt_real(6, "GE")?;
+            r.opt_real(7, "S")?;
+            r.at_most(8)?;
+        } else {
+            r.at_most(6)?;
+        }
         ScalarValue::Value(r.real(1, "K/B")?)
     } else {
         r.at_most(6)?;

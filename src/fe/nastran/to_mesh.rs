@@ -134,12 +134,12 @@ impl Cards {
                     c.masses.insert(m.id, m);
                 }
                 "CELAS1" | "CELAS2" => {
-                    let s = cards::scalar(&r, raw.name == "CELAS2")?;
+                    let s = cards::scalar(&r, raw.name == "CELAS2", true)?;
                     c.element_id(s.id, line, &raw.name)?;
                     c.springs.insert(s.id, s);
                 }
                 "CDAMP1" | "CDAMP2" => {
-                    let s = cards::scalar(&r, raw.name == "CDAMP2")?;
+                    let s = cards::scalar(&r, raw.name == "CDAMP2", false)?;
                     c.element_id(s.id, line, &raw.name)?;
                     c.dampers.insert(s.id, s);
                 }
@@ -351,6 +351,7 @@ pub(crate) fn build(deck: &Deck) -> Result<NastranBody, FeError> {
     add_scalars(&c, &mut body)?;
     add_links(&c, &mut body)?;
     add_supports(&c, deck.spc_selection, &mut body)?;
+    check_dependents(&c, &body)?;
     Ok(body)
 }
 
@@ -677,6 +678,54 @@ fn add_links(c: &Cards, body: &mut NastranBody) -> Result<(), FeError> {
             sources,
         });
         body.element_ids.interpolation_links.push(id);
+    }
+    Ok(())
+}
+
+/// A DOF may be dependent in one RBE only and not also supported (Nastran's rule; assembly
+/// enforces it too, but here the message can name the cards).
+fn check_dependents(c: &Cards, body: &NastranBody) -> Result<(), FeError> {
+    let names = ["1", "2", "3", "4", "5", "6"];
+    let mut owner: BTreeMap<(u32, usize), (String, usize)> = BTreeMap::new();
+    let dependents = c
+        .rigid
+        .iter()
+        .flat_map(|(id, e)| {
+            e.dependent.iter().flat_map(move |&g| {
+                mask_nodes(e.components).map(move |d| (g, d, format!("RBE2 {id}"), e.line))
+            })
+        })
+        .chain(c.interpolation.iter().flat_map(|(id, e)| {
+            mask_nodes(e.reference_components)
+                .map(move |d| (e.reference, d, format!("RBE3 {id}"), e.line))
+        }));
+    for (grid, d, card, line) in dependents {
+        if let Some((first, _)) = owner.get(&(grid, d)) {
+            return Err(mesh_error(
+                line,
+                format!(
+                    "GRID {grid} component {} is dependent in both {first} and {card}",
+                    names[d]
+                ),
+            ));
+        }
+        owner.insert((grid, d), (card, line));
+    }
+    let grid_of: BTreeMap<usize, u32> = body.grid_index.iter().map(|(g, n)| (*n, *g)).collect();
+    for &(node, d) in &body.mesh.constraints {
+        let Some(grid) = grid_of.get(&node) else {
+            continue;
+        };
+        if let Some((card, line)) = owner.get(&(*grid, d)) {
+            return Err(mesh_error(
+                *line,
+                format!(
+                    "GRID {grid} component {} is dependent in {card} and also constrained \
+                     (SPC or GRID PS); constrain the independent grid instead",
+                    names[d]
+                ),
+            ));
+        }
     }
     Ok(())
 }
