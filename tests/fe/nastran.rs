@@ -364,6 +364,19 @@ fn chassis_written_as_bulk_data_and_read_back_has_the_same_lowest_20_modes() {
     let points = BTreeMap::from([("steering_wheel".to_string(), wheel as u32 + 1)]);
     body.name_points(&points).unwrap();
     assert_eq!(body.mesh.named("steering_wheel"), Some(wheel));
+    let missing = BTreeMap::from([("seat".to_string(), 10_000_000)]);
+    let err = body.name_points(&missing).unwrap_err().to_string();
+    assert!(
+        err.contains("'seat'") && err.contains("GRID 10000000"),
+        "{err}"
+    );
+    let floor: Vec<u32> = chassis.mesh.regions["floor"]
+        .iter()
+        .map(|&n| n as u32 + 1)
+        .collect();
+    body.name_regions(&BTreeMap::from([("floor".to_string(), floor)]))
+        .unwrap();
+    assert_eq!(body.mesh.regions["floor"], chassis.mesh.regions["floor"]);
 
     let original = assemble(&chassis.mesh).unwrap();
     let read = assemble(&body.mesh).unwrap();

@@ -101,6 +101,20 @@ impl NastranBody {
         }
         Ok(())
     }
+
+    /// Adds `name → GRID ids` node sets to `mesh.regions` (mode descriptions need the regions
+    /// of [`crate::fe::chassis::region`], which a bulk data file does not carry).
+    pub fn name_regions(&mut self, regions: &BTreeMap<String, Vec<u32>>) -> Result<(), FeError> {
+        for (name, grids) in regions {
+            let nodes = grids
+                .iter()
+                .map(|&g| self.node_of_grid(g))
+                .collect::<Result<Vec<_>, _>>()
+                .map_err(|e| FeError::InvalidInput(format!("region '{name}': {e}")))?;
+            self.mesh.regions.insert(name.clone(), nodes);
+        }
+        Ok(())
+    }
 }
 
 /// Parses bulk data text (see the module documentation for what is accepted).
