@@ -335,7 +335,7 @@ fn rbe3_reference_moves_with_the_weighted_mean_of_its_sources() {
         .map(|g| ((g * 7919) % 31) as f64 / 7.0 - 2.0)
         .collect();
     let u = mat_vec(&t, &q);
-    let node = |grid: u32| body.node_of_grid(grid).unwrap();
+    let node = |grid: u32| body.node(grid).unwrap();
     for d in 0..3 {
         let at = |grid: u32| u[node(grid) * 6 + d];
         let mean = (at(1) + at(2) + 3.0 * at(3) + 3.0 * at(4)) / 8.0;
@@ -468,7 +468,7 @@ fn grids_and_masses_in_nested_cord2r_systems_land_in_basic() {
                 GRID,1,5,0.5,0.25,2.\nGRID,2,6,0.5,0.25,2.\n\
                 CONM2,9,1,5,4.,0.1,0.,0.\n,1.,,2.,,,3.\nENDDATA\n";
     let body = parse_str(deck).unwrap();
-    let at = |g: u32| body.mesh.nodes[body.node_of_grid(g).unwrap()];
+    let at = |g: u32| body.mesh.nodes[body.node(g).unwrap()];
     assert!(
         (at(1) - Vector3::new(3.0, 2.5, 3.25)).norm() < 1e-14,
         "{}",

@@ -84,7 +84,7 @@ pub struct NastranBody {
 
 impl NastranBody {
     /// Node index of GRID `grid`.
-    pub fn node_of_grid(&self, grid: u32) -> Result<usize, FeError> {
+    pub fn node(&self, grid: u32) -> Result<usize, FeError> {
         self.grid_index
             .get(&grid)
             .copied()
@@ -95,7 +95,7 @@ impl NastranBody {
     pub fn name_points(&mut self, points: &BTreeMap<String, u32>) -> Result<(), FeError> {
         for (name, &grid) in points {
             let node = self
-                .node_of_grid(grid)
+                .node(grid)
                 .map_err(|e| FeError::InvalidInput(format!("point '{name}': {e}")))?;
             self.mesh.named_nodes.insert(name.clone(), node);
         }
@@ -108,7 +108,7 @@ impl NastranBody {
         for (name, grids) in regions {
             let nodes = grids
                 .iter()
-                .map(|&g| self.node_of_grid(g))
+                .map(|&g| self.node(g))
                 .collect::<Result<Vec<_>, _>>()
                 .map_err(|e| FeError::InvalidInput(format!("region '{name}': {e}")))?;
             self.mesh.regions.insert(name.clone(), nodes);
