@@ -21,9 +21,11 @@ mod cvode {
     use std::os::raw::{c_int, c_void};
     use std::time::Instant;
 
+    use engine_mount_chassis::cosim::scene::{apply_inputs, build_model, outputs};
     use engine_mount_chassis::cosim::{
-        BodyOptions, Inputs, Outputs, Scene, Settings, Signal, RPM_TO_RAD_PER_S,
+        BodyOptions, Inputs, Outputs, Settings, Signal, RPM_TO_RAD_PER_S,
     };
+    use engine_mount_chassis::model::CoupledModel as Scene;
     use engine_mount_chassis::ode::{Bdf, BdfOptions, OdeProblem, Tolerance};
     use faer::linalg::solvers::Solve;
     use faer::Mat;
@@ -48,9 +50,9 @@ mod cvode {
             stiffness_scale: [Signal::constant(1.0); 4],
             damping_scale: [Signal::constant(1.0); 4],
         };
-        let mut s = Scene::build(&settings).expect("scene");
-        s.set_inputs(&inputs).expect("inputs");
-        let y0 = s.initial_state(0.0).expect("statics");
+        let (mut s, _) = build_model(&settings).expect("scene");
+        apply_inputs(&mut s, &inputs).expect("inputs");
+        let y0 = s.static_equilibrium(0.0).expect("statics");
         (s, y0)
     }
 
@@ -180,8 +182,8 @@ mod cvode {
             let (s, y0) = scene(number);
             let (ours, ours_steps, ours_t) = run_ours(s.clone(), &y0);
             let (theirs, cv_steps, cv_t) = run_cvode(s.clone(), &y0);
-            let a = forces(&s.outputs(T_END, &ours).expect("outputs"));
-            let b = forces(&s.outputs(T_END, &theirs).expect("outputs"));
+            let a = forces(&outputs(&s, T_END, &ours).expect("outputs"));
+            let b = forces(&outputs(&s, T_END, &theirs).expect("outputs"));
             let scale = b.iter().map(|x| x.abs()).fold(1e-30, f64::max);
             let diff = a
                 .iter()

@@ -94,7 +94,7 @@ fn checksum(reduced: &ReducedChassis) -> Result<String, String> {
 /// assembly, eigen solver, reduction). Hashing it into the key means an edited generator or
 /// solver can never be served a reduction computed by the old code, even without a bump of
 /// [`FORMAT_VERSION`]. A new file that affects the result must be added here.
-const ALGORITHM_SOURCES: [&str; 20] = [
+const ALGORITHM_SOURCES: [&str; 23] = [
     include_str!("../fe/assembly.rs"),
     include_str!("../fe/beam.rs"),
     include_str!("../fe/chassis.rs"),
@@ -104,8 +104,11 @@ const ALGORITHM_SOURCES: [&str; 20] = [
     include_str!("../fe/eigen.rs"),
     include_str!("../fe/mass.rs"),
     include_str!("../fe/mesh.rs"),
+    include_str!("../fe/links.rs"),
+    include_str!("../fe/nastran/cards.rs"),
     include_str!("../fe/nastran/lexer.rs"),
-    include_str!("../fe/nastran/model.rs"),
+    include_str!("../fe/nastran/to_mesh.rs"),
+    include_str!("../fe/shell3.rs"),
     include_str!("../fe/shell.rs"),
     include_str!("../fe/spring.rs"),
     include_str!("craig_bampton.rs"),

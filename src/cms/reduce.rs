@@ -114,10 +114,7 @@ fn deck_body(deck: &BulkDeckBody) -> Result<Chassis, CmsError> {
     let mut body = crate::fe::nastran::parse_str(&text).map_err(|e| {
         CmsError::InvalidInput(format!("bulk data deck {}: {e}", deck.path.display()))
     })?;
-    for (name, grid) in &deck.points {
-        let node = body.node(*grid)?;
-        body.mesh.named_nodes.insert(name.clone(), node);
-    }
+    body.name_points(&deck.points)?;
     crate::fe::checks::check_mesh(&body.mesh, &crate::fe::checks::CheckLimits::default())?;
     Ok(Chassis {
         mesh: body.mesh,
@@ -144,14 +141,18 @@ fn recovery_point(
             "recovery point '{name}' refers to missing node {node}"
         ))
     })?;
-    let rows: Vec<Option<usize>> = (0..DOF_PER_NODE).map(|d| dofs.global(node, d)).collect();
+    // A node of a rigid or interpolation link (RBE2, RBE3) moves with its independent nodes.
+    let rows = (0..DOF_PER_NODE)
+        .map(|d| dofs.motion_row(node, d))
+        .collect::<Result<Vec<_>, _>>()?;
     let shape = (0..modes.omega.len())
         .map(|k| {
             let mut row = [0.0; 6];
-            for (d, g) in rows.iter().enumerate() {
-                if let Some(g) = g {
-                    row[d] = modes.shapes[(*g, k)];
-                }
+            for (d, combination) in rows.iter().enumerate() {
+                row[d] = combination
+                    .iter()
+                    .map(|(g, c)| c * modes.shapes[(*g, k)])
+                    .sum();
             }
             row
         })

@@ -3,15 +3,16 @@
 use faer::sparse::{SparseColMat, Triplet};
 use nalgebra::{Dim, Matrix, RawStorage, Vector3};
 
-use super::dof::{DofMap, DOF_PER_NODE};
+use super::dof::{DofMap, Expansion, DOF_PER_NODE};
 use super::error::FeError;
 use super::mesh::Mesh;
-use super::{beam, mass, shell, spring};
+use super::{beam, links, mass, shell, shell3, spring};
 
 /// Sparse symmetric matrix type of the FE model (both triangles stored).
 pub type SparseMat = SparseColMat<usize, f64>;
 
-/// The assembled system: stiffness, lumped mass and viscous damping on the free DOFs.
+/// The assembled system: stiffness, lumped mass and viscous damping on the free DOFs. With
+/// rigid/interpolation links the matrices are Tᵀ K T etc. on the independent DOFs (u = T q).
 #[derive(Debug, Clone)]
 pub struct Assembled {
     /// Stiffness matrix (N/m, N m/rad).
@@ -35,16 +36,35 @@ impl TripletSink<'_> {
         nodes: &[usize],
         local: &Matrix<f64, R, C, S>,
     ) {
-        let index = |k: usize| self.dofs.global(nodes[k / DOF_PER_NODE], k % DOF_PER_NODE);
+        let dofs = self.dofs;
+        let index = |k: usize| {
+            dofs.expansion(nodes[k / DOF_PER_NODE], k % DOF_PER_NODE)
+                .unwrap_or(Expansion::Fixed)
+        };
         for j in 0..local.ncols() {
-            let Some(gj) = index(j) else { continue };
+            let ej = index(j);
+            if ej == Expansion::Fixed {
+                continue;
+            }
             for i in 0..local.nrows() {
                 let v = local[(i, j)];
                 if v == 0.0 {
                     continue;
                 }
-                if let Some(gi) = index(i) {
-                    self.entries.push(Triplet::new(gi, gj, v));
+                match (index(i), ej) {
+                    (Expansion::Fixed, _) => {}
+                    (Expansion::Equation(gi), Expansion::Equation(gj)) => {
+                        self.entries.push(Triplet::new(gi, gj, v));
+                    }
+                    // Dependent DOFs: the entry spreads as (Tᵀ K T)[a, b] += T[i, a] K[i, j] T[j, b].
+                    (ei, ej) => {
+                        let tj = terms(ej);
+                        for (gi, ci) in terms(ei) {
+                            for &(gj, cj) in &tj {
+                                self.entries.push(Triplet::new(gi, gj, ci * v * cj));
+                            }
+                        }
+                    }
                 }
             }
         }
@@ -53,6 +73,15 @@ impl TripletSink<'_> {
     fn finish(self, n: usize, what: &str) -> Result<SparseMat, FeError> {
         SparseColMat::try_new_from_triplets(n, n, &self.entries)
             .map_err(|e| FeError::Numerical(format!("building sparse {what}: {e:?}")))
+    }
+}
+
+/// The `(equation, coefficient)` terms of one DOF (the slow path: only for dependent DOFs).
+fn terms(e: Expansion<'_>) -> Vec<(usize, f64)> {
+    match e {
+        Expansion::Equation(g) => vec![(g, 1.0)],
+        Expansion::Fixed => Vec::new(),
+        Expansion::Combination(row) => row.to_vec(),
     }
 }
 
@@ -73,7 +102,11 @@ fn node_of(mesh: &Mesh, what: &str, node: usize) -> Result<Vector3<f64>, FeError
 
 /// Assembles K, M, C of `mesh` on the DOFs left free by `mesh.constraints`.
 pub fn assemble(mesh: &Mesh) -> Result<Assembled, FeError> {
-    let dofs = DofMap::new(mesh.nodes.len(), &mesh.constraints)?;
+    let dofs = DofMap::with_links(
+        mesh.nodes.len(),
+        &mesh.constraints,
+        &links::equations(mesh)?,
+    )?;
     let n = dofs.n_free();
     let mut k = TripletSink {
         dofs: &dofs,
@@ -104,6 +137,16 @@ pub fn assemble(mesh: &Mesh) -> Result<Assembled, FeError> {
         ];
         k.scatter(&s.nodes, &shell::stiffness(i, s, &p)?);
         m.scatter(&s.nodes, &shell::lumped_mass(i, s, &p)?);
+    }
+    for (i, t) in mesh.triangles.iter().enumerate() {
+        let what = format!("triangle {i}");
+        let p = [
+            node_of(mesh, &what, t.nodes[0])?,
+            node_of(mesh, &what, t.nodes[1])?,
+            node_of(mesh, &what, t.nodes[2])?,
+        ];
+        k.scatter(&t.nodes, &shell3::stiffness(i, t, &p)?);
+        m.scatter(&t.nodes, &shell3::lumped_mass(i, t, &p)?);
     }
     for (i, pm) in mesh.masses.iter().enumerate() {
         node_of(mesh, &format!("point mass {i}"), pm.node)?;
@@ -187,6 +230,44 @@ mod tests {
             assert_eq!(k[(d, d)], 130.0);
             assert_eq!(c[(d, d)], 1.0);
         }
+    }
+
+    #[test]
+    fn a_rigidly_linked_point_mass_moves_to_the_independent_node_with_its_lever_arm() {
+        use crate::fe::mesh::{PointMass, RigidLink};
+        use nalgebra::Matrix3;
+        let mut mesh = two_nodes();
+        mesh.nodes[1] = Vector3::new(0.5, -0.2, 0.3);
+        mesh.ground_springs.push(GroundSpring {
+            node: 0,
+            stiffness: [1.0; 6],
+            damping: [0.0; 6],
+        });
+        mesh.masses.push(PointMass {
+            node: 1,
+            mass: 2.0,
+            inertia: Matrix3::from_diagonal(&Vector3::new(0.1, 0.2, 0.3)),
+        });
+        mesh.rigid_links.push(RigidLink {
+            independent: 0,
+            dependent: vec![1],
+            components: [true; 6],
+        });
+        let a = assemble(&mesh).unwrap();
+        assert_eq!(a.dofs.n_free(), 6);
+        let m = a.m.to_dense();
+        // Parallel-axis theorem: J + m (|r|² I − r rᵀ); coupling m [r]× between u and θ.
+        let r = mesh.nodes[1];
+        let j = Matrix3::from_diagonal(&Vector3::new(0.1, 0.2, 0.3))
+            + 2.0 * (r.norm_squared() * Matrix3::identity() - r * r.transpose());
+        for p in 0..3 {
+            assert!((m[(p, p)] - 2.0).abs() < 1e-14);
+            for q in 0..3 {
+                assert!((m[(3 + p, 3 + q)] - j[(p, q)]).abs() < 1e-14);
+            }
+        }
+        // Translation x couples to rotation y through z-offset: ∂(u + θ × r)_x/∂θ_y = r_z.
+        assert!((m[(0, 4)] - 2.0 * r.z).abs() < 1e-14);
     }
 
     #[test]

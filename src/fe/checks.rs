@@ -6,7 +6,7 @@ use nalgebra::Vector3;
 use super::assembly::Assembled;
 use super::error::FeError;
 use super::mesh::Mesh;
-use super::shell;
+use super::{shell, shell3};
 
 /// Limits of the geometric checks.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -127,6 +127,24 @@ pub fn check_mesh(mesh: &Mesh, limits: &CheckLimits) -> Result<(), FeError> {
             has_stiffness[k] = true;
         }
     }
+    for (i, t) in mesh.triangles.iter().enumerate() {
+        let pts: Option<Vec<Vector3<f64>>> = t.nodes.iter().map(|&k| node(mesh, k)).collect();
+        let Some(pts) = pts else {
+            problems.push(format!("triangle {i}: node {:?} does not exist", t.nodes));
+            continue;
+        };
+        match shell3::geometry(i, &[pts[0], pts[1], pts[2]]) {
+            Err(e) => problems.push(e.to_string()),
+            Ok(g) if g.area < limits.min_shell_area => {
+                problems.push(format!("triangle {i}: degenerate (area {:.3e} m²)", g.area))
+            }
+            Ok(_) => {}
+        }
+        for &k in &t.nodes {
+            connected[k] = true;
+            has_stiffness[k] = true;
+        }
+    }
     for (i, m) in mesh.masses.iter().enumerate() {
         match connected.get_mut(m.node) {
             Some(c) => *c = true,
@@ -144,6 +162,20 @@ pub fn check_mesh(mesh: &Mesh, limits: &CheckLimits) -> Result<(), FeError> {
             match connected.get_mut(k) {
                 Some(c) => *c = true,
                 None => problems.push(format!("spring {i}: node {k} does not exist")),
+            }
+        }
+    }
+    // A node tied by a rigid or interpolation link is held by the link (or holds it): count it
+    // as structurally connected; a link on a node without any real stiffness shows up as a
+    // singular DOF in `check_assembled`.
+    for (what, nodes) in link_node_sets(mesh) {
+        for k in nodes {
+            match connected.get_mut(k) {
+                Some(c) => {
+                    *c = true;
+                    has_stiffness[k] = true;
+                }
+                None => problems.push(format!("{what}: node {k} does not exist")),
             }
         }
     }
@@ -175,6 +207,21 @@ pub fn check_mesh(mesh: &Mesh, limits: &CheckLimits) -> Result<(), FeError> {
     report(problems)
 }
 
+/// The nodes of every rigid and interpolation link, named for messages.
+fn link_node_sets(mesh: &Mesh) -> Vec<(String, Vec<usize>)> {
+    let rigid = mesh.rigid_links.iter().enumerate().map(|(i, l)| {
+        let mut nodes = vec![l.independent];
+        nodes.extend(&l.dependent);
+        (format!("rigid link {i}"), nodes)
+    });
+    let interpolation = mesh.interpolation_links.iter().enumerate().map(|(i, l)| {
+        let mut nodes = vec![l.reference];
+        nodes.extend(l.sources.iter().flat_map(|s| s.nodes.iter().copied()));
+        (format!("interpolation link {i}"), nodes)
+    });
+    rigid.chain(interpolation).collect()
+}
+
 fn find(parent: &mut [usize], mut i: usize) -> usize {
     while parent[i] != i {
         parent[i] = parent[parent[i]];
@@ -203,7 +250,9 @@ fn disconnected_parts(
         .iter()
         .map(|b| b.nodes.to_vec())
         .chain(mesh.shells.iter().map(|s| s.nodes.to_vec()))
-        .chain(mesh.springs.iter().map(|s| s.nodes.to_vec()));
+        .chain(mesh.triangles.iter().map(|t| t.nodes.to_vec()))
+        .chain(mesh.springs.iter().map(|s| s.nodes.to_vec()))
+        .chain(link_node_sets(mesh).into_iter().map(|(_, nodes)| nodes));
     for nodes in links {
         for w in nodes.windows(2) {
             join(w[0], w[1]);

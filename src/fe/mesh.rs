@@ -101,6 +101,22 @@ pub struct Shell {
     pub extra_mass_per_area: f64,
 }
 
+/// Three-node flat shell (CST membrane with drilling rotation + DKT plate, lumped mass); the
+/// fields mean what they mean for [`Shell`].
+#[derive(Debug, Clone, PartialEq)]
+pub struct TriShell {
+    /// Corner nodes, counter-clockwise seen from the side the normal points to.
+    pub nodes: [usize; 3],
+    /// Material.
+    pub material: Material,
+    /// Thickness (m) (membrane stiffness and mass).
+    pub thickness: f64,
+    /// Effective thickness for plate bending (m).
+    pub bending_thickness: f64,
+    /// Non-structural mass per area (kg/m²).
+    pub extra_mass_per_area: f64,
+}
+
 /// Point mass with rotary inertia (global axes) at a node.
 #[derive(Debug, Clone, PartialEq)]
 pub struct PointMass {
@@ -134,6 +150,43 @@ pub struct Spring {
     pub damping: [f64; 6],
 }
 
+/// Rigid element (Nastran RBE2): the listed components of every dependent node follow the
+/// small-displacement rigid-body motion of the independent node,
+/// u_d = u_i + θ_i × (x_d − x_i), θ_d = θ_i. Eliminated exactly in assembly.
+#[derive(Debug, Clone, PartialEq)]
+pub struct RigidLink {
+    /// Node whose six DOFs drive the link.
+    pub independent: usize,
+    /// Nodes that follow it.
+    pub dependent: Vec<usize>,
+    /// Which local DOFs (ux uy uz rx ry rz) of the dependent nodes are tied.
+    pub components: [bool; 6],
+}
+
+/// One group of source nodes of an [`InterpolationLink`] with a common weight.
+#[derive(Debug, Clone, PartialEq)]
+pub struct InterpolationSource {
+    /// Nodes of the group.
+    pub nodes: Vec<usize>,
+    /// Weight (> 0) of the group.
+    pub weight: f64,
+    /// Which local DOFs of these nodes take part in the average.
+    pub components: [bool; 6],
+}
+
+/// Interpolation element (Nastran RBE3): the reference node moves with the rigid-body motion
+/// that best fits, in the weighted least-squares sense, the motion of the source nodes. Adds no
+/// stiffness; eliminated exactly in assembly. See [`crate::fe::links`] for the weighting.
+#[derive(Debug, Clone, PartialEq)]
+pub struct InterpolationLink {
+    /// The dependent reference node.
+    pub reference: usize,
+    /// Which local DOFs of the reference node are dependent.
+    pub reference_components: [bool; 6],
+    /// Weighted source node groups.
+    pub sources: Vec<InterpolationSource>,
+}
+
 /// A complete FE model description before assembly.
 #[derive(Debug, Clone, Default, PartialEq)]
 pub struct Mesh {
@@ -143,6 +196,8 @@ pub struct Mesh {
     pub beams: Vec<Beam>,
     /// Shell elements.
     pub shells: Vec<Shell>,
+    /// Three-node shell elements.
+    pub triangles: Vec<TriShell>,
     /// Point masses.
     pub masses: Vec<PointMass>,
     /// Springs to ground.
@@ -151,6 +206,10 @@ pub struct Mesh {
     pub springs: Vec<Spring>,
     /// Fixed DOFs `(node, local dof 0..5)`.
     pub constraints: Vec<(usize, usize)>,
+    /// Rigid elements (dependent DOFs eliminated in assembly).
+    pub rigid_links: Vec<RigidLink>,
+    /// Interpolation elements (dependent reference DOFs eliminated in assembly).
+    pub interpolation_links: Vec<InterpolationLink>,
     /// Named special nodes (engine mounts, steering wheel, seat rail, wheel centres …).
     pub named_nodes: BTreeMap<String, usize>,
     /// Named node sets used to describe mode shapes (steering column, front end …).

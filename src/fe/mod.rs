@@ -27,8 +27,12 @@
 //! # }
 //! ```
 //!
+//! Rigid and interpolation links (RBE2/RBE3, [`links`]) are eliminated exactly in assembly.
+//! [`nastran`] reads and writes Nastran bulk data.
+//!
 //! Elements: [`beam`] (Euler-Bernoulli, 12 DOF, HRZ-lumped mass), [`shell`] (QM6 membrane
-//! with Hughes–Brezzi drilling rotation + MITC4 plate, lumped mass), [`mass`] (point mass with
+//! with Hughes–Brezzi drilling rotation + MITC4 plate, lumped mass), [`shell3`] (CST membrane +
+//! DKT plate), [`mass`] (point mass with
 //! rotary inertia), [`spring`] (grounded and two-node spring-dampers).
 
 pub mod assembly;
@@ -40,11 +44,13 @@ pub mod dof;
 pub mod eigen;
 pub mod error;
 pub mod export;
+pub mod links;
 pub mod mass;
 pub mod mesh;
 pub mod modal;
 pub mod nastran;
 pub mod shell;
+pub mod shell3;
 pub mod spring;
 
 pub use error::FeError;

@@ -8,6 +8,7 @@ use nalgebra::{Matrix6, Vector3, Vector6};
 
 use super::assembly::{mat_vec, Assembled};
 use super::chassis::{region, STEERING_WHEEL};
+use super::dof::Expansion;
 use super::eigen::Modes;
 use super::error::FeError;
 use super::mesh::Mesh;
@@ -90,9 +91,12 @@ impl ModeDescription {
 fn translation(asm: &Assembled, shape: &[f64], node: usize) -> Vector3<f64> {
     let mut u = Vector3::zeros();
     for d in 0..3 {
-        if let Some(g) = asm.dofs.global(node, d) {
-            u[d] = shape[g];
-        }
+        // A node on a rigid/interpolation link moves with its row of T.
+        u[d] = match asm.dofs.expansion(node, d) {
+            Some(Expansion::Equation(g)) => shape[g],
+            Some(Expansion::Combination(row)) => row.iter().map(|&(g, c)| c * shape[g]).sum(),
+            _ => 0.0,
+        };
     }
     u
 }

@@ -1,175 +1,305 @@
-//! Bulk data text → cards: free field (comma separated) and small field (8 columns), with
-//! continuation lines, comments, and the `BEGIN BULK` … `ENDDATA` section.
+//! Bulk data lines → cards of fields: small field (8 columns), large field (16 columns, `*`),
+//! free field (commas), continuation lines (`+`, `*` or blank first field), `$` comments,
+//! optional executive/case control before `BEGIN BULK`, `ENDDATA`. Also Nastran's number forms.
 
-use crate::fe::FeError;
+use crate::fe::error::FeError;
 
-/// One bulk data card: its name, its data fields (field 2 on; continuation lines appended eight
-/// at a time) and the line it starts on.
+/// One data field with where it came from.
 #[derive(Debug, Clone, PartialEq)]
-pub struct Card {
-    pub name: String,
-    pub fields: Vec<String>,
+pub struct Field {
+    /// Trimmed, upper-case text ("" for blank).
+    pub text: String,
+    /// 1-based line number in the file.
     pub line: usize,
+    /// Nastran field number on that line (2..9 small/free field, 2..5 large field).
+    pub position: usize,
 }
 
-impl Card {
-    fn error(&self, field: usize, message: &str) -> FeError {
-        FeError::InvalidInput(format!(
-            "{} card on line {}, field {}: {message}",
-            self.name,
-            self.line,
-            field + 2
-        ))
-    }
-
-    fn raw(&self, field: usize) -> &str {
-        self.fields.get(field).map(|s| s.trim()).unwrap_or("")
-    }
-
-    /// Whether data field `field` (0 = the card's field 2) is blank.
-    pub fn blank(&self, field: usize) -> bool {
-        self.raw(field).is_empty()
-    }
-
-    /// An integer field; `default` when blank (`None`: required).
-    pub fn int(&self, field: usize, default: Option<i64>) -> Result<i64, FeError> {
-        let text = self.raw(field);
-        if text.is_empty() {
-            return default.ok_or_else(|| self.error(field, "a required integer is missing"));
-        }
-        text.parse()
-            .map_err(|_| self.error(field, &format!("\"{text}\" is not an integer")))
-    }
-
-    /// A real field in Nastran's forms (`1.5`, `1.5E-3`, `1.5-3`, `.5`, `7.85+3`, `1.D6`);
-    /// `default` when blank (`None`: required).
-    pub fn real(&self, field: usize, default: Option<f64>) -> Result<f64, FeError> {
-        let text = self.raw(field);
-        if text.is_empty() {
-            return default.ok_or_else(|| self.error(field, "a required real is missing"));
-        }
-        parse_real(text)
-            .filter(|x| x.is_finite())
-            .ok_or_else(|| self.error(field, &format!("\"{text}\" is not a real number")))
-    }
-
-    /// The text of a field (upper case), empty when blank.
-    pub fn text(&self, field: usize) -> String {
-        self.raw(field).to_ascii_uppercase()
-    }
-
-    /// An error about the card as a whole.
-    pub fn invalid(&self, message: &str) -> FeError {
-        FeError::InvalidInput(format!(
-            "{} card on line {}: {message}",
-            self.name, self.line
-        ))
-    }
+/// A card: its name and data fields (Nastran field 2 of the first line onwards, continuation
+/// markers removed).
+#[derive(Debug, Clone, PartialEq)]
+pub struct RawCard {
+    /// Upper-case name without the large-field `*`.
+    pub name: String,
+    /// 1-based line of the card's first line.
+    pub line: usize,
+    /// Data fields in order.
+    pub fields: Vec<Field>,
 }
 
-/// Nastran's real number forms; an integer is not a real (Nastran insists on the point).
+/// The bulk data cards and what the case control selects.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Deck {
+    /// Cards in file order.
+    pub cards: Vec<RawCard>,
+    /// `SPC = n` of the case control, if any.
+    pub spc_selection: Option<u32>,
+}
+
+/// A field's value by Nastran's typing rules: integers have no decimal point or exponent, reals
+/// do (`1.`, `.5`, `1.5-3`, `7.85+3`, `2.1E11`, `1.D0`), character values start with a letter.
+#[derive(Debug, Clone, PartialEq)]
+pub enum Value {
+    /// Empty field.
+    Blank,
+    /// Integer.
+    Int(i64),
+    /// Real.
+    Real(f64),
+    /// Character string.
+    Text(String),
+}
+
+/// Classifies a trimmed, upper-case field.
+pub fn classify(text: &str) -> Result<Value, String> {
+    if text.is_empty() {
+        return Ok(Value::Blank);
+    }
+    let first = text.chars().next().unwrap_or(' ');
+    if first.is_ascii_alphabetic() {
+        return if text.chars().all(|c| c.is_ascii_alphanumeric() || c == '_') {
+            Ok(Value::Text(text.to_string()))
+        } else {
+            Err(format!("'{text}' is not a valid character value"))
+        };
+    }
+    let unsigned = text.strip_prefix(['+', '-']).unwrap_or(text);
+    if !unsigned.is_empty() && unsigned.chars().all(|c| c.is_ascii_digit()) {
+        return text
+            .parse::<i64>()
+            .map(Value::Int)
+            .map_err(|_| format!("integer '{text}' is out of range"));
+    }
+    parse_real(text)
+        .map(Value::Real)
+        .ok_or_else(|| format!("'{text}' is not a number"))
+}
+
+/// Parses a Nastran real: optional sign, mantissa with a decimal point, optional exponent
+/// written `E±n`, `D±n` or just `±n` (`1.5-3` = 1.5e-3).
 pub fn parse_real(text: &str) -> Option<f64> {
-    let t = text.trim().to_ascii_uppercase().replace('D', "E");
-    if !t.contains('.') {
+    let (sign, body) = match text.as_bytes().first()? {
+        b'-' => ("-", &text[1..]),
+        b'+' => ("", &text[1..]),
+        _ => ("", text),
+    };
+    let (mantissa, exponent) = match body.find(['E', 'D', 'e', 'd']) {
+        Some(p) => (&body[..p], Some(&body[p + 1..])),
+        None => match body.find(['+', '-']) {
+            Some(p) if p > 0 => (&body[..p], Some(&body[p..])),
+            _ => (body, None),
+        },
+    };
+    let digits = mantissa.chars().filter(|c| c.is_ascii_digit()).count();
+    let dots = mantissa.chars().filter(|&c| c == '.').count();
+    if digits == 0 || dots > 1 || digits + dots != mantissa.len() {
         return None;
     }
-    if let Ok(x) = t.parse::<f64>() {
-        return Some(x);
+    if exponent.is_none() && dots == 0 {
+        return None; // an integer, not a real
     }
-    // Exponent without the letter: a sign after the mantissa's first character.
-    let bytes = t.as_bytes();
-    let split = (1..bytes.len())
-        .find(|&i| (bytes[i] == b'+' || bytes[i] == b'-') && bytes[i - 1] != b'E')?;
-    let (mantissa, exponent) = t.split_at(split);
-    format!("{mantissa}E{exponent}").parse().ok()
-}
-
-/// Fields of one line: the card-name field and up to eight data fields.
-fn split_line(line: &str) -> (String, Vec<String>) {
-    if line.contains(',') {
-        let mut parts = line.split(',').map(|s| s.trim().to_owned());
-        let first = parts.next().unwrap_or_default();
-        let mut data: Vec<String> = parts.collect();
-        data.truncate(8);
-        (first, data)
-    } else {
-        let chars: Vec<char> = line.chars().collect();
-        let field = |k: usize| -> String {
-            let start = 8 * k;
-            if start >= chars.len() {
-                return String::new();
+    let exponent = match exponent {
+        None => String::new(),
+        Some(e) => {
+            let unsigned = e.strip_prefix(['+', '-']).unwrap_or(e);
+            if unsigned.is_empty() || !unsigned.chars().all(|c| c.is_ascii_digit()) {
+                return None;
             }
-            chars[start..(start + 8).min(chars.len())]
-                .iter()
-                .collect::<String>()
-                .trim()
-                .to_owned()
-        };
-        let first = field(0);
-        let data = (1..9).map(field).collect();
-        (first, data)
+            format!("e{e}")
+        }
+    };
+    let value: f64 = format!("{sign}{mantissa}{exponent}").parse().ok()?;
+    value.is_finite().then_some(value)
+}
+
+fn strip_comment(line: &str) -> &str {
+    match line.find('$') {
+        Some(p) => &line[..p],
+        None => line,
     }
 }
 
-/// The cards of a bulk data deck. Lines before `BEGIN BULK` (executive and case control) are
-/// skipped when the deck has that line; reading stops at `ENDDATA`. Large-field (`*`) cards are
-/// refused with their line.
-pub fn cards(text: &str) -> Result<Vec<Card>, FeError> {
-    let lines: Vec<&str> = text.lines().collect();
-    let begin = lines
+/// Tabs expand to the next multiple of 8 columns (the fixed-field grid).
+fn expand_tabs(line: &str) -> String {
+    let mut out = String::with_capacity(line.len() + 8);
+    for c in line.chars() {
+        if c == '\t' {
+            let n = 8 - out.chars().count() % 8;
+            out.extend(std::iter::repeat_n(' ', n));
+        } else {
+            out.push(c);
+        }
+    }
+    out
+}
+
+fn column_slice(chars: &[char], from: usize, width: usize) -> String {
+    chars
         .iter()
-        .position(|l| {
-            l.trim_start()
-                .to_ascii_uppercase()
-                .starts_with("BEGIN BULK")
-        })
-        .map_or(0, |i| i + 1);
-    let mut cards: Vec<Card> = Vec::new();
-    for (i, raw) in lines.iter().enumerate().skip(begin) {
-        let number = i + 1;
-        let line = raw.split('$').next().unwrap_or("").trim_end();
+        .skip(from)
+        .take(width)
+        .collect::<String>()
+        .trim()
+        .to_ascii_uppercase()
+}
+
+fn lex_error(line: usize, message: impl std::fmt::Display) -> FeError {
+    FeError::InvalidInput(format!("Nastran bulk data line {line}: {message}"))
+}
+
+/// Splits one bulk data line into its first field and data fields `(text, position)`.
+fn split_line(line: &str, lineno: usize) -> Result<(String, Vec<(String, usize)>), FeError> {
+    if line.contains(',') {
+        let parts: Vec<String> = line
+            .split(',')
+            .map(|p| p.trim().to_ascii_uppercase())
+            .collect();
+        let first = parts[0].clone();
+        let per_line = if first.ends_with('*') { 4 } else { 8 };
+        let data = &parts[1..];
+        // The field after the data fields is the (ignored) continuation field; beyond it the
+        // line is malformed.
+        if data.len() > per_line + 1 {
+            return Err(lex_error(
+                lineno,
+                format!(
+                    "free-field line has {} data fields, at most {per_line} plus a continuation \
+                     field are allowed",
+                    data.len()
+                ),
+            ));
+        }
+        // A short line still stands for all its fields: the next line continues at field 2.
+        let fields = (0..per_line)
+            .map(|k| (data.get(k).cloned().unwrap_or_default(), k + 2))
+            .collect();
+        return Ok((first, fields));
+    }
+    let chars: Vec<char> = expand_tabs(line).chars().collect();
+    let first = column_slice(&chars, 0, 8);
+    let (per_line, width) = if first.ends_with('*') {
+        (4, 16)
+    } else {
+        (8, 8)
+    };
+    let mut fields = Vec::with_capacity(per_line);
+    for k in 0..per_line {
+        let text = column_slice(&chars, 8 + k * width, width);
+        if text.contains(char::is_whitespace) {
+            return Err(lex_error(
+                lineno,
+                format!(
+                    "field {} '{text}' contains a blank (fixed-format fields are {width} columns \
+                     wide; check the alignment)",
+                    k + 2
+                ),
+            ));
+        }
+        fields.push((text, k + 2));
+    }
+    Ok((first, fields))
+}
+
+fn is_begin_bulk(line: &str) -> bool {
+    let compact: String = strip_comment(line)
+        .chars()
+        .filter(|c| !c.is_whitespace() && *c != ',')
+        .collect::<String>()
+        .to_ascii_uppercase();
+    compact.starts_with("BEGINBULK")
+}
+
+/// `SPC = n` in a case control line.
+fn case_control_spc(line: &str, lineno: usize) -> Result<Option<u32>, FeError> {
+    let upper = strip_comment(line).trim().to_ascii_uppercase();
+    let Some(rest) = upper.strip_prefix("SPC") else {
+        return Ok(None);
+    };
+    let Some(value) = rest.trim_start().strip_prefix('=') else {
+        return Ok(None);
+    };
+    value.trim().parse::<u32>().map(Some).map_err(|_| {
+        lex_error(
+            lineno,
+            format!("case control '{}' is not SPC = <set id>", upper),
+        )
+    })
+}
+
+/// Splits `text` into cards.
+pub fn lex(text: &str) -> Result<Deck, FeError> {
+    let has_begin_bulk = text.lines().any(is_begin_bulk);
+    let mut in_bulk = !has_begin_bulk;
+    let mut spc_selection: Option<u32> = None;
+    let mut cards: Vec<RawCard> = Vec::new();
+    for (k, raw) in text.lines().enumerate() {
+        let lineno = k + 1;
+        if !in_bulk {
+            if is_begin_bulk(raw) {
+                in_bulk = true;
+            } else if let Some(set) = case_control_spc(raw, lineno)? {
+                if spc_selection.is_some_and(|s| s != set) {
+                    return Err(lex_error(
+                        lineno,
+                        "subcases select different SPC sets; one body needs one set of supports",
+                    ));
+                }
+                spc_selection = Some(set);
+            }
+            continue;
+        }
+        let line = strip_comment(raw.trim_end_matches('\r'));
         if line.trim().is_empty() {
             continue;
         }
-        if line
-            .trim_start()
-            .to_ascii_uppercase()
-            .starts_with("ENDDATA")
-        {
+        let head = line.trim_start().to_ascii_uppercase();
+        if head.starts_with("ENDDATA") {
             break;
         }
-        let (first, data) = split_line(line);
-        let continuation = first.is_empty() || first.starts_with('+') || first.starts_with('*');
-        if continuation {
-            if first.starts_with('*') {
-                return Err(FeError::InvalidInput(format!(
-                    "line {number}: large-field continuation (*) is not supported; use free or small field"
-                )));
-            }
-            let Some(card) = cards.last_mut() else {
-                return Err(FeError::InvalidInput(format!(
-                    "line {number}: a continuation line without a card before it"
-                )));
-            };
-            // The previous line's data fields count as eight, blanks included.
-            let filled = card.fields.len().div_ceil(8).max(1) * 8;
-            card.fields.resize(filled, String::new());
-            card.fields.extend(data);
-            continue;
+        if head.starts_with("INCLUDE") {
+            return Err(lex_error(
+                lineno,
+                "INCLUDE is not supported: merge the included file into one bulk data file",
+            ));
         }
-        let name = first.to_ascii_uppercase();
-        if name.ends_with('*') {
-            return Err(FeError::InvalidInput(format!(
-                "line {number}: large-field card {name} is not supported; use free or small field"
-            )));
+        if !line.is_ascii() {
+            return Err(lex_error(lineno, "non-ASCII character in bulk data"));
         }
-        cards.push(Card {
-            name,
-            fields: data,
-            line: number,
+        let (first, data) = split_line(line, lineno)?;
+        let fields = data.into_iter().map(|(text, position)| Field {
+            text,
+            line: lineno,
+            position,
         });
+        if first.is_empty() || first.starts_with('+') || first.starts_with('*') {
+            let Some(card) = cards.last_mut() else {
+                return Err(lex_error(
+                    lineno,
+                    "continuation line without a card before it",
+                ));
+            };
+            card.fields.extend(fields);
+        } else {
+            let name = first.trim_end_matches('*').to_string();
+            if name.is_empty() || !name.chars().all(|c| c.is_ascii_alphanumeric()) {
+                return Err(lex_error(lineno, format!("'{first}' is not a card name")));
+            }
+            cards.push(RawCard {
+                name,
+                line: lineno,
+                fields: fields.collect(),
+            });
+        }
     }
-    Ok(cards)
+    for card in &mut cards {
+        while card.fields.last().is_some_and(|f| f.text.is_empty()) {
+            card.fields.pop();
+        }
+    }
+    Ok(Deck {
+        cards,
+        spc_selection,
+    })
 }
 
 #[cfg(test)]
@@ -177,60 +307,82 @@ mod tests {
     use super::*;
 
     #[test]
-    fn nastran_reals() {
+    fn nastran_reals_in_all_their_forms() {
         for (text, value) in [
-            ("1.5", 1.5),
-            ("1.5E-3", 1.5e-3),
             ("1.5-3", 1.5e-3),
             (".5", 0.5),
             ("7.85+3", 7850.0),
-            ("-2.+4", -2.0e4),
-            ("1.D6", 1.0e6),
-            ("2.1e11", 2.1e11),
+            ("-2.1E+11", -2.1e11),
+            ("1.D0", 1.0),
+            ("5.", 5.0),
+            ("-.25E-2", -0.0025),
+            ("+3.", 3.0),
+            ("1E3", 1000.0),
         ] {
-            assert_eq!(parse_real(text), Some(value), "{text}");
+            assert_eq!(classify(text), Ok(Value::Real(value)), "{text}");
         }
-        assert_eq!(parse_real("3"), None);
-        assert_eq!(parse_real("abc"), None);
+        assert_eq!(classify("12"), Ok(Value::Int(12)));
+        assert_eq!(classify("-7"), Ok(Value::Int(-7)));
+        assert_eq!(classify(""), Ok(Value::Blank));
+        assert_eq!(classify("THRU"), Ok(Value::Text("THRU".into())));
+        for bad in ["1.2.3", "1.5-", "--1.", "1..", ".", "1.5E", "3,", "1.0X"] {
+            assert!(classify(bad).is_err(), "{bad}");
+        }
     }
 
     #[test]
-    fn free_and_small_field_with_continuations_and_comments() {
-        let deck = "SOL 103\nCEND\nBEGIN BULK\n$ a comment\nGRID,1,,0.,1.,2.\n\
-                    GRID    2               1.      2.      3.\n\
-                    CONM2   7       2               5.      \n\
-                    +       1.      0.      2.      0.      0.      3.\n\
-                    CONM2,8,1,,4.,,,,,+\n+,1.,,1.,,,1.\nENDDATA\nGRID,9,,0.,0.,0.\n";
-        let cards = cards(deck).unwrap();
-        assert_eq!(cards.len(), 4);
-        assert_eq!(cards[0].name, "GRID");
-        assert_eq!(cards[0].line, 5);
-        assert_eq!(cards[0].real(2, None).unwrap(), 0.0);
-        assert_eq!(cards[1].real(3, None).unwrap(), 2.0);
-        assert_eq!(cards[2].int(1, None).unwrap(), 2);
-        assert_eq!(cards[2].real(3, None).unwrap(), 5.0);
-        assert_eq!(cards[2].real(8, None).unwrap(), 1.0);
-        assert_eq!(cards[2].real(13, None).unwrap(), 3.0);
-        assert_eq!(cards[3].real(8, None).unwrap(), 1.0);
-        assert_eq!(cards[3].real(10, None).unwrap(), 1.0);
-        assert_eq!(cards[3].real(13, None).unwrap(), 1.0);
+    fn small_large_and_free_field_give_the_same_card() {
+        let small = "GRID           1       0      1.     2.5   -3.-2\n";
+        let large = "GRID*                  1               0              1.             2.5\n\
+                     *             -3.-2\n";
+        let free = "GRID,1,0,1.,2.5,-3.-2\n";
+        let texts = |t: &str| -> Vec<String> {
+            lex(t).unwrap().cards[0]
+                .fields
+                .iter()
+                .map(|f| f.text.clone())
+                .collect()
+        };
+        let expected: Vec<String> = ["1", "0", "1.", "2.5", "-3.-2"].map(String::from).to_vec();
+        assert_eq!(texts(small), expected);
+        assert_eq!(texts(large), expected);
+        assert_eq!(texts(free), expected);
     }
 
     #[test]
-    fn malformed_fields_name_card_line_and_field() {
-        let c = cards("GRID,1,,0.,x,0.\n").unwrap();
-        let e = c[0].real(3, None).unwrap_err().to_string();
-        assert!(
-            e.contains("GRID card on line 1, field 5") && e.contains("\"x\""),
-            "{e}"
+    fn continuations_comments_and_control_sections() {
+        let deck = concat!(
+            "SOL 103\nCEND\nSUBCASE 1\n  SPC = 7\nBEGIN BULK\n",
+            "$ a comment line\n",
+            "CBAR,1,2,3,4,0.,0.,1.,,+C1 $ trailing comment\n",
+            "+C1,,,1.0\n",
+            "CQUAD4         5       6       1       2       3       4\n",
+            "        0.\n",
+            "ENDDATA\nGARBAGE after enddata\n",
         );
-        assert!(cards("GRID*   1\n")
-            .unwrap_err()
-            .to_string()
-            .contains("line 1"));
-        assert!(cards("+,1.\n")
-            .unwrap_err()
-            .to_string()
-            .contains("without a card"));
+        let d = lex(deck).unwrap();
+        assert_eq!(d.spc_selection, Some(7));
+        assert_eq!(d.cards.len(), 2);
+        let bar = &d.cards[0];
+        assert_eq!((bar.name.as_str(), bar.line), ("CBAR", 7));
+        assert_eq!(bar.fields.len(), 11);
+        assert_eq!(bar.fields[10].text, "1.0");
+        assert_eq!((bar.fields[10].line, bar.fields[10].position), (8, 4));
+        let quad = &d.cards[1];
+        assert_eq!(quad.fields.len(), 9);
+        assert_eq!(quad.fields[8].text, "0.");
+    }
+
+    #[test]
+    fn misaligned_fixed_field_and_orphan_continuation_name_the_line() {
+        let err = lex("GRID    1 2\n").unwrap_err().to_string();
+        assert!(err.contains("line 1") && err.contains("field 2"), "{err}");
+        let err = lex("\n+C1,1\n").unwrap_err().to_string();
+        assert!(
+            err.contains("line 2") && err.contains("continuation"),
+            "{err}"
+        );
+        let err = lex("INCLUDE 'x.bdf'\n").unwrap_err().to_string();
+        assert!(err.contains("INCLUDE"), "{err}");
     }
 }

@@ -1,38 +1,131 @@
-//! A user's body from a Nastran bulk data deck (free field and small field).
+//! Nastran bulk data input and output: a user's car body as a [`Mesh`].
 //!
-//! Supported: `GRID` (in the basic system or a `CORD2R`; permanent constraints), `CORD2R`,
-//! `CQUAD4` with `PSHELL` (membrane and bending thickness via 12I/T³, non-structural mass),
-//! `CBAR`/`CBEAM` with `PBAR`/`PBEAM` (constant section, orientation vector or G0), `MAT1`,
-//! `CONM2` (at its grid, with rotary inertia), `CELAS1`/`PELAS`, `CELAS2`, `CDAMP2` (to ground or
-//! between like components of two grids), `SPC1` (with `THRU`); `PARAM`, `EIGRL`, `EIGR` are
-//! accepted and ignored. Everything else — `CTRIA3`, `RBE2`, `RBE3`, offsets, pin flags,
-//! large-field cards, other cards — is an error naming the card and its line: nothing is silently
-//! dropped. Mount and output points are grids, named by their GRID id in the vehicle
-//! configuration.
+//! Reading: [`read_bulk_deck`] / [`parse_str`] → [`NastranBody`] (mesh + GRID id → node index).
+//! Formats: small field, large field (`*`), free field (commas), continuations (`+`, `*`,
+//! blank first field), `$` comments, optional executive and case control before `BEGIN BULK`
+//! (only `SPC = n` is read from it), `ENDDATA`. Units are taken as given (use SI: m, kg, s, N).
 //!
-//! [`write_bulk_deck`] writes a [`Mesh`] of these elements back (free field, full precision).
+//! Cards and how they map:
+//! - GRID (CP → CORD2R, coordinates converted to basic; CD must be 0/blank; PS → supports),
+//!   CORD2R (RID chains).
+//! - MAT1: two of E, G, NU given, the third by E = 2(1+ν)G (Nastran's rule); all three given:
+//!   beams keep E and G, shells need G within 1 % of E/2(1+ν). RHO; GE/A/TREF ignored
+//!   (structural damping is added modally by the caller).
+//! - PSHELL (MID1 = MID2, MID3 blank or MID1, T, 12I/T³ → bending thickness T·(12I/T³)^⅓, NSM):
+//!   CQUAD4 is the QM6 + MITC4 shell with transverse shear (k = 5/6) always included (Nastran
+//!   omits transverse shear for MID3 blank: a difference of O((t/L)²) for thin sheets); CTRIA3
+//!   is the CST + DKT shell ([`crate::fe::shell3`], Kirchhoff: no transverse shear). No offsets,
+//!   no corner thicknesses.
+//! - PBAR (A, I1, I2, J, NSM; I12 must be 0), PBEAM (constant section only), CBAR/CBEAM with
+//!   X1..X3 or G0, no pins or offsets. The element is Euler-Bernoulli: shear flexibility (PBAR/
+//!   PBEAM K1, K2) is not modelled. I1 bends in Nastran's plane 1 (element x-y) → `iz`,
+//!   I2 → `iy`.
+//! - CONM2 (CID −1, 0 or a CORD2R; offset masses sit on an extra node rigidly linked to the
+//!   grid, so the translation–rotation coupling is exact; products of inertia as in the QRG).
+//! - CELAS1/PELAS, CELAS2, CDAMP1/PDAMP, CDAMP2: one component, to ground or between two grids
+//!   along the same component. Merged per node / node pair.
+//! - RBE2 → [`crate::fe::mesh::RigidLink`], RBE3 (no UM) → [`crate::fe::mesh::InterpolationLink`],
+//!   both eliminated exactly in assembly.
+//! - SPC1 (with THRU), SPC (zero displacement) of the set chosen by case control, or of the only
+//!   set in the file.
+//! - PARAM WTMASS (scales all mass), PARAM POST/GRDPNT/… (output only) and EIGRL/EIGR
+//!   (extraction requests) are accepted; any other card is an error naming card and line.
+//!
+//! Writing: [`write_bulk_deck`] emits large-field cards for a mesh of the supported elements.
 
+mod cards;
 mod lexer;
-mod model;
+mod to_mesh;
 mod writer;
 
+use std::collections::BTreeMap;
 use std::path::Path;
 
-pub use lexer::{cards, parse_real, Card};
-pub use model::NastranBody;
+pub use lexer::{classify, parse_real, Value};
 pub use writer::write_bulk_deck;
 
-use crate::fe::FeError;
+use super::error::FeError;
+use super::mesh::Mesh;
 
-/// Parses a bulk data deck given as text.
-pub fn parse_str(text: &str) -> Result<NastranBody, FeError> {
-    model::build(&cards(text)?)
+/// Largest bulk data file read (bytes).
+pub const MAX_FILE_BYTES: u64 = 256 * 1024 * 1024;
+
+/// Nastran ids of the mesh entities, in mesh order (`beams[i]` is the CBAR/CBEAM id of
+/// `mesh.beams[i]`, …). A CONM2 with an offset appears in `masses` and in `rigid_links`.
+#[derive(Debug, Clone, Default, PartialEq)]
+pub struct ElementIds {
+    /// CBAR / CBEAM ids.
+    pub beams: Vec<u32>,
+    /// CQUAD4 ids.
+    pub shells: Vec<u32>,
+    /// CTRIA3 ids.
+    pub triangles: Vec<u32>,
+    /// CONM2 ids.
+    pub masses: Vec<u32>,
+    /// RBE2 ids (and CONM2 ids of offset masses).
+    pub rigid_links: Vec<u32>,
+    /// RBE3 ids.
+    pub interpolation_links: Vec<u32>,
 }
 
-/// Reads a bulk data deck (a regular file of at most [`crate::text_file::DATA_LIMIT`] bytes).
+/// A body read from bulk data.
+#[derive(Debug, Clone, PartialEq)]
+pub struct NastranBody {
+    /// The mesh (no named nodes or regions: name points with [`NastranBody::name_points`]).
+    pub mesh: Mesh,
+    /// GRID id → node index. Nodes are numbered in ascending GRID id; nodes beyond the GRIDs
+    /// are the centres of gravity of offset CONM2 masses.
+    pub grid_index: BTreeMap<u32, usize>,
+    /// Element ids per mesh entity.
+    pub element_ids: ElementIds,
+    /// The SPC set applied, if any.
+    pub spc_set: Option<u32>,
+}
+
+impl NastranBody {
+    /// Node index of GRID `grid`.
+    pub fn node(&self, grid: u32) -> Result<usize, FeError> {
+        self.grid_index
+            .get(&grid)
+            .copied()
+            .ok_or_else(|| FeError::InvalidInput(format!("GRID {grid} is not in the bulk data")))
+    }
+
+    /// Adds `name → GRID id` pairs (e.g. `"mount_front_left": 1001`) to `mesh.named_nodes`.
+    pub fn name_points(&mut self, points: &BTreeMap<String, u32>) -> Result<(), FeError> {
+        for (name, &grid) in points {
+            let node = self
+                .node(grid)
+                .map_err(|e| FeError::InvalidInput(format!("point '{name}': {e}")))?;
+            self.mesh.named_nodes.insert(name.clone(), node);
+        }
+        Ok(())
+    }
+
+    /// Adds `name → GRID ids` node sets to `mesh.regions` (mode descriptions need the regions
+    /// of [`crate::fe::chassis::region`], which a bulk data file does not carry).
+    pub fn name_regions(&mut self, regions: &BTreeMap<String, Vec<u32>>) -> Result<(), FeError> {
+        for (name, grids) in regions {
+            let nodes = grids
+                .iter()
+                .map(|&g| self.node(g))
+                .collect::<Result<Vec<_>, _>>()
+                .map_err(|e| FeError::InvalidInput(format!("region '{name}': {e}")))?;
+            self.mesh.regions.insert(name.clone(), nodes);
+        }
+        Ok(())
+    }
+}
+
+/// Parses bulk data text (see the module documentation for what is accepted).
+pub fn parse_str(text: &str) -> Result<NastranBody, FeError> {
+    to_mesh::build(&lexer::lex(text)?)
+}
+
+/// Reads a bulk data file: a regular file of at most [`MAX_FILE_BYTES`], UTF-8/ASCII text.
 pub fn read_bulk_deck(path: &Path) -> Result<NastranBody, FeError> {
-    let text =
-        crate::text_file::read_limited(path, crate::text_file::DATA_LIMIT).map_err(FeError::Io)?;
+    let text = crate::text_file::read_limited(path, MAX_FILE_BYTES)
+        .map_err(|e| FeError::Io(format!("bulk data file: {e}")))?;
     parse_str(&text).map_err(|e| match e {
         FeError::InvalidInput(m) => FeError::InvalidInput(format!("{}: {m}", path.display())),
         other => other,

@@ -1,0 +1,320 @@
+//! Constraint equations of the rigid and interpolation links (Nastran RBE2 / RBE3).
+//!
+//! Each dependent DOF becomes one equation u_dep = Σ cᵢ uᵢ over other DOFs; [`super::dof::DofMap`]
+//! resolves chains and numbers the remaining independent DOFs, and assembly forms Tᵀ K T exactly
+//! (no penalty stiffness). DOFs are addressed as slots `node * 6 + dof`.
+//!
+//! Interpolation (RBE3): the reference motion q = (u, θ) is the weighted least-squares fit of the
+//! rigid-body motion to the source motions: with Sⱼ the rigid map from the reference to source j
+//! (u_j = u + θ × (x_j − x_ref), θ_j = θ) restricted to the listed components and Wⱼ the
+//! weights, q = (Σ SⱼᵀWⱼSⱼ)⁺ Σ SⱼᵀWⱼ uⱼ. Rotational source components are weighted by WT·L²,
+//! L = mean distance of the source nodes from the reference (MSC Nastran's rule, which makes the
+//! result independent of the length unit); translational ones by WT. For sources around the
+//! reference with translations only, the reference translation is the weighted mean of the
+//! source translations. Reference components left undetermined by the sources (e.g. rotation
+//! about the line through collinear sources) are an error.
+
+use nalgebra::{Matrix3, Matrix6, SMatrix, Vector3};
+
+use super::dof::DOF_PER_NODE;
+use super::error::FeError;
+use super::mesh::{InterpolationLink, Mesh, RigidLink};
+
+/// One dependent DOF expressed through other DOFs.
+#[derive(Debug, Clone, PartialEq)]
+pub struct LinkEquation {
+    /// Dependent slot `node * 6 + dof`.
+    pub dependent: usize,
+    /// `(slot, coefficient)` terms; the referenced slots may themselves be dependent.
+    pub terms: Vec<(usize, f64)>,
+    /// The link that produced the equation, for error messages ("rigid link 3").
+    pub origin: String,
+}
+
+fn position(mesh: &Mesh, what: &str, node: usize) -> Result<Vector3<f64>, FeError> {
+    let p = mesh.nodes.get(node).copied().ok_or_else(|| {
+        FeError::Mesh(format!(
+            "{what} refers to node {node}, mesh has {} nodes",
+            mesh.nodes.len()
+        ))
+    })?;
+    if p.iter().any(|c| !c.is_finite()) {
+        return Err(FeError::Mesh(format!(
+            "{what}: node {node} has non-finite coordinates"
+        )));
+    }
+    Ok(p)
+}
+
+/// Rigid map from the motion (u, θ) of a point to the motion of a point at offset `d` from it:
+/// u' = u + θ × d = u − [d]× θ, θ' = θ.
+fn rigid_map(d: &Vector3<f64>) -> Matrix6<f64> {
+    let mut s = Matrix6::identity();
+    let skew = Matrix3::new(0.0, -d.z, d.y, d.z, 0.0, -d.x, -d.y, d.x, 0.0);
+    s.fixed_view_mut::<3, 3>(0, 3).copy_from(&(-skew));
+    s
+}
+
+fn rigid_equations(
+    mesh: &Mesh,
+    index: usize,
+    link: &RigidLink,
+) -> Result<Vec<LinkEquation>, FeError> {
+    let origin = format!("rigid link {index}");
+    let xi = position(mesh, &origin, link.independent)?;
+    let mut out = Vec::new();
+    for &dep in &link.dependent {
+        if dep == link.independent {
+            return Err(FeError::Mesh(format!(
+                "{origin}: node {dep} is both independent and dependent"
+            )));
+        }
+        let s = rigid_map(&(position(mesh, &origin, dep)? - xi));
+        for (row, _) in link.components.iter().enumerate().filter(|(_, on)| **on) {
+            let terms = (0..DOF_PER_NODE)
+                .filter(|&col| s[(row, col)] != 0.0)
+                .map(|col| (link.independent * DOF_PER_NODE + col, s[(row, col)]))
+                .collect();
+            out.push(LinkEquation {
+                dependent: dep * DOF_PER_NODE + row,
+                terms,
+                origin: origin.clone(),
+            });
+        }
+    }
+    Ok(out)
+}
+
+const DOF_NAMES: [&str; 6] = ["ux", "uy", "uz", "rx", "ry", "rz"];
+
+fn interpolation_equations(
+    mesh: &Mesh,
+    index: usize,
+    link: &InterpolationLink,
+) -> Result<Vec<LinkEquation>, FeError> {
+    let origin = format!("interpolation link {index}");
+    let xr = position(mesh, &origin, link.reference)?;
+    let mut sources = Vec::new();
+    for group in &link.sources {
+        if !(group.weight.is_finite() && group.weight > 0.0) {
+            return Err(FeError::InvalidInput(format!(
+                "{origin}: weight must be finite and > 0, got {}",
+                group.weight
+            )));
+        }
+        if !group.components.iter().any(|c| *c) {
+            return Err(FeError::InvalidInput(format!(
+                "{origin}: a source group lists no components"
+            )));
+        }
+        for &node in &group.nodes {
+            if node == link.reference {
+                return Err(FeError::Mesh(format!(
+                    "{origin}: reference node {node} is also a source node"
+                )));
+            }
+            sources.push((node, position(mesh, &origin, node)? - xr, group));
+        }
+    }
+    if sources.is_empty() {
+        return Err(FeError::InvalidInput(format!("{origin}: no source nodes")));
+    }
+    let mean_distance =
+        sources.iter().map(|(_, d, _)| d.norm()).sum::<f64>() / sources.len() as f64;
+    let length = if mean_distance > 0.0 {
+        mean_distance
+    } else {
+        1.0
+    };
+    let weight_of = |group: &super::mesh::InterpolationSource, c: usize| {
+        if !group.components[c] {
+            0.0
+        } else if c < 3 {
+            group.weight
+        } else {
+            group.weight * length * length
+        }
+    };
+    let mut normal = Matrix6::<f64>::zeros();
+    for (_, d, group) in &sources {
+        let s = rigid_map(d);
+        let w = Matrix6::from_diagonal(&SMatrix::<f64, 6, 1>::from_fn(|c, _| weight_of(group, c)));
+        normal += s.transpose() * w * s;
+    }
+    // Pseudo-inverse: reference components in the null space are reported below rather than
+    // silently set to zero.
+    let eig = normal.symmetric_eigen();
+    let largest = eig.eigenvalues.amax();
+    let mut pinv = Matrix6::<f64>::zeros();
+    for k in 0..6 {
+        let v = eig.eigenvectors.column(k);
+        if eig.eigenvalues[k] > 1e-10 * largest {
+            pinv += v * v.transpose() / eig.eigenvalues[k];
+        } else {
+            for (c, _) in link
+                .reference_components
+                .iter()
+                .enumerate()
+                .filter(|(_, on)| **on)
+            {
+                if v[c].abs() > 1e-6 {
+                    return Err(FeError::Mesh(format!(
+                        "{origin}: reference component {} of node {} is not determined by the \
+                         source nodes and components (collinear or too few sources)",
+                        DOF_NAMES[c], link.reference
+                    )));
+                }
+            }
+        }
+    }
+    let mut out = Vec::new();
+    for (row, _) in link
+        .reference_components
+        .iter()
+        .enumerate()
+        .filter(|(_, on)| **on)
+    {
+        let mut terms = Vec::new();
+        for (node, d, group) in &sources {
+            let s = rigid_map(d);
+            // Row `row` of pinv · Sⱼᵀ Wⱼ: the coefficient of each source component.
+            let coupling = pinv.row(row) * s.transpose();
+            for c in 0..DOF_PER_NODE {
+                let coefficient = coupling[c] * weight_of(group, c);
+                if coefficient != 0.0 {
+                    terms.push((node * DOF_PER_NODE + c, coefficient));
+                }
+            }
+        }
+        out.push(LinkEquation {
+            dependent: link.reference * DOF_PER_NODE + row,
+            terms,
+            origin: origin.clone(),
+        });
+    }
+    Ok(out)
+}
+
+/// All constraint equations of the rigid and interpolation links of `mesh`.
+pub fn equations(mesh: &Mesh) -> Result<Vec<LinkEquation>, FeError> {
+    let mut out = Vec::new();
+    for (i, link) in mesh.rigid_links.iter().enumerate() {
+        out.extend(rigid_equations(mesh, i, link)?);
+    }
+    for (i, link) in mesh.interpolation_links.iter().enumerate() {
+        out.extend(interpolation_equations(mesh, i, link)?);
+    }
+    Ok(out)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::fe::mesh::InterpolationSource;
+
+    fn evaluate(eq: &LinkEquation, u: &dyn Fn(usize) -> f64) -> f64 {
+        eq.terms.iter().map(|&(slot, c)| c * u(slot)).sum()
+    }
+
+    /// Rigid-body motion (translation t, rotation w) evaluated at every slot of `mesh`.
+    fn rigid_field(mesh: &Mesh, t: Vector3<f64>, w: Vector3<f64>) -> impl Fn(usize) -> f64 + '_ {
+        move |slot| {
+            let (node, dof) = (slot / 6, slot % 6);
+            let v = t + w.cross(&mesh.nodes[node]);
+            if dof < 3 {
+                v[dof]
+            } else {
+                w[dof - 3]
+            }
+        }
+    }
+
+    #[test]
+    fn rigid_link_reproduces_a_rigid_body_motion() {
+        let mut mesh = Mesh::default();
+        mesh.add_node(Vector3::new(0.3, -0.2, 0.1));
+        mesh.add_node(Vector3::new(1.0, 0.5, -0.7));
+        mesh.rigid_links.push(RigidLink {
+            independent: 0,
+            dependent: vec![1],
+            components: [true; 6],
+        });
+        let eqs = equations(&mesh).unwrap();
+        assert_eq!(eqs.len(), 6);
+        let u = rigid_field(
+            &mesh,
+            Vector3::new(1.0, 2.0, 3.0),
+            Vector3::new(0.3, -0.4, 0.5),
+        );
+        for eq in &eqs {
+            assert!((evaluate(eq, &u) - u(eq.dependent)).abs() < 1e-14);
+        }
+    }
+
+    #[test]
+    fn interpolation_link_is_exact_for_rigid_motion_and_a_mean_at_the_centroid() {
+        let mut mesh = Mesh::default();
+        let pts = [
+            [1.0, 0.0, 0.0],
+            [0.0, 2.0, 0.0],
+            [-1.0, 0.0, 0.5],
+            [0.0, -2.0, -0.5],
+        ];
+        for p in pts {
+            mesh.add_node(Vector3::from(p));
+        }
+        let reference = mesh.add_node(Vector3::new(0.4, 0.1, 0.2));
+        mesh.interpolation_links.push(InterpolationLink {
+            reference,
+            reference_components: [true; 6],
+            sources: vec![InterpolationSource {
+                nodes: vec![0, 1, 2, 3],
+                weight: 1.0,
+                components: [true, true, true, false, false, false],
+            }],
+        });
+        {
+            let eqs = equations(&mesh).unwrap();
+            let u = rigid_field(
+                &mesh,
+                Vector3::new(-1.0, 0.5, 2.0),
+                Vector3::new(0.2, 0.7, -0.1),
+            );
+            for eq in &eqs {
+                assert!((evaluate(eq, &u) - u(eq.dependent)).abs() < 1e-12);
+            }
+        }
+        // At the centroid of equal weights, translations average the source translations.
+        mesh.nodes[reference] = Vector3::zeros();
+        let eqs = equations(&mesh).unwrap();
+        let arbitrary = |slot: usize| ((slot * 7919) % 23) as f64 - 11.0;
+        for eq in eqs.iter().filter(|e| e.dependent % 6 < 3) {
+            let dof = eq.dependent % 6;
+            let mean = (0..4).map(|n| arbitrary(6 * n + dof)).sum::<f64>() / 4.0;
+            assert!((evaluate(eq, &arbitrary) - mean).abs() < 1e-12);
+        }
+    }
+
+    #[test]
+    fn collinear_sources_cannot_fix_the_rotation_about_their_line() {
+        let mut mesh = Mesh::default();
+        mesh.add_node(Vector3::new(-1.0, 0.0, 0.0));
+        mesh.add_node(Vector3::new(1.0, 0.0, 0.0));
+        let reference = mesh.add_node(Vector3::zeros());
+        let mut link = InterpolationLink {
+            reference,
+            reference_components: [true, true, true, false, false, false],
+            sources: vec![InterpolationSource {
+                nodes: vec![0, 1],
+                weight: 1.0,
+                components: [true, true, true, false, false, false],
+            }],
+        };
+        mesh.interpolation_links.push(link.clone());
+        assert_eq!(equations(&mesh).unwrap().len(), 3);
+        link.reference_components = [true; 6];
+        mesh.interpolation_links[0] = link;
+        let err = equations(&mesh).unwrap_err().to_string();
+        assert!(err.contains("component rx of node 2"), "{err}");
+    }
+}

@@ -1,0 +1,833 @@
+//! Typed bulk data cards: each supported card's fields read by position with Nastran's types
+//! and defaults; every malformed field is an error naming the line, field number and meaning.
+
+use super::lexer::{classify, RawCard, Value};
+use crate::fe::error::FeError;
+
+/// Typed access to the fields of one card.
+pub(crate) struct Reader<'a> {
+    card: &'a RawCard,
+}
+
+impl<'a> Reader<'a> {
+    pub(crate) fn new(card: &'a RawCard) -> Self {
+        Self { card }
+    }
+
+    pub(crate) fn card(&self) -> &RawCard {
+        self.card
+    }
+
+    /// Where data field `i` is (or would be): line and Nastran field number.
+    fn place(&self, i: usize) -> (usize, usize) {
+        match self.card.fields.get(i) {
+            Some(f) => (f.line, f.position),
+            None => (self.card.line, i % 8 + 2),
+        }
+    }
+
+    pub(crate) fn error(&self, i: usize, name: &str, message: impl std::fmt::Display) -> FeError {
+        let (line, position) = self.place(i);
+        FeError::InvalidInput(format!(
+            "Nastran bulk data line {line}: {} (card at line {}) field {position} ({name}): \
+             {message}",
+            self.card.name, self.card.line
+        ))
+    }
+
+    /// A whole-card error at the card's first line.
+    pub(crate) fn card_error(&self, message: impl std::fmt::Display) -> FeError {
+        FeError::InvalidInput(format!(
+            "Nastran bulk data line {}: {}: {message}",
+            self.card.line, self.card.name
+        ))
+    }
+
+    pub(crate) fn len(&self) -> usize {
+        self.card.fields.len()
+    }
+
+    pub(crate) fn value(&self, i: usize, name: &str) -> Result<Value, FeError> {
+        match self.card.fields.get(i) {
+            None => Ok(Value::Blank),
+            Some(f) => classify(&f.text).map_err(|m| self.error(i, name, m)),
+        }
+    }
+
+    pub(crate) fn opt_int(&self, i: usize, name: &str) -> Result<Option<i64>, FeError> {
+        match self.value(i, name)? {
+            Value::Blank => Ok(None),
+            Value::Int(v) => Ok(Some(v)),
+            other => Err(self.error(i, name, format!("expected an integer, found {other:?}"))),
+        }
+    }
+
+    pub(crate) fn int_or(&self, i: usize, name: &str, default: i64) -> Result<i64, FeError> {
+        Ok(self.opt_int(i, name)?.unwrap_or(default))
+    }
+
+    /// A positive identification number (required).
+    pub(crate) fn id(&self, i: usize, name: &str) -> Result<u32, FeError> {
+        match self.opt_id(i, name)? {
+            Some(v) => Ok(v),
+            None => Err(self.error(i, name, "is required")),
+        }
+    }
+
+    /// A positive identification number or blank.
+    pub(crate) fn opt_id(&self, i: usize, name: &str) -> Result<Option<u32>, FeError> {
+        match self.opt_int(i, name)? {
+            None => Ok(None),
+            Some(v) if v > 0 && v <= u32::MAX as i64 => Ok(Some(v as u32)),
+            Some(v) => Err(self.error(i, name, format!("must be a positive id, got {v}"))),
+        }
+    }
+
+    /// An id where blank and 0 both mean "none" (coordinate systems, optional grids).
+    pub(crate) fn opt_id_or_zero(&self, i: usize, name: &str) -> Result<Option<u32>, FeError> {
+        match self.opt_int(i, name)? {
+            None | Some(0) => Ok(None),
+            Some(v) if v > 0 && v <= u32::MAX as i64 => Ok(Some(v as u32)),
+            Some(v) => Err(self.error(i, name, format!("must be >= 0, got {v}"))),
+        }
+    }
+
+    pub(crate) fn opt_real(&self, i: usize, name: &str) -> Result<Option<f64>, FeError> {
+        match self.value(i, name)? {
+            Value::Blank => Ok(None),
+            Value::Real(v) => Ok(Some(v)),
+            Value::Int(v) => Err(self.error(
+                i,
+                name,
+                format!("expected a real, found integer {v} (Nastran reals need a decimal point)"),
+            )),
+            other => Err(self.error(i, name, format!("expected a real, found {other:?}"))),
+        }
+    }
+
+    pub(crate) fn real(&self, i: usize, name: &str) -> Result<f64, FeError> {
+        self.opt_real(i, name)?
+            .ok_or_else(|| self.error(i, name, "is required"))
+    }
+
+    pub(crate) fn real_or(&self, i: usize, name: &str, default: f64) -> Result<f64, FeError> {
+        Ok(self.opt_real(i, name)?.unwrap_or(default))
+    }
+
+    /// Component digits 1..6 ("123456", no repeats) as a DOF mask (required, non-empty).
+    pub(crate) fn components(&self, i: usize, name: &str) -> Result<[bool; 6], FeError> {
+        let Some(v) = self.opt_int(i, name)? else {
+            return Err(self.error(i, name, "component digits 1..6 are required"));
+        };
+        let text = v.to_string();
+        let mut mask = [false; 6];
+        for c in text.chars() {
+            match c.to_digit(10) {
+                Some(d @ 1..=6) if !mask[d as usize - 1] => mask[d as usize - 1] = true,
+                _ => {
+                    return Err(self.error(
+                        i,
+                        name,
+                        format!("'{text}' is not a set of distinct component digits 1..6"),
+                    ))
+                }
+            }
+        }
+        Ok(mask)
+    }
+
+    /// A single scalar-element component 1..6 (0/blank would be a scalar point: not supported).
+    pub(crate) fn component(&self, i: usize, name: &str) -> Result<usize, FeError> {
+        match self.opt_int(i, name)? {
+            Some(c @ 1..=6) => Ok(c as usize - 1),
+            other => Err(self.error(
+                i,
+                name,
+                format!(
+                    "expected one component 1..6, found {other:?} (scalar points are not supported)"
+                ),
+            )),
+        }
+    }
+
+    /// Field `i` must be blank (or a zero of either type): features this reader does not model.
+    pub(crate) fn require_blank(&self, i: usize, name: &str, why: &str) -> Result<(), FeError> {
+        match self.value(i, name)? {
+            Value::Blank => Ok(()),
+            Value::Int(0) | Value::Real(0.0) => Ok(()),
+            other => Err(self.error(i, name, format!("{other:?} is not supported: {why}"))),
+        }
+    }
+
+    /// No data beyond field index `n - 1`.
+    pub(crate) fn at_most(&self, n: usize) -> Result<(), FeError> {
+        match self
+            .card
+            .fields
+            .iter()
+            .enumerate()
+            .skip(n)
+            .find(|(_, f)| !f.text.is_empty())
+        {
+            Some((i, f)) => Err(self.error(
+                i,
+                "beyond the card's last field",
+                format!("unexpected data '{}'", f.text),
+            )),
+            None => Ok(()),
+        }
+    }
+}
+
+/// GRID: a node.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Grid {
+    pub id: u32,
+    pub cp: Option<u32>,
+    pub x: [f64; 3],
+    pub ps: [bool; 6],
+    pub line: usize,
+}
+
+pub(crate) fn grid(r: &Reader) -> Result<Grid, FeError> {
+    r.at_most(8)?;
+    r.require_blank(
+        5,
+        "CD",
+        "non-basic displacement coordinate systems are not supported; set CD blank or 0",
+    )?;
+    r.require_blank(7, "SEID", "superelements are not supported")?;
+    let ps = if r.opt_int(6, "PS")?.is_some() {
+        r.components(6, "PS")?
+    } else {
+        [false; 6]
+    };
+    Ok(Grid {
+        id: r.id(0, "ID")?,
+        cp: r.opt_id_or_zero(1, "CP")?,
+        x: [
+            r.real_or(2, "X1", 0.0)?,
+            r.real_or(3, "X2", 0.0)?,
+            r.real_or(4, "X3", 0.0)?,
+        ],
+        ps,
+        line: r.card().line,
+    })
+}
+
+/// CORD2R: rectangular system by three points in the system RID.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Cord2r {
+    pub id: u32,
+    pub rid: Option<u32>,
+    pub a: [f64; 3],
+    pub b: [f64; 3],
+    pub c: [f64; 3],
+    pub line: usize,
+}
+
+pub(crate) fn cord2r(r: &Reader) -> Result<Cord2r, FeError> {
+    r.at_most(11)?;
+    let p = |k: usize, n: &str| -> Result<[f64; 3], FeError> {
+        Ok([
+            r.real_or(k, &format!("{n}1"), 0.0)?,
+            r.real_or(k + 1, &format!("{n}2"), 0.0)?,
+            r.real_or(k + 2, &format!("{n}3"), 0.0)?,
+        ])
+    };
+    Ok(Cord2r {
+        id: r.id(0, "CID")?,
+        rid: r.opt_id_or_zero(1, "RID")?,
+        a: p(2, "A")?,
+        b: p(5, "B")?,
+        c: p(8, "C")?,
+        line: r.card().line,
+    })
+}
+
+/// MAT1: isotropic material; missing E, G or NU follow Nastran's rule in `to_mesh`.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Mat1 {
+    pub id: u32,
+    pub e: Option<f64>,
+    pub g: Option<f64>,
+    pub nu: Option<f64>,
+    pub rho: f64,
+    pub line: usize,
+}
+
+pub(crate) fn mat1(r: &Reader) -> Result<Mat1, FeError> {
+    // A, TREF (thermal), GE (structural damping: added modally by the caller), ST/SC/SS
+    // (allowables), MCSID are accepted and do not enter K or M.
+    r.at_most(12)?;
+    for (k, n) in [
+        (5, "A"),
+        (6, "TREF"),
+        (7, "GE"),
+        (8, "ST"),
+        (9, "SC"),
+        (10, "SS"),
+    ] {
+        r.opt_real(k, n)?;
+    }
+    r.opt_int(11, "MCSID")?;
+    Ok(Mat1 {
+        id: r.id(0, "MID")?,
+        e: r.opt_real(1, "E")?,
+        g: r.opt_real(2, "G")?,
+        nu: r.opt_real(3, "NU")?,
+        rho: r.real_or(4, "RHO", 0.0)?,
+        line: r.card().line,
+    })
+}
+
+/// PSHELL: homogeneous shell property.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Pshell {
+    pub id: u32,
+    pub mid1: Option<u32>,
+    pub t: f64,
+    pub mid2: Option<i64>,
+    pub bending_ratio: f64,
+    pub mid3: Option<u32>,
+    pub ts_t: f64,
+    pub nsm: f64,
+    pub line: usize,
+}
+
+pub(crate) fn pshell(r: &Reader) -> Result<Pshell, FeError> {
+    r.at_most(11)?;
+    r.opt_real(8, "Z1")?;
+    r.opt_real(9, "Z2")?;
+    r.require_blank(10, "MID4", "membrane-bending coupling is not supported")?;
+    Ok(Pshell {
+        id: r.id(0, "PID")?,
+        mid1: r.opt_id(1, "MID1")?,
+        t: r.real(2, "T")?,
+        mid2: r.opt_int(3, "MID2")?,
+        bending_ratio: r.real_or(4, "12I/T**3", 1.0)?,
+        mid3: r.opt_id(5, "MID3")?,
+        ts_t: r.real_or(6, "TS/T", 0.833333)?,
+        nsm: r.real_or(7, "NSM", 0.0)?,
+        line: r.card().line,
+    })
+}
+
+/// PBAR / PBEAM reduced to a constant prismatic section.
+#[derive(Debug, Clone, PartialEq)]
+pub struct BeamProperty {
+    pub id: u32,
+    pub mid: u32,
+    pub a: f64,
+    pub i1: f64,
+    pub i2: f64,
+    pub j: f64,
+    pub nsm: f64,
+    pub line: usize,
+}
+
+pub(crate) fn pbar(r: &Reader) -> Result<BeamProperty, FeError> {
+    r.at_most(19)?;
+    r.require_blank(7, "blank", "field 9 of PBAR is unused")?;
+    for (k, n) in [
+        (8, "C1"),
+        (9, "C2"),
+        (10, "D1"),
+        (11, "D2"),
+        (12, "E1"),
+        (13, "E2"),
+        (14, "F1"),
+        (15, "F2"),
+        (16, "K1"),
+        (17, "K2"),
+    ] {
+        // Stress recovery points; K1/K2 (shear flexibility, default rigid): the element is
+        // Euler-Bernoulli, so finite K1/K2 are read and not used.
+        r.opt_real(k, n)?;
+    }
+    r.require_blank(18, "I12", "unsymmetric sections are not supported")?;
+    Ok(BeamProperty {
+        id: r.id(0, "PID")?,
+        mid: r.id(1, "MID")?,
+        a: r.real(2, "A")?,
+        i1: r.real_or(3, "I1", 0.0)?,
+        i2: r.real_or(4, "I2", 0.0)?,
+        j: r.real_or(5, "J", 0.0)?,
+        nsm: r.real_or(6, "NSM", 0.0)?,
+        line: r.card().line,
+    })
+}
+
+pub(crate) fn pbeam(r: &Reader) -> Result<BeamProperty, FeError> {
+    let end_a = BeamProperty {
+        id: r.id(0, "PID")?,
+        mid: r.id(1, "MID")?,
+        a: r.real(2, "A(A)")?,
+        i1: r.real_or(3, "I1(A)", 0.0)?,
+        i2: r.real_or(4, "I2(A)", 0.0)?,
+        j: r.real_or(6, "J(A)", 0.0)?,
+        nsm: r.real_or(7, "NSM(A)", 0.0)?,
+        line: r.card().line,
+    };
+    r.require_blank(5, "I12(A)", "unsymmetric sections are not supported")?;
+    for k in 8..16 {
+        r.opt_real(k, "stress recovery point")?;
+    }
+    // Intermediate stations and end B: SO, X/XB, A, I1, I2, I12, J, NSM [, C1 … F2 if SO = YES].
+    let mut i = 16;
+    while let Value::Text(so) = r.value(i, "SO")? {
+        if !matches!(so.as_str(), "YES" | "YESA" | "NO") {
+            return Err(r.error(i, "SO", format!("expected YES, YESA or NO, found {so}")));
+        }
+        r.real(i + 1, "X/XB")?;
+        let same = [
+            (2, "A", end_a.a),
+            (3, "I1", end_a.i1),
+            (4, "I2", end_a.i2),
+            (5, "I12", 0.0),
+            (6, "J", end_a.j),
+            (7, "NSM", end_a.nsm),
+        ];
+        for (k, name, at_a) in same {
+            if let Some(v) = r.opt_real(i + k, name)? {
+                if (v - at_a).abs() > 1e-9 * at_a.abs().max(f64::MIN_POSITIVE) {
+                    return Err(r.error(
+                        i + k,
+                        name,
+                        format!(
+                            "{v} differs from end A ({at_a}): tapered PBEAM sections are not \
+                             supported"
+                        ),
+                    ));
+                }
+            }
+        }
+        if so == "YES" {
+            for k in 8..16 {
+                r.opt_real(i + k, "stress recovery point")?;
+            }
+            i += 16;
+        } else {
+            i += 8;
+        }
+    }
+    // K1 K2 (shear area factors: the element is Euler-Bernoulli, read and not used), S1 S2
+    // (shear relief for tapered beams: irrelevant for a constant section), then features that
+    // change K or M.
+    for (k, name) in [(0, "K1"), (1, "K2"), (2, "S1"), (3, "S2")] {
+        r.opt_real(i + k, name)?;
+    }
+    let why = "non-structural mass inertia, warping and offsets of the centre of gravity or \
+               neutral axis are not supported";
+    for (k, name) in [
+        (4, "NSI(A)"),
+        (5, "NSI(B)"),
+        (6, "CW(A)"),
+        (7, "CW(B)"),
+        (8, "M1(A)"),
+        (9, "M2(A)"),
+        (10, "M1(B)"),
+        (11, "M2(B)"),
+        (12, "N1(A)"),
+        (13, "N2(A)"),
+        (14, "N1(B)"),
+        (15, "N2(B)"),
+    ] {
+        r.require_blank(i + k, name, why)?;
+    }
+    r.at_most(i + 16)?;
+    Ok(end_a)
+}
+
+/// How a bar's element y axis is given.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum Orientation {
+    /// Vector X1, X2, X3 (basic, since CD = 0 everywhere).
+    Vector([f64; 3]),
+    /// Direction from end A to grid G0.
+    Node(u32),
+}
+
+/// CBAR / CBEAM.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Bar {
+    pub id: u32,
+    pub pid: u32,
+    pub ga: u32,
+    pub gb: u32,
+    pub orientation: Orientation,
+    pub line: usize,
+}
+
+pub(crate) fn bar(r: &Reader, is_beam: bool) -> Result<Bar, FeError> {
+    r.at_most(if is_beam { 18 } else { 16 })?;
+    let id = r.id(0, "EID")?;
+    let orientation =
+        match r.value(4, "X1/G0")? {
+            Value::Int(_) => {
+                r.require_blank(5, "X2", "with G0 given, X2 must be blank")?;
+                r.require_blank(6, "X3", "with G0 given, X3 must be blank")?;
+                Orientation::Node(r.id(4, "G0")?)
+            }
+            Value::Real(x1) => {
+                Orientation::Vector([x1, r.real_or(5, "X2", 0.0)?, r.real_or(6, "X3", 0.0)?])
+            }
+            _ => return Err(r.error(
+                4,
+                "X1/G0",
+                "an orientation vector or G0 is required (BAROR/BEAMOR defaults are not supported)",
+            )),
+        };
+    match r.value(7, "OFFT")? {
+        Value::Blank => {}
+        Value::Text(t)
+            if t.len() == 3
+                && t.chars().enumerate().all(|(k, c)| match k {
+                    0 => c == 'G' || c == 'B',
+                    _ => c == 'G' || c == 'O',
+                }) => {}
+        other => {
+            return Err(r.error(
+                7,
+                "OFFT",
+                format!("{other:?} is not a supported offset code"),
+            ))
+        }
+    }
+    let why = "pin flags and offsets are not supported";
+    r.require_blank(8, "PA", why)?;
+    r.require_blank(9, "PB", why)?;
+    for (k, n) in [
+        (10, "W1A"),
+        (11, "W2A"),
+        (12, "W3A"),
+        (13, "W1B"),
+        (14, "W2B"),
+        (15, "W3B"),
+    ] {
+        r.require_blank(k, n, why)?;
+    }
+    if is_beam {
+        r.require_blank(16, "SA", "warping scalar points are not supported")?;
+        r.require_blank(17, "SB", "warping scalar points are not supported")?;
+    }
+    Ok(Bar {
+        id,
+        pid: r.opt_id(1, "PID")?.unwrap_or(id),
+        ga: r.id(2, "GA")?,
+        gb: r.id(3, "GB")?,
+        orientation,
+        line: r.card().line,
+    })
+}
+
+/// CQUAD4 / CTRIA3.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Plate {
+    pub id: u32,
+    pub pid: u32,
+    pub grids: Vec<u32>,
+    pub line: usize,
+}
+
+pub(crate) fn plate(r: &Reader, corners: usize) -> Result<Plate, FeError> {
+    let id = r.id(0, "EID")?;
+    let grids = (0..corners)
+        .map(|k| r.id(2 + k, &format!("G{}", k + 1)))
+        .collect::<Result<Vec<_>, _>>()?;
+    // THETA/MCID: material orientation, irrelevant for isotropic MAT1.
+    r.value(2 + corners, "THETA/MCID")?;
+    r.require_blank(3 + corners, "ZOFFS", "shell offsets are not supported")?;
+    let why = "corner thicknesses are not supported; give T on the PSHELL";
+    let tflag = if corners == 4 { 9 } else { 10 };
+    r.require_blank(tflag, "TFLAG", why)?;
+    for k in 0..corners {
+        r.require_blank(tflag + 1 + k, &format!("T{}", k + 1), why)?;
+    }
+    r.at_most(tflag + 1 + corners)?;
+    Ok(Plate {
+        id,
+        pid: r.opt_id(1, "PID")?.unwrap_or(id),
+        grids,
+        line: r.card().line,
+    })
+}
+
+/// CONM2: concentrated mass with offset and inertia about its centre of gravity.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Conm2 {
+    pub id: u32,
+    pub grid: u32,
+    /// -1: X is the centre of gravity in basic; 0/blank: offset in basic; > 0: offset in CORD2R.
+    pub cid: i64,
+    pub mass: f64,
+    pub x: [f64; 3],
+    /// I11, I21, I22, I31, I32, I33 as entered.
+    pub inertia: [f64; 6],
+    pub line: usize,
+}
+
+pub(crate) fn conm2(r: &Reader) -> Result<Conm2, FeError> {
+    r.at_most(14)?;
+    r.require_blank(7, "blank", "field 9 of CONM2 is unused")?;
+    let cid = r.int_or(2, "CID", 0)?;
+    if cid < -1 {
+        return Err(r.error(2, "CID", format!("must be >= -1, got {cid}")));
+    }
+    let names = ["I11", "I21", "I22", "I31", "I32", "I33"];
+    let mut inertia = [0.0; 6];
+    for (k, n) in names.iter().enumerate() {
+        inertia[k] = r.real_or(8 + k, n, 0.0)?;
+    }
+    Ok(Conm2 {
+        id: r.id(0, "EID")?,
+        grid: r.id(1, "G")?,
+        cid,
+        mass: r.real(3, "M")?,
+        x: [
+            r.real_or(4, "X1", 0.0)?,
+            r.real_or(5, "X2", 0.0)?,
+            r.real_or(6, "X3", 0.0)?,
+        ],
+        inertia,
+        line: r.card().line,
+    })
+}
+
+/// Magnitude of a scalar element: a property reference or a value on the card.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum ScalarValue {
+    /// PELAS / PDAMP id.
+    Property(u32),
+    /// K or B given directly.
+    Value(f64),
+}
+
+/// CELAS1/2, CDAMP1/2: scalar spring or damper between two grid components or to ground.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Scalar {
+    pub id: u32,
+    pub value: ScalarValue,
+    pub ends: Vec<(u32, usize)>,
+    pub line: usize,
+}
+
+pub(crate) fn scalar(r: &Reader, direct: bool, spring: bool) -> Result<Scalar, FeError> {
+    let id = r.id(0, "EID")?;
+    let value = if direct {
+        if spring {
+            // CELAS2: GE (structural damping) and S (stress coefficient) follow; GE is added
+            // modally by the caller, like MAT1 GE.
+            r.opt_real(6, "GE")?;
+            r.opt_real(7, "S")?;
+            r.at_most(8)?;
+        } else {
+            r.at_most(6)?;
+        }
+        ScalarValue::Value(r.real(1, "K/B")?)
+    } else {
+        r.at_most(6)?;
+        ScalarValue::Property(r.opt_id(1, "PID")?.unwrap_or(id))
+    };
+    let mut ends = Vec::new();
+    for (g, c) in [(2, 3), (4, 5)] {
+        let name_g = format!("G{}", g / 2);
+        let name_c = format!("C{}", g / 2);
+        match r.opt_id_or_zero(g, &name_g)? {
+            Some(grid) => ends.push((grid, r.component(c, &name_c)?)),
+            None => r.require_blank(c, &name_c, "a component without a grid")?,
+        }
+    }
+    if ends.is_empty() {
+        return Err(r.card_error("needs at least one grid (G1 or G2)"));
+    }
+    Ok(Scalar {
+        id,
+        value,
+        ends,
+        line: r.card().line,
+    })
+}
+
+/// PELAS (up to two properties per card) or PDAMP (up to four): `(pid, value)`.
+pub(crate) fn scalar_properties(r: &Reader, per_entry: usize) -> Result<Vec<(u32, f64)>, FeError> {
+    let mut out = Vec::new();
+    let mut k = 0;
+    while k < r.len() {
+        if let Some(pid) = r.opt_id(k, "PID")? {
+            out.push((pid, r.real(k + 1, "K/B")?));
+            for extra in 2..per_entry {
+                r.opt_real(k + extra, "GE/S")?;
+            }
+        }
+        k += per_entry;
+    }
+    r.at_most(8)?;
+    if out.is_empty() {
+        return Err(r.card_error("no property defined"));
+    }
+    Ok(out)
+}
+
+/// RBE2: rigid element.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Rbe2 {
+    pub id: u32,
+    pub independent: u32,
+    pub components: [bool; 6],
+    pub dependent: Vec<u32>,
+    pub line: usize,
+}
+
+pub(crate) fn rbe2(r: &Reader) -> Result<Rbe2, FeError> {
+    let mut dependent = Vec::new();
+    let mut i = 3;
+    while i < r.len() {
+        match r.value(i, "GMi")? {
+            Value::Blank => {}
+            Value::Int(_) => dependent.push(r.id(i, "GMi")?),
+            // ALPHA (and TREF) close the card: thermal expansion, not used.
+            Value::Real(_) => {
+                r.opt_real(i + 1, "TREF")?;
+                r.at_most(i + 2)?;
+                break;
+            }
+            Value::Text(t) => return Err(r.error(i, "GMi", format!("unexpected '{t}'"))),
+        }
+        i += 1;
+    }
+    if dependent.is_empty() {
+        return Err(r.card_error("no dependent grid"));
+    }
+    Ok(Rbe2 {
+        id: r.id(0, "EID")?,
+        independent: r.id(1, "GN")?,
+        components: r.components(2, "CM")?,
+        dependent,
+        line: r.card().line,
+    })
+}
+
+/// RBE3: interpolation element.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Rbe3 {
+    pub id: u32,
+    pub reference: u32,
+    pub reference_components: [bool; 6],
+    /// (weight, components, grids).
+    pub groups: Vec<(f64, [bool; 6], Vec<u32>)>,
+    pub line: usize,
+}
+
+pub(crate) fn rbe3(r: &Reader) -> Result<Rbe3, FeError> {
+    r.require_blank(1, "blank", "field 3 of RBE3 is unused")?;
+    let mut groups: Vec<(f64, [bool; 6], Vec<u32>)> = Vec::new();
+    let mut i = 4;
+    while i < r.len() {
+        match r.value(i, "WTi/Gi,j")? {
+            Value::Blank => i += 1,
+            Value::Real(w) => {
+                let components = r.components(i + 1, "Ci")?;
+                groups.push((w, components, Vec::new()));
+                i += 2;
+            }
+            Value::Int(_) => {
+                let g = r.id(i, "Gi,j")?;
+                match groups.last_mut() {
+                    Some(group) => group.2.push(g),
+                    None => return Err(r.error(i, "WT1", "a weight must precede the grids")),
+                }
+                i += 1;
+            }
+            Value::Text(t) if t == "ALPHA" => {
+                r.opt_real(i + 1, "ALPHA")?;
+                i += 2;
+            }
+            Value::Text(t) if t == "TREF" => {
+                r.opt_real(i + 1, "TREF")?;
+                i += 2;
+            }
+            Value::Text(t) => {
+                return Err(r.error(
+                    i,
+                    "WTi",
+                    format!("'{t}' is not supported (UM: the dependent set must be REFGRID/REFC)"),
+                ))
+            }
+        }
+    }
+    if let Some((w, _, _)) = groups.iter().find(|(_, _, g)| g.is_empty()) {
+        return Err(r.card_error(format!("weight {w} has no grids")));
+    }
+    if groups.is_empty() {
+        return Err(r.card_error("no weighted grid groups"));
+    }
+    Ok(Rbe3 {
+        id: r.id(0, "EID")?,
+        reference: r.id(2, "REFGRID")?,
+        reference_components: r.components(3, "REFC")?,
+        groups,
+        line: r.card().line,
+    })
+}
+
+/// Grids of a support card: listed ones must exist; a THRU range takes the grids that exist
+/// in it (as Nastran does).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum Grids {
+    /// One grid.
+    One(u32),
+    /// All existing grids from..=to.
+    Range(u32, u32),
+}
+
+/// One support entry: set id, grids, components.
+pub type Support = (u32, Grids, [bool; 6]);
+
+/// SPC1 / SPC with zero enforced displacement.
+pub(crate) fn spc1(r: &Reader) -> Result<Vec<Support>, FeError> {
+    let sid = r.id(0, "SID")?;
+    let comps = r.components(1, "C")?;
+    let mut out = Vec::new();
+    if matches!(r.value(3, "THRU")?, Value::Text(ref t) if t == "THRU") {
+        r.at_most(5)?;
+        let (from, to) = (r.id(2, "G1")?, r.id(4, "G2")?);
+        if to < from {
+            return Err(r.error(4, "G2", format!("THRU range {from} to {to} is empty")));
+        }
+        out.push((sid, Grids::Range(from, to), comps));
+    } else {
+        for i in 2..r.len() {
+            if let Some(g) = r.opt_id(i, "Gi")? {
+                out.push((sid, Grids::One(g), comps));
+            }
+        }
+    }
+    if out.is_empty() {
+        return Err(r.card_error("no grid listed"));
+    }
+    Ok(out)
+}
+
+pub(crate) fn spc(r: &Reader) -> Result<Vec<Support>, FeError> {
+    r.at_most(7)?;
+    let sid = r.id(0, "SID")?;
+    let mut out = Vec::new();
+    for k in [1, 4] {
+        if let Some(g) = r.opt_id(k, "Gi")? {
+            let d = r.real_or(k + 2, "Di", 0.0)?;
+            if d != 0.0 {
+                return Err(r.error(
+                    k + 2,
+                    "Di",
+                    "enforced displacement is not supported (supports are fixed)",
+                ));
+            }
+            out.push((sid, Grids::One(g), r.components(k + 1, "Ci")?));
+        }
+    }
+    if out.is_empty() {
+        return Err(r.card_error("no grid listed"));
+    }
+    Ok(out)
+}

@@ -1,0 +1,774 @@
+//! Typed cards → [`Mesh`]: coordinate systems resolved to basic, properties and materials
+//! looked up, scalar springs merged per node, supports of the selected SPC set applied.
+
+use std::collections::{BTreeMap, BTreeSet};
+
+use nalgebra::{Matrix3, Vector3};
+
+use super::cards::{self, Orientation, Reader, ScalarValue};
+use super::lexer::{Deck, Value};
+use super::NastranBody;
+use crate::fe::error::FeError;
+use crate::fe::mesh::{
+    Beam, BeamSection, GroundSpring, InterpolationLink, InterpolationSource, Material, Mesh,
+    PointMass, RigidLink, Shell, Spring, TriShell,
+};
+
+/// Parameters that only steer output or solution bookkeeping: accepted and ignored.
+const IGNORED_PARAMS: [&str; 8] = [
+    "POST", "GRDPNT", "AUTOSPC", "PRGPST", "MAXRATIO", "OGEOM", "NOCOMPS", "BAILOUT",
+];
+
+fn mesh_error(line: usize, message: impl std::fmt::Display) -> FeError {
+    FeError::InvalidInput(format!("Nastran bulk data line {line}: {message}"))
+}
+
+#[derive(Default)]
+struct Cards {
+    grids: BTreeMap<u32, cards::Grid>,
+    systems: BTreeMap<u32, cards::Cord2r>,
+    materials: BTreeMap<u32, cards::Mat1>,
+    shell_properties: BTreeMap<u32, cards::Pshell>,
+    beam_properties: BTreeMap<u32, (cards::BeamProperty, &'static str)>,
+    spring_properties: BTreeMap<u32, (f64, usize)>,
+    damper_properties: BTreeMap<u32, (f64, usize)>,
+    bars: BTreeMap<u32, cards::Bar>,
+    plates: BTreeMap<u32, (cards::Plate, &'static str)>,
+    masses: BTreeMap<u32, cards::Conm2>,
+    springs: BTreeMap<u32, cards::Scalar>,
+    dampers: BTreeMap<u32, cards::Scalar>,
+    rigid: BTreeMap<u32, cards::Rbe2>,
+    interpolation: BTreeMap<u32, cards::Rbe3>,
+    supports: Vec<(cards::Support, usize)>,
+    element_lines: BTreeMap<u32, (usize, String)>,
+    mass_scale: f64,
+}
+
+fn insert_unique<T>(
+    map: &mut BTreeMap<u32, T>,
+    what: &str,
+    id: u32,
+    line: usize,
+    value: T,
+) -> Result<(), FeError> {
+    if map.insert(id, value).is_some() {
+        return Err(mesh_error(line, format!("{what} {id} is defined twice")));
+    }
+    Ok(())
+}
+
+impl Cards {
+    /// Element ids are unique over all element cards, as in Nastran.
+    fn element_id(&mut self, id: u32, line: usize, name: &str) -> Result<(), FeError> {
+        if let Some((first, other)) = self.element_lines.get(&id) {
+            return Err(mesh_error(
+                line,
+                format!("{name} {id}: element id already used by {other} at line {first}"),
+            ));
+        }
+        self.element_lines.insert(id, (line, name.to_string()));
+        Ok(())
+    }
+
+    fn read(deck: &Deck) -> Result<Self, FeError> {
+        let mut c = Cards {
+            mass_scale: 1.0,
+            ..Cards::default()
+        };
+        for raw in &deck.cards {
+            let r = Reader::new(raw);
+            let line = raw.line;
+            match raw.name.as_str() {
+                "GRID" => {
+                    let g = cards::grid(&r)?;
+                    insert_unique(&mut c.grids, "GRID", g.id, line, g)?;
+                }
+                "CORD2R" => {
+                    let s = cards::cord2r(&r)?;
+                    insert_unique(&mut c.systems, "CORD2R", s.id, line, s)?;
+                }
+                "MAT1" => {
+                    let m = cards::mat1(&r)?;
+                    insert_unique(&mut c.materials, "MAT1", m.id, line, m)?;
+                }
+                "PSHELL" => {
+                    let p = cards::pshell(&r)?;
+                    insert_unique(&mut c.shell_properties, "property", p.id, line, p)?;
+                }
+                "PBAR" | "PBEAM" => {
+                    let p = if raw.name == "PBAR" {
+                        (cards::pbar(&r)?, "PBAR")
+                    } else {
+                        (cards::pbeam(&r)?, "PBEAM")
+                    };
+                    insert_unique(&mut c.beam_properties, "property", p.0.id, line, p)?;
+                }
+                "PELAS" => {
+                    for (pid, k) in cards::scalar_properties(&r, 4)? {
+                        insert_unique(&mut c.spring_properties, "PELAS", pid, line, (k, line))?;
+                    }
+                }
+                "PDAMP" => {
+                    for (pid, b) in cards::scalar_properties(&r, 2)? {
+                        insert_unique(&mut c.damper_properties, "PDAMP", pid, line, (b, line))?;
+                    }
+                }
+                "CBAR" | "CBEAM" => {
+                    let b = cards::bar(&r, raw.name == "CBEAM")?;
+                    c.element_id(b.id, line, &raw.name)?;
+                    c.bars.insert(b.id, b);
+                }
+                "CQUAD4" | "CTRIA3" => {
+                    let (corners, name) = if raw.name == "CQUAD4" {
+                        (4, "CQUAD4")
+                    } else {
+                        (3, "CTRIA3")
+                    };
+                    let p = cards::plate(&r, corners)?;
+                    c.element_id(p.id, line, name)?;
+                    c.plates.insert(p.id, (p, name));
+                }
+                "CONM2" => {
+                    let m = cards::conm2(&r)?;
+                    c.element_id(m.id, line, "CONM2")?;
+                    c.masses.insert(m.id, m);
+                }
+                "CELAS1" | "CELAS2" => {
+                    let s = cards::scalar(&r, raw.name == "CELAS2", true)?;
+                    c.element_id(s.id, line, &raw.name)?;
+                    c.springs.insert(s.id, s);
+                }
+                "CDAMP1" | "CDAMP2" => {
+                    let s = cards::scalar(&r, raw.name == "CDAMP2", false)?;
+                    c.element_id(s.id, line, &raw.name)?;
+                    c.dampers.insert(s.id, s);
+                }
+                "RBE2" => {
+                    let e = cards::rbe2(&r)?;
+                    c.element_id(e.id, line, "RBE2")?;
+                    c.rigid.insert(e.id, e);
+                }
+                "RBE3" => {
+                    let e = cards::rbe3(&r)?;
+                    c.element_id(e.id, line, "RBE3")?;
+                    c.interpolation.insert(e.id, e);
+                }
+                "SPC1" | "SPC" => {
+                    let list = if raw.name == "SPC1" {
+                        cards::spc1(&r)?
+                    } else {
+                        cards::spc(&r)?
+                    };
+                    c.supports.extend(list.into_iter().map(|s| (s, line)));
+                }
+                "PARAM" => c.param(&r)?,
+                // Eigenvalue extraction requests: the caller chooses the modes.
+                "EIGRL" | "EIGR" => {}
+                other => {
+                    return Err(mesh_error(
+                        line,
+                        format!(
+                            "card {other} is not supported (supported: GRID, CORD2R, MAT1, \
+                             PSHELL, PBAR, PBEAM, PELAS, PDAMP, CQUAD4, CTRIA3, CBAR, CBEAM, \
+                             CONM2, CELAS1, CELAS2, CDAMP1, CDAMP2, RBE2, RBE3, SPC1, SPC, \
+                             PARAM, EIGRL, EIGR)"
+                        ),
+                    ))
+                }
+            }
+        }
+        Ok(c)
+    }
+
+    fn param(&mut self, r: &Reader) -> Result<(), FeError> {
+        let name = match r.value(0, "N")? {
+            Value::Text(t) => t,
+            other => return Err(r.error(0, "N", format!("expected a name, found {other:?}"))),
+        };
+        if name == "WTMASS" {
+            let w = r.real(1, "V1")?;
+            if !(w.is_finite() && w > 0.0) {
+                return Err(r.error(1, "V1", format!("WTMASS must be > 0, got {w}")));
+            }
+            self.mass_scale = w;
+            Ok(())
+        } else if IGNORED_PARAMS.contains(&name.as_str()) {
+            Ok(())
+        } else {
+            Err(r.card_error(format!(
+                "PARAM {name} is not supported (it may change K or M); supported: WTMASS, and \
+                 ignored as output-only: {}",
+                IGNORED_PARAMS.join(", ")
+            )))
+        }
+    }
+}
+
+/// Resolved rectangular systems: origin and rotation (columns: axes in basic).
+struct Systems {
+    resolved: BTreeMap<u32, (Vector3<f64>, Matrix3<f64>)>,
+}
+
+impl Systems {
+    fn new(defs: &BTreeMap<u32, cards::Cord2r>) -> Result<Self, FeError> {
+        let mut resolved = BTreeMap::new();
+        for &id in defs.keys() {
+            let mut chain = vec![id];
+            // Walk down to a resolved or basic system, then back up.
+            loop {
+                let cur = defs[chain.last().unwrap_or(&id)].rid;
+                match cur {
+                    Some(rid) if !resolved.contains_key(&rid) => {
+                        if chain.contains(&rid) {
+                            return Err(mesh_error(
+                                defs[&id].line,
+                                format!("CORD2R {id}: reference systems form a cycle"),
+                            ));
+                        }
+                        if !defs.contains_key(&rid) {
+                            let d = &defs[chain.last().unwrap_or(&id)];
+                            return Err(mesh_error(
+                                d.line,
+                                format!("CORD2R {}: reference system RID {rid} not found", d.id),
+                            ));
+                        }
+                        chain.push(rid);
+                    }
+                    _ => break,
+                }
+            }
+            while let Some(cid) = chain.pop() {
+                let d = &defs[&cid];
+                let to_basic = |p: [f64; 3]| -> Vector3<f64> {
+                    let v = Vector3::from(p);
+                    match d.rid.and_then(|rid| resolved.get(&rid)) {
+                        Some((o, r)) => o + r * v,
+                        None => v,
+                    }
+                };
+                let (a, b, c) = (to_basic(d.a), to_basic(d.b), to_basic(d.c));
+                let z = b - a;
+                let x = (c - a) - z * (z.dot(&(c - a)) / z.norm_squared());
+                if !(z.norm() > 0.0 && x.norm() > 1e-12 * z.norm() && x.norm().is_finite()) {
+                    return Err(mesh_error(
+                        d.line,
+                        format!("CORD2R {cid}: points A, B, C are coincident or collinear"),
+                    ));
+                }
+                let (ez, ex) = (z.normalize(), x.normalize());
+                let r = Matrix3::from_columns(&[ex, ez.cross(&ex), ez]);
+                resolved.insert(cid, (a, r));
+            }
+        }
+        Ok(Self { resolved })
+    }
+
+    fn get(
+        &self,
+        id: u32,
+        line: usize,
+        user: &str,
+    ) -> Result<&(Vector3<f64>, Matrix3<f64>), FeError> {
+        self.resolved.get(&id).ok_or_else(|| {
+            mesh_error(
+                line,
+                format!("{user}: coordinate system {id} not found (CORD2R)"),
+            )
+        })
+    }
+}
+
+fn material_named(c: &Cards, mid: u32, line: usize, user: &str) -> Result<cards::Mat1, FeError> {
+    c.materials
+        .get(&mid)
+        .cloned()
+        .ok_or_else(|| mesh_error(line, format!("{user}: material MAT1 {mid} not found")))
+}
+
+/// E and G of a MAT1 by Nastran's rule for the missing one (E = 2 (1 + ν) G).
+fn moduli(m: &cards::Mat1, user: &str) -> Result<(f64, f64, f64), FeError> {
+    let fail = |why: &str| mesh_error(m.line, format!("MAT1 {} (used by {user}): {why}", m.id));
+    let (e, g, nu) = match (m.e, m.g, m.nu) {
+        (Some(e), Some(g), Some(nu)) => (e, g, nu),
+        (Some(e), Some(g), None) => (e, g, e / (2.0 * g) - 1.0),
+        (Some(e), None, Some(nu)) => (e, e / (2.0 * (1.0 + nu)), nu),
+        (None, Some(g), Some(nu)) => (2.0 * (1.0 + nu) * g, g, nu),
+        _ => {
+            return Err(fail(
+                "give two of E, G, NU (with only one, Nastran sets the others to zero, which \
+                 leaves shear or extension without stiffness)",
+            ))
+        }
+    };
+    if !(e > 0.0 && g > 0.0 && e.is_finite() && g.is_finite()) {
+        return Err(fail(&format!("E = {e} and G = {g} must be > 0")));
+    }
+    if !(nu > -1.0 && nu < 0.5) {
+        return Err(fail(&format!("NU = {nu} must lie in (-1, 0.5)")));
+    }
+    Ok((e, g, nu))
+}
+
+fn node_of(body: &NastranBody, grid: u32, line: usize, user: &str) -> Result<usize, FeError> {
+    body.grid_index
+        .get(&grid)
+        .copied()
+        .ok_or_else(|| mesh_error(line, format!("{user}: GRID {grid} not found")))
+}
+
+fn mask_nodes(mask: [bool; 6]) -> impl Iterator<Item = usize> {
+    (0..6).filter(move |&d| mask[d])
+}
+
+/// Builds the body from the lexed deck.
+pub(crate) fn build(deck: &Deck) -> Result<NastranBody, FeError> {
+    let c = Cards::read(deck)?;
+    let systems = Systems::new(&c.systems)?;
+    let mut body = NastranBody {
+        mesh: Mesh::default(),
+        grid_index: BTreeMap::new(),
+        element_ids: Default::default(),
+        spc_set: None,
+    };
+    for (&id, g) in &c.grids {
+        let x = Vector3::from(g.x);
+        let p = match g.cp {
+            None => x,
+            Some(cp) => {
+                let (o, r) = systems.get(cp, g.line, &format!("GRID {id} CP"))?;
+                o + r * x
+            }
+        };
+        let node = body.mesh.add_node(p);
+        body.grid_index.insert(id, node);
+        body.mesh
+            .constraints
+            .extend(mask_nodes(g.ps).map(|d| (node, d)));
+    }
+    add_shells(&c, &mut body)?;
+    add_beams(&c, &mut body)?;
+    add_masses(&c, &systems, &mut body)?;
+    add_scalars(&c, &mut body)?;
+    add_links(&c, &mut body)?;
+    add_supports(&c, deck.spc_selection, &mut body)?;
+    check_dependents(&c, &body)?;
+    Ok(body)
+}
+
+fn add_shells(c: &Cards, body: &mut NastranBody) -> Result<(), FeError> {
+    for (&id, (plate, name)) in &c.plates {
+        let user = format!("{name} {id}");
+        let line = plate.line;
+        let p = c.shell_properties.get(&plate.pid).ok_or_else(|| {
+            mesh_error(
+                line,
+                format!("{user}: property PSHELL {} not found", plate.pid),
+            )
+        })?;
+        let fail =
+            |why: String| mesh_error(p.line, format!("PSHELL {} (used by {user}): {why}", p.id));
+        let mid1 = p.mid1.ok_or_else(|| {
+            fail("MID1 is blank: shells without membrane stiffness are not supported".into())
+        })?;
+        let m = material_named(c, mid1, p.line, &format!("PSHELL {}", p.id))?;
+        let same_material = |mid2: i64| {
+            mid2 == mid1 as i64
+                || (mid2 > 0
+                    && c.materials
+                        .get(&(mid2 as u32))
+                        .is_some_and(|m2| (m2.e, m2.g, m2.nu) == (m.e, m.g, m.nu)))
+        };
+        if !p.mid2.is_some_and(same_material) {
+            return Err(fail(format!(
+                "MID2 = {:?}: bending must use the membrane material MID1 = {mid1} \
+                 (membrane-only, plane-strain and mixed-material shells are not supported)",
+                p.mid2
+            )));
+        }
+        if p.mid3.is_some_and(|m3| m3 != mid1) {
+            return Err(fail(format!(
+                "MID3 must be blank or equal MID1 = {mid1} (transverse shear uses the shell material)"
+            )));
+        }
+        if (p.ts_t - 5.0 / 6.0).abs() > 1e-3 {
+            return Err(fail(format!(
+                "TS/T = {} is not supported (the shell uses 5/6)",
+                p.ts_t
+            )));
+        }
+        if !(p.t > 0.0 && p.bending_ratio > 0.0) {
+            return Err(fail(format!(
+                "T = {} and 12I/T**3 = {} must be > 0",
+                p.t, p.bending_ratio
+            )));
+        }
+        let (e, g, nu) = moduli(&m, &user)?;
+        if (g / (e / (2.0 * (1.0 + nu))) - 1.0).abs() > 0.01 {
+            return Err(mesh_error(
+                m.line,
+                format!(
+                    "MAT1 {} (used by {user}): G = {g} differs from E / 2(1 + NU) = {} by more \
+                     than 1 %; the isotropic shell needs consistent E, G, NU",
+                    m.id,
+                    e / (2.0 * (1.0 + nu))
+                ),
+            ));
+        }
+        let nodes = plate
+            .grids
+            .iter()
+            .map(|&g| node_of(body, g, line, &user))
+            .collect::<Result<Vec<_>, _>>()?;
+        let material = Material {
+            youngs_modulus: e,
+            poisson_ratio: nu,
+            density: m.rho * c.mass_scale,
+        };
+        let (thickness, bending_thickness) = (p.t, p.t * p.bending_ratio.cbrt());
+        let extra_mass_per_area = p.nsm * c.mass_scale;
+        if let [a, b, cc, d] = nodes[..] {
+            body.mesh.shells.push(Shell {
+                nodes: [a, b, cc, d],
+                material,
+                thickness,
+                bending_thickness,
+                extra_mass_per_area,
+            });
+            body.element_ids.shells.push(id);
+        } else if let [a, b, cc] = nodes[..] {
+            body.mesh.triangles.push(TriShell {
+                nodes: [a, b, cc],
+                material,
+                thickness,
+                bending_thickness,
+                extra_mass_per_area,
+            });
+            body.element_ids.triangles.push(id);
+        }
+    }
+    Ok(())
+}
+
+fn add_beams(c: &Cards, body: &mut NastranBody) -> Result<(), FeError> {
+    for (&id, bar) in &c.bars {
+        let user = format!("{} {id}", c.element_lines[&id].1);
+        let line = bar.line;
+        let (p, kind) = c.beam_properties.get(&bar.pid).ok_or_else(|| {
+            mesh_error(
+                line,
+                format!("{user}: property PBAR/PBEAM {} not found", bar.pid),
+            )
+        })?;
+        if (c.element_lines[&id].1 == "CBAR") != (*kind == "PBAR") {
+            return Err(mesh_error(
+                line,
+                format!("{user}: property {} is a {kind}", bar.pid),
+            ));
+        }
+        let m = material_named(c, p.mid, p.line, &format!("{kind} {}", p.id))?;
+        let (e, g, _) = moduli(&m, &user)?;
+        // The beam takes G through ν = E/2G − 1, so a MAT1 with all three values keeps its G.
+        let nu_for_g = e / (2.0 * g) - 1.0;
+        if !(nu_for_g > -1.0 && nu_for_g < 0.5) {
+            return Err(mesh_error(
+                m.line,
+                format!(
+                    "MAT1 {} (used by {user}): E/2G − 1 = {nu_for_g} outside (-1, 0.5)",
+                    m.id
+                ),
+            ));
+        }
+        let a = node_of(body, bar.ga, line, &user)?;
+        let b = node_of(body, bar.gb, line, &user)?;
+        let orientation = match bar.orientation {
+            Orientation::Vector(v) => Vector3::from(v),
+            Orientation::Node(g0) => {
+                body.mesh.nodes[node_of(body, g0, line, &format!("{user} G0"))?]
+                    - body.mesh.nodes[a]
+            }
+        };
+        body.mesh.beams.push(Beam {
+            nodes: [a, b],
+            material: Material {
+                youngs_modulus: e,
+                poisson_ratio: nu_for_g,
+                density: m.rho * c.mass_scale,
+            },
+            // Nastran's plane 1 (element x-y) bends about z with I1; plane 2 about y with I2.
+            section: BeamSection {
+                area: p.a,
+                iy: p.i2,
+                iz: p.i1,
+                j: p.j,
+            },
+            orientation,
+            extra_mass_per_length: p.nsm * c.mass_scale,
+        });
+        body.element_ids.beams.push(id);
+    }
+    Ok(())
+}
+
+fn add_masses(c: &Cards, systems: &Systems, body: &mut NastranBody) -> Result<(), FeError> {
+    for (&id, m) in &c.masses {
+        let user = format!("CONM2 {id}");
+        let node = node_of(body, m.grid, m.line, &user)?;
+        let [i11, i21, i22, i31, i32, i33] = m.inertia;
+        // Nastran enters the products of inertia as I21 = ∫ x1 x2 dm etc. and supplies the
+        // minus signs itself (MSC/NX QRG, CONM2 remark): the tensor is
+        // [I11 −I21 −I31; −I21 I22 −I32; −I31 −I32 I33].
+        let local = Matrix3::new(i11, -i21, -i31, -i21, i22, -i32, -i31, -i32, i33);
+        let (offset, inertia) = match m.cid {
+            -1 => (Vector3::from(m.x) - body.mesh.nodes[node], local),
+            0 => (Vector3::from(m.x), local),
+            cid => {
+                let (_, r) = systems.get(cid as u32, m.line, &user)?;
+                (r * Vector3::from(m.x), r * local * r.transpose())
+            }
+        };
+        let mass_node = if offset.norm() == 0.0 {
+            node
+        } else {
+            // The offset mass sits on its own node carried rigidly by the grid: exact coupling
+            // of translation and rotation, no lumping approximation.
+            let cg = body.mesh.add_node(body.mesh.nodes[node] + offset);
+            body.mesh.rigid_links.push(RigidLink {
+                independent: node,
+                dependent: vec![cg],
+                components: [true; 6],
+            });
+            body.element_ids.rigid_links.push(id);
+            cg
+        };
+        body.mesh.masses.push(PointMass {
+            node: mass_node,
+            mass: m.mass * c.mass_scale,
+            inertia: inertia * c.mass_scale,
+        });
+        body.element_ids.masses.push(id);
+    }
+    Ok(())
+}
+
+fn add_scalars(c: &Cards, body: &mut NastranBody) -> Result<(), FeError> {
+    // Per node (ground) or node pair: (stiffness, damping) per DOF, summed over cards.
+    let mut ground: BTreeMap<usize, ([f64; 6], [f64; 6])> = BTreeMap::new();
+    let mut pairs: BTreeMap<(usize, usize), ([f64; 6], [f64; 6])> = BTreeMap::new();
+    for (is_damper, list) in [(false, &c.springs), (true, &c.dampers)] {
+        for (&id, s) in list {
+            let user = format!("{} {id}", c.element_lines[&id].1);
+            let value = match s.value {
+                ScalarValue::Value(v) => v,
+                ScalarValue::Property(pid) => {
+                    let table = if is_damper {
+                        &c.damper_properties
+                    } else {
+                        &c.spring_properties
+                    };
+                    table.get(&pid).map(|(v, _)| *v).ok_or_else(|| {
+                        mesh_error(
+                            s.line,
+                            format!(
+                                "{user}: property {} {pid} not found",
+                                if is_damper { "PDAMP" } else { "PELAS" }
+                            ),
+                        )
+                    })?
+                }
+            };
+            let slot = usize::from(is_damper);
+            match s.ends.as_slice() {
+                [(g, comp)] => {
+                    let n = node_of(body, *g, s.line, &user)?;
+                    let e = ground.entry(n).or_insert(([0.0; 6], [0.0; 6]));
+                    [&mut e.0, &mut e.1][slot][*comp] += value;
+                }
+                [(g1, c1), (g2, c2)] => {
+                    if c1 != c2 {
+                        return Err(mesh_error(
+                            s.line,
+                            format!(
+                                "{user}: components C1 = {} and C2 = {} differ; only springs \
+                                 and dampers acting along one direction are supported",
+                                c1 + 1,
+                                c2 + 1
+                            ),
+                        ));
+                    }
+                    let (n1, n2) = (
+                        node_of(body, *g1, s.line, &user)?,
+                        node_of(body, *g2, s.line, &user)?,
+                    );
+                    if n1 == n2 {
+                        return Err(mesh_error(
+                            s.line,
+                            format!("{user}: both ends on GRID {g1}"),
+                        ));
+                    }
+                    let e = pairs
+                        .entry((n1.min(n2), n1.max(n2)))
+                        .or_insert(([0.0; 6], [0.0; 6]));
+                    [&mut e.0, &mut e.1][slot][*c1] += value;
+                }
+                _ => {
+                    return Err(mesh_error(
+                        s.line,
+                        format!("{user}: needs one or two grids"),
+                    ))
+                }
+            }
+        }
+    }
+    for (node, (stiffness, damping)) in ground {
+        body.mesh.ground_springs.push(GroundSpring {
+            node,
+            stiffness,
+            damping,
+        });
+    }
+    for ((a, b), (stiffness, damping)) in pairs {
+        body.mesh.springs.push(Spring {
+            nodes: [a, b],
+            stiffness,
+            damping,
+        });
+    }
+    Ok(())
+}
+
+fn add_links(c: &Cards, body: &mut NastranBody) -> Result<(), FeError> {
+    for (&id, e) in &c.rigid {
+        let user = format!("RBE2 {id}");
+        let independent = node_of(body, e.independent, e.line, &user)?;
+        let dependent = e
+            .dependent
+            .iter()
+            .map(|&g| node_of(body, g, e.line, &user))
+            .collect::<Result<Vec<_>, _>>()?;
+        body.mesh.rigid_links.push(RigidLink {
+            independent,
+            dependent,
+            components: e.components,
+        });
+        body.element_ids.rigid_links.push(id);
+    }
+    for (&id, e) in &c.interpolation {
+        let user = format!("RBE3 {id}");
+        let reference = node_of(body, e.reference, e.line, &user)?;
+        let mut sources = Vec::new();
+        for (weight, components, grids) in &e.groups {
+            if weight.is_nan() || *weight <= 0.0 {
+                return Err(mesh_error(
+                    e.line,
+                    format!("{user}: weight {weight} must be > 0"),
+                ));
+            }
+            sources.push(InterpolationSource {
+                nodes: grids
+                    .iter()
+                    .map(|&g| node_of(body, g, e.line, &user))
+                    .collect::<Result<Vec<_>, _>>()?,
+                weight: *weight,
+                components: *components,
+            });
+        }
+        body.mesh.interpolation_links.push(InterpolationLink {
+            reference,
+            reference_components: e.reference_components,
+            sources,
+        });
+        body.element_ids.interpolation_links.push(id);
+    }
+    Ok(())
+}
+
+/// A DOF may be dependent in one RBE only and not also supported (Nastran's rule; assembly
+/// enforces it too, but here the message can name the cards).
+fn check_dependents(c: &Cards, body: &NastranBody) -> Result<(), FeError> {
+    let names = ["1", "2", "3", "4", "5", "6"];
+    let mut owner: BTreeMap<(u32, usize), (String, usize)> = BTreeMap::new();
+    let dependents = c
+        .rigid
+        .iter()
+        .flat_map(|(id, e)| {
+            e.dependent.iter().flat_map(move |&g| {
+                mask_nodes(e.components).map(move |d| (g, d, format!("RBE2 {id}"), e.line))
+            })
+        })
+        .chain(c.interpolation.iter().flat_map(|(id, e)| {
+            mask_nodes(e.reference_components)
+                .map(move |d| (e.reference, d, format!("RBE3 {id}"), e.line))
+        }));
+    for (grid, d, card, line) in dependents {
+        if let Some((first, _)) = owner.get(&(grid, d)) {
+            return Err(mesh_error(
+                line,
+                format!(
+                    "GRID {grid} component {} is dependent in both {first} and {card}",
+                    names[d]
+                ),
+            ));
+        }
+        owner.insert((grid, d), (card, line));
+    }
+    let grid_of: BTreeMap<usize, u32> = body.grid_index.iter().map(|(g, n)| (*n, *g)).collect();
+    for &(node, d) in &body.mesh.constraints {
+        let Some(grid) = grid_of.get(&node) else {
+            continue;
+        };
+        if let Some((card, line)) = owner.get(&(*grid, d)) {
+            return Err(mesh_error(
+                *line,
+                format!(
+                    "GRID {grid} component {} is dependent in {card} and also constrained \
+                     (SPC or GRID PS); constrain the independent grid instead",
+                    names[d]
+                ),
+            ));
+        }
+    }
+    Ok(())
+}
+
+fn add_supports(c: &Cards, selected: Option<u32>, body: &mut NastranBody) -> Result<(), FeError> {
+    let sets: BTreeSet<u32> = c.supports.iter().map(|s| s.0 .0).collect();
+    let set = match (selected, sets.len()) {
+        (Some(s), _) => {
+            if !sets.is_empty() && !sets.contains(&s) {
+                return Err(FeError::InvalidInput(format!(
+                    "Nastran case control selects SPC = {s}, but the bulk data defines SPC sets {sets:?}"
+                )));
+            }
+            Some(s)
+        }
+        (None, 0) => None,
+        (None, 1) => sets.first().copied(),
+        (None, _) => {
+            return Err(FeError::InvalidInput(format!(
+                "the bulk data defines several SPC sets {sets:?} and no case control selects one \
+                 (add 'SPC = <id>' before BEGIN BULK)"
+            )))
+        }
+    };
+    body.spc_set = set;
+    let mut seen = BTreeSet::new();
+    for &((sid, grids, mask), line) in &c.supports {
+        if Some(sid) != set {
+            continue;
+        }
+        let nodes: Vec<usize> = match grids {
+            cards::Grids::One(grid) => vec![node_of(body, grid, line, &format!("SPC set {sid}"))?],
+            cards::Grids::Range(from, to) => {
+                body.grid_index.range(from..=to).map(|(_, &n)| n).collect()
+            }
+        };
+        for node in nodes {
+            for d in mask_nodes(mask) {
+                if seen.insert((node, d)) {
+                    body.mesh.constraints.push((node, d));
+                }
+            }
+        }
+    }
+    Ok(())
+}
