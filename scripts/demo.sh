@@ -10,5 +10,6 @@ bash packaging/package.sh
 .venv/bin/emc sweep --fmu dist/EngineMountChassis.fmu --rpm 800 2500 --count 18 \
   --revolutions 40 --settle 40 --set scene=2 --case "scene 2" --out out/demo \
   --signal "steeringWheel.a[3]" --signal "steeringWheel.a[2]" --signal "mount[1].F[3]" \
+  --signal "steeringWheel.a[1]" --signal "seat.a[1]" --signal "seat.a[2]" --signal "seat.a[3]" \
   --plot "steeringWheel.a[3]" --plot "steeringWheel.a[2]" --plot "mount[1].F[3]"
-echo "demo: waterfalls in out/demo/waterfall_*.png, order cuts in out/demo/order_cuts_*.png"
+echo "demo: waterfalls in out/demo/waterfall_*.png, order cuts in out/demo/order_cuts_*.png, comfort in out/demo/comfort.{csv,png}"

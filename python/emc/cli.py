@@ -19,6 +19,7 @@ import numpy as np
 import pandas as pd
 
 from . import plots
+from .comfort import comfort_table
 from .runner import OperatingPoint, Runner
 from .spectra import amplitude_spectrum
 from .sweep import run_sweep, save, speed_points
@@ -69,6 +70,10 @@ def cmd_sweep(args) -> int:
     for signal in args.plot or sorted(orders.signal.unique())[:1]:
         plots.waterfall(spectra, signal, str(out / f"waterfall_{safe_name(signal)}.png"))
         plots.order_cuts(orders, signal, str(out / f"order_cuts_{safe_name(signal)}.png"))
+    exposure = comfort_table(spectra)
+    if not exposure.empty:
+        save(exposure, str(out / f"comfort{suffix}"))
+        plots.comfort(exposure, str(out / "comfort.png"))
     print(f"{len(points)} points in {elapsed:.1f} s -> {out}")
     return 0
 

@@ -95,3 +95,22 @@ def side_by_side(spectra: pd.DataFrame, orders: pd.DataFrame, signal: str, cases
     fig.tight_layout()
     fig.savefig(order_cut_path, dpi=120)
     plt.close(fig)
+
+
+def comfort(table: pd.DataFrame, path: str):
+    """Weighted seat and steering-wheel accelerations over engine speed, one line per case."""
+    panels = [(c, label) for c, label in (
+        ("seat_av_comfort", "seat, vibration total value a_v (ISO 2631-1, Wk/Wd, comfort)"),
+        ("wheel_ahv", "steering wheel, a_hv (ISO 5349-1, Wh)")) if c in table]
+    fig, axes = plt.subplots(1, len(panels), figsize=(7 * len(panels), 4.5), squeeze=False)
+    for ax, (column, label) in zip(axes[0], panels):
+        for case, d in table.groupby("case"):
+            ax.plot(d.rpm, d[column], marker="o", label=case or "model")
+        ax.set_xlabel("engine speed [rpm]")
+        ax.set_ylabel("weighted RMS acceleration [m/s²]")
+        ax.set_title(label, fontsize=10)
+        ax.grid(True, which="both", alpha=0.4)
+        ax.legend()
+    fig.tight_layout()
+    fig.savefig(path, dpi=120)
+    plt.close(fig)
