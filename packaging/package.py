@@ -26,25 +26,30 @@ ROOT = pathlib.Path(__file__).resolve().parent.parent
 CRATE = "engine_mount_chassis"
 
 
-def build() -> tuple[pathlib.Path, pathlib.Path]:
-    """Runs cargo and returns (cdylib path, build-script OUT_DIR)."""
-    cmd = ["cargo", "build", "--release", "--lib", "--message-format=json-render-diagnostics"]
-    proc = subprocess.run(cmd, cwd=ROOT, stdout=subprocess.PIPE, text=True)
+def cargo(args: list[str], crate_type: str, suffix: str) -> tuple[pathlib.Path, pathlib.Path]:
+    """Runs cargo with ``args`` and returns (the crate's artifact of ``crate_type`` ending in
+    ``suffix``, the build script's OUT_DIR)."""
+    proc = subprocess.run(["cargo", *args, "--message-format=json-render-diagnostics"], cwd=ROOT,
+                          stdout=subprocess.PIPE, text=True)
     if proc.returncode != 0:
-        sys.exit(f"package: cargo build failed ({proc.returncode})")
-    library = out_dir = None
+        sys.exit(f"package: cargo {' '.join(args)} failed ({proc.returncode})")
+    artifact = out_dir = None
     for line in proc.stdout.splitlines():
         msg = json.loads(line)
-        pkg = msg.get("package_id", "")
-        if CRATE not in pkg.replace("-", "_"):
+        if CRATE not in msg.get("package_id", "").replace("-", "_"):
             continue
         if msg.get("reason") == "build-script-executed":
             out_dir = pathlib.Path(msg["out_dir"])
-        if msg.get("reason") == "compiler-artifact" and "cdylib" in msg["target"]["crate_types"]:
-            library = next(pathlib.Path(f) for f in msg["filenames"] if f.endswith(".so"))
-    if library is None or out_dir is None:
-        sys.exit("package: cargo did not report the cdylib and the build-script output directory")
-    return library, out_dir
+        if msg.get("reason") == "compiler-artifact" and crate_type in msg["target"]["crate_types"]:
+            artifact = next(pathlib.Path(f) for f in msg["filenames"] if f.endswith(suffix))
+    if artifact is None or out_dir is None:
+        sys.exit(f"package: cargo did not report the {crate_type} and the build-script output directory")
+    return artifact, out_dir
+
+
+def build() -> tuple[pathlib.Path, pathlib.Path]:
+    """The linux cdylib and its build-script OUT_DIR."""
+    return cargo(["build", "--release", "--lib"], "cdylib", ".so")
 
 
 WINDOWS_TARGET = "x86_64-pc-windows-gnu"
@@ -60,23 +65,8 @@ def build_windows(work: pathlib.Path) -> pathlib.Path:
     """Cross-builds the Windows DLL and returns its path."""
     if shutil.which(MINGW_GCC) is None:
         sys.exit(f"package: {MINGW_GCC} is missing (scripts/setup.sh installs gcc-mingw-w64-x86-64)")
-    cmd = ["cargo", "rustc", "--release", "--lib", "--target", WINDOWS_TARGET, "--crate-type", "staticlib",
-           "--message-format=json-render-diagnostics"]
-    proc = subprocess.run(cmd, cwd=ROOT, stdout=subprocess.PIPE, text=True)
-    if proc.returncode != 0:
-        sys.exit(f"package: cargo rustc for {WINDOWS_TARGET} failed ({proc.returncode}); "
-                 f"is the target installed (rustup target add {WINDOWS_TARGET})?")
-    archive = out_dir = None
-    for line in proc.stdout.splitlines():
-        msg = json.loads(line)
-        if CRATE not in msg.get("package_id", "").replace("-", "_"):
-            continue
-        if msg.get("reason") == "build-script-executed":
-            out_dir = pathlib.Path(msg["out_dir"])
-        if msg.get("reason") == "compiler-artifact" and "staticlib" in msg["target"]["crate_types"]:
-            archive = next(pathlib.Path(f) for f in msg["filenames"] if f.endswith(".a"))
-    if archive is None or out_dir is None:
-        sys.exit("package: cargo did not report the Windows static library and its OUT_DIR")
+    archive, out_dir = cargo(["rustc", "--release", "--lib", "--target", WINDOWS_TARGET,
+                              "--crate-type", "staticlib"], "staticlib", ".a")
     dll = work / "EngineMountChassis.dll"
     link = [MINGW_GCC, "-shared", "-s", "-o", str(dll), str(out_dir / "exports.def"), str(archive),
             "-static", "-static-libgcc", *WINDOWS_LIBS]

@@ -212,28 +212,20 @@ def main(argv: list[str] | None = None) -> int:
     r.add_argument("--window", type=float, default=0.25, help="analysis window (s)")
     r.set_defaults(func=cmd_runup)
 
-    m = sub.add_parser("study-mounts", help="paper §7.1: 4 mounts vs 3 mounts + stiffening bar (scene 2)")
-    common(m)
-    m.add_argument("--count", type=int, default=18)
-    m.add_argument("--revolutions", type=int, default=40, help="stationary window (even)")
-    m.add_argument("--settle", type=int, default=20, help="revolutions before the window")
-    m.add_argument("--serial", action="store_true", help="no Dask")
-    m.add_argument("--workers", type=int, default=2)
-    m.add_argument("--scheduler", help="address of a running Dask scheduler")
-    m.add_argument("--quiet", action="store_true")
-    m.set_defaults(func=cmd_study_mounts)
-
-    e = sub.add_parser("study-engines", help="inline-3 (M13) vs the inline-4 it replaced, with and without "
-                                             "Lanchester shafts (scene 2)")
-    common(e)
-    e.add_argument("--count", type=int, default=18)
-    e.add_argument("--revolutions", type=int, default=40, help="stationary window (even)")
-    e.add_argument("--settle", type=int, default=20, help="revolutions before the window")
-    e.add_argument("--serial", action="store_true", help="no Dask")
-    e.add_argument("--workers", type=int, default=2)
-    e.add_argument("--scheduler", help="address of a running Dask scheduler")
-    e.add_argument("--quiet", action="store_true")
-    e.set_defaults(func=cmd_study_engines)
+    studies = [("study-mounts", "paper §7.1: 4 mounts vs 3 mounts + stiffening bar (scene 2)", cmd_study_mounts),
+               ("study-engines", "inline-3 (M13) vs the inline-4 it replaced, with and without Lanchester "
+                                 "shafts (scene 2)", cmd_study_engines)]
+    for name, help_text, func in studies:
+        m = sub.add_parser(name, help=help_text)
+        common(m)
+        m.add_argument("--count", type=int, default=18)
+        m.add_argument("--revolutions", type=int, default=40, help="stationary window (even)")
+        m.add_argument("--settle", type=int, default=20, help="revolutions before the window")
+        m.add_argument("--serial", action="store_true", help="no Dask")
+        m.add_argument("--workers", type=int, default=2)
+        m.add_argument("--scheduler", help="address of a running Dask scheduler")
+        m.add_argument("--quiet", action="store_true")
+        m.set_defaults(func=func)
 
     b = sub.add_parser("bench-effects", help="CPU time per simulated second for each scene and effect set")
     b.add_argument("--fmu", default="dist/EngineMountChassis.fmu")

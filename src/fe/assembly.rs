@@ -1,7 +1,7 @@
 //! Sparse assembly of K, M and C from the element matrices (triplets → faer `SparseColMat`).
 
 use faer::sparse::{SparseColMat, Triplet};
-use nalgebra::{Dim, Matrix, RawStorage, Vector3};
+use nalgebra::{Dim, Matrix, RawStorage};
 
 use super::dof::{DofMap, Expansion, DOF_PER_NODE};
 use super::error::FeError;
@@ -85,21 +85,6 @@ fn terms(e: Expansion<'_>) -> Vec<(usize, f64)> {
     }
 }
 
-fn node_of(mesh: &Mesh, what: &str, node: usize) -> Result<Vector3<f64>, FeError> {
-    let p = mesh.nodes.get(node).copied().ok_or_else(|| {
-        FeError::Mesh(format!(
-            "{what} refers to node {node}, mesh has {} nodes",
-            mesh.nodes.len()
-        ))
-    })?;
-    if p.iter().any(|c| !c.is_finite()) {
-        return Err(FeError::Mesh(format!(
-            "node {node} has non-finite coordinates"
-        )));
-    }
-    Ok(p)
-}
-
 /// Assembles K, M, C of `mesh` on the DOFs left free by `mesh.constraints`.
 pub fn assemble(mesh: &Mesh) -> Result<Assembled, FeError> {
     let dofs = DofMap::with_links(
@@ -122,18 +107,18 @@ pub fn assemble(mesh: &Mesh) -> Result<Assembled, FeError> {
     };
     for (i, b) in mesh.beams.iter().enumerate() {
         let what = format!("beam {i}");
-        let p1 = node_of(mesh, &what, b.nodes[0])?;
-        let p2 = node_of(mesh, &what, b.nodes[1])?;
+        let p1 = mesh.position(&what, b.nodes[0])?;
+        let p2 = mesh.position(&what, b.nodes[1])?;
         k.scatter(&b.nodes, &beam::stiffness(i, b, &p1, &p2)?);
         m.scatter(&b.nodes, &beam::lumped_mass(i, b, &p1, &p2)?);
     }
     for (i, s) in mesh.shells.iter().enumerate() {
         let what = format!("shell {i}");
         let p = [
-            node_of(mesh, &what, s.nodes[0])?,
-            node_of(mesh, &what, s.nodes[1])?,
-            node_of(mesh, &what, s.nodes[2])?,
-            node_of(mesh, &what, s.nodes[3])?,
+            mesh.position(&what, s.nodes[0])?,
+            mesh.position(&what, s.nodes[1])?,
+            mesh.position(&what, s.nodes[2])?,
+            mesh.position(&what, s.nodes[3])?,
         ];
         k.scatter(&s.nodes, &shell::stiffness(i, s, &p)?);
         m.scatter(&s.nodes, &shell::lumped_mass(i, s, &p)?);
@@ -141,27 +126,27 @@ pub fn assemble(mesh: &Mesh) -> Result<Assembled, FeError> {
     for (i, t) in mesh.triangles.iter().enumerate() {
         let what = format!("triangle {i}");
         let p = [
-            node_of(mesh, &what, t.nodes[0])?,
-            node_of(mesh, &what, t.nodes[1])?,
-            node_of(mesh, &what, t.nodes[2])?,
+            mesh.position(&what, t.nodes[0])?,
+            mesh.position(&what, t.nodes[1])?,
+            mesh.position(&what, t.nodes[2])?,
         ];
         k.scatter(&t.nodes, &shell3::stiffness(i, t, &p)?);
         m.scatter(&t.nodes, &shell3::lumped_mass(i, t, &p)?);
     }
     for (i, pm) in mesh.masses.iter().enumerate() {
-        node_of(mesh, &format!("point mass {i}"), pm.node)?;
+        mesh.position(&format!("point mass {i}"), pm.node)?;
         m.scatter(&[pm.node], &mass::matrix(i, pm)?);
     }
     for (i, s) in mesh.ground_springs.iter().enumerate() {
-        node_of(mesh, &format!("ground spring {i}"), s.node)?;
+        mesh.position(&format!("ground spring {i}"), s.node)?;
         let (ks, cs) = spring::ground_matrices(i, s)?;
         k.scatter(&[s.node], &ks);
         c.scatter(&[s.node], &cs);
     }
     for (i, s) in mesh.springs.iter().enumerate() {
         let what = format!("spring {i}");
-        node_of(mesh, &what, s.nodes[0])?;
-        node_of(mesh, &what, s.nodes[1])?;
+        mesh.position(&what, s.nodes[0])?;
+        mesh.position(&what, s.nodes[1])?;
         let (ks, cs) = spring::two_node_matrices(i, s)?;
         k.scatter(&s.nodes, &ks);
         c.scatter(&s.nodes, &cs);
@@ -198,6 +183,7 @@ pub fn translational_mass(a: &Assembled, direction: usize) -> f64 {
 mod tests {
     use super::*;
     use crate::fe::mesh::{GroundSpring, Spring};
+    use nalgebra::Vector3;
 
     fn two_nodes() -> Mesh {
         let mut mesh = Mesh::default();

@@ -31,21 +31,6 @@ pub struct LinkEquation {
     pub origin: String,
 }
 
-fn position(mesh: &Mesh, what: &str, node: usize) -> Result<Vector3<f64>, FeError> {
-    let p = mesh.nodes.get(node).copied().ok_or_else(|| {
-        FeError::Mesh(format!(
-            "{what} refers to node {node}, mesh has {} nodes",
-            mesh.nodes.len()
-        ))
-    })?;
-    if p.iter().any(|c| !c.is_finite()) {
-        return Err(FeError::Mesh(format!(
-            "{what}: node {node} has non-finite coordinates"
-        )));
-    }
-    Ok(p)
-}
-
 /// Rigid map from the motion (u, θ) of a point to the motion of a point at offset `d` from it:
 /// u' = u + θ × d = u − [d]× θ, θ' = θ.
 fn rigid_map(d: &Vector3<f64>) -> Matrix6<f64> {
@@ -61,7 +46,7 @@ fn rigid_equations(
     link: &RigidLink,
 ) -> Result<Vec<LinkEquation>, FeError> {
     let origin = format!("rigid link {index}");
-    let xi = position(mesh, &origin, link.independent)?;
+    let xi = mesh.position(&origin, link.independent)?;
     let mut out = Vec::new();
     for &dep in &link.dependent {
         if dep == link.independent {
@@ -69,7 +54,7 @@ fn rigid_equations(
                 "{origin}: node {dep} is both independent and dependent"
             )));
         }
-        let s = rigid_map(&(position(mesh, &origin, dep)? - xi));
+        let s = rigid_map(&(mesh.position(&origin, dep)? - xi));
         for (row, _) in link.components.iter().enumerate().filter(|(_, on)| **on) {
             let terms = (0..DOF_PER_NODE)
                 .filter(|&col| s[(row, col)] != 0.0)
@@ -93,7 +78,7 @@ fn interpolation_equations(
     link: &InterpolationLink,
 ) -> Result<Vec<LinkEquation>, FeError> {
     let origin = format!("interpolation link {index}");
-    let xr = position(mesh, &origin, link.reference)?;
+    let xr = mesh.position(&origin, link.reference)?;
     let mut sources = Vec::new();
     for group in &link.sources {
         if !(group.weight.is_finite() && group.weight > 0.0) {
@@ -113,7 +98,7 @@ fn interpolation_equations(
                     "{origin}: reference node {node} is also a source node"
                 )));
             }
-            sources.push((node, position(mesh, &origin, node)? - xr, group));
+            sources.push((node, mesh.position(&origin, node)? - xr, group));
         }
     }
     if sources.is_empty() {

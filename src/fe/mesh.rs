@@ -223,6 +223,23 @@ impl Mesh {
         self.nodes.len() - 1
     }
 
+    /// Position of `node`, which `what` (an element, a link) refers to: an error if the node
+    /// does not exist or its coordinates are not finite.
+    pub fn position(&self, what: &str, node: usize) -> Result<Vector3<f64>, super::FeError> {
+        let p = self.nodes.get(node).copied().ok_or_else(|| {
+            super::FeError::Mesh(format!(
+                "{what} refers to node {node}, mesh has {} nodes",
+                self.nodes.len()
+            ))
+        })?;
+        if p.iter().any(|c| !c.is_finite()) {
+            return Err(super::FeError::Mesh(format!(
+                "{what}: node {node} has non-finite coordinates"
+            )));
+        }
+        Ok(p)
+    }
+
     /// Id of a named node.
     pub fn named(&self, name: &str) -> Option<usize> {
         self.named_nodes.get(name).copied()
