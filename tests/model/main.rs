@@ -11,4 +11,5 @@ mod hybrid_coupling;
 mod hybrid_paper;
 mod inline_four;
 mod scene_effects;
+mod torque_path;
 mod wrench_orders;

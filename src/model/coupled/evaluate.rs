@@ -113,8 +113,9 @@ impl CoupledModel {
         let phi = y[self.layout.crank_angle()];
         let (speed, acceleration) = self.crank_motion(t, y);
         let crank = self.crank_state(t, phi, speed, acceleration, mode);
+        // Combustion needs a turning crank: the gas excitation fades out below the firing speed.
         let gas_scale = if mode.running {
-            self.excitation(t)
+            self.excitation(t) * super::super::powertrain::firing_factor(speed)
         } else {
             0.0
         };

@@ -59,6 +59,18 @@ impl LoadPoints {
     }
 }
 
+/// Crank speed (rad/s) from which the engine fires fully; below it the gas excitation fades out
+/// smoothly to none at standstill (the cylinders do not fire on a standing crank). 300 rpm is
+/// below any idle speed and above a starter's cranking speed.
+pub const FIRING_SPEED: f64 = 300.0 * std::f64::consts::PI / 30.0;
+
+/// Share of the gas excitation at crank speed `speed`: smoothstep from 0 at rest to 1 at
+/// [`FIRING_SPEED`].
+pub fn firing_factor(speed: f64) -> f64 {
+    let x = (speed.abs() / FIRING_SPEED).min(1.0);
+    x * x * (3.0 - 2.0 * x)
+}
+
 /// Gas excitation prepared from the configuration.
 #[derive(Debug, Clone, PartialEq)]
 struct GasExcitation {
@@ -67,6 +79,8 @@ struct GasExcitation {
     load_points: Option<LoadPoints>,
     /// Relative heat-release deviation per cylinder (empty: identical cylinders).
     spread: Vec<f64>,
+    /// Mean indicated torque of all cylinders (N m), from the pressure curves' work per cycle.
+    mean_torque: f64,
     area: f64,
     crankcase_pressure: f64,
     radius: f64,
@@ -111,10 +125,11 @@ impl GasExcitation {
                 ((0..n).map(|_| Arc::clone(&shared)).collect(), None)
             }
         };
-        Ok(GasExcitation {
+        let mut gas = GasExcitation {
             curves,
             load_points,
             spread,
+            mean_torque: 0.0,
             area: geometry.piston_area(),
             crankcase_pressure: config.gas.crankcase_pressure,
             radius: c.crank_radius,
@@ -132,7 +147,25 @@ impl GasExcitation {
                 .collect(),
             crank_centre: v3(&c.crank_centre) - reference,
             bore: v3(&c.bore_axis),
-        })
+        };
+        gas.mean_torque = gas.indicated_torque();
+        Ok(gas)
+    }
+
+    /// Mean indicated torque `Σ_i ∮ (p_i − p_crankcase) dV / 4π` (N m) of the current curves.
+    fn indicated_torque(&self) -> f64 {
+        const SAMPLES: usize = 2880;
+        let step = 4.0 * std::f64::consts::PI / SAMPLES as f64;
+        let volume = |psi: f64| -self.area * slider_crank(psi, self.radius, self.conrod).0;
+        let mut work = 0.0;
+        for (&(_, throw, firing), curve) in self.cylinders.iter().zip(&self.curves) {
+            for k in 0..SAMPLES {
+                let (a, b) = (k as f64 * step, (k + 1) as f64 * step);
+                let p = 0.5 * (curve.pressure(a - firing) + curve.pressure(b - firing));
+                work += (p - self.crankcase_pressure) * (volume(b - throw) - volume(a - throw));
+            }
+        }
+        work / (4.0 * std::f64::consts::PI)
     }
 }
 
@@ -246,6 +279,7 @@ impl Powertrain {
                 ));
             };
             gas.curves = points.curves(load, &gas.spread, gas.cylinders.len());
+            gas.mean_torque = gas.indicated_torque();
         }
         self.config.gas.load = load;
         Ok(())
@@ -315,6 +349,19 @@ impl Powertrain {
             out.add_point_force(body, &pin, &(-n * side));
             out.add_point_force(body, &bearing, &(n * side));
         }
+        // The mean of the gas torque leaves the crank inside the powertrain, to the engine's
+        // friction and into the gearbox; its reaction on the block closes the torque path, so on
+        // average the mounts carry only the drivetrain's reaction (the load torque input) and the
+        // gas forces excite the alternating part.
+        out.add_wrench(
+            &Vector3::zeros(),
+            &(body.rotation * Vector3::y() * (gas.mean_torque * scale)),
+        );
+    }
+
+    /// Mean indicated torque of the engine at its current load (N m; 0 without gas forces).
+    pub fn mean_indicated_torque(&self) -> f64 {
+        self.gas.as_ref().map_or(0.0, |g| g.mean_torque)
     }
 
     /// Cylinder pressure of cylinder `i` at crank angle `phi` (Pa), if gas forces are on.
