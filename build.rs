@@ -6,6 +6,8 @@
 //!
 //! The GUID is a hash of the table's content, so the XML and the binary can never disagree.
 
+use quick_xml::events::{BytesDecl, BytesText, Event};
+use quick_xml::Writer;
 use serde_json::Value;
 use std::collections::BTreeMap;
 use std::fmt::Write as _;
@@ -293,159 +295,204 @@ fn validate(table: &Value, scalars: &[Scalar]) {
     }
 }
 
-fn xml_escape(s: &str) -> String {
-    s.replace('&', "&amp;")
-        .replace('<', "&lt;")
-        .replace('>', "&gt;")
-        .replace('"', "&quot;")
-}
-
+/// A start value as XML attribute text (quick-xml escapes it).
 fn value_text(v: &Value) -> String {
     match v {
         Value::Bool(b) => b.to_string(),
         Value::Number(n) => n.to_string(),
-        Value::String(s) => xml_escape(s),
+        Value::String(s) => s.clone(),
         other => fail(&format!("unsupported start value {other}")),
     }
 }
 
+/// Attributes in the order given (quick-xml escapes the values).
+type Attributes = Vec<(String, String)>;
+
+fn attr(key: &str, value: impl ToString) -> (String, String) {
+    (key.to_string(), value.to_string())
+}
+
+fn element<'w>(
+    w: &'w mut Writer<Vec<u8>>,
+    name: &'w str,
+    attributes: &'w Attributes,
+) -> quick_xml::writer::ElementWriter<'w, Vec<u8>> {
+    w.create_element(name)
+        .with_attributes(attributes.iter().map(|(k, v)| (k.as_str(), v.as_str())))
+}
+
 fn model_description(table: &Value, scalars: &[Scalar], guid: &str) -> String {
-    let mut x = String::new();
-    let id = str_field(table, "modelIdentifier");
-    let _ = writeln!(x, r#"<?xml version="1.0" encoding="UTF-8"?>"#);
-    let _ = writeln!(
-        x,
-        r#"<fmiModelDescription fmiVersion="2.0" modelName="{}" guid="{guid}" description="{}" author="{}" version="{}" generationTool="engine_mount_chassis build.rs" variableNamingConvention="structured" numberOfEventIndicators="0">"#,
-        xml_escape(str_field(table, "modelName")),
-        xml_escape(str_field(table, "description")),
-        xml_escape(str_field(table, "author")),
-        xml_escape(str_field(table, "version")),
-    );
-    let _ = writeln!(
-        x,
-        r#"  <CoSimulation modelIdentifier="{id}" needsExecutionTool="false" canHandleVariableCommunicationStepSize="true" canInterpolateInputs="true" maxOutputDerivativeOrder="0" canRunAsynchronuously="false" canBeInstantiatedOnlyOncePerProcess="false" canNotUseMemoryManagementFunctions="true" canGetAndSetFMUstate="true" canSerializeFMUstate="true" providesDirectionalDerivative="false"/>"#
-    );
-    x.push_str("  <UnitDefinitions>\n");
-    for u in table
-        .get("units")
-        .and_then(Value::as_array)
-        .into_iter()
-        .flatten()
-    {
-        let _ = writeln!(
-            x,
-            r#"    <Unit name="{}">"#,
-            xml_escape(str_field(u, "name"))
-        );
-        let mut base = String::from("      <BaseUnit");
-        if let Some(obj) = u.get("base").and_then(Value::as_object) {
-            for (k, v) in obj {
-                let _ = write!(base, r#" {k}="{v}""#);
-            }
-        }
-        if let Some(f) = u.get("factor").and_then(Value::as_f64) {
-            let _ = write!(base, r#" factor="{f:?}""#);
-        }
-        base.push_str("/>\n");
-        x.push_str(&base);
-        for d in u
-            .get("display")
+    let mut w = Writer::new_with_indent(Vec::new(), b' ', 2);
+    write_model_description(&mut w, table, scalars, guid)
+        .unwrap_or_else(|e| fail(&format!("writing modelDescription.xml: {e}")));
+    let mut xml = String::from_utf8(w.into_inner()).expect("quick-xml writes UTF-8");
+    xml.push('\n');
+    xml
+}
+
+fn write_model_description(
+    w: &mut Writer<Vec<u8>>,
+    table: &Value,
+    scalars: &[Scalar],
+    guid: &str,
+) -> std::io::Result<()> {
+    let array = |key: &str| -> Vec<Value> {
+        table
+            .get(key)
             .and_then(Value::as_array)
-            .into_iter()
-            .flatten()
-        {
-            let factor = d.get("factor").and_then(Value::as_f64).unwrap_or(1.0);
-            let _ = writeln!(
-                x,
-                r#"      <DisplayUnit name="{}" factor="{factor:?}"/>"#,
-                xml_escape(str_field(d, "name"))
-            );
+            .cloned()
+            .unwrap_or_default()
+    };
+    w.write_event(Event::Decl(BytesDecl::new("1.0", Some("UTF-8"), None)))?;
+    let root = vec![
+        attr("fmiVersion", "2.0"),
+        attr("modelName", str_field(table, "modelName")),
+        attr("guid", guid),
+        attr("description", str_field(table, "description")),
+        attr("author", str_field(table, "author")),
+        attr("version", str_field(table, "version")),
+        attr("generationTool", "engine_mount_chassis build.rs"),
+        attr("variableNamingConvention", "structured"),
+        attr("numberOfEventIndicators", 0),
+    ];
+    element(w, "fmiModelDescription", &root).write_inner_content(|w| {
+        let co_simulation = vec![
+            attr("modelIdentifier", str_field(table, "modelIdentifier")),
+            attr("needsExecutionTool", false),
+            attr("canHandleVariableCommunicationStepSize", true),
+            attr("canInterpolateInputs", true),
+            attr("maxOutputDerivativeOrder", 0),
+            attr("canRunAsynchronuously", false),
+            attr("canBeInstantiatedOnlyOncePerProcess", false),
+            attr("canNotUseMemoryManagementFunctions", true),
+            attr("canGetAndSetFMUstate", true),
+            attr("canSerializeFMUstate", true),
+            attr("providesDirectionalDerivative", false),
+        ];
+        element(w, "CoSimulation", &co_simulation).write_empty()?;
+        w.create_element("UnitDefinitions")
+            .write_inner_content(|w| {
+                for u in array("units") {
+                    let name = vec![attr("name", str_field(&u, "name"))];
+                    element(w, "Unit", &name).write_inner_content(|w| {
+                        let mut base: Attributes = u
+                            .get("base")
+                            .and_then(Value::as_object)
+                            .into_iter()
+                            .flatten()
+                            .map(|(k, v)| attr(k, v))
+                            .collect();
+                        if let Some(f) = u.get("factor").and_then(Value::as_f64) {
+                            base.push(attr("factor", format!("{f:?}")));
+                        }
+                        element(w, "BaseUnit", &base).write_empty()?;
+                        for d in u
+                            .get("display")
+                            .and_then(Value::as_array)
+                            .into_iter()
+                            .flatten()
+                        {
+                            let factor = d.get("factor").and_then(Value::as_f64).unwrap_or(1.0);
+                            let display = vec![
+                                attr("name", str_field(d, "name")),
+                                attr("factor", format!("{factor:?}")),
+                            ];
+                            element(w, "DisplayUnit", &display).write_empty()?;
+                        }
+                        Ok(())
+                    })?;
+                }
+                Ok(())
+            })?;
+        w.create_element("LogCategories").write_inner_content(|w| {
+            for c in array("logCategories") {
+                let category = vec![
+                    attr("name", str_field(&c, "name")),
+                    attr("description", str_field(&c, "description")),
+                ];
+                element(w, "Category", &category).write_empty()?;
+            }
+            Ok(())
+        })?;
+        if let Some(de) = table.get("defaultExperiment").and_then(Value::as_object) {
+            let experiment: Attributes = de.iter().map(|(k, v)| attr(k, v)).collect();
+            element(w, "DefaultExperiment", &experiment).write_empty()?;
         }
-        x.push_str("    </Unit>\n");
-    }
-    x.push_str("  </UnitDefinitions>\n");
-    x.push_str("  <LogCategories>\n");
-    for c in table
-        .get("logCategories")
-        .and_then(Value::as_array)
-        .into_iter()
-        .flatten()
-    {
-        let _ = writeln!(
-            x,
-            r#"    <Category name="{}" description="{}"/>"#,
-            xml_escape(str_field(c, "name")),
-            xml_escape(str_field(c, "description"))
-        );
-    }
-    x.push_str("  </LogCategories>\n");
-    if let Some(de) = table.get("defaultExperiment").and_then(Value::as_object) {
-        x.push_str("  <DefaultExperiment");
-        for (k, v) in de {
-            let _ = write!(x, r#" {k}="{v}""#);
-        }
-        x.push_str("/>\n");
-    }
-    x.push_str("  <ModelVariables>\n");
-    for (index, s) in scalars.iter().enumerate() {
-        let _ = writeln!(x, "    <!-- index {} -->", index + 1);
-        let _ = writeln!(
-            x,
-            r#"    <ScalarVariable name="{}" valueReference="{}" causality="{}" variability="{}" description="{}">"#,
-            xml_escape(&s.name),
-            s.vr + vr_base(s.ty),
-            s.causality,
-            s.variability,
-            xml_escape(&s.description)
-        );
-        let mut attrs = String::new();
-        if let Some(v) = &s.start {
-            let _ = write!(attrs, r#" start="{}""#, value_text(v));
-        }
-        if let Some(u) = &s.unit {
-            let _ = write!(attrs, r#" unit="{}""#, xml_escape(u));
-        }
-        if let Some(u) = &s.display_unit {
-            let _ = write!(attrs, r#" displayUnit="{}""#, xml_escape(u));
-        }
-        if let Some(m) = s.min {
-            let _ = write!(attrs, r#" min="{}""#, number_text(s.ty, m));
-        }
-        if let Some(m) = s.max {
-            let _ = write!(attrs, r#" max="{}""#, number_text(s.ty, m));
-        }
-        let _ = writeln!(x, "      <{}{attrs}/>", s.ty);
-        x.push_str("    </ScalarVariable>\n");
-    }
-    x.push_str("  </ModelVariables>\n  <ModelStructure>\n    <Outputs>\n");
-    let outputs: Vec<usize> = scalars
-        .iter()
-        .enumerate()
-        .filter(|(_, s)| s.causality == "output")
-        .map(|(i, _)| i + 1)
-        .collect();
-    // Outputs are computed from the integrator's state at the communication point, in
-    // fmi2DoStep (and at initialisation): an input set at a communication point acts from there
-    // on and changes no output before the next step, so no output depends on an input directly.
-    for i in &outputs {
-        let _ = writeln!(x, r#"      <Unknown index="{i}" dependencies=""/>"#);
-    }
-    x.push_str("    </Outputs>\n    <InitialUnknowns>\n");
-    // At the end of initialisation the outputs describe the static equilibrium: it depends on
-    // every parameter and on the inputs marked "statics" (load torque, mount stiffness scales),
-    // not on rpm or the damping scales (a test checks each input).
-    let knowns: Vec<String> = scalars
-        .iter()
-        .enumerate()
-        .filter(|(_, s)| s.causality == "parameter" || (s.causality == "input" && s.statics))
-        .map(|(i, _)| (i + 1).to_string())
-        .collect();
-    let knowns = knowns.join(" ");
-    for i in &outputs {
-        let _ = writeln!(x, r#"      <Unknown index="{i}" dependencies="{knowns}"/>"#);
-    }
-    x.push_str("    </InitialUnknowns>\n  </ModelStructure>\n</fmiModelDescription>\n");
-    x
+        w.create_element("ModelVariables")
+            .write_inner_content(|w| {
+                for (index, s) in scalars.iter().enumerate() {
+                    w.write_event(Event::Comment(BytesText::from_escaped(format!(
+                        " index {} ",
+                        index + 1
+                    ))))?;
+                    let variable = vec![
+                        attr("name", &s.name),
+                        attr("valueReference", s.vr + vr_base(s.ty)),
+                        attr("causality", &s.causality),
+                        attr("variability", &s.variability),
+                        attr("description", &s.description),
+                    ];
+                    element(w, "ScalarVariable", &variable).write_inner_content(|w| {
+                        let mut typed = Attributes::new();
+                        if let Some(v) = &s.start {
+                            typed.push(attr("start", value_text(v)));
+                        }
+                        if let Some(u) = &s.unit {
+                            typed.push(attr("unit", u));
+                        }
+                        if let Some(u) = &s.display_unit {
+                            typed.push(attr("displayUnit", u));
+                        }
+                        if let Some(m) = s.min {
+                            typed.push(attr("min", number_text(s.ty, m)));
+                        }
+                        if let Some(m) = s.max {
+                            typed.push(attr("max", number_text(s.ty, m)));
+                        }
+                        element(w, s.ty, &typed).write_empty()?;
+                        Ok(())
+                    })?;
+                }
+                Ok(())
+            })?;
+        let outputs: Vec<usize> = scalars
+            .iter()
+            .enumerate()
+            .filter(|(_, s)| s.causality == "output")
+            .map(|(i, _)| i + 1)
+            .collect();
+        // At the end of initialisation the outputs describe the static equilibrium: it depends
+        // on every parameter and on the inputs marked "statics" (load torque, mount stiffness
+        // scales), not on rpm or the damping scales (a test checks each input).
+        let knowns = scalars
+            .iter()
+            .enumerate()
+            .filter(|(_, s)| s.causality == "parameter" || (s.causality == "input" && s.statics))
+            .map(|(i, _)| (i + 1).to_string())
+            .collect::<Vec<_>>()
+            .join(" ");
+        w.create_element("ModelStructure")
+            .write_inner_content(|w| {
+                // Outputs are computed from the integrator's state at the communication point, in
+                // fmi2DoStep (and at initialisation): an input set at a communication point acts
+                // from there on and changes no output before the next step, so no output depends on
+                // an input directly.
+                for (list, dependencies) in [("Outputs", ""), ("InitialUnknowns", knowns.as_str())]
+                {
+                    w.create_element(list).write_inner_content(|w| {
+                        for i in &outputs {
+                            let unknown =
+                                vec![attr("index", i), attr("dependencies", dependencies)];
+                            element(w, "Unknown", &unknown).write_empty()?;
+                        }
+                        Ok(())
+                    })?;
+                }
+                Ok(())
+            })?;
+        Ok(())
+    })?;
+    Ok(())
 }
 
 fn number_text(ty: &str, v: f64) -> String {
@@ -571,6 +618,11 @@ fn rust_table(table: &Value, scalars: &[Scalar], families: &[Family], guid: &str
         r.push_str("];\n");
     }
     r
+}
+
+/// Text escaped for the documentation page's HTML.
+fn xml_escape(s: &str) -> String {
+    quick_xml::escape::escape(s).into_owned()
 }
 
 fn documentation(table: &Value, scalars: &[Scalar], guid: &str) -> String {

@@ -16,4 +16,5 @@ pub mod fmi2;
 pub mod model;
 pub mod ode;
 pub mod paper;
+pub mod saved_state;
 pub mod text_file;

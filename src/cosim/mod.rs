@@ -268,53 +268,56 @@ impl Simulation {
         }
     }
 
-    /// Everything that is not in the settings, as numbers: where the simulation started, the
-    /// inputs, and the integrator state. [`Simulation::restore`] rebuilds from it.
-    pub fn dynamic_state(&self) -> Vec<f64> {
-        let mut v = vec![self.initial_time];
-        v.extend(self.initial_inputs.to_vec());
-        v.extend(self.inputs.to_vec());
-        v.push(self.time);
-        v.extend(&self.state);
-        v.extend(self.integrator.snapshot().to_f64_vec());
-        v
+    /// Everything that is not in the settings: where the simulation started, the inputs, and
+    /// the integrator state. [`Simulation::restore`] rebuilds from it.
+    pub fn dynamic_state(&self) -> SimulationState {
+        SimulationState {
+            initial_time: self.initial_time,
+            initial_inputs: self.initial_inputs,
+            inputs: self.inputs,
+            time: self.time,
+            state: self.state.clone(),
+            integrator: self.integrator.snapshot(),
+        }
     }
 
     /// Rebuilds a simulation from its settings and [`Simulation::dynamic_state`]; continuing it
     /// reproduces the original run bit for bit.
-    pub fn restore(settings: &Settings, data: &[f64]) -> Result<Simulation, String> {
-        let n = Inputs::FLAT_LEN;
-        if data.len() < 2 + 2 * n {
-            return Err("simulation state is truncated".into());
-        }
-        let initial_time = data[0];
-        let initial_inputs = Inputs::from_slice(&data[1..1 + n])?;
-        let inputs = Inputs::from_slice(&data[1 + n..1 + 2 * n])?;
-        let time = data[1 + 2 * n];
-        if data[..1 + 2 * n].iter().any(|x| !x.is_finite()) {
-            return Err("simulation state holds a non-finite input or start time".into());
-        }
-        inputs.validate()?;
-        let mut sim = Simulation::new(settings, initial_time, &initial_inputs)?;
-        let states = sim.state.len();
-        let start = 2 + 2 * n;
-        let state = data
-            .get(start..start + states)
-            .ok_or("simulation state is truncated")?;
-        if !time.is_finite() || state.iter().any(|v| !v.is_finite()) {
+    pub fn restore(settings: &Settings, saved: &SimulationState) -> Result<Simulation, String> {
+        let times = [saved.initial_time, saved.time];
+        if times.iter().chain(&saved.state).any(|x| !x.is_finite()) {
             return Err("simulation state holds a non-finite time or state".into());
         }
-        let snapshot =
-            BdfSnapshot::from_f64_slice(&data[start + states..]).map_err(|e| e.to_string())?;
+        saved.initial_inputs.validate()?;
+        saved.inputs.validate()?;
+        let mut sim = Simulation::new(settings, saved.initial_time, &saved.initial_inputs)?;
+        if saved.state.len() != sim.state.len() {
+            return Err(format!(
+                "simulation state has {} states, this model {}",
+                saved.state.len(),
+                sim.state.len()
+            ));
+        }
         sim.integrator
-            .restore(&snapshot)
+            .restore(&saved.integrator)
             .map_err(|e| e.to_string())?;
-        scene::apply_inputs(&mut sim.scene, &inputs)?;
-        sim.inputs = inputs;
-        sim.time = time;
-        sim.state.copy_from_slice(state);
+        scene::apply_inputs(&mut sim.scene, &saved.inputs)?;
+        sim.inputs = saved.inputs;
+        sim.time = saved.time;
+        sim.state.copy_from_slice(&saved.state);
         Ok(sim)
     }
+}
+
+/// The part of a [`Simulation`] its settings do not determine (see [`Simulation::dynamic_state`]).
+#[derive(Debug, Clone, PartialEq, serde::Serialize, serde::Deserialize)]
+pub struct SimulationState {
+    initial_time: f64,
+    initial_inputs: Inputs,
+    inputs: Inputs,
+    time: f64,
+    state: Vec<f64>,
+    integrator: BdfSnapshot,
 }
 
 #[cfg(test)]

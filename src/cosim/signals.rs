@@ -2,7 +2,7 @@
 
 /// A real input that changes linearly from its reference time on: the value set at a
 /// communication point plus the first derivative from `fmi2SetRealInputDerivatives`.
-#[derive(Debug, Clone, Copy, PartialEq)]
+#[derive(Debug, Clone, Copy, PartialEq, serde::Serialize, serde::Deserialize)]
 pub struct Signal {
     pub value: f64,
     pub derivative: f64,
@@ -31,7 +31,7 @@ impl Signal {
 }
 
 /// All inputs of the model, in SI units.
-#[derive(Debug, Clone, Copy, PartialEq)]
+#[derive(Debug, Clone, Copy, PartialEq, serde::Serialize, serde::Deserialize)]
 pub struct Inputs {
     /// Crank speed in rad/s.
     pub crank_speed: Signal,
@@ -102,40 +102,6 @@ impl Inputs {
                 .zip(&next.damping_scale)
                 .all(|(a, b)| a.continues_into(b, t))
     }
-
-    /// The signals as a flat vector (for the serialized state), and back.
-    pub fn to_vec(&self) -> Vec<f64> {
-        let mut v = Vec::with_capacity(30);
-        let mut push = |s: &Signal| v.extend_from_slice(&[s.value, s.derivative, s.reference_time]);
-        push(&self.crank_speed);
-        push(&self.load_torque);
-        self.stiffness_scale.iter().for_each(&mut push);
-        self.damping_scale.iter().for_each(&mut push);
-        v
-    }
-
-    pub const FLAT_LEN: usize = 30;
-
-    pub fn from_slice(v: &[f64]) -> Result<Inputs, String> {
-        if v.len() != Self::FLAT_LEN {
-            return Err(format!(
-                "input state has {} numbers, expected {}",
-                v.len(),
-                Self::FLAT_LEN
-            ));
-        }
-        let s = |k: usize| Signal {
-            value: v[3 * k],
-            derivative: v[3 * k + 1],
-            reference_time: v[3 * k + 2],
-        };
-        Ok(Inputs {
-            crank_speed: s(0),
-            load_torque: s(1),
-            stiffness_scale: [s(2), s(3), s(4), s(5)],
-            damping_scale: [s(6), s(7), s(8), s(9)],
-        })
-    }
 }
 
 #[cfg(test)]
@@ -170,10 +136,9 @@ mod tests {
     }
 
     #[test]
-    fn flat_round_trip_and_validation() {
+    fn validation_names_the_bad_input() {
         let a = inputs();
-        assert_eq!(Inputs::from_slice(&a.to_vec()).unwrap(), a);
-        assert!(Inputs::from_slice(&[0.0; 3]).is_err());
+        assert!(a.validate().is_ok());
         let mut bad = a;
         bad.stiffness_scale[2].value = -1.0;
         assert!(bad

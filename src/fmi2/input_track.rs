@@ -23,7 +23,7 @@
 pub const SMOOTH_SLOPE_TOLERANCE: f64 = 0.25;
 
 /// One continuous Real input: the linear signal in force and what the master set since.
-#[derive(Debug, Clone, Copy, PartialEq)]
+#[derive(Debug, Clone, Copy, PartialEq, serde::Serialize, serde::Deserialize)]
 pub struct InputTrack {
     /// Value at `since`.
     pub value: f64,

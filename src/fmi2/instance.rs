@@ -27,7 +27,7 @@ pub enum Status {
 }
 
 /// All variable values, indexed by value reference.
-#[derive(Debug, Clone, PartialEq)]
+#[derive(Debug, Clone, PartialEq, serde::Serialize, serde::Deserialize)]
 pub struct Values {
     pub reals: Vec<f64>,
     pub integers: Vec<i32>,
@@ -282,7 +282,11 @@ impl Instance {
     }
 
     /// A simulation for a deserialized FMU state, rebuilt from that state's own parameters.
-    pub fn restore_simulation(&self, core: &Core, dynamic: &[f64]) -> Result<Simulation, String> {
+    pub fn restore_simulation(
+        &self,
+        core: &Core,
+        dynamic: &cosim::SimulationState,
+    ) -> Result<Simulation, String> {
         Simulation::restore(&self.settings_for(core)?, dynamic)
     }
 

@@ -2,7 +2,7 @@
 //! Reference-FMUs): every entry point states the phases in which it may be called.
 
 /// Where an instance is in the co-simulation state machine.
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+#[derive(Debug, Clone, Copy, PartialEq, Eq, serde::Serialize, serde::Deserialize)]
 pub enum Phase {
     Instantiated,
     InitializationMode,
@@ -16,26 +16,6 @@ pub enum Phase {
 impl Phase {
     fn bit(self) -> u16 {
         1 << (self as u16)
-    }
-
-    /// A stable code for the serialized FMU state.
-    pub fn code(self) -> u8 {
-        self as u8
-    }
-
-    pub fn from_code(code: u8) -> Option<Phase> {
-        use Phase::*;
-        [
-            Instantiated,
-            InitializationMode,
-            StepComplete,
-            StepFailed,
-            Terminated,
-            Error,
-            Fatal,
-        ]
-        .into_iter()
-        .find(|p| p.code() == code)
     }
 }
 

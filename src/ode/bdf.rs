@@ -54,7 +54,7 @@ pub(super) enum NlsOutcome {
 }
 
 /// Newton iteration matrix `M - gamma J` and the Jacobian it was built from.
-#[derive(Debug, Clone, PartialEq)]
+#[derive(Debug, Clone, PartialEq, serde::Serialize, serde::Deserialize)]
 pub(super) struct LinearSystem {
     pub matrix: IterationMatrix,
     /// Step count (since the last (re)start) of the last Jacobian evaluation.
@@ -64,7 +64,7 @@ pub(super) struct LinearSystem {
 }
 
 /// Everything that determines the future of the integration; cloned by snapshots.
-#[derive(Debug, Clone, PartialEq)]
+#[derive(Debug, Clone, PartialEq, serde::Serialize, serde::Deserialize)]
 pub(super) struct BdfState {
     pub opts: BdfOptions,
     pub n: usize,

@@ -17,7 +17,7 @@ use faer::{Accum, Mat, MatMut, MatRef, Par};
 use super::linear_solver::DenseLu;
 
 /// Which states form each diagonal block, and the rank of the coupling `U Vᵀ`.
-#[derive(Debug, Clone, PartialEq, Eq)]
+#[derive(Debug, Clone, PartialEq, Eq, serde::Serialize, serde::Deserialize)]
 pub struct BlockLowRankShape {
     /// State indices of each block; together they must list every state exactly once. Within a
     /// block the order of the indices is the order of the block's rows and columns.
@@ -59,7 +59,8 @@ impl BlockLowRankShape {
 }
 
 /// Values of a Jacobian `J = blockdiag(J_1, …, J_k) + U Vᵀ` with a given shape.
-#[derive(Debug, Clone, PartialEq)]
+#[derive(Debug, Clone, PartialEq, serde::Serialize, serde::Deserialize)]
+#[serde(into = "SavedBlockLowRank", try_from = "SavedBlockLowRank")]
 pub struct BlockLowRankJacobian {
     shape: BlockLowRankShape,
     /// The blocks, column-major, one after the other.
@@ -68,6 +69,38 @@ pub struct BlockLowRankJacobian {
     offsets: Vec<usize>,
     u: Mat<f64>,
     v: Mat<f64>,
+}
+
+/// A [`BlockLowRankJacobian`] as saved: its shape and values; the offsets follow from the shape.
+#[derive(Clone, serde::Serialize, serde::Deserialize)]
+struct SavedBlockLowRank {
+    shape: BlockLowRankShape,
+    values: Vec<f64>,
+    #[serde(with = "crate::saved_state::dense_matrix")]
+    u: Mat<f64>,
+    #[serde(with = "crate::saved_state::dense_matrix")]
+    v: Mat<f64>,
+}
+
+impl From<BlockLowRankJacobian> for SavedBlockLowRank {
+    fn from(j: BlockLowRankJacobian) -> Self {
+        Self {
+            shape: j.shape,
+            values: j.values,
+            u: j.u,
+            v: j.v,
+        }
+    }
+}
+
+impl TryFrom<SavedBlockLowRank> for BlockLowRankJacobian {
+    type Error = String;
+
+    fn try_from(s: SavedBlockLowRank) -> Result<Self, String> {
+        s.shape.validate(s.u.nrows())?;
+        Self::from_values(s.shape, s.values, s.u, s.v)
+            .ok_or_else(|| "the saved Jacobian's sizes do not match its block shape".to_string())
+    }
 }
 
 impl BlockLowRankJacobian {
@@ -170,11 +203,6 @@ impl BlockLowRankJacobian {
         }
     }
 
-    /// The raw values for serialisation: blocks, `U`, `V`.
-    pub(super) fn values(&self) -> (&[f64], &Mat<f64>, &Mat<f64>) {
-        (&self.values, &self.u, &self.v)
-    }
-
     /// Rebuilds from a shape and raw values; `None` when the sizes do not match the shape.
     pub(super) fn from_values(
         shape: BlockLowRankShape,
@@ -221,7 +249,8 @@ pub struct BlockLowRankLu {
     v: Mat<f64>,
     /// `I_r − γ Vᵀ D⁻¹ U`.
     capacitance: DenseLu,
-    factored: bool,
+    /// `γ` of the last successful factorisation.
+    factored_with: Option<f64>,
 }
 
 /// A pivot this small relative to the entries that formed it marks a singular 2×2 block.
@@ -257,18 +286,23 @@ impl BlockLowRankLu {
             correction: Mat::zeros(n, r),
             v: Mat::zeros(n, r),
             capacitance: DenseLu::new(r),
-            factored: false,
+            factored_with: None,
         }
     }
 
     pub fn is_factored(&self) -> bool {
-        self.factored
+        self.factored_with.is_some()
+    }
+
+    /// `γ` of the factorisation in force, if any.
+    pub fn factored_gamma(&self) -> Option<f64> {
+        self.factored_with
     }
 
     /// Factorises `I − γ J`. Returns `false` when a block or the capacitance matrix is singular
     /// to working precision.
     pub fn factor(&mut self, j: &BlockLowRankJacobian, gamma: f64) -> bool {
-        self.factored = false;
+        self.factored_with = None;
         for (k, inverse) in self.inverses.iter_mut().enumerate() {
             let b = j.block(k);
             let ok = match inverse {
@@ -293,7 +327,7 @@ impl BlockLowRankLu {
         }
         let r = j.shape().rank;
         if r == 0 {
-            self.factored = true;
+            self.factored_with = Some(gamma);
             return true;
         }
         // Y = D⁻¹ U.
@@ -341,7 +375,7 @@ impl BlockLowRankLu {
             gamma,
             Par::Seq,
         );
-        self.factored = true;
+        self.factored_with = Some(gamma);
         true
     }
 

@@ -9,7 +9,8 @@ use faer::{Mat, MatMut, Par};
 use super::block_low_rank::{BlockLowRankJacobian, BlockLowRankLu, BlockLowRankShape};
 
 /// The saved Jacobian and the factorised iteration matrix built from it.
-#[derive(Debug, Clone, PartialEq)]
+#[derive(Debug, Clone, PartialEq, serde::Serialize, serde::Deserialize)]
+#[serde(into = "SavedIterationMatrix", try_from = "SavedIterationMatrix")]
 pub enum IterationMatrix {
     /// Any problem: `J` dense (analytic or by finite differences), `M − γ J` by dense LU.
     Dense { saved_j: Mat<f64>, lu: DenseLu },
@@ -20,7 +21,80 @@ pub enum IterationMatrix {
     },
 }
 
+/// How an [`IterationMatrix`] is saved: the dense factorisation as it is (its pivoting is not
+/// reproducible from `J` alone once `M` varies); the block-plus-low-rank one as the Jacobian
+/// and the `γ` it was factorised with, refactorised on loading (deterministic, so bit for bit).
+#[derive(Clone, serde::Serialize, serde::Deserialize)]
+enum SavedIterationMatrix {
+    Dense {
+        #[serde(with = "crate::saved_state::dense_matrix")]
+        saved_j: Mat<f64>,
+        lu: DenseLu,
+    },
+    BlockLowRank {
+        saved_j: BlockLowRankJacobian,
+        factored_gamma: Option<f64>,
+    },
+}
+
+impl From<IterationMatrix> for SavedIterationMatrix {
+    fn from(m: IterationMatrix) -> Self {
+        match m {
+            IterationMatrix::Dense { saved_j, lu } => Self::Dense { saved_j, lu },
+            IterationMatrix::BlockLowRank { saved_j, lu } => Self::BlockLowRank {
+                saved_j: *saved_j,
+                factored_gamma: lu.factored_gamma(),
+            },
+        }
+    }
+}
+
+impl TryFrom<SavedIterationMatrix> for IterationMatrix {
+    type Error = String;
+
+    fn try_from(m: SavedIterationMatrix) -> Result<Self, String> {
+        match m {
+            SavedIterationMatrix::Dense { saved_j, lu } => {
+                let n = saved_j.nrows();
+                let (lu_values, perm, perm_inv, _) = lu.parts();
+                if saved_j.ncols() != n
+                    || (lu_values.nrows(), lu_values.ncols()) != (n, n)
+                    || perm.len() != n
+                    || perm_inv.len() != n
+                    || (0..n).any(|i| perm[i] >= n || perm_inv[i] >= n || perm_inv[perm[i]] != i)
+                {
+                    return Err("the saved dense iteration matrix is inconsistent".into());
+                }
+                Ok(Self::Dense { saved_j, lu })
+            }
+            SavedIterationMatrix::BlockLowRank {
+                saved_j,
+                factored_gamma,
+            } => {
+                let mut lu = BlockLowRankLu::new(saved_j.shape());
+                if let Some(gamma) = factored_gamma {
+                    if !lu.factor(&saved_j, gamma) {
+                        return Err("the saved iteration matrix is singular".into());
+                    }
+                }
+                Ok(Self::BlockLowRank {
+                    saved_j: Box::new(saved_j),
+                    lu: Box::new(lu),
+                })
+            }
+        }
+    }
+}
+
 impl IterationMatrix {
+    /// The dimension of the system.
+    pub fn dim(&self) -> usize {
+        match self {
+            Self::Dense { saved_j, .. } => saved_j.nrows(),
+            Self::BlockLowRank { saved_j, .. } => saved_j.dim(),
+        }
+    }
+
     pub fn dense(n: usize) -> Self {
         Self::Dense {
             saved_j: Mat::zeros(n, n),
@@ -65,8 +139,9 @@ impl IterationMatrix {
 }
 
 /// A factorised square matrix `P A = L U`, stored in place.
-#[derive(Debug, Clone, PartialEq)]
+#[derive(Debug, Clone, PartialEq, serde::Serialize, serde::Deserialize)]
 pub struct DenseLu {
+    #[serde(with = "crate::saved_state::dense_matrix")]
     lu: Mat<f64>,
     perm: Vec<usize>,
     perm_inv: Vec<usize>,
@@ -148,21 +223,6 @@ impl DenseLu {
     /// The raw parts for serialisation: the factor storage, the permutation and the flag.
     pub fn parts(&self) -> (&Mat<f64>, &[usize], &[usize], bool) {
         (&self.lu, &self.perm, &self.perm_inv, self.factored)
-    }
-
-    /// Rebuilds from raw parts (validated by the caller: square storage, permutation of 0..n).
-    pub fn from_parts(
-        lu: Mat<f64>,
-        perm: Vec<usize>,
-        perm_inv: Vec<usize>,
-        factored: bool,
-    ) -> Self {
-        Self {
-            lu,
-            perm,
-            perm_inv,
-            factored,
-        }
     }
 }
 

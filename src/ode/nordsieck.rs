@@ -6,7 +6,7 @@ use super::coefficients::{decrease_order_coefficients, increase_order_coefficien
 
 /// History array of `max_order + 1` vectors of length `n`. `zn[max_order]` doubles as storage
 /// of the saved correction for a later order increase (as in CVODE) while `q < max_order`.
-#[derive(Debug, Clone, PartialEq)]
+#[derive(Debug, Clone, PartialEq, serde::Serialize, serde::Deserialize)]
 pub struct Nordsieck {
     pub zn: Vec<Vec<f64>>,
 }

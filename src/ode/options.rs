@@ -3,7 +3,7 @@
 use super::error::BdfError;
 
 /// Absolute tolerance: one value for all components or one per component.
-#[derive(Debug, Clone, PartialEq)]
+#[derive(Debug, Clone, PartialEq, serde::Serialize, serde::Deserialize)]
 pub enum Tolerance {
     /// The same absolute tolerance for every state.
     Scalar(f64),
@@ -23,7 +23,7 @@ impl Tolerance {
 }
 
 /// Options of the BDF integrator. `Default` gives CVODE's defaults with rtol 1e-6, atol 1e-8.
-#[derive(Debug, Clone, PartialEq)]
+#[derive(Debug, Clone, PartialEq, serde::Serialize, serde::Deserialize)]
 pub struct BdfOptions {
     /// Relative tolerance (> 0, finite).
     pub rtol: f64,

@@ -34,7 +34,7 @@ const PAYOFF_GROWTH: f64 = 1.0;
 const INITIAL_LOCKOUT: u64 = 500;
 
 /// State of the detector; part of the integrator snapshot.
-#[derive(Debug, Clone, PartialEq)]
+#[derive(Debug, Clone, PartialEq, serde::Serialize, serde::Deserialize)]
 pub struct StabilityGuard {
     /// (step count, step size, time) of recent error-test failures at q >= 3.
     pub(crate) failures: Vec<(u64, f64, f64)>,

@@ -1,7 +1,7 @@
 //! Work counters of the integrator, readable after every call.
 
 /// Cumulative counters (since construction) and the current step size and order.
-#[derive(Debug, Clone, Default, PartialEq)]
+#[derive(Debug, Clone, Default, PartialEq, serde::Serialize, serde::Deserialize)]
 pub struct BdfStats {
     /// Successful internal steps.
     pub steps: u64,
