@@ -617,7 +617,76 @@ fn rust_table(table: &Value, scalars: &[Scalar], families: &[Family], guid: &str
         }
         r.push_str("];\n");
     }
+    r.push_str(&parameters_struct(scalars, families));
     r
+}
+
+/// `Parameters`: every scalar parameter as a typed field named after its `rust` name, with the
+/// FMI name for serde; `Default` reads the start values from the tables above, so the defaults
+/// live in the variable table alone.
+fn parameters_struct(scalars: &[Scalar], families: &[Family]) -> String {
+    let mut fields = String::new();
+    let mut from_values = String::new();
+    for s in scalars.iter().filter(|s| s.causality == "parameter") {
+        let family = families
+            .iter()
+            .find(|f| f.ty == s.ty && f.dims.is_empty() && f.first_vr == s.vr)
+            .unwrap_or_else(|| fail(&format!("parameter {} must be a scalar", s.name)));
+        let field = family.rust.to_lowercase();
+        let (rust_ty, read) = match s.ty {
+            "Real" => ("f64", format!("reals[{}]", s.vr)),
+            "Integer" => ("i32", format!("integers[{}]", s.vr)),
+            "Boolean" => ("bool", format!("booleans[{}]", s.vr)),
+            _ => ("String", format!("strings[{}].as_ref().to_owned()", s.vr)),
+        };
+        let unit = s
+            .unit
+            .as_ref()
+            .map(|u| format!(" [{u}]"))
+            .unwrap_or_default();
+        let _ = writeln!(
+            fields,
+            "    /// `{}`{unit}: {}\n    #[serde(rename = {:?})]\n    pub {field}: {rust_ty},",
+            s.name,
+            s.description.replace('[', "\\[").replace(']', "\\]"),
+            s.name
+        );
+        let _ = writeln!(from_values, "            {field}: {read},");
+    }
+    format!(
+        r#"
+/// Every parameter of the model description as one typed structure. Serde names are the FMI
+/// names; unknown names are refused and missing ones take their start values.
+#[derive(Debug, Clone, PartialEq, serde::Serialize, serde::Deserialize)]
+#[serde(deny_unknown_fields, default)]
+pub struct Parameters {{
+{fields}}}
+
+impl Parameters {{
+    /// The parameters among per-type values indexed by value reference (as [`REALS`], …).
+    pub fn from_values<S: AsRef<str>>(
+        reals: &[f64],
+        integers: &[i32],
+        booleans: &[bool],
+        strings: &[S],
+    ) -> Self {{
+        Self {{
+{from_values}        }}
+    }}
+}}
+
+impl Default for Parameters {{
+    /// The start values of the variable table.
+    fn default() -> Self {{
+        let reals: Vec<f64> = REALS.iter().map(|v| v.start).collect();
+        let integers: Vec<i32> = INTEGERS.iter().map(|v| v.start).collect();
+        let booleans: Vec<bool> = BOOLEANS.iter().map(|v| v.start).collect();
+        let strings: Vec<&str> = STRINGS.iter().map(|v| v.start).collect();
+        Self::from_values(&reals, &integers, &booleans, &strings)
+    }}
+}}
+"#
+    )
 }
 
 /// Text escaped for the documentation page's HTML.

@@ -8,6 +8,8 @@
 //! - [`model`]: engine multibody model, mounts, coupled system, outputs.
 //! - [`cosim`]: a scene with its integrator and inputs, stepped between communication points.
 //! - [`fmi2`]: the FMI 2.0 co-simulation C ABI (the only `unsafe` code).
+//! - [`variables`]: the variable table generated from `modelDescription/variables.json`, with
+//!   [`variables::Parameters`], every parameter as one typed structure (defaults in the table).
 
 pub mod cms;
 pub mod cosim;
@@ -18,3 +20,4 @@ pub mod ode;
 pub mod paper;
 pub mod saved_state;
 pub mod text_file;
+pub mod variables;

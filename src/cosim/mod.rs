@@ -57,22 +57,36 @@ pub struct Settings {
 }
 
 impl Default for Settings {
+    /// The start values of the variable table, the built-in vehicle.
     fn default() -> Self {
-        Settings {
-            scene: 1,
-            config_file: None,
-            effects: Effects::default(),
-            gas_load: 0.0,
-            fade_in_time: 0.1,
-            crank_start_angle: 0.0,
-            speed_time_constant: crate::model::SpeedFollower::default().time_constant,
-            rel_tol: 1e-5,
-            abs_tol: 1e-8,
-            max_order: 5,
-            stability_limit_detection: true,
-            chassis: BodyOptions::default(),
+        Settings::from_parameters(&crate::variables::Parameters::default(), None)
+            .expect("the variable table's start values are valid")
+    }
+}
+
+impl Settings {
+    /// The settings the FMU parameters describe, with the vehicle from `config_file` (`None`:
+    /// the built-in one). The experiment's tolerance and which parameters were set explicitly
+    /// are the FMI layer's to add.
+    pub fn from_parameters(
+        p: &crate::variables::Parameters,
+        config_file: Option<PathBuf>,
+    ) -> Result<Settings, String> {
+        Ok(Settings {
+            scene: p.scene,
+            config_file,
+            effects: p.effects(),
+            gas_load: p.engine_load,
+            fade_in_time: p.fade_in_time,
+            crank_start_angle: p.crank_start_angle,
+            speed_time_constant: p.crank_speed_time_constant,
+            rel_tol: p.solver_rel_tol,
+            abs_tol: p.solver_abs_tol,
+            max_order: p.solver_max_order,
+            stability_limit_detection: p.solver_stability_limit_detection,
+            chassis: p.body_options()?,
             explicit: None,
-        }
+        })
     }
 }
 

@@ -11,8 +11,8 @@ use super::input_track::InputTrack;
 use super::logger::{Level, Logger};
 use super::state::{self, Mask, Phase};
 use super::variables::{
-    boolean, integer, real, string, Causality, Variability, Variable, BOOLEANS, INTEGERS, REALS,
-    STRINGS,
+    boolean, integer, real, string, Causality, Parameters, Variability, Variable, BOOLEANS,
+    INTEGERS, REALS, STRINGS,
 };
 use crate::cosim::{self, Simulation};
 
@@ -325,54 +325,20 @@ impl Instance {
                 }
             }
         };
+        let parameters = Parameters::from_values(&v.reals, &v.integers, &v.booleans, &v.strings);
+        let settings = cosim::Settings::from_parameters(&parameters, config_file)?;
         Ok(cosim::Settings {
-            scene: v.integers[integer::SCENE as usize],
-            config_file,
-            effects: cosim::Effects {
-                gas_forces: v.booleans[boolean::EFFECT_GAS_FORCES as usize],
-                mass_forces: v.booleans[boolean::EFFECT_MASS_FORCES as usize],
-                balance_shaft: v.booleans[boolean::EFFECT_BALANCE_SHAFT as usize],
-                gyroscopic: v.booleans[boolean::EFFECT_GYROSCOPIC as usize],
-                ring_carrier_elasticity: v.booleans[boolean::EFFECT_RING_CARRIER as usize],
-                mount_nonlinearity: v.booleans[boolean::EFFECT_MOUNT_NONLINEARITY as usize],
-                chassis_flexibility: v.booleans[boolean::EFFECT_CHASSIS_FLEXIBILITY as usize],
-            },
-            gas_load: v.reals[real::ENGINE_LOAD as usize],
-            fade_in_time: v.reals[real::FADE_IN_TIME as usize],
-            crank_start_angle: v.reals[real::CRANK_START_ANGLE as usize],
-            speed_time_constant: v.reals[real::CRANK_SPEED_TIME_CONSTANT as usize],
+            // The experiment's tolerance is the relative tolerance unless the master set
+            // solver.relTol itself.
             rel_tol: match (
                 core.experiment_tolerance,
                 core.explicit.contains("solver.relTol"),
             ) {
                 (Some(tolerance), false) => tolerance,
-                _ => v.reals[real::SOLVER_REL_TOL as usize],
-            },
-            abs_tol: v.reals[real::SOLVER_ABS_TOL as usize],
-            max_order: v.integers[integer::SOLVER_MAX_ORDER as usize],
-            stability_limit_detection: v.booleans
-                [boolean::SOLVER_STABILITY_LIMIT_DETECTION as usize],
-            chassis: cosim::BodyOptions {
-                mode_cutoff_hz: v.reals[real::CHASSIS_MODE_CUTOFF as usize],
-                modal_damping_scale: v.reals[real::CHASSIS_MODAL_DAMPING_SCALE as usize],
-                interface_rotations: v.booleans[boolean::CHASSIS_INTERFACE_ROTATIONS as usize],
-                max_rpm: v.reals[real::SCENE_MAX_RPM as usize],
-                max_engine_order: v.reals[real::SCENE_MAX_ENGINE_ORDER as usize],
-                max_modes: usize::try_from(v.integers[integer::CHASSIS_MAX_MODES as usize])
-                    .map_err(|_| {
-                        "chassis.maxModes must be >= 0 (0: select by chassis.modeCutoff)"
-                    })?,
-                stiffening_bar: v.booleans[boolean::CHASSIS_STIFFENING_BAR as usize],
-                cache: if !v.booleans[boolean::CHASSIS_CACHE_ENABLED as usize] {
-                    cosim::CacheSetting::Disabled
-                } else {
-                    match v.strings[string::CHASSIS_CACHE_DIR as usize].trim() {
-                        "" => cosim::CacheSetting::Default,
-                        dir => cosim::CacheSetting::Dir(PathBuf::from(dir)),
-                    }
-                },
+                _ => settings.rel_tol,
             },
             explicit: Some(core.explicit.clone()),
+            ..settings
         })
     }
 

@@ -24,15 +24,8 @@ pub struct Effects {
 }
 
 impl Default for Effects {
+    /// The start values of the `effects.*` parameters.
     fn default() -> Self {
-        Self {
-            gas_forces: true,
-            mass_forces: true,
-            balance_shaft: true,
-            gyroscopic: true,
-            ring_carrier_elasticity: true,
-            mount_nonlinearity: true,
-            chassis_flexibility: true,
-        }
+        crate::variables::Parameters::default().effects()
     }
 }

@@ -21,11 +21,11 @@ pub struct SpeedFollower {
 }
 
 impl Default for SpeedFollower {
-    /// 5 ms: a set-point step settles in about 30 ms, far faster than any engine speed change a
+    /// `crank.speedTimeConstant`'s start value, 5 ms: a set-point step settles in about 30 ms, far faster than any engine speed change a
     /// drivetrain produces, far slower than the integrator's steps.
     fn default() -> Self {
         Self {
-            time_constant: 0.005,
+            time_constant: crate::variables::Parameters::default().crank_speed_time_constant,
         }
     }
 }

@@ -49,17 +49,11 @@ pub struct BodyOptions {
 }
 
 impl Default for BodyOptions {
+    /// The start values of the `chassis.*` and `scene.*` parameters.
     fn default() -> Self {
-        Self {
-            mode_cutoff_hz: 0.0,
-            max_modes: 0,
-            max_rpm: 2500.0,
-            max_engine_order: 4.5,
-            interface_rotations: false,
-            modal_damping_scale: 1.0,
-            stiffening_bar: false,
-            cache: CacheSetting::Default,
-        }
+        crate::variables::Parameters::default()
+            .body_options()
+            .expect("the variable table's start values are valid")
     }
 }
 
