@@ -1,32 +1,21 @@
 //! The error type of the finite-element module: every failure is a value naming what went wrong.
 
-use std::fmt;
-
 /// A finite-element failure. The message names the element, node, field or value concerned.
-#[derive(Debug, Clone, PartialEq)]
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
 pub enum FeError {
     /// An input value (section, material, parameter) is out of range or not finite.
+    #[error("invalid FE input: {0}")]
     InvalidInput(String),
     /// The mesh is inconsistent: degenerate element, dangling node, DOF without mass or stiffness.
+    #[error("mesh error: {0}")]
     Mesh(String),
     /// A numerical method failed (factorisation, eigen solve did not converge).
+    #[error("numerical failure: {0}")]
     Numerical(String),
     /// Reading or writing a file failed.
+    #[error("I/O error: {0}")]
     Io(String),
 }
-
-impl fmt::Display for FeError {
-    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
-        match self {
-            FeError::InvalidInput(m) => write!(f, "invalid FE input: {m}"),
-            FeError::Mesh(m) => write!(f, "mesh error: {m}"),
-            FeError::Numerical(m) => write!(f, "numerical failure: {m}"),
-            FeError::Io(m) => write!(f, "I/O error: {m}"),
-        }
-    }
-}
-
-impl std::error::Error for FeError {}
 
 /// Checks that `value` is finite and strictly positive; `what` names it in the error.
 pub(crate) fn require_positive(what: &str, value: f64) -> Result<f64, FeError> {
