@@ -32,7 +32,8 @@ def effect_sets(scene: int) -> list[tuple[str, dict]]:
 
 def measure(runner: Runner, rpm: float, seconds: float, parameters: dict, signal: str) -> dict:
     revolutions = max(2, int(round(seconds * rpm / 60 / 2)) * 2)
-    point = OperatingPoint(rpm=rpm, revolutions=revolutions, settle_revolutions=4,
+    # The stepping cost alone: a fade-in start (no periodic initialisation), 4 revolutions.
+    point = OperatingPoint(rpm=rpm, revolutions=revolutions, settle_revolutions=4, periodic=False,
                            parameters=tuple(parameters.items()))
     result = runner.run_point(point, [signal])
     cpu, wall, simulated = result["cpu"], result["wall"], result["simulated"]

@@ -49,6 +49,28 @@ def parse_settings(items: list[str]) -> tuple:
     return tuple(out)
 
 
+def start_options(args) -> dict:
+    """How each speed point starts: on the periodic steady state, or settled after a fade-in."""
+    if args.start == "periodic":
+        if args.settle is not None:
+            raise SystemExit("--settle applies to --start settle only (a periodic start has no "
+                             "transient to wait for)")
+        return {"periodic": True, "settle_revolutions": 0}
+    settle = 20 if args.settle is None else args.settle
+    if settle < 0:
+        raise SystemExit(f"--settle must be >= 0, got {settle}")
+    return {"periodic": False, "settle_revolutions": settle}
+
+
+def add_start_options(p):
+    p.add_argument("--start", choices=("periodic", "settle"), default="periodic",
+                   help="periodic (default): each point starts on its periodic steady state and "
+                        "simulates only the window; settle: fade the excitation in and wait "
+                        "--settle revolutions")
+    p.add_argument("--settle", type=int, default=None,
+                   help="revolutions before the window with --start settle (default 20)")
+
+
 def safe_name(signal: str) -> str:
     return re.sub(r"[^A-Za-z0-9_.-]+", "_", re.sub(r"\[(\d+)\]", r"\1", signal)).strip("_")
 
@@ -57,8 +79,8 @@ def cmd_sweep(args) -> int:
     out = pathlib.Path(args.out)
     out.mkdir(parents=True, exist_ok=True)
     points = speed_points(args.rpm[0], args.rpm[1], args.count, revolutions=args.revolutions,
-                          settle_revolutions=args.settle, steps_per_revolution=args.steps_per_rev,
-                          load_torque=args.load_torque, parameters=parse_settings(args.set))
+                          steps_per_revolution=args.steps_per_rev, load_torque=args.load_torque,
+                          parameters=parse_settings(args.set), **start_options(args))
     started = time.perf_counter()
     orders, spectra = run_sweep(args.fmu, points, signals=args.signal or None, case=args.case,
                                 parallel=not args.serial, scheduler=args.scheduler,
@@ -140,8 +162,8 @@ def run_study(args, cases: dict) -> int:
     started = time.perf_counter()
     for case, params in cases.items():
         points = speed_points(args.rpm[0], args.rpm[1], args.count, revolutions=args.revolutions,
-                              settle_revolutions=args.settle,
-                              parameters=tuple(params.items()) + parse_settings(args.set))
+                              parameters=tuple(params.items()) + parse_settings(args.set),
+                              **start_options(args))
         tables.append(run_sweep(args.fmu, points, signals=args.signal or STUDY_SIGNALS, case=case,
                                 parallel=not args.serial, scheduler=args.scheduler,
                                 workers=args.workers, progress=not args.quiet))
@@ -190,11 +212,11 @@ def main(argv: list[str] | None = None) -> int:
         p.add_argument("--out", required=True)
         p.add_argument("--parquet", action="store_true", help="write Parquet instead of CSV")
 
-    s = sub.add_parser("sweep", help="constant-speed points: fade-in, settle, stationary window")
+    s = sub.add_parser("sweep", help="constant-speed points on their periodic steady state")
     common(s)
     s.add_argument("--count", type=int, default=18)
     s.add_argument("--revolutions", type=int, default=40, help="stationary window (even)")
-    s.add_argument("--settle", type=int, default=20, help="revolutions before the window")
+    add_start_options(s)
     s.add_argument("--steps-per-rev", type=int, default=72)
     s.add_argument("--load-torque", type=float, default=0.0)
     s.add_argument("--case", default="")
@@ -220,7 +242,7 @@ def main(argv: list[str] | None = None) -> int:
         common(m)
         m.add_argument("--count", type=int, default=18)
         m.add_argument("--revolutions", type=int, default=40, help="stationary window (even)")
-        m.add_argument("--settle", type=int, default=20, help="revolutions before the window")
+        add_start_options(m)
         m.add_argument("--serial", action="store_true", help="no Dask")
         m.add_argument("--workers", type=int, default=2)
         m.add_argument("--scheduler", help="address of a running Dask scheduler")

@@ -54,7 +54,7 @@ def test_a_sweep_writes_comfort_values(fmu_path, tmp_path):
 
     signals = [f"seat.a[{i}]" for i in (1, 2, 3)] + [f"steeringWheel.a[{i}]" for i in (1, 2, 3)]
     args = ["sweep", "--fmu", str(fmu_path), "--rpm", "1500", "2000", "--count", "2", "--revolutions", "4",
-            "--settle", "6", "--serial", "--quiet", "--set", "scene=2", "--out", str(tmp_path)]
+            "--serial", "--quiet", "--set", "scene=2", "--out", str(tmp_path)]
     for s in signals:
         args += ["--signal", s]
     assert main(args) == 0

@@ -30,7 +30,7 @@ def runs(fmu_path):
                 # the ideal crank drive the facts are about (no unbalance, identical cylinders)
                 params = {"configFile": "vehicle_ideal_engine.json", **params}
                 point = OperatingPoint(rpm=1500.0, load_torque=torque, revolutions=REVOLUTIONS,
-                                       settle_revolutions=12, parameters=tuple(params.items()))
+                                       parameters=tuple(params.items()))
                 result = runner.run_point(point, SIGNALS)
                 steps = runner.slave.getInteger([runner.vr["solver.steps"]])[0]
                 x = result["samples"]

@@ -2,8 +2,9 @@
 
 import numpy as np
 import pandas as pd
+import pytest
 
-from emc.runner import OperatingPoint
+from emc.runner import OperatingPoint, Runner
 from emc.spectra import amplitude_spectrum, order_amplitudes
 from emc.sweep import run_sweep, speed_points
 
@@ -31,7 +32,7 @@ def test_operating_points_reject_windows_without_half_orders():
 
 
 def test_dask_sweep_equals_serial_sweep(fmu_path):
-    points = speed_points(900, 2100, 3, revolutions=4, settle_revolutions=4)
+    points = speed_points(900, 2100, 3, revolutions=4)
     signals = ["mount[1].F[3]", "mount[3].F[1]"]
     serial = run_sweep(str(fmu_path), points, signals, parallel=False, progress=False)
     parallel = run_sweep(str(fmu_path), points, signals, parallel=True, workers=2, progress=False)
@@ -51,7 +52,7 @@ def test_study_engines_compares_the_inline_three_with_the_inline_four(fmu_path, 
     from emc.cli import main
 
     assert main(["study-engines", "--fmu", str(fmu_path), "--rpm", "1500", "2000", "--count", "2",
-                 "--revolutions", "4", "--settle", "6", "--serial", "--quiet",
+                 "--revolutions", "4", "--serial", "--quiet",
                  "--signal", "mount[1].F[3]", "--out", str(tmp_path)]) == 0
     orders = pd.read_csv(tmp_path / "orders.csv")
     force = orders[orders.signal == "mount[1].F[3]"]
@@ -59,3 +60,33 @@ def test_study_engines_compares_the_inline_three_with_the_inline_four(fmu_path, 
     assert peak.loc["inline-3 (M13)", 1.5] > 3 * peak.loc["inline-3 (M13)", 2.0]
     assert peak.loc["inline-4", 2.0] > 10 * peak.loc["inline-4", 1.5]
     assert (tmp_path / "study_waterfall_mount1.F3.png").exists()
+
+
+def test_a_periodic_start_gives_the_orders_of_a_long_settled_run(fmu_path):
+    """Through the FMU (initialization.periodic): a window right after initialisation has the
+    order amplitudes of a window after 300 settling revolutions (scene 1, 1800 rpm)."""
+    signals = ["mount[1].F[3]", "mount[3].F[1]"]
+    solver = (("solver.relTol", 1e-7), ("solver.absTol", 1e-10))
+    periodic = OperatingPoint(rpm=1800.0, revolutions=8, parameters=solver)
+    settled = OperatingPoint(rpm=1800.0, revolutions=8, periodic=False, settle_revolutions=300,
+                             parameters=solver)
+    with Runner(str(fmu_path)) as runner:
+        a = runner.run_point(periodic, signals)["samples"]
+        b = runner.run_point(settled, signals)["samples"]
+    for j, signal in enumerate(signals):
+        oa = order_amplitudes(a[:, j], 8, [1.5, 3.0, 4.5])
+        ob = order_amplitudes(b[:, j], 8, [1.5, 3.0, 4.5])
+        for order in oa:
+            assert abs(oa[order] - ob[order]) <= 1e-3 * ob[order], (signal, order, oa[order], ob[order])
+
+
+def test_settle_options_are_checked(fmu_path, tmp_path):
+    from emc.cli import main
+
+    base = ["sweep", "--fmu", str(fmu_path), "--rpm", "1500", "2000", "--count", "2",
+            "--revolutions", "4", "--serial", "--quiet", "--out", str(tmp_path)]
+    with pytest.raises(SystemExit, match="--start settle"):
+        main(base + ["--settle", "6"])
+    with pytest.raises(SystemExit, match=">= 0"):
+        main(base + ["--start", "settle", "--settle", "-5"])
+    assert main(base + ["--start", "settle", "--settle", "6"]) == 0

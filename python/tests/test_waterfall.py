@@ -16,9 +16,8 @@ IDEAL_ENGINE = "vehicle_ideal_engine.json"
 
 
 def run(runner, rpm, **parameters):
-    # 1 % modal damping: the free vibration started by the fade-in needs ~5 time constants
-    # (1/(ζω) ≈ 0.5 s at 31 Hz) to fall below the 5 % line threshold.
-    point = OperatingPoint(rpm=rpm, revolutions=REVOLUTIONS, settle_revolutions=70,
+    # A periodic start (the default): no free vibration of the 1 %-damped body modes to wait for.
+    point = OperatingPoint(rpm=rpm, revolutions=REVOLUTIONS,
                            parameters=tuple({"scene": 2, "configFile": IDEAL_ENGINE,
                                              **parameters}.items()))
     result = runner.run_point(point, [SIGNAL])

@@ -6,6 +6,7 @@
 //! The integrator keeps its history across communication points and lands exactly on each one
 //! (a stop time, not a restart); it restarts at order 1 only where an input really jumps.
 
+pub mod periodic;
 pub mod scene;
 mod signals;
 
@@ -46,6 +47,9 @@ pub struct Settings {
     pub abs_tol: f64,
     pub max_order: i32,
     pub stability_limit_detection: bool,
+    /// Start on the periodic steady state at the start inputs ([`periodic`]) instead of the
+    /// static equilibrium with a fade-in.
+    pub periodic_start: bool,
     /// Used by scene 2 only.
     pub chassis: BodyOptions,
     /// Which of the vehicle settings above (by FMU parameter name: `engine.load`,
@@ -84,6 +88,7 @@ impl Settings {
             abs_tol: p.solver_abs_tol,
             max_order: p.solver_max_order,
             stability_limit_detection: p.solver_stability_limit_detection,
+            periodic_start: p.initialization_periodic,
             chassis: p.body_options()?,
             explicit: None,
         })
@@ -149,8 +154,21 @@ pub struct Simulation {
 
 impl Simulation {
     /// Builds the scene, finds its static equilibrium under the inputs at `t0` and starts the
-    /// integrator there.
+    /// integrator there, or, with [`Settings::periodic_start`], on the periodic steady state.
     pub fn new(settings: &Settings, t0: f64, inputs: &Inputs) -> Result<Simulation, String> {
+        let mut sim = Self::at_static_equilibrium(settings, t0, inputs)?;
+        if settings.periodic_start {
+            sim.start_on_periodic_orbit()?;
+        }
+        Ok(sim)
+    }
+
+    /// The scene at its static equilibrium under the inputs at `t0`, excitation fading in.
+    fn at_static_equilibrium(
+        settings: &Settings,
+        t0: f64,
+        inputs: &Inputs,
+    ) -> Result<Simulation, String> {
         inputs.validate()?;
         let mut options = BdfOptions {
             rtol: settings.rel_tol,
@@ -175,6 +193,31 @@ impl Simulation {
             initial_inputs: *inputs,
             restarts: 0,
         })
+    }
+
+    /// Moves the start onto the periodic orbit at the current inputs: excitation in full from
+    /// the start time, state from [`periodic::periodic_start`], integrator restarted there.
+    fn start_on_periodic_orbit(&mut self) -> Result<(), String> {
+        let t0 = self.time;
+        let fade_in = self.scene.powertrain().config().excitation_fade_in;
+        self.scene
+            .set_fade_start(t0 - fade_in)
+            .map_err(|e| e.to_string())?;
+        let options = self.integrator.options().clone();
+        let start = periodic::periodic_start(&mut self.scene, &options, t0, &self.state)
+            .map_err(|m| format!("periodic start: {m}"))?;
+        self.notes.push(format!(
+            "periodic start: orbit of one working cycle ({:.3} ms) closed to {:.2e} of the error \
+             weights after {} iterations (start guess {:.2e})",
+            start.period * 1e3,
+            start.residual,
+            start.iterations,
+            start.initial_residual
+        ));
+        self.integrator =
+            Bdf::new(&mut self.scene, t0, &start.state, options).map_err(|e| e.to_string())?;
+        self.state = start.state;
+        Ok(())
     }
 
     /// Lines for the log describing the scene.
@@ -288,6 +331,7 @@ impl Simulation {
         SimulationState {
             initial_time: self.initial_time,
             initial_inputs: self.initial_inputs,
+            fade_start: self.scene.fade_start(),
             inputs: self.inputs,
             time: self.time,
             state: self.state.clone(),
@@ -298,13 +342,17 @@ impl Simulation {
     /// Rebuilds a simulation from its settings and [`Simulation::dynamic_state`]; continuing it
     /// reproduces the original run bit for bit.
     pub fn restore(settings: &Settings, saved: &SimulationState) -> Result<Simulation, String> {
-        let times = [saved.initial_time, saved.time];
+        let times = [saved.initial_time, saved.time, saved.fade_start];
         if times.iter().chain(&saved.state).any(|x| !x.is_finite()) {
             return Err("simulation state holds a non-finite time or state".into());
         }
         saved.initial_inputs.validate()?;
         saved.inputs.validate()?;
-        let mut sim = Simulation::new(settings, saved.initial_time, &saved.initial_inputs)?;
+        let mut sim =
+            Simulation::at_static_equilibrium(settings, saved.initial_time, &saved.initial_inputs)?;
+        sim.scene
+            .set_fade_start(saved.fade_start)
+            .map_err(|e| e.to_string())?;
         if saved.state.len() != sim.state.len() {
             return Err(format!(
                 "simulation state has {} states, this model {}",
@@ -328,6 +376,8 @@ impl Simulation {
 pub struct SimulationState {
     initial_time: f64,
     initial_inputs: Inputs,
+    /// Start of the excitation fade-in (before the start time for a periodic start).
+    fade_start: f64,
     inputs: Inputs,
     time: f64,
     state: Vec<f64>,

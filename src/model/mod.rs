@@ -32,6 +32,7 @@
 //! # Ok(()) }
 //! ```
 
+pub mod blend;
 pub mod coupled;
 pub mod effects;
 pub mod follower;

@@ -2,3 +2,4 @@
 
 mod hard_cases;
 mod hybrid_cosim;
+mod periodic_start;

@@ -432,7 +432,7 @@ impl CoupledModel {
         if tf <= 0.0 {
             1.0
         } else {
-            smooth_step((t - self.fade_start) / tf)
+            crate::model::blend::smooth_step((t - self.fade_start) / tf)
         }
     }
 
@@ -505,9 +505,4 @@ impl CoupledModel {
             self.effects()
         )
     }
-}
-
-fn smooth_step(x: f64) -> f64 {
-    let x = x.clamp(0.0, 1.0);
-    x * x * x * (10.0 + x * (-15.0 + 6.0 * x))
 }

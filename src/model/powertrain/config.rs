@@ -82,9 +82,6 @@ pub struct EccentricWeight {
     pub phase_deg: f64,
 }
 
-/// A balance shaft: a shaft parallel to the crank axis turning at `ratio` times the crank's speed
-/// relative to the block (−1: the inline-3's counter-rotating first-order shaft; ±2: a pair of
-/// Lanchester shafts of an inline-4), carrying eccentric weights.
 /// Residual unbalance of a rotating part after balancing, by its balance grade (ISO 21940-11,
 /// formerly ISO 1940-1): the permissible specific unbalance `e = G / Ω` at the maximum service
 /// speed `Ω`, so `U = m G / Ω` for a part of mass `m`. It acts as a point mass `U / r` at radius
@@ -107,6 +104,9 @@ pub struct ResidualUnbalance {
 /// Radius at which a residual unbalance is placed as a point mass (m).
 pub const UNBALANCE_RADIUS: f64 = 0.05;
 
+/// A balance shaft: a shaft parallel to the crank axis turning at `ratio` times the crank's speed
+/// relative to the block (−1: the inline-3's counter-rotating first-order shaft; ±2: a pair of
+/// Lanchester shafts of an inline-4), carrying eccentric weights.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct BalanceShaftConfig {

@@ -144,6 +144,9 @@ impl CylinderGeometry {
 /// below what `examples/accuracy_cost.rs` resolves: C¹ and C² give the same floor.)
 const GRID_DEG: f64 = 0.05;
 
+/// Crank angle over which the charge pressure blends into the compression before IVC.
+const IVC_LEAD_IN_DEG: f64 = 10.0;
+
 /// Tabulated cylinder pressure over one cycle, ready for fast C² evaluation.
 #[derive(Debug, Clone, PartialEq)]
 pub struct PressureCurve {
@@ -271,29 +274,62 @@ impl PressureCurve {
         }
         let p_evo = closed[closed.len() - 1];
         let charge = point.pressure_ivc;
+        // The valve events are blended so that the curve stays C¹ (the integrator's error
+        // estimate, and with it its accuracy, breaks down at a kink): before IVC the charge
+        // pressure turns smoothly into the polytropic compression the closed cylinder starts
+        // with; after EVO the polytropic expansion fades smoothly into the charge pressure over
+        // the blow-down.
+        let (v_ivc, _) = geometry.volume(ivc, model.compression_ratio);
+        let (v_evo, _) = geometry.volume(evo, model.compression_ratio);
+        let compression = |th: f64| {
+            let (v, _) = geometry.volume(th, model.compression_ratio);
+            charge * (v_ivc / v).powf(model.kappa_compression)
+        };
+        let expansion = |th: f64| {
+            let (v, _) = geometry.volume(th, model.compression_ratio);
+            p_evo * (v_evo / v).powf(model.kappa_expansion)
+        };
+        // Ten degrees, or what the gas exchange leaves between blow-down and IVC.
+        let lead_in = IVC_LEAD_IN_DEG
+            .to_radians()
+            .min(ivc + 4.0 * std::f64::consts::PI - evo - blow);
+        // Phases are decided in degrees on the grid: in radians, rounding put the knot at EVO
+        // outside both the closed phase and the blow-down, and the curve dropped to the charge
+        // pressure at that one knot (a spike the integrator could not resolve: its error
+        // stalled near 1e-4 whatever the tolerance).
+        let (ivc_deg, evo_deg) = (model.ivc_deg, model.evo_deg);
+        let knot_tolerance = 1e-9 * GRID_DEG;
         let values = (0..n)
             .map(|k| {
-                let th = (-360.0 + k as f64 * GRID_DEG).to_radians();
-                if th >= ivc && th <= ivc + closed_steps as f64 * step {
-                    let u = (th - ivc) / step;
+                let deg = -360.0 + k as f64 * GRID_DEG;
+                let th = deg.to_radians();
+                if deg >= ivc_deg - knot_tolerance && deg <= evo_deg + knot_tolerance {
+                    let u = ((deg - ivc_deg) / GRID_DEG).max(0.0);
                     let i = (u.floor() as usize).min(closed.len() - 2);
-                    let t = u - i as f64;
-                    if th <= evo {
-                        return closed[i] + t * (closed[i + 1] - closed[i]);
-                    }
+                    let t = (u - i as f64).min(1.0);
+                    return closed[i] + t * (closed[i + 1] - closed[i]);
                 }
-                // Smooth (cosine) blow-down from EVO, charge pressure during gas exchange.
-                let since = if th > evo {
+                // Angle since EVO within the 720° cycle (the cycle wraps between EVO and IVC).
+                let since = if deg > evo_deg {
                     th - evo
                 } else {
                     th + 4.0 * std::f64::consts::PI - evo
                 };
                 if since < blow {
-                    let w = 0.5 * (1.0 + (std::f64::consts::PI * since / blow).cos());
-                    charge + w * (p_evo - charge)
-                } else {
-                    charge
+                    let w = 1.0 - crate::model::blend::smooth_step(since / blow);
+                    return charge + w * (expansion(evo + since) - charge);
                 }
+                // Angle before the next IVC (after EVO the next IVC is a cycle later).
+                let before = if th < ivc {
+                    ivc - th
+                } else {
+                    ivc + 4.0 * std::f64::consts::PI - th
+                };
+                if before < lead_in {
+                    let w = 1.0 - crate::model::blend::smooth_step(before / lead_in);
+                    return charge + w * (compression(th) - charge);
+                }
+                charge
             })
             .collect();
         Self::from_samples(values)

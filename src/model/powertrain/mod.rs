@@ -261,6 +261,24 @@ impl Powertrain {
             .sum()
     }
 
+    /// The crank angle after which every excitation repeats (rad): the four-stroke working cycle
+    /// of two revolutions, provided every balance shaft's turn fits into it a whole number of
+    /// times (ratio a multiple of ½); otherwise an error naming the shaft.
+    pub fn cycle_angle(&self) -> Result<f64, String> {
+        let cycle = 4.0 * std::f64::consts::PI;
+        for shaft in &self.config.balance_shafts {
+            let turns = 2.0 * shaft.ratio;
+            if (turns - turns.round()).abs() > 1e-9 {
+                return Err(format!(
+                    "balance shaft {} turns {} times per working cycle: the engine's excitation \
+                     has no period of one cycle",
+                    shaft.name, turns
+                ));
+            }
+        }
+        Ok(cycle)
+    }
+
     /// Crank angle at the start of a simulation (rad, relative to the monoblock).
     pub fn start_angle(&self) -> f64 {
         self.config.start_crank_angle_deg.to_radians()
