@@ -51,15 +51,24 @@ def parse_settings(items: list[str]) -> tuple:
 
 def start_options(args) -> dict:
     """How each speed point starts: on the periodic steady state, or settled after a fade-in."""
+    # A periodic response is resolved exactly by whole working cycles: 8 revolutions (4 cycles)
+    # put every half order on a bin without leakage. After a settle the longer window averages
+    # what is left of the transients.
     if args.start == "periodic":
         if args.settle is not None:
             raise SystemExit("--settle applies to --start settle only (a periodic start has no "
                              "transient to wait for)")
-        return {"periodic": True, "settle_revolutions": 0}
-    settle = 20 if args.settle is None else args.settle
-    if settle < 0:
-        raise SystemExit(f"--settle must be >= 0, got {settle}")
-    return {"periodic": False, "settle_revolutions": settle}
+        options = {"periodic": True, "settle_revolutions": 0, "revolutions": 8}
+    else:
+        settle = 20 if args.settle is None else args.settle
+        if settle < 0:
+            raise SystemExit(f"--settle must be >= 0, got {settle}")
+        options = {"periodic": False, "settle_revolutions": settle, "revolutions": 40}
+    if args.revolutions is not None:
+        if args.revolutions < 2 or args.revolutions % 2:
+            raise SystemExit(f"--revolutions must be even and >= 2, got {args.revolutions}")
+        options["revolutions"] = args.revolutions
+    return options
 
 
 def add_start_options(p):
@@ -78,8 +87,7 @@ def safe_name(signal: str) -> str:
 def cmd_sweep(args) -> int:
     out = pathlib.Path(args.out)
     out.mkdir(parents=True, exist_ok=True)
-    points = speed_points(args.rpm[0], args.rpm[1], args.count, revolutions=args.revolutions,
-                          steps_per_revolution=args.steps_per_rev, load_torque=args.load_torque,
+    points = speed_points(args.rpm[0], args.rpm[1], args.count, steps_per_revolution=args.steps_per_rev, load_torque=args.load_torque,
                           parameters=parse_settings(args.set), **start_options(args))
     started = time.perf_counter()
     orders, spectra = run_sweep(args.fmu, points, signals=args.signal or None, case=args.case,
@@ -161,8 +169,7 @@ def run_study(args, cases: dict) -> int:
     tables = []
     started = time.perf_counter()
     for case, params in cases.items():
-        points = speed_points(args.rpm[0], args.rpm[1], args.count, revolutions=args.revolutions,
-                              parameters=tuple(params.items()) + parse_settings(args.set),
+        points = speed_points(args.rpm[0], args.rpm[1], args.count, parameters=tuple(params.items()) + parse_settings(args.set),
                               **start_options(args))
         tables.append(run_sweep(args.fmu, points, signals=args.signal or STUDY_SIGNALS, case=case,
                                 parallel=not args.serial, scheduler=args.scheduler,
@@ -215,7 +222,8 @@ def main(argv: list[str] | None = None) -> int:
     s = sub.add_parser("sweep", help="constant-speed points on their periodic steady state")
     common(s)
     s.add_argument("--count", type=int, default=18)
-    s.add_argument("--revolutions", type=int, default=40, help="stationary window (even)")
+    s.add_argument("--revolutions", type=int, default=None,
+                   help="analysed window (even; default 8 with a periodic start, 40 after a settle)")
     add_start_options(s)
     s.add_argument("--steps-per-rev", type=int, default=72)
     s.add_argument("--load-torque", type=float, default=0.0)
@@ -241,7 +249,8 @@ def main(argv: list[str] | None = None) -> int:
         m = sub.add_parser(name, help=help_text)
         common(m)
         m.add_argument("--count", type=int, default=18)
-        m.add_argument("--revolutions", type=int, default=40, help="stationary window (even)")
+        m.add_argument("--revolutions", type=int, default=None,
+                       help="analysed window (even; default 8 with a periodic start, 40 after a settle)")
         add_start_options(m)
         m.add_argument("--serial", action="store_true", help="no Dask")
         m.add_argument("--workers", type=int, default=2)

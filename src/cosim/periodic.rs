@@ -3,16 +3,21 @@
 //! The running engine repeats its excitation after one working cycle `T` (two crank revolutions
 //! for a four-stroke engine). The vibration state `x` (powertrain positions and velocities, body
 //! modal coordinates and rates) on the periodic orbit is the fixed point of the cycle map `Φ`:
-//! integrate from `x` over `T` with the crank turning at the set-point speed. Newton's equation
-//! `(I − Φ'(x)) δ = Φ(x) − x` is solved with a fixed approximation `P ≈ Φ'`: the transition
-//! matrix `exp(Ā T)` of the linearised vibration equations, `Ā` the Jacobian averaged over the
-//! cycle's crank angles. For a linear model this is exact and the first step lands on the orbit;
-//! the mounts' nonlinearity and the crank-angle-dependent inertia make the rest of the iterations
-//! (chord Newton, linear convergence at the rate of the mismatch). Each iteration costs one cycle
-//! of simulation; the monodromy itself is never formed by simulation.
+//! integrate from `x` over `T` with the crank turning at the set-point speed from its start
+//! angle. Newton's equation `(I − Φ'(x)) δ = Φ(x) − x` is solved with a fixed approximation
+//! `P ≈ Φ'`: the vibration block of `exp(Ā T)`, `Ā` the Jacobian of the whole state (crank angle
+//! included: a roll of the block moves the crank relative to it, and with it the excitation's
+//! phase) averaged over the cycle's crank angles. For a linear model this is exact and the first
+//! step lands on the orbit; the mounts' nonlinearity and the crank-angle-dependent inertia leave
+//! a mismatch in a few directions, which Anderson acceleration of the chord iteration removes.
+//! Each iteration costs one cycle of simulation; `Φ'` is never formed by simulation, and modes
+//! that decay within a cycle (`exp(λT) ≈ 0`) converge in the first step whatever `P` says.
 //!
-//! Modes that decay within one cycle contribute `exp(λT) ≈ 0` to `P` and converge in the first
-//! step whatever the approximation; the lightly damped ones are where `P` matters.
+//! The cycle map carries the integration error of one cycle, tens of error weights at the run's
+//! tolerance (the error of a cycle is a global error). The iteration therefore switches to a
+//! 1000× tighter tolerance once it reaches that floor, and accepts the orbit when one cycle
+//! returns to within one error weight of the run's tolerance: the start is on the orbit to
+//! better than the run can resolve.
 
 use faer::Mat;
 use nalgebra::DMatrix;
@@ -81,7 +86,7 @@ pub fn periodic_start(
         y0[speed] = omega;
         y0[acceleration] = 0.0;
     }
-    // First linearisation: the start guess with the crank turned through the cycle.
+    // The linearisation: the start guess with the crank turned through the cycle.
     let crank = layout.crank_angle();
     let rotated: Vec<(f64, Vec<f64>)> = (0..JACOBIAN_SAMPLES)
         .map(|k| {
@@ -91,7 +96,7 @@ pub fn periodic_start(
             (t0 + dt, y)
         })
         .collect();
-    let mut chord = ChordMatrix::new(model, &rotated, &vib, period)?;
+    let chord = ChordMatrix::new(model, &rotated, &vib, period)?;
 
     let weights = |x: &[f64]| -> Vec<f64> {
         x.iter()
@@ -119,7 +124,7 @@ pub fn periodic_start(
         for (k, &i) in vib.iter().enumerate() {
             y[i] = x[k];
         }
-        let (end, samples) = one_cycle(model, if tight { &fine } else { options }, t0, &y, period)?;
+        let end = one_cycle(model, if tight { &fine } else { options }, t0, &y, period)?;
         let r: Vec<f64> = vib.iter().zip(&x).map(|(&i, xi)| end[i] - xi).collect();
         let w = weights(&x);
         let residual = (r
@@ -154,9 +159,6 @@ pub fn periodic_start(
         // stops falling fast.
         if !tight && (residual <= COARSE_FLOOR || residual > previous / 4.0) {
             tight = true;
-            // Near the orbit now: linearise along it (its mean deflection and the mounts'
-            // stiffness over the vibration amplitude) rather than at the static guess.
-            chord = ChordMatrix::new(model, &samples, &vib, period)?;
             anderson.clear();
         }
         previous = residual;
@@ -166,29 +168,18 @@ pub fn periodic_start(
     unreachable!("the loop returns on its last iteration")
 }
 
-/// States along a cycle: (time, state).
-type Samples = Vec<(f64, Vec<f64>)>;
-
-/// Integrates the model over one cycle from `y` at `t0` with a fresh integrator; returns the
-/// end state and the (interpolated) states at [`JACOBIAN_SAMPLES`] equally spaced times.
+/// Integrates the model over one cycle from `y` at `t0` with a fresh integrator.
 fn one_cycle(
     model: &mut CoupledModel,
     options: &BdfOptions,
     t0: f64,
     y: &[f64],
     period: f64,
-) -> Result<(Vec<f64>, Samples), String> {
-    let fail = |e: crate::ode::BdfError| format!("simulating one cycle: {e}");
+) -> Result<Vec<f64>, String> {
     let mut bdf = Bdf::new(model, t0, y, options.clone()).map_err(|e| e.to_string())?;
-    let mut samples = vec![(t0, y.to_vec())];
-    for k in 1..JACOBIAN_SAMPLES {
-        let t = t0 + period * k as f64 / JACOBIAN_SAMPLES as f64;
-        let mut state = vec![0.0; y.len()];
-        bdf.advance_past(model, t, &mut state).map_err(fail)?;
-        samples.push((t, state));
-    }
-    bdf.advance_to(model, t0 + period).map_err(fail)?;
-    Ok((bdf.y().to_vec(), samples))
+    bdf.advance_to(model, t0 + period)
+        .map_err(|e| format!("simulating one cycle: {e}"))?;
+    Ok(bdf.y().to_vec())
 }
 
 /// Anderson acceleration of the chord iteration `x ← g(x) = x + (I − P)⁻¹ r(x)`: the next
