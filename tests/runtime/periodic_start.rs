@@ -78,14 +78,15 @@ fn compare(scene: i32) {
     let fresh = window(&mut periodic, scene);
     // "Largest" per quantity: the mount forces (12 components) and the steering wheel's
     // acceleration (3): an order counts when it reaches 1 % of the quantity's largest order.
-    let groups: &[std::ops::Range<usize>] = if scene == 2 {
-        &[0..12, 12..15]
+    let groups: Vec<(usize, usize)> = if scene == 2 {
+        vec![(0, 12), (12, 15)]
     } else {
-        &[0..12]
+        vec![(0, 12)]
     };
     let mut compared = 0;
     let mut worst = 0.0f64;
-    for group in groups {
+    for (first, end) in groups {
+        let group = first..end;
         let (oa, ob): (Vec<Vec<f64>>, Vec<Vec<f64>>) = group
             .clone()
             .map(|c| (orders(&truth[c]), orders(&fresh[c])))
