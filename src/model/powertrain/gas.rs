@@ -144,6 +144,9 @@ impl CylinderGeometry {
 /// below what `examples/accuracy_cost.rs` resolves: C¹ and C² give the same floor.)
 const GRID_DEG: f64 = 0.05;
 
+/// Wiebe pressure tables kept per process (four per engine configuration).
+const WIEBE_MEMO_SIZE: usize = 16;
+
 /// Crank angle over which the charge pressure blends into the compression before IVC.
 const IVC_LEAD_IN_DEG: f64 = 10.0;
 
@@ -219,8 +222,37 @@ impl PressureCurve {
         Self::from_samples(values)
     }
 
-    /// Single-zone Wiebe pressure for one load point.
+    /// Single-zone Wiebe pressure for one load point. The tables take milliseconds to integrate
+    /// and every instance of the FMU (a sweep resets it for each speed point) asks for the same
+    /// few, so the last [`WIEBE_MEMO_SIZE`] are kept for the process.
     pub fn wiebe(model: &WiebeModel, point: &CombustionPoint, geometry: &CylinderGeometry) -> Self {
+        type Memo = Vec<(WiebeModel, CombustionPoint, CylinderGeometry, PressureCurve)>;
+        static MEMO: std::sync::OnceLock<std::sync::Mutex<Memo>> = std::sync::OnceLock::new();
+        let memo = MEMO.get_or_init(Default::default);
+        let found = {
+            // A panic while the lock was held leaves plain data behind: still usable.
+            let memo = memo.lock().unwrap_or_else(|e| e.into_inner());
+            memo.iter()
+                .find(|(m, p, g, _)| m == model && p == point && g == geometry)
+                .map(|(_, _, _, curve)| curve.clone())
+        };
+        if let Some(curve) = found {
+            return curve;
+        }
+        let curve = Self::integrate_wiebe(model, point, geometry);
+        let mut memo = memo.lock().unwrap_or_else(|e| e.into_inner());
+        if memo.len() >= WIEBE_MEMO_SIZE {
+            memo.remove(0);
+        }
+        memo.push((model.clone(), point.clone(), *geometry, curve.clone()));
+        curve
+    }
+
+    fn integrate_wiebe(
+        model: &WiebeModel,
+        point: &CombustionPoint,
+        geometry: &CylinderGeometry,
+    ) -> Self {
         let n = (720.0 / GRID_DEG).round() as usize;
         let step = GRID_DEG.to_radians();
         let ivc = model.ivc_deg.to_radians();
