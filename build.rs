@@ -75,8 +75,6 @@ struct Scalar {
     display_unit: Option<String>,
     min: Option<f64>,
     max: Option<f64>,
-    /// An input the static equilibrium at initialisation depends on (`"statics": true`).
-    statics: bool,
 }
 
 /// A table entry as written: a scalar or a family with `dims`, named for Rust by `rust`.
@@ -250,7 +248,6 @@ fn expand(table: &Value) -> (Vec<Scalar>, Vec<Family>) {
                 display_unit: opt_str(e, "displayUnit"),
                 min: e.get("min").and_then(Value::as_f64),
                 max: e.get("max").and_then(Value::as_f64),
-                statics: e.get("statics").and_then(Value::as_bool).unwrap_or(false),
             });
         }
     }
@@ -278,10 +275,10 @@ fn validate(table: &Value, scalars: &[Scalar]) {
         if needs_start && s.start.is_none() {
             fail(&format!("{} ({}) needs a start value", s.name, s.causality));
         }
-        if s.causality == "output" && s.start.is_some() {
+        if matches!(s.causality.as_str(), "output" | "calculatedParameter") && s.start.is_some() {
             fail(&format!(
-                "output {} is calculated and must not have a start value",
-                s.name
+                "{} {} is calculated and must not have a start value",
+                s.causality, s.name
             ));
         }
         if let Some(u) = &s.unit {
@@ -461,13 +458,22 @@ fn write_model_description(
             .filter(|(_, s)| s.causality == "output")
             .map(|(i, _)| i + 1)
             .collect();
-        // At the end of initialisation the outputs describe the static equilibrium: it depends
-        // on every parameter and on the inputs marked "statics" (load torque, mount stiffness
-        // scales), not on rpm or the damping scales (a test checks each input).
+        // FMI 2.0 §2.2.8: the initial unknowns are the outputs and the calculated parameters,
+        // in index order.
+        let initial_unknowns: Vec<usize> = scalars
+            .iter()
+            .enumerate()
+            .filter(|(_, s)| matches!(s.causality.as_str(), "output" | "calculatedParameter"))
+            .map(|(i, _)| i + 1)
+            .collect();
+        // At the end of initialisation the outputs describe the static equilibrium, which
+        // depends on every parameter and on the load torque and mount stiffness scales; with initialization.periodic they describe the periodic orbit, and
+        // the natural modes' damping depends on the mount damping scales: so every input is a
+        // dependency (a test checks that none is missing).
         let knowns = scalars
             .iter()
             .enumerate()
-            .filter(|(_, s)| s.causality == "parameter" || (s.causality == "input" && s.statics))
+            .filter(|(_, s)| matches!(s.causality.as_str(), "parameter" | "input"))
             .map(|(i, _)| (i + 1).to_string())
             .collect::<Vec<_>>()
             .join(" ");
@@ -477,10 +483,12 @@ fn write_model_description(
                 // fmi2DoStep (and at initialisation): an input set at a communication point acts
                 // from there on and changes no output before the next step, so no output depends on
                 // an input directly.
-                for (list, dependencies) in [("Outputs", ""), ("InitialUnknowns", knowns.as_str())]
-                {
+                for (list, indices, dependencies) in [
+                    ("Outputs", &outputs, ""),
+                    ("InitialUnknowns", &initial_unknowns, knowns.as_str()),
+                ] {
                     w.create_element(list).write_inner_content(|w| {
-                        for i in &outputs {
+                        for i in indices {
                             let unknown =
                                 vec![attr("index", i), attr("dependencies", dependencies)];
                             element(w, "Unknown", &unknown).write_empty()?;

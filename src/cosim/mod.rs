@@ -150,6 +150,8 @@ pub struct Simulation {
     /// rebuilds the scene exactly (fade-in start, mount operating points).
     initial_time: f64,
     initial_inputs: Inputs,
+    /// The static equilibrium found there (the linearisation point of [`Simulation::natural_modes`]).
+    equilibrium: Vec<f64>,
 }
 
 impl Simulation {
@@ -187,6 +189,7 @@ impl Simulation {
             notes,
             integrator,
             time: t0,
+            equilibrium: y0.clone(),
             state: y0,
             inputs: *inputs,
             initial_time: t0,
@@ -223,6 +226,18 @@ impl Simulation {
     /// Lines for the log describing the scene.
     pub fn describe(&self) -> Vec<String> {
         self.notes.clone()
+    }
+
+    /// Natural modes of the model linearised at its static equilibrium under the initial inputs
+    /// (engine at rest, mounts at their operating points), ascending in frequency: the coupled
+    /// frequencies of a Campbell diagram. Independent of how far the simulation has run.
+    pub fn natural_modes(&self) -> Result<Vec<crate::model::Mode>, String> {
+        let mut model = self.scene.clone();
+        scene::apply_inputs(&mut model, &self.initial_inputs)?;
+        model
+            .set_fade_start(self.initial_time)
+            .map_err(|e| e.to_string())?;
+        model.modes(&self.equilibrium)
     }
 
     /// The coupled model being integrated.

@@ -93,6 +93,13 @@ pub struct Instance {
     pub core: Core,
 }
 
+/// Whether `vr` names a calculated parameter of `table` (the natural modes).
+fn is_calculated<T>(table: &[Variable<T>], vr: u32) -> bool {
+    table
+        .get(vr as usize)
+        .is_some_and(|v| v.causality == Causality::CalculatedParameter)
+}
+
 /// Relative tolerance on communication points: masters compute them as `t0 + n h`.
 const TIME_JITTER: f64 = 1e-9;
 
@@ -230,7 +237,48 @@ impl Instance {
         let outputs = simulation.outputs().map_err(|m| self.error(&m))?;
         self.write_outputs(&outputs, &simulation.counters());
         self.write_effective_parameters(&simulation);
+        // The natural modes of this model are computed when first read.
+        self.core.values.integers[integer::MODES_COUNT as usize] = -1;
         self.core.simulation = Some(simulation);
+        Ok(())
+    }
+
+    /// Fills the natural-mode calculated parameters (`modes.count`, `mode[k].*`) if this
+    /// simulation's have not been computed yet: a linearisation and a dense eigenproblem of the
+    /// vibration coordinates, tens of milliseconds that a sweep which never reads them saves.
+    fn ensure_natural_modes(&mut self) -> Result<(), Status> {
+        self.ensure_simulation()?;
+        let count = integer::MODES_COUNT as usize;
+        if self.core.values.integers[count] >= 0 {
+            return Ok(());
+        }
+        let Some(simulation) = self.core.simulation.as_ref() else {
+            return Err(self.error("natural modes: the model is not built"));
+        };
+        let modes = simulation
+            .natural_modes()
+            .map_err(|m| self.error(&format!("natural modes: {m}")))?;
+        let slots = real::MODE_FREQUENCY.len();
+        let r = &mut self.core.values.reals;
+        for k in 0..slots {
+            let (f, zeta, share) = modes
+                .get(k)
+                .map_or((0.0, 0.0, 0.0), |m| {
+                    (m.frequency_hz, m.damping_ratio, m.powertrain_fraction)
+                });
+            r[real::MODE_FREQUENCY[k] as usize] = f;
+            r[real::MODE_DAMPING[k] as usize] = zeta;
+            r[real::MODE_POWERTRAIN_SHARE[k] as usize] = share;
+        }
+        let shown = modes.len().min(slots);
+        self.core.values.integers[count] = i32::try_from(shown).unwrap_or(i32::MAX);
+        self.event(&format!(
+            "natural modes: {} oscillatory modes of the linearised model, the lowest {shown} \
+             reported ({:.2}..{:.2} Hz)",
+            modes.len(),
+            modes.first().map_or(0.0, |m| m.frequency_hz),
+            modes.get(shown.saturating_sub(1)).map_or(0.0, |m| m.frequency_hz)
+        ));
         Ok(())
     }
 
@@ -429,6 +477,11 @@ impl Instance {
         if let Err(s) = self.prepare_get("fmi2GetReal", vrs, is_output) {
             return s;
         }
+        if vrs.iter().any(|vr| is_calculated(REALS, *vr)) {
+            if let Err(s) = self.ensure_natural_modes() {
+                return s;
+            }
+        }
         self.get_values(
             vrs,
             out,
@@ -447,6 +500,11 @@ impl Instance {
         };
         if let Err(s) = self.prepare_get("fmi2GetInteger", vrs, is_output) {
             return s;
+        }
+        if vrs.iter().any(|vr| is_calculated(INTEGERS, *vr)) {
+            if let Err(s) = self.ensure_natural_modes() {
+                return s;
+            }
         }
         self.get_values(
             vrs,

@@ -5,4 +5,5 @@ mod bad_inputs;
 mod common;
 mod inputs;
 mod model_structure;
+mod natural_modes;
 mod precedence;

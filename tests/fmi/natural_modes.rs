@@ -1,0 +1,101 @@
+//! The natural modes as calculated parameters (`modes.count`, `mode[k].frequency`, `.damping`,
+//! `.powertrainShare`): the coupled frequencies a Campbell diagram needs, from the FMU alone.
+//! Truth: the analytic frequencies of the decoupled rigid mount layout and the paper's Table 1.
+
+use crate::common::*;
+use engine_mount_chassis::fmi2::variables::{boolean, integer, real};
+use engine_mount_chassis::paper::{TABLE1_RIGID, TABLE1_RING_CARRIER};
+
+const TWO_PI: f64 = 2.0 * std::f64::consts::PI;
+
+fn read_modes(s: &Slave<'_>) -> (i32, Vec<f64>, Vec<f64>, Vec<f64>) {
+    let (status, count) = s.get_integer(&[integer::MODES_COUNT]);
+    assert_eq!(status, OK, "{:?}", s.logs());
+    let n = real::MODE_FREQUENCY.len();
+    let frequency = s.reals(&real::MODE_FREQUENCY);
+    let damping = s.reals(&real::MODE_DAMPING);
+    let share = s.reals(&real::MODE_POWERTRAIN_SHARE);
+    assert_eq!(frequency.len(), n);
+    (count[0], frequency, damping, share)
+}
+
+#[test]
+fn rigid_powertrain_modes_match_the_decoupled_analytic_frequencies() {
+    // With rigid ring carriers the default layout decouples: f = sqrt(k/m)/2pi per direction
+    // with the summed mount rates (4 mounts: 51.5, 36.6, 48.3 kN/m in x, y, z) and the
+    // powertrain's effective inertias about the mount plane.
+    let fmu = Fmu::load();
+    let s = fmu.instantiate("modes-rigid");
+    assert_eq!(s.set_integer(&[integer::SCENE], &[1]), OK);
+    assert_eq!(s.set_boolean(&[boolean::EFFECT_RING_CARRIER], &[false]), OK);
+    s.initialize();
+    let (count, f, zeta, share) = read_modes(&s);
+    assert_eq!(count, 6, "{f:?}");
+    let (kx, ky, kz): (f64, f64, f64) = (4.0 * 51_500.0, 4.0 * 36_600.0, 4.0 * 48_300.0);
+    let analytic = [
+        (ky / 180.0).sqrt() / TWO_PI,
+        (kz / 180.0).sqrt() / TWO_PI,
+        (kx / 180.0).sqrt() / TWO_PI,
+        (kz * 0.16 / 6.8).sqrt() / TWO_PI,
+        (kz * 0.09 / 3.1).sqrt() / TWO_PI,
+        ((kx * 0.16 + ky * 0.09) / 6.9).sqrt() / TWO_PI,
+    ];
+    for (k, want) in analytic.iter().enumerate() {
+        assert!((f[k] / want - 1.0).abs() < 0.005, "mode {k}: {} vs {want}", f[k]);
+        assert!(zeta[k] > 0.0 && zeta[k] < 0.5, "mode {k}: damping {}", zeta[k]);
+        assert!((share[k] - 1.0).abs() < 1e-9, "mode {k}: share {}", share[k]);
+    }
+    assert!(f[6..].iter().chain(&zeta[6..]).all(|x| *x == 0.0));
+}
+
+#[test]
+fn ground_modes_are_the_papers_table_1_and_stay_fixed_while_the_engine_runs() {
+    let fmu = Fmu::load();
+    let s = fmu.instantiate("modes-ground");
+    assert_eq!(s.set_integer(&[integer::SCENE], &[1]), OK);
+    s.setup(0.0, None);
+    s.enter_init();
+    // Readable in initialisation mode (FMI 2.0: calculated parameters are initial unknowns).
+    let (count, f, _, _) = read_modes(&s);
+    assert_eq!(count, 12, "{f:?}");
+    for (k, (want, name)) in TABLE1_RIGID.iter().chain(&TABLE1_RING_CARRIER).enumerate() {
+        assert!((f[k] / want - 1.0).abs() < 0.05, "{name}: {} vs paper {want}", f[k]);
+    }
+    assert_eq!(s.exit_init(), OK);
+    for k in 0..20 {
+        assert_eq!(s.do_step(k as f64 * 1e-3, 1e-3), OK);
+    }
+    assert_eq!(read_modes(&s).1, f, "the modes are a property of the model, not of the run");
+
+    // After a reset with other parameters they are recomputed, never stale.
+    assert_eq!(s.reset(), OK);
+    assert_eq!(s.set_integer(&[integer::SCENE], &[1]), OK);
+    assert_eq!(s.set_boolean(&[boolean::EFFECT_RING_CARRIER], &[false]), OK);
+    s.initialize();
+    assert_eq!(read_modes(&s).0, 6);
+}
+
+#[test]
+fn a_stiffer_mount_set_raises_the_rigid_frequencies_by_the_square_root() {
+    // Scaling every mount's stiffness by 4 at the start scales each rigid-body frequency by 2
+    // (the decoupled layout, the mounts' linear range).
+    let fmu = Fmu::load();
+    let frequencies = |scale: f64| {
+        let s = fmu.instantiate("modes-scaled");
+        assert_eq!(s.set_integer(&[integer::SCENE], &[1]), OK);
+        assert_eq!(s.set_boolean(&[boolean::EFFECT_RING_CARRIER], &[false]), OK);
+        let scales: Vec<u32> = real::MOUNT_STIFFNESS_SCALE.to_vec();
+        assert_eq!(s.set_real(&scales, &[scale; 4]), OK);
+        s.initialize();
+        read_modes(&s).1
+    };
+    let (base, stiff) = (frequencies(1.0), frequencies(4.0));
+    for k in 0..6 {
+        assert!(
+            (stiff[k] / base[k] - 2.0).abs() < 0.02,
+            "mode {k}: {} -> {}",
+            base[k],
+            stiff[k]
+        );
+    }
+}
