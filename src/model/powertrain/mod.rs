@@ -30,32 +30,57 @@ use super::effects::Effects;
 use super::inputs::InputError;
 use super::validate::ConfigError;
 
-/// The Wiebe model's fired and motored curves at idle and full load, for changing the load at
-/// run time.
+/// The Wiebe model's curves at idle and full load, one per distinct cylinder, for changing the
+/// load at run time.
 #[derive(Debug, Clone, PartialEq)]
 struct LoadPoints {
-    idle: PressureCurve,
-    full: PressureCurve,
-    idle_motored: PressureCurve,
-    full_motored: PressureCurve,
+    /// Per cylinder with the heat-release spread; a single curve when the cylinders are alike.
+    idle: Vec<PressureCurve>,
+    full: Vec<PressureCurve>,
 }
 
 impl LoadPoints {
-    /// Per-cylinder curves at `load` with the heat-release spread `spread` (shared when the
-    /// cylinders are identical).
-    fn curves(&self, load: f64, spread: &[f64], cylinders: usize) -> Vec<Arc<PressureCurve>> {
-        let fired = PressureCurve::blend(&self.idle, &self.full, load);
-        if spread.iter().all(|d| *d == 0.0) {
-            let shared = Arc::new(fired);
-            return (0..cylinders).map(|_| Arc::clone(&shared)).collect();
+    /// Each cylinder's heat scaled by `1 + δ` of `spread` (empty: identical cylinders) and
+    /// integrated on its own: with wall heat loss the pressure is not linear in the heat, so a
+    /// blend of motored and fired curves would only be the first-order term.
+    fn new(
+        model: &gas::WiebeModel,
+        spread: &[f64],
+        geometry: &CylinderGeometry,
+    ) -> LoadPoints {
+        let per_cylinder = |point: &gas::CombustionPoint| -> Vec<PressureCurve> {
+            if spread.iter().all(|d| *d == 0.0) {
+                return vec![PressureCurve::wiebe(model, point, geometry)];
+            }
+            spread
+                .iter()
+                .map(|d| {
+                    let scaled = gas::CombustionPoint {
+                        heat: point.heat * (1.0 + d),
+                        ..point.clone()
+                    };
+                    PressureCurve::wiebe(model, &scaled, geometry)
+                })
+                .collect()
+        };
+        LoadPoints {
+            idle: per_cylinder(&model.idle),
+            full: per_cylinder(&model.full_load),
         }
-        // The pressure equation is linear in the heat released: scaling the heat by 1 + δ
-        // scales the pressure rise over the motored curve by the same factor.
-        let motored = PressureCurve::blend(&self.idle_motored, &self.full_motored, load);
-        spread
+    }
+
+    /// Per-cylinder curves at `load` (shared when the cylinders are identical).
+    fn curves(&self, load: f64, cylinders: usize) -> Vec<Arc<PressureCurve>> {
+        let blended: Vec<Arc<PressureCurve>> = self
+            .idle
             .iter()
-            .map(|d| Arc::new(PressureCurve::blend(&motored, &fired, 1.0 + d)))
-            .collect()
+            .zip(&self.full)
+            .map(|(idle, full)| Arc::new(PressureCurve::blend(idle, full, load)))
+            .collect();
+        if blended.len() == 1 {
+            return (0..cylinders).map(|_| Arc::clone(&blended[0])).collect();
+        }
+        blended
     }
 }
 
@@ -104,17 +129,8 @@ impl GasExcitation {
         let spread = config.gas.cylinder_heat_spread.clone();
         let (curves, load_points) = match &config.gas.model {
             GasModel::Wiebe(w) => {
-                let motored = |point: &gas::CombustionPoint| gas::CombustionPoint {
-                    heat: 0.0,
-                    ..point.clone()
-                };
-                let points = LoadPoints {
-                    idle: PressureCurve::wiebe(w, &w.idle, &geometry),
-                    full: PressureCurve::wiebe(w, &w.full_load, &geometry),
-                    idle_motored: PressureCurve::wiebe(w, &motored(&w.idle), &geometry),
-                    full_motored: PressureCurve::wiebe(w, &motored(&w.full_load), &geometry),
-                };
-                (points.curves(config.gas.load, &spread, n), Some(points))
+                let points = LoadPoints::new(w, &spread, &geometry);
+                (points.curves(config.gas.load, n), Some(points))
             }
             GasModel::Table(t) => {
                 let curve = PressureCurve::from_table(t).map_err(|message| ConfigError {
@@ -296,7 +312,7 @@ impl Powertrain {
                     "the gas pressure comes from a user table; its load cannot change".into(),
                 ));
             };
-            gas.curves = points.curves(load, &gas.spread, gas.cylinders.len());
+            gas.curves = points.curves(load, gas.cylinders.len());
             gas.mean_torque = gas.indicated_torque();
         }
         self.config.gas.load = load;
