@@ -67,6 +67,7 @@ impl Parameters {
                 "chassis.maxModes must be >= 0 (0: select by chassis.modeCutoff)".to_string()
             })?,
             stiffening_bar: self.chassis_stiffening_bar,
+            stiff_front_plate: self.chassis_stiff_front_plate,
             cache: if !self.chassis_cache_enabled {
                 CacheSetting::Disabled
             } else {

@@ -261,11 +261,9 @@ impl Instance {
         let slots = real::MODE_FREQUENCY.len();
         let r = &mut self.core.values.reals;
         for k in 0..slots {
-            let (f, zeta, share) = modes
-                .get(k)
-                .map_or((0.0, 0.0, 0.0), |m| {
-                    (m.frequency_hz, m.damping_ratio, m.powertrain_fraction)
-                });
+            let (f, zeta, share) = modes.get(k).map_or((0.0, 0.0, 0.0), |m| {
+                (m.frequency_hz, m.damping_ratio, m.powertrain_fraction)
+            });
             r[real::MODE_FREQUENCY[k] as usize] = f;
             r[real::MODE_DAMPING[k] as usize] = zeta;
             r[real::MODE_POWERTRAIN_SHARE[k] as usize] = share;
@@ -277,7 +275,9 @@ impl Instance {
              reported ({:.2}..{:.2} Hz)",
             modes.len(),
             modes.first().map_or(0.0, |m| m.frequency_hz),
-            modes.get(shown.saturating_sub(1)).map_or(0.0, |m| m.frequency_hz)
+            modes
+                .get(shown.saturating_sub(1))
+                .map_or(0.0, |m| m.frequency_hz)
         ));
         Ok(())
     }

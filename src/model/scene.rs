@@ -45,6 +45,8 @@ pub struct BodyOptions {
     pub modal_damping_scale: f64,
     /// Procedural body only: the transverse stiffening bar between the front girders.
     pub stiffening_bar: bool,
+    /// Procedural body only: the stiffer front plate under the steering column.
+    pub stiff_front_plate: bool,
     pub cache: CacheSetting,
 }
 
@@ -65,6 +67,21 @@ impl BodyOptions {
         } else {
             self.max_rpm / 60.0 * self.max_engine_order * AUTO_CUTOFF_MARGIN
         }
+    }
+
+    /// Refuses the options that modify the procedural chassis for a body that is `what`.
+    fn procedural_only(&self, what: &str) -> Result<(), String> {
+        for (set, name) in [
+            (self.stiffening_bar, "chassis.stiffeningBar"),
+            (self.stiff_front_plate, "chassis.stiffFrontPlate"),
+        ] {
+            if set {
+                return Err(format!(
+                    "{name} applies to the procedural body only; this vehicle's body is {what}"
+                ));
+            }
+        }
+        Ok(())
     }
 
     fn validate(&self) -> Result<(), String> {
@@ -124,9 +141,7 @@ pub fn reduction_spec(
     let (chassis, deck) = match &vehicle.body {
         BodyConfig::Procedural { chassis } => (chassis.as_ref().clone(), None),
         BodyConfig::Nastran { path, points } => {
-            if options.stiffening_bar {
-                return Err("chassis.stiffeningBar applies to the procedural body only; this vehicle's body is a bulk data deck".into());
-            }
+            options.procedural_only("a bulk data deck")?;
             let text = crate::text_file::read_limited(path, crate::text_file::DATA_LIMIT)
                 .map_err(|e| format!("bulk data deck: {e}"))?;
             let deck = BulkDeckBody {
@@ -167,6 +182,7 @@ pub fn reduction_spec(
     };
     let mut chassis = chassis;
     chassis.options.stiffening_bar |= options.stiffening_bar;
+    chassis.options.stiff_front_plate |= options.stiff_front_plate;
     let spec = ReductionSpec {
         chassis,
         deck,
@@ -211,23 +227,20 @@ pub fn body(
                     "bulk data deck {} (Craig-Bampton, {origin})",
                     deck.path.display()
                 ),
-                None => format!(
-                    "procedural chassis (Craig-Bampton, {origin}, stiffening bar {})",
-                    if spec.chassis.options.stiffening_bar {
-                        "on"
-                    } else {
-                        "off"
-                    }
-                ),
+                None => {
+                    let on = |b: bool| if b { "on" } else { "off" };
+                    let o = &spec.chassis.options;
+                    format!(
+                        "procedural chassis (Craig-Bampton, {origin}, stiffening bar {}, stiffer front plate {})",
+                        on(o.stiffening_bar),
+                        on(o.stiff_front_plate)
+                    )
+                }
             };
             (body, format!("{what}, {source}"))
         }
         BodyConfig::Reduced { path } => {
-            if options.stiffening_bar {
-                return Err(
-                    "chassis.stiffeningBar applies to the procedural body only; this vehicle's body is a reduced model from a file".into(),
-                );
-            }
+            options.procedural_only("a reduced model from a file")?;
             let text = crate::text_file::read_limited(path, crate::text_file::DATA_LIMIT)
                 .map_err(|e| format!("reduced body: {e}"))?;
             let body: ReducedChassis = serde_json::from_str(&text)

@@ -354,10 +354,15 @@ impl PressureCurve {
                 return 0.0;
             };
             let omega = wall.reference_speed_rpm * std::f64::consts::PI / 30.0;
-            let mean_piston_speed = 4.0 * geometry.crank_radius * omega / (2.0 * std::f64::consts::PI);
+            let mean_piston_speed =
+                4.0 * geometry.crank_radius * omega / (2.0 * std::f64::consts::PI);
             let temperature = wall.charge_temperature * p * v / (point.pressure_ivc * v_ivc);
             let motored = point.pressure_ivc * (v_ivc / v).powf(model.kappa_compression);
-            let c2 = if theta >= combustion_start { 3.24e-3 } else { 0.0 };
+            let c2 = if theta >= combustion_start {
+                3.24e-3
+            } else {
+                0.0
+            };
             let velocity = 2.28 * mean_piston_speed
                 + c2 * geometry.displacement() * wall.charge_temperature
                     / (point.pressure_ivc * v_ivc)
@@ -633,7 +638,10 @@ mod tests {
             let real = efficiency(&model, point);
             let ideal = efficiency(&adiabatic, point);
             assert!((0.45..0.52).contains(&real), "{name}: efficiency {real:.3}");
-            assert!(ideal > real + 0.05, "{name}: adiabatic {ideal:.3} vs {real:.3}");
+            assert!(
+                ideal > real + 0.05,
+                "{name}: adiabatic {ideal:.3} vs {real:.3}"
+            );
         }
     }
 

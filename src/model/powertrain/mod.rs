@@ -43,11 +43,7 @@ impl LoadPoints {
     /// Each cylinder's heat scaled by `1 + δ` of `spread` (empty: identical cylinders) and
     /// integrated on its own: with wall heat loss the pressure is not linear in the heat, so a
     /// blend of motored and fired curves would only be the first-order term.
-    fn new(
-        model: &gas::WiebeModel,
-        spread: &[f64],
-        geometry: &CylinderGeometry,
-    ) -> LoadPoints {
+    fn new(model: &gas::WiebeModel, spread: &[f64], geometry: &CylinderGeometry) -> LoadPoints {
         let per_cylinder = |point: &gas::CombustionPoint| -> Vec<PressureCurve> {
             if spread.iter().all(|d| *d == 0.0) {
                 return vec![PressureCurve::wiebe(model, point, geometry)];
