@@ -11,7 +11,54 @@ from typing import Iterable
 
 import numpy as np
 from fmpy import extract, read_model_description
-from fmpy.fmi2 import FMU2Slave
+from fmpy.fmi2 import (FMU2Slave, calloc, fmi2CallbackAllocateMemoryTYPE,
+                       fmi2CallbackFreeMemoryTYPE, fmi2CallbackFunctions, fmi2CallbackLoggerTYPE,
+                       free)
+
+STATUS_LABELS = ("ok", "warning", "discard", "error", "fatal", "pending")
+
+
+class PointFailed(RuntimeError):
+    """An FMU call failed: the FMU's own cause first, then every log line of the point.
+
+    Picklable, so it travels back from Dask workers with its log.
+    """
+
+    def __init__(self, cause: str, log: tuple = ()):
+        super().__init__(cause)
+        self.cause = cause
+        self.log = tuple(log)
+
+    def __reduce__(self):
+        return (PointFailed, (self.cause, self.log))
+
+    def report(self) -> str:
+        lines = [f"error: {self.cause}"]
+        if self.log:
+            lines.append("FMU log of the failed point:")
+            lines += [f"  {line}" for line in self.log]
+        return "\n".join(lines)
+
+
+def logging_callbacks(sink: list) -> fmi2CallbackFunctions:
+    """FMI callbacks whose logger appends "[status] category: message" lines to ``sink``."""
+
+    def logger(_env, _instance, status, category, message):
+        label = STATUS_LABELS[status] if 0 <= status < len(STATUS_LABELS) else str(status)
+        sink.append(f"[{label}] {category.decode('utf-8', 'replace')}: "
+                    f"{message.decode('utf-8', 'replace')}")
+
+    callbacks = fmi2CallbackFunctions()
+    callbacks.logger = fmi2CallbackLoggerTYPE(logger)
+    callbacks.allocateMemory = fmi2CallbackAllocateMemoryTYPE(calloc)
+    callbacks.freeMemory = fmi2CallbackFreeMemoryTYPE(free)
+    # The FMU formats its messages printf-style ("%s" and one argument): fmpy's proxy does that.
+    from ctypes import byref
+
+    from fmpy.logging import addLoggerProxy
+
+    addLoggerProxy(byref(callbacks))
+    return callbacks
 
 
 @dataclasses.dataclass(frozen=True)
@@ -55,13 +102,25 @@ class Runner:
             modelIdentifier=self.md.coSimulation.modelIdentifier,
             instanceName=instance_name,
         )
-        self.slave.instantiate()
+        self.log: list[str] = []
+        self.callbacks = logging_callbacks(self.log)
+        self.slave.instantiate(callbacks=self.callbacks)
         self.fresh = True
 
     def close(self):
-        self.slave.terminate()
+        try:
+            self.slave.terminate()
+        except Exception:  # noqa: BLE001 - a failed point leaves the instance in an error state
+            pass
         self.slave.freeInstance()
         shutil.rmtree(self.unzipdir, ignore_errors=True)
+
+    def failure(self, what: str, error: Exception) -> PointFailed:
+        """The cause of a failed call: the FMU's error messages first, else fmpy's."""
+        errors = [line.split(": ", 1)[1] for line in self.log
+                  if line.startswith(("[error]", "[fatal]")) and ": " in line]
+        cause = "; ".join(errors) if errors else str(error)
+        return PointFailed(f"{what}: {cause}", tuple(self.log))
 
     def __enter__(self):
         return self
@@ -96,8 +155,19 @@ class Runner:
         self.slave.enterInitializationMode()
         self.slave.exitInitializationMode()
 
-    def run_point(self, point: OperatingPoint, signals: list[str]) -> dict:
-        """Runs one point; returns the stationary window of ``signals`` sampled per step."""
+    def run_point(self, point: OperatingPoint, signals: list[str], case: str = "") -> dict:
+        """Runs one point; returns the stationary window of ``signals`` sampled per step.
+        A failed FMU call raises :class:`PointFailed` with the FMU's cause and log."""
+        self.log.clear()
+        try:
+            return self._run_point(point, signals)
+        except PointFailed:
+            raise
+        except Exception as error:  # fmpy raises plain exceptions for failed calls
+            where = f"{point.rpm:g} rpm" + (f", case {case!r}" if case else "")
+            raise self.failure(where, error) from None
+
+    def _run_point(self, point: OperatingPoint, signals: list[str]) -> dict:
         start = {"rpm": point.rpm, "loadTorque": point.load_torque, **dict(point.parameters)}
         if point.periodic:
             if "initialization.periodic" not in self.vr:
@@ -128,15 +198,26 @@ class Runner:
                 "cpu": cpu, "wall": wall, "simulated": t}
 
     def run_up(self, rpm_from: float, rpm_to: float, duration: float, signals: list[str],
-               step: float = 2e-4, start_values: dict | None = None) -> dict:
-        """A slow linear run-up, the speed given continuously by input derivatives."""
+               step: float = 2e-4, start_values: dict | None = None, progress=None) -> dict:
+        """A slow linear run-up, the speed given continuously by input derivatives; the crank
+        angle is recorded beside ``signals`` for order tracking. ``progress(fraction)`` is
+        called every 1 % of the run."""
+        self.log.clear()
+        try:
+            return self._run_up(rpm_from, rpm_to, duration, signals, step, start_values,
+                                progress)
+        except Exception as error:
+            raise self.failure(f"run-up {rpm_from:g}->{rpm_to:g} rpm", error) from None
+
+    def _run_up(self, rpm_from, rpm_to, duration, signals, step, start_values, progress):
         self._start({"rpm": rpm_from, **(start_values or {})})
         rate = (rpm_to - rpm_from) / duration
         n = int(round(duration / step))
-        vrs = [self.vr[s] for s in signals]
+        vrs = [self.vr[s] for s in signals] + [self.vr["crankAngle"]]
         samples = np.empty((n, len(vrs)))
         rpm = np.empty(n)
         t = 0.0
+        tick = max(1, n // 100)
         for k in range(n):
             self.slave.setReal([self.vr["rpm"]], [rpm_from + rate * t])
             self.slave.setRealInputDerivatives([self.vr["rpm"]], [1], [rate])
@@ -144,10 +225,26 @@ class Runner:
             t = (k + 1) * step
             samples[k] = self.slave.getReal(vrs)
             rpm[k] = rpm_from + rate * t
-        return {"dt": step, "rpm": rpm, "signals": signals, "samples": samples}
+            if progress is not None and (k + 1) % tick == 0:
+                progress((k + 1) / n)
+        if not np.all(np.isfinite(samples)):
+            raise RuntimeError("non-finite outputs in the run-up")
+        return {"dt": step, "rpm": rpm, "signals": signals, "samples": samples[:, :-1],
+                "crank_angle": samples[:, -1]}
 
 
-def temporary_copy(path: str) -> str:
-    """A private copy of the FMU (each Dask worker extracts its own)."""
-    tmp = tempfile.mkdtemp(prefix="emc-")
-    return shutil.copy(path, tmp)
+def fmu_from_content(content: bytes, sha256: str) -> str:
+    """The FMU with this content as a local file: written once per machine into the temporary
+    directory under its checksum (Dask workers get the FMU's bytes, not the caller's path)."""
+    import hashlib
+    import os
+
+    path = os.path.join(tempfile.gettempdir(), f"emc-fmu-{sha256}.fmu")
+    if not os.path.exists(path):
+        if hashlib.sha256(content).hexdigest() != sha256:
+            raise ValueError("the FMU's content does not match its checksum")
+        fd, partial = tempfile.mkstemp(prefix="emc-fmu-", suffix=".part")
+        with os.fdopen(fd, "wb") as out:
+            out.write(content)
+        os.replace(partial, path)
+    return path

@@ -10,7 +10,9 @@ from __future__ import annotations
 import numpy as np
 import pandas as pd
 
-from .runner import OperatingPoint, Runner
+import hashlib
+
+from .runner import OperatingPoint, Runner, fmu_from_content
 from .spectra import amplitude_spectrum, order_amplitudes
 
 ORDERS = tuple(k / 2 for k in range(1, 13))  # 0.5 … 6.0
@@ -39,12 +41,14 @@ def analyse(result: dict, case: str = "") -> tuple[list[dict], list[dict]]:
     return order_rows, spectrum_rows
 
 
-def _run_partition(fmu_path: str, points: list, signals: list[str] | None, case: str):
+def _run_partition(fmu: tuple[bytes, str], points: list, signals: list[str] | None, case: str):
+    """One partition on a worker: the FMU arrives as its content (and checksum), so workers need
+    not share the caller's file system."""
     rows = []
-    with Runner(fmu_path) as runner:
+    with Runner(fmu_from_content(*fmu)) as runner:
         names = signals or default_signals(runner)
         for point in points:
-            rows.append(analyse(runner.run_point(point, names), case))
+            rows.append(analyse(runner.run_point(point, names, case), case))
     return [rows]
 
 
@@ -68,7 +72,10 @@ def run_sweep(fmu_path: str, points: list[OperatingPoint], signals: list[str] | 
             # balance slow low-speed points and give the progress bar something to show.
             npart = max(1, min(len(points), 3 * workers if not scheduler else len(points)))
             bag = db.from_sequence(points, npartitions=npart)
-            delayed_parts = bag.map_partitions(lambda part: _run_partition(fmu_path, list(part), signals, case))
+            with open(fmu_path, "rb") as f:
+                content = f.read()
+            fmu = (content, hashlib.sha256(content).hexdigest())
+            delayed_parts = bag.map_partitions(lambda part: _run_partition(fmu, list(part), signals, case))
             futures = client.compute(delayed_parts)
             if progress:
                 from dask.distributed import progress as dask_progress
@@ -88,7 +95,7 @@ def run_sweep(fmu_path: str, points: list[OperatingPoint], signals: list[str] | 
         with Runner(fmu_path) as runner:
             names = signals or default_signals(runner)
             for point in iterator:
-                results.append(analyse(runner.run_point(point, names), case))
+                results.append(analyse(runner.run_point(point, names, case), case))
     orders = pd.DataFrame([row for r in results for row in r[0]])
     spectra = pd.DataFrame([row for r in results for row in r[1]])
     sort = ["case", "signal", "rpm"]

@@ -1,0 +1,57 @@
+"""Order tracking of run-ups in the crank-angle domain.
+
+A run-up changes the speed continuously, so a fixed-length time window smears every order over a
+band of frequencies. Resampled at equal increments of the crank angle (the FMU's ``crankAngle``
+output), each engine order is a fixed number of cycles per revolution: a block of whole
+revolutions puts every half order exactly on a bin, as in a stationary window, and the block's
+mean speed labels it.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+import pandas as pd
+
+ORDERS = tuple(k / 2 for k in range(1, 13))  # 0.5 … 6.0
+
+
+def resample_by_angle(crank_angle: np.ndarray, values: np.ndarray, samples_per_revolution: int):
+    """``values`` (samples × signals) at equal crank-angle steps from the first sample on, over
+    whole revolutions; returns (angle grid, resampled values). The crank angle must increase."""
+    theta = np.asarray(crank_angle, dtype=float) - float(crank_angle[0])
+    if np.any(np.diff(theta) <= 0.0):
+        raise ValueError("the crank angle must increase strictly for order tracking")
+    revolutions = int(np.floor(theta[-1] / (2.0 * np.pi)))
+    grid = np.arange(revolutions * samples_per_revolution) * (2.0 * np.pi / samples_per_revolution)
+    values = np.asarray(values, dtype=float)
+    if values.ndim == 1:
+        return grid, np.interp(grid, theta, values)
+    return grid, np.column_stack([np.interp(grid, theta, values[:, j])
+                                  for j in range(values.shape[1])])
+
+
+def track_orders(crank_angle, rpm, samples: np.ndarray, signals: list[str],
+                 revolutions_per_block: int = 4, samples_per_revolution: int = 64,
+                 orders=ORDERS, case: str = "runup") -> pd.DataFrame:
+    """Order amplitudes (peak) of each signal per block of ``revolutions_per_block``
+    revolutions, labelled with the block's mean speed: a table like a stationary sweep's."""
+    if revolutions_per_block < 2 or revolutions_per_block % 2:
+        raise ValueError("blocks must hold an even number of revolutions (half orders on bins)")
+    if samples_per_revolution < 2 * max(orders) + 2:
+        raise ValueError("too few samples per revolution for the highest order")
+    grid, resampled = resample_by_angle(crank_angle, np.column_stack([samples, rpm]),
+                                        samples_per_revolution)
+    n = revolutions_per_block * samples_per_revolution
+    rows = []
+    for start in range(0, len(grid) - n + 1, n):
+        block = resampled[start:start + n]
+        speed = float(np.mean(block[:, -1]))
+        for j, signal in enumerate(signals):
+            x = block[:, j] - np.mean(block[:, j])
+            spectrum = np.fft.rfft(x)
+            for order in orders:
+                k = int(round(order * revolutions_per_block))
+                rows.append({"case": case, "rpm": speed, "signal": signal, "order": float(order),
+                             "frequency": order * speed / 60.0,
+                             "amplitude": 2.0 * abs(spectrum[k]) / n})
+    return pd.DataFrame(rows)
