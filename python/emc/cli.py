@@ -492,7 +492,7 @@ def run_study(args, cases: dict) -> int:
     save(orders, str(out / f"orders{suffix}"))
     save(spectra, str(out / f"spectra{suffix}"))
     units = units_of(variables)
-    for signal in args.signal or STUDY_SIGNALS:
+    for signal in args.signal or STUDY_PLOTS:
         name = safe_name(signal)
         plots.side_by_side(spectra, orders, signal, list(cases),
                            str(out / f"study_waterfall_{name}.png"),
@@ -501,6 +501,9 @@ def run_study(args, cases: dict) -> int:
     if not exposure.empty:
         save(exposure, str(out / f"comfort{suffix}"))
         plots.comfort(exposure, str(out / "comfort.png"))
+        comfort_summary = exposure.groupby("case", sort=False)[["wheel_ahv", "seat_av_comfort"]]
+        print("weighted steering-wheel a_hv and seat a_v [m/s²], mean and maximum over the speeds:")
+        print(comfort_summary.agg(["mean", "max"]).to_string(float_format=lambda v: f"{v:.3g}"))
     write_metadata(out, args, variables, study, {"start": options})
     summary = (orders[orders.order.isin([1.0, 1.5, 2.0, 4.0])]
                .groupby(["signal", "case", "order"]).amplitude.max().unstack("order"))
@@ -509,7 +512,11 @@ def run_study(args, cases: dict) -> int:
     return 0
 
 
-STUDY_SIGNALS = ["steeringWheel.a[3]", "steeringWheel.a[2]", "mount[1].F[3]"]
+# Recorded in a study: what the comfort values need (all axes of the steering wheel and the
+# seat) and the front left mount; plotted: the steering wheel's z and y and that mount.
+STUDY_SIGNALS = ([f"steeringWheel.a[{i}]" for i in (1, 2, 3)] + [f"seat.a[{i}]" for i in (1, 2, 3)]
+                 + ["mount[1].F[3]"])
+STUDY_PLOTS = ["steeringWheel.a[3]", "steeringWheel.a[2]", "mount[1].F[3]"]
 
 
 def cmd_bench_effects(args) -> int:
