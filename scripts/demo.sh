@@ -12,4 +12,5 @@ bash packaging/package.sh
   --signal "steeringWheel.a[3]" --signal "steeringWheel.a[2]" --signal "mount[1].F[3]" \
   --signal "steeringWheel.a[1]" --signal "seat.a[1]" --signal "seat.a[2]" --signal "seat.a[3]" \
   --plot "steeringWheel.a[3]" --plot "steeringWheel.a[2]" --plot "mount[1].F[3]"
-echo "demo: waterfalls in out/demo/waterfall_*.png, order cuts in out/demo/order_cuts_*.png, comfort in out/demo/comfort.{csv,png}"
+.venv/bin/emc campbell --fmu dist/EngineMountChassis.fmu --rpm 800 2500 --set scene=2 --out out/demo/campbell >/dev/null
+echo "demo: waterfalls in out/demo/waterfall_*.png, order cuts in out/demo/order_cuts_*.png, comfort in out/demo/comfort.{csv,png}, Campbell diagram in out/demo/campbell/campbell.png"
