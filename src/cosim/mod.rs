@@ -121,6 +121,8 @@ pub struct Counters {
     pub rhs_evaluations: u64,
     pub jacobian_evaluations: u64,
     pub factorizations: u64,
+    /// Newton iterations (one linear solve each).
+    pub newton_iterations: u64,
     /// Integrator restarts at order 1 for input discontinuities since this simulation was built
     /// or restored.
     pub restarts: u64,
@@ -245,6 +247,11 @@ impl Simulation {
         &self.scene
     }
 
+    /// The state at the communication time.
+    pub fn state(&self) -> &[f64] {
+        &self.state
+    }
+
     /// Number of integrator states (what a switched-off effect saves).
     pub fn state_count(&self) -> usize {
         self.scene.dim()
@@ -336,6 +343,7 @@ impl Simulation {
             rhs_evaluations: s.rhs_evals,
             jacobian_evaluations: s.jac_evals,
             factorizations: s.factorizations,
+            newton_iterations: s.newton_iters,
             restarts: self.restarts,
         }
     }

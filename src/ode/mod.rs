@@ -73,6 +73,7 @@ pub use bdf::Bdf;
 pub use block_low_rank::{BlockLowRankJacobian, BlockLowRankLu, BlockLowRankShape};
 pub use error::BdfError;
 pub use jacobian::JacobianPattern;
+pub use linear_solver::DenseLu;
 pub use options::{BdfOptions, Tolerance};
 pub use problem::{OdeProblem, ProblemError};
 pub use snapshot::BdfSnapshot;

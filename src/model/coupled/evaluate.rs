@@ -55,6 +55,34 @@ pub struct Evaluation {
     pub crank_acceleration: f64,
 }
 
+impl Evaluation {
+    /// Storage for [`CoupledModel::evaluate_into`], grown on first use.
+    pub(crate) fn empty() -> Self {
+        Self {
+            kinematics: Vec::new(),
+            dynamics: Vec::new(),
+            mounts: Vec::new(),
+            modal_force: Vec::new(),
+            crank: CrankDriveState::at_rest(0.0),
+            crank_rate: 0.0,
+            crank_speed: 0.0,
+            crank_acceleration: 0.0,
+        }
+    }
+}
+
+/// `M⁻¹ Q` of one body: Cholesky (the composite mass matrix is symmetric positive definite), LU
+/// should rounding leave it indefinite.
+fn body_acceleration(d: &BodyDynamics) -> Result<Vector6<f64>, ProblemError> {
+    if let Some(c) = d.mass.cholesky() {
+        return Ok(c.solve(&d.force));
+    }
+    d.mass
+        .lu()
+        .solve(&d.force)
+        .ok_or_else(|| ProblemError::Fatal("singular body mass matrix".into()))
+}
+
 impl CoupledModel {
     /// Pose and velocity of powertrain body `b` in state `y`.
     pub(crate) fn kinematics(&self, y: &[f64], b: usize) -> BodyKinematics {
@@ -109,6 +137,13 @@ impl CoupledModel {
     }
 
     pub(crate) fn evaluate_mode(&self, t: f64, y: &[f64], mode: Mode) -> Evaluation {
+        let mut ev = Evaluation::empty();
+        self.evaluate_into(t, y, mode, &mut ev);
+        ev
+    }
+
+    /// [`Self::evaluate_mode`] into `ev`'s storage: no allocation once it has grown.
+    pub(crate) fn evaluate_into(&self, t: f64, y: &[f64], mode: Mode, ev: &mut Evaluation) {
         let nb = self.layout.bodies();
         let phi = y[self.layout.crank_angle()];
         let (speed, acceleration) = self.crank_motion(t, y);
@@ -120,98 +155,79 @@ impl CoupledModel {
             0.0
         };
         let load_torque = self.inputs.load_torque.at(t);
-        let kin: Vec<BodyKinematics> = (0..nb).map(|b| self.kinematics(y, b)).collect();
-        let mut dynamics: Vec<BodyDynamics> = (0..nb)
-            .map(|b| {
-                self.powertrain
-                    .local_dynamics(b, &kin[b], &crank, phi, gas_scale, load_torque)
-            })
-            .collect();
-        self.powertrain.add_ring_carriers(&kin, &mut dynamics);
-        let hb = self.powertrain.housing_index();
-        let (mounts, modal_force) = self.add_mounts(t, y, &kin[hb], mode, &mut dynamics[hb]);
-        let e = kin[0].rotation * Vector3::y();
-        let crank_rate = if mode.running { speed } else { 0.0 } - e.dot(&kin[0].omega);
-        Evaluation {
-            kinematics: kin,
-            dynamics,
-            mounts,
-            modal_force,
-            crank,
-            crank_rate,
-            crank_speed: speed,
-            crank_acceleration: acceleration,
+        ev.kinematics.clear();
+        ev.kinematics.extend((0..nb).map(|b| self.kinematics(y, b)));
+        ev.dynamics.clear();
+        for b in 0..nb {
+            let d = self.powertrain.local_dynamics(
+                b,
+                &ev.kinematics[b],
+                &crank,
+                phi,
+                gas_scale,
+                load_torque,
+            );
+            ev.dynamics.push(d);
         }
+        self.powertrain
+            .add_ring_carriers(&ev.kinematics, &mut ev.dynamics);
+        let hb = self.powertrain.housing_index();
+        self.add_mounts(t, y, hb, mode, ev);
+        let k0 = &ev.kinematics[0];
+        let e = k0.rotation * Vector3::y();
+        ev.crank_rate = if mode.running { speed } else { 0.0 } - e.dot(&k0.omega);
+        ev.crank = crank;
+        ev.crank_speed = speed;
+        ev.crank_acceleration = acceleration;
     }
 
-    /// Mount forces on the housing `h` and, as generalised forces, on the body; the responses per
-    /// configured mount.
-    fn add_mounts(
-        &self,
-        t: f64,
-        y: &[f64],
-        h: &BodyKinematics,
-        mode: Mode,
-        out: &mut BodyDynamics,
-    ) -> (Vec<Option<MountResponse>>, Vec<f64>) {
-        let hb = self.powertrain.housing_index();
+    /// Mount forces on the housing (body `hb`) and, as generalised forces, on the body: into
+    /// `ev.dynamics[hb]`, `ev.mounts` (per configured mount) and `ev.modal_force`.
+    fn add_mounts(&self, t: f64, y: &[f64], hb: usize, mode: Mode, ev: &mut Evaluation) {
         let reference = self.powertrain.bodies()[hb].reference;
         let nonlinear = mode.nonlinear_mounts || self.effects().mount_nonlinearity;
         let eta = &y[self.layout.eta()];
         let eta_rate = &y[self.layout.eta_rate()];
-        let mut modal_force = vec![0.0; self.layout.modes()];
-        let responses = self
-            .mounts
-            .iter()
-            .enumerate()
-            .map(|(i, m)| {
-                let m = m.as_ref()?;
-                let local = m.mount.bracket - reference;
-                let x = h.point(&local);
-                let xv = h.point_velocity(&local);
-                let (a, av) = match m.target {
-                    MountTarget::Ground => (Vector3::zeros(), Vector3::zeros()),
-                    MountTarget::BodyPoint(p) => (
-                        self.point_translation(p, eta),
-                        self.point_translation(p, eta_rate),
-                    ),
-                };
-                let (k_scale, c_scale) = self.inputs.mount_scales(i, t);
-                let r = m.mount.response(
-                    &(x - m.mount.attachment - a),
-                    &(xv - av),
-                    k_scale,
-                    c_scale,
-                    nonlinear,
-                );
-                out.add_point_force(h, &x, &r.force);
-                if let MountTarget::BodyPoint(p) = m.target {
-                    for (g, s) in modal_force.iter_mut().zip(&self.body.points[p].shape) {
-                        *g -= s[0] * r.force.x + s[1] * r.force.y + s[2] * r.force.z;
-                    }
+        ev.modal_force.clear();
+        ev.modal_force.resize(self.layout.modes(), 0.0);
+        ev.mounts.clear();
+        let h = ev.kinematics[hb];
+        for (i, m) in self.mounts.iter().enumerate() {
+            let Some(m) = m.as_ref() else {
+                ev.mounts.push(None);
+                continue;
+            };
+            let local = m.mount.bracket - reference;
+            let x = h.point(&local);
+            let xv = h.point_velocity(&local);
+            let (a, av) = match m.target {
+                MountTarget::Ground => (Vector3::zeros(), Vector3::zeros()),
+                MountTarget::BodyPoint(p) => (
+                    self.point_translation(p, eta),
+                    self.point_translation(p, eta_rate),
+                ),
+            };
+            let (k_scale, c_scale) = self.inputs.mount_scales(i, t);
+            let r = m.mount.response(
+                &(x - m.mount.attachment - a),
+                &(xv - av),
+                k_scale,
+                c_scale,
+                nonlinear,
+            );
+            ev.dynamics[hb].add_point_force(&h, &x, &r.force);
+            if let MountTarget::BodyPoint(p) = m.target {
+                for (g, s) in ev.modal_force.iter_mut().zip(&self.body.points[p].shape) {
+                    *g -= s[0] * r.force.x + s[1] * r.force.y + s[2] * r.force.z;
                 }
-                Some(r)
-            })
-            .collect();
-        (responses, modal_force)
+            }
+            ev.mounts.push(Some(r));
+        }
     }
 
     /// One evaluation of the equations of motion of the running engine at `(t, y)`.
     pub fn evaluate(&self, t: f64, y: &[f64]) -> Evaluation {
         self.evaluate_mode(t, y, Mode::RUNNING)
-    }
-
-    /// Accelerations `[u'', ω']` per powertrain body from one evaluation.
-    pub(crate) fn accelerations(&self, ev: &Evaluation) -> Result<Vec<Vector6<f64>>, ProblemError> {
-        ev.dynamics
-            .iter()
-            .map(|d| {
-                d.mass
-                    .lu()
-                    .solve(&d.force)
-                    .ok_or_else(|| ProblemError::Fatal("singular body mass matrix".into()))
-            })
-            .collect()
     }
 
     /// Writes `f(t, y)` from an evaluation at `(t, y)` in mode `mode`.
@@ -224,7 +240,8 @@ impl CoupledModel {
         f: &mut [f64],
     ) -> Result<(), ProblemError> {
         let l = &self.layout;
-        for (b, acc) in self.accelerations(ev)?.iter().enumerate() {
+        for (b, dynamics) in ev.dynamics.iter().enumerate() {
+            let acc = body_acceleration(dynamics)?;
             let q = &y[l.q(b)];
             let k = &ev.kinematics[b];
             let theta = Vector3::new(q[3], q[4], q[5]);
@@ -300,8 +317,13 @@ impl OdeProblem for CoupledModel {
                 f.len()
             )));
         }
-        let ev = self.evaluate(t, y);
-        self.write_rhs(t, y, &ev, Mode::RUNNING, f)
+        // The evaluation's vectors are the model's own scratch, so the right-hand side does not
+        // allocate.
+        let mut ev = std::mem::replace(&mut self.scratch, Evaluation::empty());
+        self.evaluate_into(t, y, Mode::RUNNING, &mut ev);
+        let result = self.write_rhs(t, y, &ev, Mode::RUNNING, f);
+        self.scratch = ev;
+        result
     }
 
     fn jacobian(&mut self, t: f64, y: &[f64], j: MatMut<'_, f64>) -> Result<bool, ProblemError> {

@@ -116,6 +116,7 @@ impl CoupledModel {
             };
             let x = h.point(&(mount.bracket - reference));
             let shape = &self.body.points[p].shape;
+            let (stiffness, damping) = (r.stiffness(), r.damping());
             for d in 0..3 {
                 let (c_body, c_engine) = (3 * a + d, 3 * n_links + 3 * a + d);
                 let mut unit = Vector3::zeros();
@@ -136,8 +137,8 @@ impl CoupledModel {
                 let mut v = j.v_mut();
                 for (k, s) in shape.iter().enumerate() {
                     let phi = Vector3::new(s[0], s[1], s[2]);
-                    v[(eta_row + k, c_body)] = -(r.stiffness * phi)[d];
-                    v[(rate_row + k, c_body)] = -(r.damping * phi)[d];
+                    v[(eta_row + k, c_body)] = -(stiffness * phi)[d];
+                    v[(rate_row + k, c_body)] = -(damping * phi)[d];
                 }
             }
         }

@@ -101,6 +101,8 @@ pub struct CoupledModel {
     /// Hand the integrator a dense Jacobian even where the structure allows block plus low rank
     /// (comparisons).
     dense_newton: bool,
+    /// Storage of the right-hand side's evaluation, reused between calls.
+    scratch: Evaluation,
 }
 
 /// Checks the body's modal data before anything uses it.
@@ -249,6 +251,7 @@ impl CoupledModel {
             layout,
             fade_start: 0.0,
             dense_newton: false,
+            scratch: Evaluation::empty(),
         })
     }
 

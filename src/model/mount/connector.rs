@@ -8,7 +8,7 @@
 use nalgebra::{Matrix3, Vector3};
 
 use super::config::MountConfig;
-use super::curve::MountCurve;
+use super::curve::{CurveTable, MountCurve};
 use crate::model::powertrain::assembly::{m3, v3};
 
 /// Mount force and its derivatives, in the vehicle frame.
@@ -16,12 +16,25 @@ use crate::model::powertrain::assembly::{m3, v3};
 pub struct MountResponse {
     /// Force the mount exerts on the bracket (N). The force on the ground/chassis side is `−force`.
     pub force: Vector3<f64>,
-    /// `∂force/∂(bracket displacement relative to attachment)`.
-    pub stiffness: Matrix3<f64>,
-    /// `∂force/∂(relative velocity)`.
-    pub damping: Matrix3<f64>,
     /// Deflection in mount axes (m).
     pub deflection: Vector3<f64>,
+    /// Tangent stiffness and damping per mount axis; the vehicle-frame matrices are formed only
+    /// when a Jacobian asks for them.
+    axial_stiffness: Vector3<f64>,
+    axial_damping: Vector3<f64>,
+    axes: Matrix3<f64>,
+}
+
+impl MountResponse {
+    /// `∂force/∂(bracket displacement relative to attachment)`.
+    pub fn stiffness(&self) -> Matrix3<f64> {
+        -(self.axes.transpose() * Matrix3::from_diagonal(&self.axial_stiffness) * self.axes)
+    }
+
+    /// `∂force/∂(relative velocity)`.
+    pub fn damping(&self) -> Matrix3<f64> {
+        -(self.axes.transpose() * Matrix3::from_diagonal(&self.axial_damping) * self.axes)
+    }
 }
 
 /// A mount ready for evaluation.
@@ -35,6 +48,8 @@ pub struct Mount {
     /// Rows: local axes.
     pub axes: Matrix3<f64>,
     pub curves: [MountCurve; 3],
+    /// The curves prepared for evaluation.
+    tables: [CurveTable; 3],
     pub damping: Vector3<f64>,
     pub preload: Vector3<f64>,
     /// Deflection of the static operating point; with the nonlinearity switched off the curves
@@ -51,6 +66,7 @@ impl Mount {
             attachment,
             axes: m3(&c.axes),
             curves: c.curves.clone(),
+            tables: c.curves.each_ref().map(CurveTable::new),
             damping: v3(&c.damping),
             preload: v3(&c.preload),
             operating_point: Vector3::zeros(),
@@ -82,24 +98,24 @@ impl Mount {
         let mut f_local = Vector3::zeros();
         let mut k_local = Vector3::zeros();
         for i in 0..3 {
-            let curve = &self.curves[i];
+            let table = &self.tables[i];
             let (g, k) = if nonlinear {
-                (curve.force(delta[i]), curve.stiffness(delta[i]))
+                table.force_and_stiffness(delta[i])
             } else {
                 let d0 = self.operating_point[i];
-                let k0 = curve.stiffness(d0);
-                (curve.force(d0) + k0 * (delta[i] - d0), k0)
+                let (g0, k0) = table.force_and_stiffness(d0);
+                (g0 + k0 * (delta[i] - d0), k0)
             };
             f_local[i] =
                 self.preload[i] - stiffness_scale * g - damping_scale * self.damping[i] * rate[i];
             k_local[i] = stiffness_scale * k;
         }
-        let at = self.axes.transpose();
         MountResponse {
-            force: at * f_local,
-            stiffness: -(at * Matrix3::from_diagonal(&k_local) * self.axes),
-            damping: -(at * Matrix3::from_diagonal(&(self.damping * damping_scale)) * self.axes),
+            force: self.axes.tr_mul(&f_local),
             deflection: delta,
+            axial_stiffness: k_local,
+            axial_damping: self.damping * damping_scale,
+            axes: self.axes,
         }
     }
 
@@ -147,14 +163,14 @@ mod tests {
                 - mount.response(&(rel - dx), &vel, 1.3, 0.7, true).force)
                 / (2.0 * h);
             assert!(
-                (fd - r.stiffness.column(j)).norm() < 1e-4 * r.stiffness.norm(),
+                (fd - r.stiffness().column(j)).norm() < 1e-4 * r.stiffness().norm(),
                 "stiffness column {j}"
             );
             let fv = (mount.response(&rel, &(vel + dx), 1.3, 0.7, true).force
                 - mount.response(&rel, &(vel - dx), 1.3, 0.7, true).force)
                 / (2.0 * h);
             assert!(
-                (fv - r.damping.column(j)).norm() < 1e-6 * r.damping.norm(),
+                (fv - r.damping().column(j)).norm() < 1e-6 * r.damping().norm(),
                 "damping column {j}"
             );
         }

@@ -198,6 +198,48 @@ impl MountCurve {
     }
 }
 
+/// A [`MountCurve`] prepared for evaluation: the force at every knot integrated once, so force
+/// and tangent stiffness come from one scan of the knots.
+#[derive(Debug, Clone, PartialEq)]
+pub struct CurveTable {
+    /// (deflection, stiffness, force `g` at the knot).
+    knots: Vec<(f64, f64, f64)>,
+}
+
+impl CurveTable {
+    pub fn new(curve: &MountCurve) -> Self {
+        Self {
+            knots: curve
+                .knots
+                .iter()
+                .map(|k| (k.deflection, k.stiffness, curve.force(k.deflection)))
+                .collect(),
+        }
+    }
+
+    /// Force `g(δ)` and tangent stiffness `k(δ)`: the same values as [`MountCurve::force`] and
+    /// [`MountCurve::stiffness`].
+    pub fn force_and_stiffness(&self, d: f64) -> (f64, f64) {
+        let k = &self.knots;
+        let Some(&(x0, k0, g0)) = k.first() else {
+            return (0.0, 0.0);
+        };
+        if d <= x0 {
+            return (g0 + k0 * (d - x0), k0);
+        }
+        for w in k.windows(2) {
+            let ((xa, ka, ga), (xb, kb, _)) = (w[0], w[1]);
+            if d <= xb {
+                let h = d - xa;
+                let slope = (kb - ka) / (xb - xa);
+                return (ga + h * (ka + 0.5 * slope * h), ka + slope * h);
+            }
+        }
+        let (xn, kn, gn) = k[k.len() - 1];
+        (gn + kn * (d - xn), kn)
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -221,6 +263,18 @@ mod tests {
         // Linear range: 48.3 N/mm × 2 mm, exactly.
         assert!((c.force(0.002) - 96.6).abs() < 1e-9);
         assert!((c.force(-0.002) + 96.6).abs() < 1e-9);
+    }
+
+    #[test]
+    fn table_gives_the_curve_everywhere() {
+        let c = MountCurve::progressive(48_300.0);
+        let table = CurveTable::new(&c);
+        for i in -400..=400 {
+            let d = i as f64 * 1e-4 + 3e-6;
+            let (g, k) = table.force_and_stiffness(d);
+            assert!((g - c.force(d)).abs() < 1e-9 * (1.0 + g.abs()), "d={d}");
+            assert!((k - c.stiffness(d)).abs() < 1e-9 * k, "d={d}");
+        }
     }
 
     #[test]

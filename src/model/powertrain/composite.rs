@@ -15,6 +15,7 @@
 
 use nalgebra::{Matrix3, Matrix6, Vector3, Vector6};
 
+#[cfg(test)]
 use super::parts::Part;
 
 /// Pose and velocity of one body.
@@ -108,8 +109,11 @@ impl BodyDynamics {
     }
 }
 
-/// Adds the contributions of `parts` (including gravity `g`) to `out`.
-pub fn add_parts(
+/// Adds the contributions of `parts` (including gravity `g`) to `out`, projecting each part's
+/// Newton–Euler equations one by one. The model evaluates the same projection through the
+/// parts' mass moments ([`super::part_moments`]); this direct form is their test reference.
+#[cfg(test)]
+pub(super) fn add_parts(
     parts: &[Part],
     body: &BodyKinematics,
     crank: &CrankDriveState,
@@ -174,6 +178,7 @@ mod tests {
     use super::*;
     use crate::model::effects::Effects;
     use crate::model::powertrain::assembly::build_bodies;
+    use crate::model::powertrain::part_moments::PartMoments;
     use crate::model::powertrain::parts::PartMotion;
     use crate::model::EngineConfig;
 
@@ -205,7 +210,8 @@ mod tests {
             spin: 200.0,
         };
         let mut d = BodyDynamics::zero();
-        add_parts(&parts, &body, &crank, &Vector3::zeros(), &mut d);
+        let moments = PartMoments::new(&parts);
+        moments.add(&body, &crank, &Vector3::zeros(), &mut d);
         let expect = -omega.cross(&(Vector3::y() * (j * 200.0)));
         let got = Vector3::new(d.force[3], d.force[4], d.force[5]);
         assert!(
@@ -214,8 +220,7 @@ mod tests {
         );
         // Without the gyroscopic effect the spin does not enter.
         let mut d0 = BodyDynamics::zero();
-        add_parts(
-            &parts,
+        moments.add(
             &body,
             &CrankDriveState { spin: 0.0, ..crank },
             &Vector3::zeros(),
@@ -235,7 +240,7 @@ mod tests {
                 ..BodyKinematics::at_rest(bodies[0].reference)
             };
             let mut d = BodyDynamics::zero();
-            add_parts(&bodies[0].parts, &body, &crank, &Vector3::zeros(), &mut d);
+            PartMoments::new(&bodies[0].parts).add(&body, &crank, &Vector3::zeros(), &mut d);
             assert!((d.mass - d.mass.transpose()).abs().max() < 1e-12);
             assert!(d.mass.cholesky().is_some());
         }

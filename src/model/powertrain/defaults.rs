@@ -26,12 +26,13 @@ use std::f64::consts::PI;
 use nalgebra::{Matrix3, Vector3};
 
 use super::assembly::{balance_parts, crank_drive_parts};
-use super::composite::{add_parts, BodyDynamics, BodyKinematics, CrankDriveState};
+use super::composite::{BodyDynamics, BodyKinematics, CrankDriveState};
 use super::config::{
     BalanceShaftConfig, BushingConfig, CrankDriveConfig, CylinderConfig, EccentricWeight,
     EngineConfig, GasConfig, ResidualUnbalance, RigidBodyConfig,
 };
 use super::gas::GasModel;
+use super::part_moments::PartMoments;
 use crate::paper::TABLE1_RING_CARRIER;
 
 /// Powertrain centre of mass (vehicle frame).
@@ -169,8 +170,7 @@ fn monoblock_structure(engine: &EngineConfig, phi0: f64) -> RigidBodyConfig {
     let mut parts = crank_drive_parts(&engine.crank_drive, &target);
     parts.extend(balance_parts(engine, &target, true));
     let mut dynamics = BodyDynamics::zero();
-    add_parts(
-        &parts,
+    PartMoments::new(&parts).add(
         &BodyKinematics::at_rest(target),
         &CrankDriveState::at_rest(phi0),
         &Vector3::zeros(),

@@ -202,22 +202,26 @@ const IVC_LEAD_IN_DEG: f64 = 10.0;
 /// Tabulated cylinder pressure over one cycle, ready for fast C² evaluation.
 #[derive(Debug, Clone, PartialEq)]
 pub struct PressureCurve {
-    /// Pressure at angles −360° + k·GRID_DEG (k = 0..14400), periodic.
-    values: Vec<f64>,
-    /// First and second derivatives per grid step (units of pressure per knot spacing).
-    first: Vec<f64>,
-    second: Vec<f64>,
+    /// Per knot at angles −360° + k·GRID_DEG (k = 0..14400, periodic): the pressure and its first
+    /// and second derivatives per grid step (units of pressure per knot spacing). Kept together
+    /// so one evaluation reads two adjacent entries: a cycle's table is 350 kB, and three
+    /// cylinders' tables as separate arrays made every lookup six cache misses.
+    knots: Vec<[f64; 3]>,
 }
+
+/// Knots per degree of crank angle.
+const KNOTS_PER_DEG: f64 = 1.0 / GRID_DEG;
 
 impl PressureCurve {
     /// Absolute pressure at cycle angle `theta` (rad after firing TDC, any value; period 4π).
     pub fn pressure(&self, theta: f64) -> f64 {
-        let n = self.values.len();
-        let deg = theta.to_degrees();
-        let u = (deg + 360.0).rem_euclid(720.0) / GRID_DEG;
-        let i = (u.floor() as usize).min(n - 1);
+        let n = self.knots.len();
+        let u = (theta.to_degrees() + 360.0) * KNOTS_PER_DEG;
+        let period = n as f64;
+        let u = u - period * (u / period).floor();
+        let i = (u as usize).min(n - 1);
         let t = u - i as f64;
-        let j = (i + 1) % n;
+        let j = if i + 1 == n { 0 } else { i + 1 };
         let (t2, t3) = (t * t, t * t * t);
         let (t4, t5) = (t3 * t, t3 * t2);
         // Quintic Hermite basis: value, slope and curvature at each end.
@@ -227,60 +231,54 @@ impl PressureCurve {
         let h_d1 = -4.0 * t3 + 7.0 * t4 - 3.0 * t5;
         let h_s0 = 0.5 * t2 - 1.5 * t3 + 1.5 * t4 - 0.5 * t5;
         let h_s1 = 0.5 * t3 - t4 + 0.5 * t5;
-        h_p0 * self.values[i]
-            + h_p1 * self.values[j]
-            + h_d0 * self.first[i]
-            + h_d1 * self.first[j]
-            + h_s0 * self.second[i]
-            + h_s1 * self.second[j]
+        let [p0, d0, s0] = self.knots[i];
+        let [p1, d1, s1] = self.knots[j];
+        h_p0 * p0 + h_p1 * p1 + h_d0 * d0 + h_d1 * d1 + h_s0 * s0 + h_s1 * s1
     }
 
     /// Indicated work per cycle `∮ p dV` of one cylinder (J), gross of pumping: the trapezoid
     /// rule over the table's grid (exact to the grid's resolution).
     pub fn indicated_work(&self, geometry: &CylinderGeometry, compression_ratio: f64) -> f64 {
-        let n = self.values.len();
         let step = GRID_DEG.to_radians();
-        (0..n)
-            .map(|k| {
+        self.knots
+            .iter()
+            .enumerate()
+            .map(|(k, knot)| {
                 let theta = (-360.0 + k as f64 * GRID_DEG).to_radians();
                 let (_, dv) = geometry.volume(theta, compression_ratio);
-                self.values[k] * dv * step
+                knot[0] * dv * step
             })
             .sum()
     }
 
     /// Peak pressure over the cycle (Pa).
     pub fn peak(&self) -> f64 {
-        self.values.iter().cloned().fold(f64::MIN, f64::max)
+        self.knots.iter().map(|k| k[0]).fold(f64::MIN, f64::max)
     }
 
     fn from_samples(values: Vec<f64>) -> Self {
         let n = values.len();
         let at = |i: usize, k: isize| values[(i as isize + k).rem_euclid(n as isize) as usize];
         // Fourth-order central differences on the periodic grid.
-        let first = (0..n)
-            .map(|i| (-at(i, 2) + 8.0 * at(i, 1) - 8.0 * at(i, -1) + at(i, -2)) / 12.0)
-            .collect();
-        let second = (0..n)
+        let knots = (0..n)
             .map(|i| {
-                (-at(i, 2) + 16.0 * at(i, 1) - 30.0 * at(i, 0) + 16.0 * at(i, -1) - at(i, -2))
-                    / 12.0
+                let first = (-at(i, 2) + 8.0 * at(i, 1) - 8.0 * at(i, -1) + at(i, -2)) / 12.0;
+                let second = (-at(i, 2) + 16.0 * at(i, 1) - 30.0 * at(i, 0) + 16.0 * at(i, -1)
+                    - at(i, -2))
+                    / 12.0;
+                [values[i], first, second]
             })
             .collect();
-        Self {
-            values,
-            first,
-            second,
-        }
+        Self { knots }
     }
 
     /// Linear blend `(1−w) a + w b`.
     pub fn blend(a: &Self, b: &Self, w: f64) -> Self {
         let values = a
-            .values
+            .knots
             .iter()
-            .zip(&b.values)
-            .map(|(x, y)| (1.0 - w) * x + w * y)
+            .zip(&b.knots)
+            .map(|(x, y)| (1.0 - w) * x[0] + w * y[0])
             .collect();
         Self::from_samples(values)
     }
@@ -506,8 +504,8 @@ impl PressureCurve {
 
 /// Piston side force `F_N = F_gas tan β` with `sin β = λ sin ψ` (ψ = crank angle after TDC).
 /// Positive: the piston presses against the cylinder wall in the +x direction of the block.
-pub fn side_force(gas_force: f64, psi: f64, lambda: f64) -> f64 {
-    let sb = lambda * psi.sin();
+pub fn side_force(gas_force: f64, sin_psi: f64, lambda: f64) -> f64 {
+    let sb = lambda * sin_psi;
     gas_force * sb / (1.0 - sb * sb).sqrt()
 }
 

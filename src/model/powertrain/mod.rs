@@ -12,6 +12,7 @@ pub mod composite;
 pub mod config;
 pub mod defaults;
 pub mod gas;
+pub mod part_moments;
 pub mod parts;
 pub mod reaction;
 pub mod ring_carrier;
@@ -21,10 +22,11 @@ use std::sync::Arc;
 use nalgebra::Vector3;
 
 use self::assembly::{build_bodies, v3, Body};
-use self::composite::{add_parts, BodyDynamics, BodyKinematics, CrankDriveState};
+use self::composite::{BodyDynamics, BodyKinematics, CrankDriveState};
 use self::config::EngineConfig;
 use self::gas::{side_force, CylinderGeometry, GasModel, PressureCurve};
-use self::parts::slider_crank;
+use self::part_moments::PartMoments;
+use self::parts::{slider_crank, slider_crank_trig};
 use self::ring_carrier::RingCarrier;
 use super::effects::Effects;
 use super::inputs::InputError;
@@ -108,6 +110,8 @@ struct GasExcitation {
     conrod: f64,
     /// (y offset, throw, firing TDC) per cylinder, radians.
     cylinders: Vec<(f64, f64, f64)>,
+    /// (sin, cos) of each cylinder's throw.
+    throw_trig: Vec<(f64, f64)>,
     /// Crank centre relative to body 0's reference point, and the bore axis (body axes).
     crank_centre: Vector3<f64>,
     bore: Vector3<f64>,
@@ -157,6 +161,11 @@ impl GasExcitation {
                     )
                 })
                 .collect(),
+            throw_trig: c
+                .cylinders
+                .iter()
+                .map(|k| k.throw_deg.to_radians().sin_cos())
+                .collect(),
             crank_centre: v3(&c.crank_centre) - reference,
             bore: v3(&c.bore_axis),
         };
@@ -187,6 +196,8 @@ pub struct Powertrain {
     config: EngineConfig,
     effects: Effects,
     bodies: Vec<Body>,
+    /// Each body's parts compiled for evaluation.
+    moments: Vec<PartMoments>,
     ring_carriers: Vec<RingCarrier>,
     gas: Option<GasExcitation>,
     gravity: Vector3<f64>,
@@ -221,6 +232,7 @@ impl Powertrain {
         Ok(Self {
             config,
             effects,
+            moments: bodies.iter().map(|b| PartMoments::new(&b.parts)).collect(),
             bodies,
             ring_carriers,
             gas,
@@ -238,6 +250,11 @@ impl Powertrain {
 
     pub fn bodies(&self) -> &[Body] {
         &self.bodies
+    }
+
+    /// Body `b`'s parts compiled for evaluation.
+    pub fn part_moments(&self, b: usize) -> &PartMoments {
+        &self.moments[b]
     }
 
     pub fn ring_carriers(&self) -> &[RingCarrier] {
@@ -328,7 +345,7 @@ impl Powertrain {
         load_torque: f64,
     ) -> BodyDynamics {
         let mut d = BodyDynamics::zero();
-        add_parts(&self.bodies[b].parts, kin, crank, &self.gravity, &mut d);
+        self.moments[b].add(kin, crank, &self.gravity, &mut d);
         if b == 0 && gas_scale != 0.0 {
             self.add_gas_forces(kin, phi, gas_scale, &mut d);
         }
@@ -367,12 +384,15 @@ impl Powertrain {
     ) {
         let Some(gas) = &self.gas else { return };
         let side = body.rotation * Vector3::y().cross(&gas.bore);
-        for (&(yo, throw, firing), curve) in gas.cylinders.iter().zip(&gas.curves) {
-            let psi = phi - throw;
+        let (sin, cos) = phi.sin_cos();
+        let cylinders = gas.cylinders.iter().zip(&gas.throw_trig).zip(&gas.curves);
+        for ((&(yo, _, firing), &(sin_throw, cos_throw)), curve) in cylinders {
+            let sn = sin * cos_throw - cos * sin_throw;
+            let cs = cos * cos_throw + sin * sin_throw;
             let p = curve.pressure(phi - firing);
             let f_gas = (p - gas.crankcase_pressure) * gas.area * scale;
-            let n = side_force(f_gas, psi, gas.radius / gas.conrod);
-            let (s, _, _) = slider_crank(psi, gas.radius, gas.conrod);
+            let n = side_force(f_gas, sn, gas.radius / gas.conrod);
+            let (s, _, _) = slider_crank_trig(sn, cs, gas.radius, gas.conrod);
             let on_axis = gas.crank_centre + Vector3::new(0.0, yo, 0.0);
             let pin = body.point(&(on_axis + gas.bore * s));
             let bearing = body.point(&on_axis);

@@ -62,9 +62,14 @@ pub struct PartPath {
 /// Piston stroke position `s(ψ)` and its derivatives `(s, s', s'')`.
 pub fn slider_crank(psi: f64, r: f64, l: f64) -> (f64, f64, f64) {
     let (sn, cs) = psi.sin_cos();
+    slider_crank_trig(sn, cs, r, l)
+}
+
+/// [`slider_crank`] from `(sin ψ, cos ψ)`, for callers that share one `sin_cos` among cylinders.
+pub fn slider_crank_trig(sn: f64, cs: f64, r: f64, l: f64) -> (f64, f64, f64) {
     let w = (l * l - r * r * sn * sn).max(f64::MIN_POSITIVE).sqrt();
     let w1 = -r * r * sn * cs / w;
-    let w2 = -r * r * (2.0 * psi).cos() / w - r.powi(4) * sn * sn * cs * cs / w.powi(3);
+    let w2 = -r * r * (cs * cs - sn * sn) / w - r.powi(4) * sn * sn * cs * cs / w.powi(3);
     (r * cs + w, -r * sn + w1, -r * cs + w2)
 }
 

@@ -5,7 +5,7 @@
 use nalgebra::Vector3;
 
 use super::assembly::v3;
-use super::composite::{add_parts, BodyDynamics, BodyKinematics, CrankDriveState};
+use super::composite::{BodyDynamics, BodyKinematics, CrankDriveState};
 use super::Powertrain;
 
 /// Force and moment (vehicle frame) on the monoblock.
@@ -32,7 +32,8 @@ impl Powertrain {
             spin: if fx.gyroscopic { speed } else { 0.0 },
         };
         let mut dynamics = BodyDynamics::zero();
-        add_parts(&body.parts, &kin, &crank, &Vector3::zeros(), &mut dynamics);
+        self.part_moments(0)
+            .add(&kin, &crank, &Vector3::zeros(), &mut dynamics);
         self.add_gas_forces(&kin, phi, 1.0, &mut dynamics);
         let f = dynamics.force;
         let force = Vector3::new(f[0], f[1], f[2]);
