@@ -8,6 +8,8 @@ chassis), including fmpy's per-step call overhead. The integrator counters come 
 
 from __future__ import annotations
 
+import time
+
 import numpy as np
 import pandas as pd
 
@@ -53,4 +55,43 @@ def effects_table(fmu_path: str, scenes=(1,), rpm: float = 2000.0, seconds: floa
             for name, params in effect_sets(scene):
                 row = measure(runner, rpm, seconds, {"scene": scene, **params}, signal)
                 rows.append({"scene": scene, "effects": name, **row})
+    return pd.DataFrame(rows)
+
+
+REALTIME_CASES = (
+    ("scene 1 (ground)", {"scene": 1}),
+    ("scene 2 (body, automatic cut-off)", {"scene": 2}),
+    ("scene 2, 1 kHz body", {"scene": 2, "chassis.modeCutoff": 1000.0}),
+)
+
+
+def realtime_table(fmu_path: str, rpm: float = 2000.0, seconds: float = 1.0, repeats: int = 3,
+                   step: float = 1e-3) -> pd.DataFrame:
+    """The FMU's own speed as a host sees it: after a 0.2 s settling phase, ``repeats`` windows of
+    ``seconds`` of fmpy's low-level ``doStep`` + ``getReal`` (every Real output, every step) at a
+    fixed communication step; the wall time of that loop only (no ``simulate_fmu`` overhead).
+    Reports the range over the windows."""
+    rows = []
+    with Runner(fmu_path) as runner:
+        outputs = [runner.vr[n] for n in runner.outputs()]
+        for name, params in REALTIME_CASES:
+            runner._start({"rpm": rpm, **params})
+            t = 0.0
+            n_settle, n_window = int(round(0.2 / step)), int(round(seconds / step))
+            for k in range(n_settle):
+                runner.slave.doStep(currentCommunicationPoint=t, communicationStepSize=step)
+                t = (k + 1) * step
+            factors = []
+            for _ in range(repeats):
+                started = time.perf_counter()
+                for _ in range(n_window):
+                    runner.slave.doStep(currentCommunicationPoint=t, communicationStepSize=step)
+                    t += step
+                    runner.slave.getReal(outputs)
+                factors.append(seconds / (time.perf_counter() - started))
+            steps = runner.slave.getInteger([runner.vr["solver.steps"]])[0]
+            rows.append({"case": name, "rpm": rpm, "outputs read": len(outputs),
+                         "x realtime min": min(factors), "x realtime max": max(factors),
+                         "us per doStep+getReal": 1e6 / max(factors) * step,
+                         "integrator steps per s": steps / t})
     return pd.DataFrame(rows)

@@ -531,6 +531,15 @@ def cmd_bench_effects(args) -> int:
     return 0
 
 
+def cmd_bench_realtime(args) -> int:
+    from .bench import realtime_table
+
+    table = realtime_table(args.fmu, rpm=args.rpm_point, seconds=args.seconds, repeats=args.repeats)
+    with pd.option_context("display.width", 160, "display.max_columns", 20):
+        print(table.to_string(index=False, float_format=lambda v: f"{v:.3g}"))
+    return 0
+
+
 def main(argv: list[str] | None = None) -> int:
     parser = argparse.ArgumentParser(prog="emc", description=__doc__,
                                      formatter_class=argparse.RawDescriptionHelpFormatter)
@@ -609,6 +618,14 @@ def main(argv: list[str] | None = None) -> int:
     b.add_argument("--signal-name", default="mount[1].F[3]", help="signal whose RMS is reported")
     b.add_argument("--out", help="also write the table (CSV or .parquet)")
     b.set_defaults(func=cmd_bench_effects)
+
+    r = sub.add_parser("bench-realtime", help="the FMU's speed through fmpy's low-level doStep + getReal "
+                                              "loop (1 ms step, every output read every step)")
+    r.add_argument("--fmu", default="dist/EngineMountChassis.fmu")
+    r.add_argument("--rpm-point", type=float, default=2000.0)
+    r.add_argument("--seconds", type=float, default=1.0, help="simulated time per window")
+    r.add_argument("--repeats", type=int, default=3, help="windows per case (the range is reported)")
+    r.set_defaults(func=cmd_bench_realtime)
 
     args = parser.parse_args(argv)
     args.command_line = ["emc"] + list(sys.argv[1:] if argv is None else argv)

@@ -243,12 +243,15 @@ enum BlockInverse {
 pub struct BlockLowRankLu {
     blocks: Vec<Vec<usize>>,
     inverses: Vec<BlockInverse>,
-    /// `D⁻¹ U`, then (after the capacitance is inverted) `γ D⁻¹ U (I_r − γ Vᵀ D⁻¹ U)⁻¹`.
+    /// `Y = D⁻¹ U`.
     correction: Mat<f64>,
     /// `V` of the factorised Jacobian.
     v: Mat<f64>,
-    /// `I_r − γ Vᵀ D⁻¹ U`.
+    /// `I_r − γ Vᵀ D⁻¹ U`, factorised, and `γ` times its inverse. The solve applies
+    /// `Y (γ C⁻¹) Vᵀ` as three thin products (`2 n r + r²` per solve) rather than forming
+    /// `Y C⁻¹` at every factorisation (`n r²`, the larger part of a factorisation's cost).
     capacitance: DenseLu,
+    capacitance_inverse: Mat<f64>,
     /// `γ` of the last successful factorisation.
     factored_with: Option<f64>,
 }
@@ -286,6 +289,7 @@ impl BlockLowRankLu {
             correction: Mat::zeros(n, r),
             v: Mat::zeros(n, r),
             capacitance: DenseLu::new(r),
+            capacitance_inverse: Mat::zeros(r, r),
             factored_with: None,
         }
     }
@@ -331,7 +335,8 @@ impl BlockLowRankLu {
             return true;
         }
         // Y = D⁻¹ U.
-        let mut y = j.u().to_owned();
+        let y = &mut self.correction;
+        y.copy_from(j.u());
         for (idx, inverse) in self.blocks.iter().zip(&self.inverses) {
             match inverse {
                 BlockInverse::Small(inv) => {
@@ -356,7 +361,7 @@ impl BlockLowRankLu {
             cap.as_mut(),
             Accum::Replace,
             self.v.transpose(),
-            y.as_ref(),
+            self.correction.as_ref(),
             -gamma,
             Par::Seq,
         );
@@ -366,15 +371,7 @@ impl BlockLowRankLu {
         if !self.capacitance.factor() {
             return false;
         }
-        let cap_inverse = inverse_of(&self.capacitance, r);
-        matmul(
-            self.correction.as_mut(),
-            Accum::Replace,
-            y.as_ref(),
-            cap_inverse.as_ref(),
-            gamma,
-            Par::Seq,
-        );
+        self.capacitance_inverse = inverse_of(&self.capacitance, r) * gamma;
         self.factored_with = Some(gamma);
         true
     }
@@ -386,7 +383,7 @@ impl BlockLowRankLu {
         if r == 0 {
             return;
         }
-        // x = D⁻¹ b + γ Y (I − γ Vᵀ Y)⁻¹ Vᵀ D⁻¹ b.
+        // x = D⁻¹ b + Y (γ (I − γ Vᵀ Y)⁻¹) Vᵀ D⁻¹ b.
         let mut s = Mat::<f64>::zeros(r, 1);
         let x = MatRef::from_column_major_slice(b, n, 1);
         matmul(
@@ -397,12 +394,21 @@ impl BlockLowRankLu {
             1.0,
             Par::Seq,
         );
+        let mut t = Mat::<f64>::zeros(r, 1);
+        matmul(
+            t.as_mut(),
+            Accum::Replace,
+            self.capacitance_inverse.as_ref(),
+            s.as_ref(),
+            1.0,
+            Par::Seq,
+        );
         let x = MatMut::from_column_major_slice_mut(b, n, 1);
         matmul(
             x,
             Accum::Add,
             self.correction.as_ref(),
-            s.as_ref(),
+            t.as_ref(),
             1.0,
             Par::Seq,
         );

@@ -31,28 +31,38 @@ fn relative_error(a: &[f64], reference: &[f64]) -> f64 {
 fn structured_and_dense_newton_reach_the_same_accuracy() {
     let t_end = 0.2;
     let (reference, _) = run(false, 1e-11, t_end);
-    for rtol in [1e-4, 1e-7] {
+    // The global error of one run scatters by a factor of about 3 with the rounding of the
+    // linear solves (it changes the step sequence); over five tolerances the two solvers must
+    // agree on average, and each run must follow its tolerance.
+    let mut log_ratio = 0.0;
+    let tolerances = [1e-4, 1e-5, 1e-6, 1e-7, 1e-8];
+    for rtol in tolerances {
         let (dense, dense_steps) = run(false, rtol, t_end);
         let (structured, structured_steps) = run(true, rtol, t_end);
         let (e_dense, e_structured) = (
             relative_error(&dense, &reference),
             relative_error(&structured, &reference),
         );
-        // The global error follows the tolerance, and the two linear solvers do not change the accuracy.
         assert!(
-            e_structured < 300.0 * rtol,
+            e_structured < 300.0 * rtol && e_dense < 300.0 * rtol,
             "rtol {rtol}: error {e_structured:e} (dense {e_dense:e})"
         );
         assert!(
-            e_structured < 3.0 * e_dense && e_dense < 3.0 * e_structured,
+            e_structured < 6.0 * e_dense && e_dense < 6.0 * e_structured,
             "rtol {rtol}: dense {e_dense:e}, structured {e_structured:e}"
         );
+        log_ratio += (e_structured / e_dense).ln() / tolerances.len() as f64;
         let ratio = structured_steps as f64 / dense_steps as f64;
         assert!(
-            (0.8..1.25).contains(&ratio),
+            (0.75..1.3).contains(&ratio),
             "steps {structured_steps} vs {dense_steps}"
         );
     }
+    assert!(
+        log_ratio.abs() < 2f64.ln(),
+        "structured/dense error ratio {:.2} on average",
+        log_ratio.exp()
+    );
 }
 
 #[test]
