@@ -1,7 +1,10 @@
 //! Cross-checks the tight-tolerance reference of the accuracy benchmark (our BDF at rtol 1e-10)
 //! against SUNDIALS CVODE on the same right-hand side, for scene 1 and scene 2 at 2000 rpm.
 //! CVODE forms its own finite-difference Jacobian; a mass matrix (scene 1) is inverted in the
-//! right-hand side it sees.
+//! right-hand side it sees. A second table compares the cost per step of both integrators at
+//! working tolerances (1e-4 … 1e-7), with each one's error against the tight reference, so the
+//! two can be compared at equal error. Scene 2 here uses a 100 Hz chassis cut-off (97 states):
+//! CVODE's dense finite-difference Jacobian of the default 211 states takes minutes.
 //!
 //! `cargo run --release --example reference_vs_cvode --features bench-cvode`
 //! (scripts/bench-accuracy.sh runs it; it installs libsundials-dev).
@@ -99,7 +102,7 @@ mod cvode {
         }
     }
 
-    fn run_cvode(scene: Scene, y0: &[f64]) -> (Vec<f64>, u64, f64) {
+    fn run_cvode(scene: Scene, y0: &[f64], rtol: f64, atol: f64) -> (Vec<f64>, u64, f64) {
         let n = y0.len();
         let started = Instant::now();
         let mut out = vec![0.0; n];
@@ -121,7 +124,7 @@ mod cvode {
                 sun::CVodeSetUserData(mem, &mut user as *mut User as *mut c_void),
                 0
             );
-            assert_eq!(sun::CVodeSStolerances(mem, RTOL, ATOL), 0);
+            assert_eq!(sun::CVodeSStolerances(mem, rtol, atol), 0);
             let a = sun::SUNDenseMatrix(n as sun::sunindextype, n as sun::sunindextype, ctx);
             let ls = sun::SUNLinSol_Dense(y, a, ctx);
             assert_eq!(sun::CVodeSetLinearSolver(mem, ls, a), 0);
@@ -144,11 +147,11 @@ mod cvode {
         (out, steps as u64, started.elapsed().as_secs_f64())
     }
 
-    fn run_ours(mut scene: Scene, y0: &[f64]) -> (Vec<f64>, u64, f64) {
+    fn run_ours(mut scene: Scene, y0: &[f64], rtol: f64, atol: f64) -> (Vec<f64>, u64, f64) {
         let started = Instant::now();
         let opts = BdfOptions {
-            rtol: RTOL,
-            atol: Tolerance::Scalar(ATOL),
+            rtol,
+            atol: Tolerance::Scalar(atol),
             magnitude_cap: Some(scene.magnitude_caps()),
             ..BdfOptions::default()
         };
@@ -180,8 +183,8 @@ mod cvode {
         );
         for number in [1, 2] {
             let (s, y0) = scene(number);
-            let (ours, ours_steps, ours_t) = run_ours(s.clone(), &y0);
-            let (theirs, cv_steps, cv_t) = run_cvode(s.clone(), &y0);
+            let (ours, ours_steps, ours_t) = run_ours(s.clone(), &y0, RTOL, ATOL);
+            let (theirs, cv_steps, cv_t) = run_cvode(s.clone(), &y0, RTOL, ATOL);
             let a = forces(&outputs(&s, T_END, &ours).expect("outputs"));
             let b = forces(&outputs(&s, T_END, &theirs).expect("outputs"));
             let scale = b.iter().map(|x| x.abs()).fold(1e-30, f64::max);
@@ -205,6 +208,71 @@ mod cvode {
         println!(
             "(mount forces and steering-wheel acceleration at t = {T_END} s, 2000 rpm, rtol {RTOL:e}, \
              atol {ATOL:e}; difference relative to the largest value)"
+        );
+        per_step_costs();
+    }
+
+    /// The cost per step of both integrators at working tolerances, with their error against
+    /// our tight reference: the comparison at equal error the speed work is judged by.
+    fn per_step_costs() {
+        println!();
+        println!(
+            "{:<6} {:>7} | {:>9} {:>7} {:>9} {:>9} | {:>9} {:>7} {:>9} {:>9}",
+            "scene",
+            "rtol",
+            "ours err",
+            "steps",
+            "µs/step",
+            "ms total",
+            "CVODE err",
+            "steps",
+            "µs/step",
+            "ms total"
+        );
+        for number in [1, 2] {
+            let (s, y0) = scene(number);
+            let (reference, _, _) = run_ours(s.clone(), &y0, RTOL, ATOL);
+            let reference = forces(&outputs(&s, T_END, &reference).expect("outputs"));
+            let scale = reference.iter().map(|x| x.abs()).fold(1e-30, f64::max);
+            let error = |y: &[f64]| {
+                let v = forces(&outputs(&s, T_END, y).expect("outputs"));
+                v.iter()
+                    .zip(&reference)
+                    .map(|(x, r)| (x - r).abs())
+                    .fold(0.0, f64::max)
+                    / scale
+            };
+            for rtol in [1e-4, 1e-5, 1e-6, 1e-7] {
+                let atol = rtol * 1e-3;
+                // Fastest of three runs each (the machine's timings scatter).
+                let best = |run: &dyn Fn() -> (Vec<f64>, u64, f64)| {
+                    (0..3)
+                        .map(|_| run())
+                        .min_by(|a, b| a.2.total_cmp(&b.2))
+                        .expect("runs")
+                };
+                let (ours, ours_steps, ours_t) = best(&|| run_ours(s.clone(), &y0, rtol, atol));
+                let (cv, cv_steps, cv_t) = best(&|| run_cvode(s.clone(), &y0, rtol, atol));
+                println!(
+                    "{:<6} {:>7.0e} | {:>9.1e} {:>7} {:>9.1} {:>9.1} | {:>9.1e} {:>7} {:>9.1} {:>9.1}",
+                    number,
+                    rtol,
+                    error(&ours),
+                    ours_steps,
+                    ours_t / ours_steps as f64 * 1e6,
+                    ours_t * 1e3,
+                    error(&cv),
+                    cv_steps,
+                    cv_t / cv_steps as f64 * 1e6,
+                    cv_t * 1e3,
+                );
+            }
+        }
+        println!(
+            "(0.3 s from the static equilibrium at 2000 rpm, atol = rtol × 1e-3, no communication \
+             points; error: max. mount-force / steering-wheel difference at the end against our \
+             rtol 1e-10 run, relative to the largest value; CVODE with its dense direct solver and \
+             finite-difference Jacobian on the same right-hand side)"
         );
     }
 }
