@@ -27,7 +27,7 @@ use super::parts::{slider_crank_trig, Part, PartMotion};
 
 /// A moving part reduced to what its path needs at run time.
 #[derive(Debug, Clone, PartialEq)]
-enum MovingPart {
+pub(super) enum MovingPart {
     /// Piston pin at `base + bore s(ψ)`, `ψ = φ − throw` (cos, sin of the throw kept).
     Piston {
         mass: f64,
@@ -70,6 +70,47 @@ fn multiple_angle(ratio: f64, phi: f64, sin: f64, cos: f64) -> (f64, f64) {
 }
 
 impl MovingPart {
+    /// The run-time form of a part that moves relative to its body, or the offset of a fixed one.
+    pub(super) fn of(part: &Part) -> Result<MovingPart, Vector3<f64>> {
+        let mass = part.mass;
+        match &part.motion {
+            PartMotion::Fixed { offset } => Err(*offset),
+            PartMotion::Piston {
+                crank_centre,
+                bore,
+                y,
+                throw,
+                radius,
+                conrod,
+            } => Ok(MovingPart::Piston {
+                mass,
+                base: crank_centre + Vector3::new(0.0, *y, 0.0),
+                bore: *bore,
+                cos_throw: throw.cos(),
+                sin_throw: throw.sin(),
+                radius: *radius,
+                conrod: *conrod,
+            }),
+            PartMotion::Orbit {
+                centre,
+                bore,
+                y,
+                radius,
+                ratio,
+                phase,
+            } => Ok(MovingPart::Orbit {
+                mass,
+                base: centre + Vector3::new(0.0, *y, 0.0),
+                bore: *bore,
+                side: Vector3::y().cross(bore),
+                radius: *radius,
+                ratio: *ratio,
+                cos_phase: phase.cos(),
+                sin_phase: phase.sin(),
+            }),
+        }
+    }
+
     fn mass(&self) -> f64 {
         match self {
             MovingPart::Piston { mass, .. } | MovingPart::Orbit { mass, .. } => *mass,
@@ -77,7 +118,7 @@ impl MovingPart {
     }
 
     /// `(ρ, ρ', ρ'')` at crank angle `phi` with `(sin φ, cos φ)` given.
-    fn path(&self, phi: f64, sin: f64, cos: f64) -> [Vector3<f64>; 3] {
+    pub(super) fn path(&self, phi: f64, sin: f64, cos: f64) -> [Vector3<f64>; 3] {
         match self {
             MovingPart::Piston {
                 base,
@@ -140,45 +181,12 @@ impl PartMoments {
         let mut moving = Vec::new();
         let mut spin_groups: Vec<(f64, Matrix3<f64>)> = Vec::new();
         for part in parts {
-            let m = part.mass;
-            match &part.motion {
-                PartMotion::Fixed { offset } => {
-                    fixed_first += offset * m;
-                    fixed_second += offset * offset.transpose() * m;
+            match MovingPart::of(part) {
+                Ok(moving_part) => moving.push(moving_part),
+                Err(offset) => {
+                    fixed_first += offset * part.mass;
+                    fixed_second += offset * offset.transpose() * part.mass;
                 }
-                PartMotion::Piston {
-                    crank_centre,
-                    bore,
-                    y,
-                    throw,
-                    radius,
-                    conrod,
-                } => moving.push(MovingPart::Piston {
-                    mass: m,
-                    base: crank_centre + Vector3::new(0.0, *y, 0.0),
-                    bore: *bore,
-                    cos_throw: throw.cos(),
-                    sin_throw: throw.sin(),
-                    radius: *radius,
-                    conrod: *conrod,
-                }),
-                PartMotion::Orbit {
-                    centre,
-                    bore,
-                    y,
-                    radius,
-                    ratio,
-                    phase,
-                } => moving.push(MovingPart::Orbit {
-                    mass: m,
-                    base: centre + Vector3::new(0.0, *y, 0.0),
-                    bore: *bore,
-                    side: Vector3::y().cross(bore),
-                    radius: *radius,
-                    ratio: *ratio,
-                    cos_phase: phase.cos(),
-                    sin_phase: phase.sin(),
-                }),
             }
             if part.inertia != Matrix3::zeros() {
                 match spin_groups.iter_mut().find(|(n, _)| *n == part.spin_ratio) {

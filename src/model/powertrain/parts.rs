@@ -11,6 +11,8 @@
 
 use nalgebra::{Matrix3, Vector3};
 
+use super::part_moments::MovingPart;
+
 /// How a part moves relative to its body.
 #[derive(Debug, Clone, PartialEq)]
 pub enum PartMotion {
@@ -76,45 +78,17 @@ pub fn slider_crank_trig(sn: f64, cs: f64, r: f64, l: f64) -> (f64, f64, f64) {
 impl Part {
     /// Path of the centre of mass at crank angle `phi`.
     pub fn path(&self, phi: f64) -> PartPath {
-        match &self.motion {
-            PartMotion::Fixed { offset } => PartPath {
-                rho: *offset,
+        match MovingPart::of(self) {
+            Ok(moving) => {
+                let (sin, cos) = phi.sin_cos();
+                let [rho, d_rho, dd_rho] = moving.path(phi, sin, cos);
+                PartPath { rho, d_rho, dd_rho }
+            }
+            Err(offset) => PartPath {
+                rho: offset,
                 d_rho: Vector3::zeros(),
                 dd_rho: Vector3::zeros(),
             },
-            PartMotion::Piston {
-                crank_centre,
-                bore,
-                y,
-                throw,
-                radius,
-                conrod,
-            } => {
-                let (s, s1, s2) = slider_crank(phi - throw, *radius, *conrod);
-                PartPath {
-                    rho: crank_centre + Vector3::new(0.0, *y, 0.0) + bore * s,
-                    d_rho: bore * s1,
-                    dd_rho: bore * s2,
-                }
-            }
-            PartMotion::Orbit {
-                centre,
-                bore,
-                y,
-                radius,
-                ratio,
-                phase,
-            } => {
-                let side = Vector3::y().cross(bore);
-                let (sn, cs) = (ratio * phi + phase).sin_cos();
-                let radial = side * sn + bore * cs;
-                let tangential = side * cs - bore * sn;
-                PartPath {
-                    rho: centre + Vector3::new(0.0, *y, 0.0) + radial * *radius,
-                    d_rho: tangential * (ratio * radius),
-                    dd_rho: radial * (-ratio * ratio * radius),
-                }
-            }
         }
     }
 }
@@ -138,6 +112,51 @@ mod tests {
             let pin = Vector3::new(0.0, 0.0, s);
             let crank_pin = Vector3::new(r * psi.sin(), 0.0, r * psi.cos());
             assert!(((pin - crank_pin).norm() - l).abs() < 1e-12);
+        }
+    }
+
+    #[test]
+    fn part_paths_are_consistent_with_their_derivatives_and_geometry() {
+        let bore = Vector3::new(0.2, 0.0, 1.0).normalize();
+        let parts = [
+            PartMotion::Orbit {
+                centre: Vector3::new(0.1, 0.0, -0.05),
+                bore,
+                y: 0.03,
+                radius: 0.02,
+                ratio: -2.0,
+                phase: 0.7,
+            },
+            PartMotion::Piston {
+                crank_centre: Vector3::new(0.0, 0.0, -0.1),
+                bore,
+                y: -0.1,
+                throw: 2.0,
+                radius: 0.047,
+                conrod: 0.156,
+            },
+        ];
+        for motion in parts {
+            let part = Part {
+                name: "p".into(),
+                mass: 1.0,
+                inertia: Matrix3::zeros(),
+                motion: motion.clone(),
+                spin_ratio: 0.0,
+            };
+            for k in 0..30 {
+                let phi = -3.0 + 0.41 * k as f64;
+                let h = 1e-5;
+                let (p, pp, pm) = (part.path(phi), part.path(phi + h), part.path(phi - h));
+                assert!(((pp.rho - pm.rho) / (2.0 * h) - p.d_rho).norm() < 1e-8);
+                assert!(((pp.d_rho - pm.d_rho) / (2.0 * h) - p.dd_rho).norm() < 1e-7);
+                if let PartMotion::Orbit { centre, radius, .. } = &motion {
+                    // Stays on its circle in the plane normal to the crank axis.
+                    let r = p.rho - centre;
+                    assert!((Vector3::new(r.x, 0.0, r.z).norm() - radius).abs() < 1e-12);
+                    assert!((r.y - 0.03).abs() < 1e-15);
+                }
+            }
         }
     }
 }
