@@ -897,17 +897,19 @@ impl Instance {
                             let i = v.vr as usize;
                             self.core.values.reals[i] = self.core.inputs[i].at(target);
                         }
-                        self.logger.log(
-                            Level::Info,
-                            "logSolver",
-                            &format!(
-                                "t = {target} s: {} steps, {} RHS, {} Jacobians, {} factorisations",
-                                counters.steps,
-                                counters.rhs_evaluations,
-                                counters.jacobian_evaluations,
-                                counters.factorizations
-                            ),
-                        );
+                        if self.logger.wants(Level::Info, "logSolver") {
+                            self.logger.log(
+                                Level::Info,
+                                "logSolver",
+                                &format!(
+                                    "t = {target} s: {} steps, {} RHS, {} Jacobians, {} factorisations",
+                                    counters.steps,
+                                    counters.rhs_evaluations,
+                                    counters.jacobian_evaluations,
+                                    counters.factorizations
+                                ),
+                            );
+                        }
                         if clipped {
                             Status::Warning
                         } else {

@@ -79,12 +79,17 @@ impl Logger {
             .unwrap_or(true)
     }
 
+    /// Whether a message of `level` in `category` would reach the environment (callers skip
+    /// formatting a per-step message nobody reads).
+    pub fn wants(&self, level: Level, category: &str) -> bool {
+        let always = matches!(level, Level::Error | Level::Fatal | Level::Warning);
+        always || (self.debug_logging && self.category_enabled(category) && self.callback.is_some())
+    }
+
     /// Errors and warnings always reach the environment; other categories only when debug
     /// logging is on for them.
     pub fn log(&self, level: Level, category: &str, message: &str) {
-        let always = matches!(level, Level::Error | Level::Fatal | Level::Warning);
-        let wanted = self.debug_logging && self.category_enabled(category);
-        if !(always || wanted) {
+        if !self.wants(level, category) {
             return;
         }
         let Some(callback) = self.callback else {

@@ -383,23 +383,31 @@ impl BlockLowRankLu {
         if r == 0 {
             return;
         }
-        // x = D⁻¹ b + Y (γ (I − γ Vᵀ Y)⁻¹) Vᵀ D⁻¹ b.
-        let mut s = Mat::<f64>::zeros(r, 1);
+        // x = D⁻¹ b + Y (γ (I − γ Vᵀ Y)⁻¹) Vᵀ D⁻¹ b, the r-vectors on the stack for the usual
+        // ranks (6 per mount).
+        let mut stack = [0.0; 2 * STACK_RANK];
+        let mut heap = Vec::new();
+        let buffer: &mut [f64] = if r <= STACK_RANK {
+            &mut stack[..2 * r]
+        } else {
+            heap.resize(2 * r, 0.0);
+            &mut heap
+        };
+        let (s, t) = buffer.split_at_mut(r);
         let x = MatRef::from_column_major_slice(b, n, 1);
         matmul(
-            s.as_mut(),
+            MatMut::from_column_major_slice_mut(s, r, 1),
             Accum::Replace,
             self.v.transpose(),
             x,
             1.0,
             Par::Seq,
         );
-        let mut t = Mat::<f64>::zeros(r, 1);
         matmul(
-            t.as_mut(),
+            MatMut::from_column_major_slice_mut(t, r, 1),
             Accum::Replace,
             self.capacitance_inverse.as_ref(),
-            s.as_ref(),
+            MatRef::from_column_major_slice(s, r, 1),
             1.0,
             Par::Seq,
         );
@@ -408,12 +416,15 @@ impl BlockLowRankLu {
             x,
             Accum::Add,
             self.correction.as_ref(),
-            t.as_ref(),
+            MatRef::from_column_major_slice(t, r, 1),
             1.0,
             Par::Seq,
         );
     }
 }
+
+/// Ranks (and dense block sizes) whose scratch vectors live on the stack in a solve.
+const STACK_RANK: usize = 64;
 
 /// Inverse of `I − γ B` for a 1×1 or 2×2 block `B`, column-major in `inv`.
 fn invert_small(b: MatRef<'_, f64>, gamma: f64, inv: &mut [f64; 4]) -> bool {
@@ -451,14 +462,21 @@ fn block_solve(blocks: &[Vec<usize>], inverses: &[BlockInverse], x: &mut [f64]) 
         match inverse {
             BlockInverse::Small(inv) => apply_small_inverse(inv, idx, x),
             BlockInverse::Dense { inverse, .. } => {
-                let mut out = vec![0.0; idx.len()];
+                let mut stack = [0.0; STACK_RANK];
+                let mut heap = Vec::new();
+                let out: &mut [f64] = if idx.len() <= STACK_RANK {
+                    &mut stack[..idx.len()]
+                } else {
+                    heap.resize(idx.len(), 0.0);
+                    &mut heap
+                };
                 for (c, &i) in idx.iter().enumerate() {
                     let xc = x[i];
                     for (o, a) in out.iter_mut().zip(inverse.col_as_slice(c)) {
                         *o += a * xc;
                     }
                 }
-                for (&i, o) in idx.iter().zip(&out) {
+                for (&i, o) in idx.iter().zip(out.iter()) {
                     x[i] = *o;
                 }
             }
