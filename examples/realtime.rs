@@ -6,9 +6,10 @@
 //! per simulated second.
 //!
 //! With `--breakdown` a second table says where the time of a step goes: the cost of one
-//! right-hand side, one Jacobian, one factorisation and one linear solve, timed on their own at
+//! right-hand side, one Jacobian, one factorisation, one linear solve and one reading of the
+//! outputs (once per communication step), timed on their own at
 //! the window's last state (1000s of calls), times how often the integrator called them; the rest
-//! is the integrator's own work (prediction, error control, history) and the communication.
+//! is the integrator's own work (prediction, error control, history, interpolation).
 //! `--repeat N` measures the window N times in a row and prints the range.
 //!
 //! `cargo run --release --example realtime -- [--window SECONDS] [--repeat N] [--breakdown] [--scene N] [--cutoff HZ] [--rtol R] [--atol A] [--max-order Q]
@@ -16,7 +17,7 @@
 
 use std::time::Instant;
 
-use engine_mount_chassis::cosim::{Counters, Inputs, Settings, Simulation};
+use engine_mount_chassis::cosim::{scene, Counters, Inputs, Settings, Simulation};
 use engine_mount_chassis::model::CoupledModel;
 use engine_mount_chassis::ode::{
     BlockLowRankJacobian, BlockLowRankLu, DenseLu, OdeProblem, ProblemError,
@@ -50,13 +51,16 @@ fn time_per_call(mut f: impl FnMut()) -> f64 {
 
 /// Cost of one right-hand side, Jacobian, factorisation and solve (seconds) at `(t, y)`, with
 /// the linear algebra the integrator uses for this model.
-fn unit_costs(model: &CoupledModel, t: f64, y: &[f64]) -> Result<[f64; 4], ProblemError> {
+fn unit_costs(model: &CoupledModel, t: f64, y: &[f64]) -> Result<[f64; 5], ProblemError> {
     let mut m = model.clone();
     let n = y.len();
     let mut f = vec![0.0; n];
     m.rhs(t, y, &mut f)?;
     let rhs = time_per_call(|| {
         m.rhs(t, y, &mut f).expect("rhs");
+    });
+    let outputs = time_per_call(|| {
+        std::hint::black_box(scene::outputs(model, t, y).expect("outputs"));
     });
     let gamma = 1e-5;
     let mut b: Vec<f64> = f.iter().map(|v| v * 1e-6).collect();
@@ -71,7 +75,7 @@ fn unit_costs(model: &CoupledModel, t: f64, y: &[f64]) -> Result<[f64; 4], Probl
             assert!(lu.factor(&j, gamma));
         });
         let solve = time_per_call(|| lu.solve_in_place(&mut b));
-        Ok([rhs, jac, factor, solve])
+        Ok([rhs, jac, factor, solve, outputs])
     } else {
         let mut j = Mat::zeros(n, n);
         let jac = time_per_call(|| {
@@ -88,17 +92,17 @@ fn unit_costs(model: &CoupledModel, t: f64, y: &[f64]) -> Result<[f64; 4], Probl
             assert!(lu.factor());
         });
         let solve = time_per_call(|| lu.solve_in_place(&mut b));
-        Ok([rhs, jac, factor, solve])
+        Ok([rhs, jac, factor, solve, outputs])
     }
 }
 
 /// One row of the breakdown: per step, microseconds in each kind of work.
-fn print_breakdown(scene: i32, rpm: f64, cpu_per_step: f64, per_step: [f64; 4], unit: [f64; 4]) {
+fn print_breakdown(scene: i32, rpm: f64, cpu_per_step: f64, per_step: [f64; 5], unit: [f64; 5]) {
     let us = |x: f64| x * 1e6;
     let parts: Vec<f64> = per_step.iter().zip(&unit).map(|(n, c)| n * c).collect();
     let rest = cpu_per_step - parts.iter().sum::<f64>();
     println!(
-        "{:>5} {:>6.0} {:>8.2} | {:>5.2} × {:>6.2} = {:>6.2} | {:>5.3} × {:>7.1} = {:>5.2} | {:>5.3} × {:>6.2} = {:>5.2} | {:>5.2} × {:>5.2} = {:>5.2} | {:>6.2}",
+        "{:>5} {:>6.0} {:>8.2} | {:>5.2} × {:>6.2} = {:>6.2} | {:>5.3} × {:>7.1} = {:>5.2} | {:>5.3} × {:>6.2} = {:>5.2} | {:>5.2} × {:>5.2} = {:>5.2} | {:>5.3} × {:>5.2} = {:>5.2} | {:>6.2}",
         scene,
         rpm,
         us(cpu_per_step),
@@ -114,18 +118,22 @@ fn print_breakdown(scene: i32, rpm: f64, cpu_per_step: f64, per_step: [f64; 4], 
         per_step[3],
         us(unit[3]),
         us(parts[3]),
+        per_step[4],
+        us(unit[4]),
+        us(parts[4]),
         us(rest),
     );
 }
 
 /// Calls per step of each kind of work between two counter readings.
-fn calls_per_step(before: &Counters, after: &Counters) -> [f64; 4] {
+fn calls_per_step(before: &Counters, after: &Counters, communication_steps: f64) -> [f64; 5] {
     let steps = (after.steps - before.steps).max(1) as f64;
     [
         (after.rhs_evaluations - before.rhs_evaluations) as f64 / steps,
         (after.jacobian_evaluations - before.jacobian_evaluations) as f64 / steps,
         (after.factorizations - before.factorizations) as f64 / steps,
         (after.newton_iterations - before.newton_iterations) as f64 / steps,
+        communication_steps / steps,
     ]
 }
 
@@ -246,7 +254,7 @@ fn main() -> Result<(), String> {
                     scene,
                     rpm,
                     cpu_per_step,
-                    calls_per_step(&first, &last),
+                    calls_per_step(&first, &last, (n_window * repeat) as f64),
                     unit,
                 ));
             }
@@ -256,8 +264,16 @@ fn main() -> Result<(), String> {
         println!();
         println!("where a step's time goes (µs; calls per step × µs per call = µs per step):");
         println!(
-            "{:>5} {:>6} {:>8} | {:^24} | {:^25} | {:^24} | {:^23} | {:>6}",
-            "scene", "rpm", "step", "right-hand side", "Jacobian", "factorisation", "solve", "rest"
+            "{:>5} {:>6} {:>8} | {:^24} | {:^25} | {:^24} | {:^23} | {:^23} | {:>6}",
+            "scene",
+            "rpm",
+            "step",
+            "right-hand side",
+            "Jacobian",
+            "factorisation",
+            "solve",
+            "outputs",
+            "rest"
         );
         for (scene, rpm, cpu, calls, unit) in breakdown_rows {
             print_breakdown(scene, rpm, cpu, calls, unit);
