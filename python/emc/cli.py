@@ -437,14 +437,15 @@ def cmd_sweep(args) -> int:
         name = safe_name(signal)
         if len(cases) == 1:
             plots.waterfall(spectra, signal, str(out / f"waterfall_{name}.png"), unit=units.get(signal))
-            plots.order_cuts(orders, signal, str(out / f"order_cuts_{name}.png"), unit=units.get(signal))
+            plots.order_cuts(orders, signal, str(out / f"order_cuts_{name}.png"),
+                             unit=units.get(signal))
         else:
             plots.side_by_side(spectra, orders, signal, labels, str(out / f"waterfall_{name}.png"),
                                str(out / f"order_cuts_{name}.png"), unit=units.get(signal))
     exposure = comfort_table(spectra)
     if not exposure.empty:
         save(exposure, str(out / f"comfort{suffix}"))
-        plots.comfort(exposure, str(out / "comfort.png"))
+        plots.comfort(exposure, str(out / "comfort.png"), cases=labels)
     write_metadata(out, args, variables, cases,
                    {"speeds": {"from": args.rpm[0], "to": args.rpm[1], "count": args.count},
                     "start": options, "steps_per_revolution": args.steps_per_rev,
@@ -514,7 +515,8 @@ def cmd_runup(args) -> int:
                         unit=units.get(signal), cases=labels,
                         title=f"{signal}: order map of a {what}")
         plots.order_cuts(orders, signal, str(out / f"runup_order_cuts_{name}.png"),
-                         unit=units.get(signal), title=f"{signal}: order cuts of a {what}")
+                         unit=units.get(signal), title=f"{signal}: order cuts of a {what}",
+                         cases=labels)
     write_metadata(out, args, variables, cases,
                    {"runup": {"from": args.rpm[0], "to": args.rpm[1], "duration": args.duration,
                               "step": args.step, "block_revolutions": args.block_revolutions,
@@ -657,7 +659,7 @@ def run_study(args, cases: dict) -> int:
     exposure = comfort_table(spectra)
     if not exposure.empty:
         save(exposure, str(out / f"comfort{suffix}"))
-        plots.comfort(exposure, str(out / "comfort.png"))
+        plots.comfort(exposure, str(out / "comfort.png"), cases=list(cases))
         comfort_summary = exposure.groupby("case", sort=False)[["wheel_ahv", "seat_av_comfort"]]
         print("weighted steering-wheel a_hv and seat a_v [m/s²], mean and maximum over the speeds:")
         print(comfort_summary.agg(["mean", "max"]).to_string(float_format=lambda v: f"{v:.3g}"))

@@ -159,14 +159,15 @@ def waterfall(spectra: pd.DataFrame, signal: str, path: str, unit: str | None = 
 
 
 def order_cuts_figure(orders: pd.DataFrame, signal: str, unit: str | None = None,
-                      title: str | None = None, cut_orders=MAIN_ORDERS):
+                      title: str | None = None, cut_orders=MAIN_ORDERS,
+                      cases: list[str] | None = None):
     """Order amplitudes over engine speed. One case: one axes, a line per order. Several cases:
     one panel per order (three to a row), the cases overlaid on common axes, one legend."""
     data = orders[orders.signal == signal]
     if data.empty:
         raise ValueError(f"no order amplitudes for {signal}")
     ylabel = f"amplitude (peak) [{level_reference(unit)[2]}]"
-    cases = _cases(data)
+    cases = cases or _cases(data)
     if len(cases) == 1:
         fig, ax = plt.subplots(figsize=(8, 5))
         for k, order in enumerate(cut_orders):
@@ -206,8 +207,8 @@ def order_cuts_figure(orders: pd.DataFrame, signal: str, unit: str | None = None
 
 
 def order_cuts(orders: pd.DataFrame, signal: str, path: str, unit: str | None = None,
-               title: str | None = None, cut_orders=MAIN_ORDERS):
-    _save(order_cuts_figure(orders, signal, unit, title, cut_orders), path)
+               title: str | None = None, cut_orders=MAIN_ORDERS, cases: list[str] | None = None):
+    _save(order_cuts_figure(orders, signal, unit, title, cut_orders, cases), path)
 
 
 def _cut_axes(ax, amplitudes):
@@ -286,17 +287,21 @@ def side_by_side(spectra: pd.DataFrame, orders: pd.DataFrame, signal: str, cases
     overlaid."""
     _save(side_by_side_figure(spectra, signal, cases, unit), waterfall_path)
     order_cuts(orders[orders.case.isin(cases)], signal, order_cut_path, unit=unit,
-               title=f"{signal}: order cuts, " + " vs ".join(case_label(c) for c in cases))
+               title=f"{signal}: order cuts, " + " vs ".join(case_label(c) for c in cases),
+               cases=cases)
 
 
-def comfort(table: pd.DataFrame, path: str):
-    """Weighted seat and steering-wheel accelerations over engine speed, one line per case."""
+def comfort_figure(table: pd.DataFrame, cases: list[str] | None = None):
+    """Weighted seat and steering-wheel accelerations over engine speed, one line per case (in
+    the order of ``cases``: the same colours as the order cuts)."""
+    cases = cases or _cases(table)
     panels = [(c, label) for c, label in (
         ("seat_av_comfort", "seat, vibration total value a_v (ISO 2631-1, Wk/Wd, comfort)"),
         ("wheel_ahv", "steering wheel, a_hv (ISO 5349-1, Wh)")) if c in table]
     fig, axes = plt.subplots(1, len(panels), figsize=(7 * len(panels), 4.5), squeeze=False)
     for ax, (column, label) in zip(axes[0], panels):
-        for k, (case, d) in enumerate(table.groupby("case", sort=False)):
+        for k, case in enumerate(cases):
+            d = table[table.case.fillna("") == case].sort_values("rpm")
             ax.plot(d.rpm, d[column], label=case_label(case), **case_style(k))
         ax.set_xlabel("engine speed [rpm]")
         ax.set_ylabel("weighted RMS acceleration [m/s²]")
@@ -304,7 +309,11 @@ def comfort(table: pd.DataFrame, path: str):
         ax.grid(True, which="both", alpha=0.4)
         ax.legend()
     fig.tight_layout()
-    _save(fig, path)
+    return fig
+
+
+def comfort(table: pd.DataFrame, path: str, cases: list[str] | None = None):
+    _save(comfort_figure(table, cases), path)
 
 
 # A Campbell diagram (engine orders against the model's natural frequencies) lives in
