@@ -267,7 +267,10 @@ def write_metadata(out: pathlib.Path, args, variables: dict, cases: list[tuple[s
 
     record = {
         "fmu": {"path": str(pathlib.Path(fmu).resolve()), "sha256": digest, "guid": md.guid,
-                "generationDateAndTime": md.generationDateAndTime, "modelName": md.modelName},
+                "generationDateAndTime": md.generationDateAndTime, "modelName": md.modelName,
+                "fileModified": datetime.datetime.fromtimestamp(
+                    pathlib.Path(fmu).stat().st_mtime, datetime.timezone.utc
+                ).isoformat(timespec="seconds")},
         # Per case: the parameters that differ from the model description's start values, and
         # every start value emc set (its defaults, the common --set, the case's own).
         "cases": {label: non_default(params) for label, params in cases},

@@ -3,6 +3,7 @@ causes first, cases that accumulate and overlay, metadata with every result, the
 content, warnings for what the sampling cannot represent, progress, default scene 2, and run-ups
 tracked in the crank-angle domain."""
 
+import datetime
 import hashlib
 import json
 import os
@@ -197,6 +198,8 @@ def test_cases_accumulate_and_overlay_with_metadata(fmu_path, tmp_path, capsys):
     assert meta["fmu"]["path"] == str(fmu_path.resolve())
     assert meta["fmu"]["guid"] == md.guid
     assert meta["fmu"]["generationDateAndTime"] == md.generationDateAndTime
+    assert datetime.datetime.fromisoformat(meta["fmu"]["fileModified"]).timestamp() == \
+        pytest.approx(fmu_path.stat().st_mtime, abs=1.0)
     # Non-default parameters per case: the default scene 2, the common and the case's own
     # settings; solver.relTol=1e-5 is the model description's start value, so not listed.
     assert meta["cases"]["with shaft"] == {"scene": 2}
@@ -210,8 +213,6 @@ def test_cases_accumulate_and_overlay_with_metadata(fmu_path, tmp_path, capsys):
                                      "python"}
     assert all(meta["versions"][p] for p in ("emc", "fmpy", "numpy", "dask", "pandas",
                                              "matplotlib", "python"))
-    import datetime
-
     date = datetime.datetime.fromisoformat(meta["date"])
     assert date.utcoffset() == datetime.timedelta(0)
     assert abs((datetime.datetime.now(datetime.timezone.utc) - date).total_seconds()) < 600
