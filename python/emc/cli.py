@@ -710,13 +710,18 @@ def build_parser() -> argparse.ArgumentParser:
     sub = parser.add_subparsers(dest="command", required=True)
 
     def common(p):
-        p.add_argument("--fmu", default="dist/EngineMountChassis.fmu")
-        p.add_argument("--rpm", nargs=2, type=float, default=[800.0, 2500.0], metavar=("FROM", "TO"))
-        p.add_argument("--signal", action="append", help="output to analyse (repeatable)")
+        p.add_argument("--fmu", default="dist/EngineMountChassis.fmu",
+                       help="the packaged FMU (default dist/EngineMountChassis.fmu)")
+        p.add_argument("--rpm", nargs=2, type=float, default=[800.0, 2500.0], metavar=("FROM", "TO"),
+                       help="speed range, rpm (default 800 2500)")
+        p.add_argument("--signal", action="append",
+                       help="output to analyse (repeatable; default: a sweep records every "
+                            "mount force and comfort-point acceleration, a run-up mount[1].F[3], "
+                            "a study the steering wheel, the seat and mount[1].F[3])")
         p.add_argument("--set", action="append", metavar="NAME=VALUE",
                        help="FMU start value for every case, e.g. effects.balanceShaft=off "
                             "(repeatable; checked against the model description; default scene=2)")
-        p.add_argument("--out", required=True)
+        p.add_argument("--out", required=True, help="result folder (tables, plots, metadata.json)")
         p.add_argument("--parquet", action="store_true", help="write Parquet instead of CSV")
         p.add_argument("--quiet", action="store_true", help="no progress bars")
 
@@ -727,18 +732,19 @@ def build_parser() -> argparse.ArgumentParser:
 
     def parallel_options(p):
         p.add_argument("--serial", action="store_true", help="no Dask")
-        p.add_argument("--workers", type=int, default=2)
+        p.add_argument("--workers", type=int, default=2, help="local Dask workers (default 2)")
         p.add_argument("--scheduler", help="address of a running Dask scheduler (the FMU is sent "
                                            "to the workers by content)")
 
     s = sub.add_parser("sweep", help="constant-speed points on their periodic steady state")
     common(s)
     case_option(s)
-    s.add_argument("--count", type=int, default=18)
+    s.add_argument("--count", type=int, default=18, help="speed points, FROM to TO (default 18)")
     s.add_argument("--revolutions", type=int, default=None,
                    help="analysed window (even; default 8 with a periodic start, 40 after a settle)")
     add_start_options(s)
-    s.add_argument("--steps-per-rev", type=int, default=72)
+    s.add_argument("--steps-per-rev", type=int, default=72,
+                   help="communication steps (output samples) per revolution (default 72)")
     s.add_argument("--load-torque", type=float, default=0.0, help="N·m, every point")
     s.add_argument("--plot", action="append",
                    help="analysed signal to plot (repeatable; default: the first)")
@@ -775,7 +781,7 @@ def build_parser() -> argparse.ArgumentParser:
     for name, help_text, func in studies:
         m = sub.add_parser(name, help=help_text)
         common(m)
-        m.add_argument("--count", type=int, default=18)
+        m.add_argument("--count", type=int, default=18, help="speed points per case (default 18)")
         m.add_argument("--revolutions", type=int, default=None,
                        help="analysed window (even; default 8 with a periodic start, 40 after a settle)")
         add_start_options(m)
