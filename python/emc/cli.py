@@ -402,6 +402,27 @@ def highest_speed(variables: dict) -> float:
     return float(rpm.max) if rpm is not None and rpm.max is not None else 6000.0
 
 
+def sweep_cases(args, cases: list[tuple[str, dict]], signals: list[str], out: pathlib.Path,
+                point_options: dict) -> tuple[pd.DataFrame, pd.DataFrame, list[str]]:
+    """Every case's speed points (serial or on Dask), the FMU's warnings summarised, the order
+    and spectrum tables of all cases written; returns (orders, spectra, FMU warnings)."""
+    tables, fmu_warnings = [], []
+    for label, parameters in cases:
+        points = speed_points(args.rpm[0], args.rpm[1], args.count,
+                              parameters=tuple(parameters.items()), **point_options)
+        tables.append(run_sweep(args.fmu, points, signals=signals, case=label,
+                                parallel=not args.serial, scheduler=args.scheduler,
+                                workers=args.workers, progress=not args.quiet,
+                                warnings=fmu_warnings))
+    fmu_warnings_summary(fmu_warnings)
+    orders = pd.concat([t[0] for t in tables], ignore_index=True)
+    spectra = pd.concat([t[1] for t in tables], ignore_index=True)
+    suffix = ".parquet" if args.parquet else ".csv"
+    save(orders, str(out / f"orders{suffix}"))
+    save(spectra, str(out / f"spectra{suffix}"))
+    return orders, spectra, fmu_warnings
+
+
 def cmd_sweep(args) -> int:
     check_range("--count", args.count, 1)
     check_range("--steps-per-rev", args.steps_per_rev, 4, 10000)
@@ -417,23 +438,11 @@ def cmd_sweep(args) -> int:
     out = pathlib.Path(args.out)
     out.mkdir(parents=True, exist_ok=True)
     started = time.perf_counter()
-    tables, fmu_warnings = [], []
-    for label, parameters in cases:
-        points = speed_points(args.rpm[0], args.rpm[1], args.count,
-                              steps_per_revolution=args.steps_per_rev,
-                              load_torque=args.load_torque,
-                              parameters=tuple(parameters.items()), **options)
-        tables.append(run_sweep(args.fmu, points, signals=signals, case=label,
-                                parallel=not args.serial, scheduler=args.scheduler,
-                                workers=args.workers, progress=not args.quiet,
-                                warnings=fmu_warnings))
+    orders, spectra, fmu_warnings = sweep_cases(
+        args, cases, signals, out, {**options, "steps_per_revolution": args.steps_per_rev,
+                                    "load_torque": args.load_torque})
     elapsed = time.perf_counter() - started
-    fmu_warnings_summary(fmu_warnings)
-    orders = pd.concat([t[0] for t in tables], ignore_index=True)
-    spectra = pd.concat([t[1] for t in tables], ignore_index=True)
     suffix = ".parquet" if args.parquet else ".csv"
-    save(orders, str(out / f"orders{suffix}"))
-    save(spectra, str(out / f"spectra{suffix}"))
     units = units_of(variables)
     labels = [label for label, _ in cases]
     for signal in args.plot or signals[:1]:
@@ -638,21 +647,9 @@ def run_study(args, cases: dict) -> int:
     reduction_notice(study[0][1], variables)
     out = pathlib.Path(args.out)
     out.mkdir(parents=True, exist_ok=True)
-    tables, fmu_warnings = [], []
     started = time.perf_counter()
-    for case, params in study:
-        points = speed_points(args.rpm[0], args.rpm[1], args.count,
-                              parameters=tuple(params.items()), **options)
-        tables.append(run_sweep(args.fmu, points, signals=signals, case=case,
-                                parallel=not args.serial, scheduler=args.scheduler,
-                                workers=args.workers, progress=not args.quiet,
-                                warnings=fmu_warnings))
-    fmu_warnings_summary(fmu_warnings)
-    orders = pd.concat([t[0] for t in tables], ignore_index=True)
-    spectra = pd.concat([t[1] for t in tables], ignore_index=True)
+    orders, spectra, fmu_warnings = sweep_cases(args, study, signals, out, options)
     suffix = ".parquet" if args.parquet else ".csv"
-    save(orders, str(out / f"orders{suffix}"))
-    save(spectra, str(out / f"spectra{suffix}"))
     units = units_of(variables)
     for signal in args.signal or STUDY_PLOTS:
         name = safe_name(signal)
