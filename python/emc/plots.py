@@ -17,6 +17,7 @@ import pandas as pd  # noqa: E402
 
 MAIN_ORDERS = (1.0, 1.5, 2.0, 3.0, 4.5)
 ALL_ORDERS = tuple(k / 2 for k in range(1, 13))
+HIGHEST_ORDER = 6.5  # the spectra of a sweep reach 6.5 orders
 # Colour range of a waterfall below its peak.
 DYNAMIC_RANGE_DB = 60.0
 
@@ -52,12 +53,47 @@ def _speed_edges(speeds: np.ndarray) -> np.ndarray:
                            [speeds[-1] + (speeds[-1] - mid[-1])]])
 
 
+# Each case's line style in overlays: colour, dash pattern and marker all differ, so that cases
+# whose curves coincide (an effect that leaves an order alone) stay visible as such.
+LINE_STYLES = ("-", "--", "-.", ":")
+MARKERS = ("o", "s", "^", "D", "v", "P")
+# Where no spectrum was analysed (above 6.5 orders of a speed point).
+NOT_ANALYSED = "0.88"
+
+
+def case_style(k: int, points: int = 0, cases: int = 1) -> dict:
+    """Line style of case ``k``; on dense curves (a run-up's blocks) about 12 markers, staggered
+    between the cases so that coinciding curves show every case's markers."""
+    style = {"color": f"C{k % 10}", "linestyle": LINE_STYLES[k % len(LINE_STYLES)],
+             "marker": MARKERS[k % len(MARKERS)], "ms": 4, "lw": 1.4}
+    if k % 2:
+        style["markerfacecolor"] = "none"
+    if points > 24:
+        every = points // 12
+        style["markevery"] = (k * every // max(cases, 1), every)
+    return style
+
+
+def case_label(case) -> str:
+    return case if isinstance(case, str) and case else "model"
+
+
+def _cases(data: pd.DataFrame) -> list[str]:
+    return list(dict.fromkeys(data.case.fillna(""))) if "case" in data else [""]
+
+
+def _save(fig, path: str):
+    fig.savefig(path, dpi=120)
+    plt.close(fig)
+
+
 def _draw_colour_map(ax, data: pd.DataFrame, unit: str | None, top: float, vmin: float,
                      vmax: float):
     """Each speed point is a vertical strip of its own spectral bins (their widths differ with
-    the speed), coloured by level."""
+    the speed), coloured by level; grey where nothing was analysed."""
     speeds = np.sort(data.rpm.unique())
     edges = _speed_edges(speeds)
+    ax.set_facecolor(NOT_ANALYSED)
     mesh = None
     for k, rpm in enumerate(speeds):
         d = data[data.rpm == rpm].sort_values("frequency")
@@ -73,10 +109,11 @@ def _draw_colour_map(ax, data: pd.DataFrame, unit: str | None, top: float, vmin:
     for order in ALL_ORDERS:
         main = order in MAIN_ORDERS
         ax.plot(rpm_line, order * rpm_line / 60.0, "--" if main else ":", color="white",
-                lw=0.8 if main else 0.5, alpha=0.8 if main else 0.5)
+                lw=0.8 if main else 0.5, alpha=0.7 if main else 0.4)
         f_end = order * edges[-1] / 60.0
         if f_end <= top:
             ax.text(edges[-1], f_end, f" {order:g}", fontsize=7, va="center", color="0.2")
+    ax.text(1.0, 1.01, "order", transform=ax.transAxes, fontsize=7, color="0.2", ha="left")
     ax.set_xlim(edges[0], edges[-1])
     ax.set_ylim(0, top)
     ax.set_xlabel("engine speed [rpm]")
@@ -90,8 +127,15 @@ def _level_range(data: pd.DataFrame, unit: str | None) -> tuple[float, float]:
     return vmax - DYNAMIC_RANGE_DB, vmax
 
 
-def waterfall(spectra: pd.DataFrame, signal: str, path: str, unit: str | None = None,
-              title: str | None = None, max_frequency: float | None = None):
+def _colour_bar(fig, mesh, axes, unit: str | None):
+    bar = fig.colorbar(mesh, ax=axes, pad=0.06 if not isinstance(axes, list) else 0.02,
+                       fraction=0.05 if not isinstance(axes, list) else 0.03, extend="min")
+    bar.set_label(f"peak amplitude [{level_reference(unit)[1]}]")
+    return bar
+
+
+def waterfall_figure(spectra: pd.DataFrame, signal: str, unit: str | None = None,
+                     title: str | None = None, max_frequency: float | None = None):
     """Colour map of the spectra of ``signal``: frequency over engine speed, level in dB."""
     data = spectra[spectra.signal == signal]
     if data.empty:
@@ -100,122 +144,177 @@ def waterfall(spectra: pd.DataFrame, signal: str, path: str, unit: str | None = 
     vmin, vmax = _level_range(data, unit)
     fig, ax = plt.subplots(figsize=(8.5, 6))
     mesh = _draw_colour_map(ax, data, unit, top, vmin, vmax)
-    bar = fig.colorbar(mesh, ax=ax, pad=0.08)
-    bar.set_label(f"peak amplitude [{level_reference(unit)[1]}]")
+    _colour_bar(fig, mesh, ax, unit)
     peak = data.amplitude.max()
-    ax.set_title(title or f"{signal}: waterfall (largest line {peak:.3g} "
-                          f"{level_reference(unit)[2]} peak; order lines dashed)", fontsize=10)
+    ax.set_title(title or f"{signal}: waterfall, largest line {peak:.3g} "
+                          f"{level_reference(unit)[2]} (peak)\norder lines dashed/dotted; grey: "
+                          f"above order {HIGHEST_ORDER:g}, not analysed", fontsize=10)
     fig.tight_layout()
-    fig.savefig(path, dpi=120)
-    plt.close(fig)
+    return fig
 
 
-def order_cuts(orders: pd.DataFrame, signal: str, path: str, unit: str | None = None,
-               title: str | None = None, cut_orders=MAIN_ORDERS):
+def waterfall(spectra: pd.DataFrame, signal: str, path: str, unit: str | None = None,
+              title: str | None = None, max_frequency: float | None = None):
+    _save(waterfall_figure(spectra, signal, unit, title, max_frequency), path)
+
+
+def order_cuts_figure(orders: pd.DataFrame, signal: str, unit: str | None = None,
+                      title: str | None = None, cut_orders=MAIN_ORDERS,
+                      cases: list[str] | None = None):
     """Order amplitudes over engine speed. One case: one axes, a line per order. Several cases:
-    one panel per order, the cases overlaid on common axes."""
+    one panel per order (three to a row), the cases overlaid on common axes, one legend."""
     data = orders[orders.signal == signal]
     if data.empty:
         raise ValueError(f"no order amplitudes for {signal}")
-    printed = level_reference(unit)[2]
-    cases = list(dict.fromkeys(data.case.fillna("")))
+    ylabel = f"amplitude (peak) [{level_reference(unit)[2]}]"
+    cases = cases or _cases(data)
     if len(cases) == 1:
         fig, ax = plt.subplots(figsize=(8, 5))
-        for order in cut_orders:
+        for k, order in enumerate(cut_orders):
             d = data[np.isclose(data.order, order)].sort_values("rpm")
-            ax.plot(d.rpm, d.amplitude, marker="o", ms=3, label=f"order {order:g}")
-        _cut_axes(ax, printed)
+            ax.plot(d.rpm, d.amplitude, label=f"order {order:g}",
+                    **{**case_style(k, len(d), len(cut_orders)), "linestyle": "-"})
+        _cut_axes(ax, data.amplitude)
+        ax.set_ylabel(ylabel)
         ax.legend(fontsize=8)
         ax.set_title(title or f"{signal}: order cuts", fontsize=10)
-    else:
-        fig, axes = plt.subplots(1, len(cut_orders), figsize=(3.6 * len(cut_orders), 4.2),
-                                 sharey=True, squeeze=False)
-        for ax, order in zip(axes[0], cut_orders):
-            for case in cases:
-                d = data[(data.case.fillna("") == case) & np.isclose(data.order, order)]
-                d = d.sort_values("rpm")
-                ax.plot(d.rpm, d.amplitude, marker="o", ms=3, label=case or "model")
-            _cut_axes(ax, printed if ax is axes[0][0] else None)
-            ax.set_title(f"order {order:g}", fontsize=10)
-        axes[0][0].legend(fontsize=8)
-        fig.suptitle(title or f"{signal}: order cuts, cases overlaid", fontsize=11)
-    fig.tight_layout()
-    fig.savefig(path, dpi=120)
-    plt.close(fig)
+        fig.tight_layout()
+        return fig
+    columns = min(3, len(cut_orders))
+    rows = -(-len(cut_orders) // columns)
+    fig, axes = plt.subplots(rows, columns, figsize=(4.3 * columns, 3.3 * rows + 0.9),
+                             sharex=True, sharey=True, squeeze=False, layout="constrained")
+    for k, ax in enumerate(axes.flat):
+        if k >= len(cut_orders):
+            ax.set_visible(False)
+            continue
+        order = cut_orders[k]
+        for j, case in enumerate(cases):
+            d = data[(data.case.fillna("") == case) & np.isclose(data.order, order)]
+            d = d.sort_values("rpm")
+            ax.plot(d.rpm, d.amplitude, label=case_label(case),
+                    **case_style(j, len(d), len(cases)))
+        _cut_axes(ax, data.amplitude)
+        ax.set_title(f"order {order:g}", fontsize=10)
+        if k % columns == 0:
+            ax.set_ylabel(ylabel)
+        ax.tick_params(labelbottom=True)
+    handles, labels = axes.flat[0].get_legend_handles_labels()
+    fig.legend(handles, labels, loc="outside lower center", ncol=min(len(cases), 4),
+               fontsize=9, frameon=False)
+    fig.suptitle(title or f"{signal}: order cuts, cases overlaid", fontsize=11)
+    return fig
 
 
-def _cut_axes(ax, printed_unit: str | None):
+def order_cuts(orders: pd.DataFrame, signal: str, path: str, unit: str | None = None,
+               title: str | None = None, cut_orders=MAIN_ORDERS, cases: list[str] | None = None):
+    _save(order_cuts_figure(orders, signal, unit, title, cut_orders, cases), path)
+
+
+def _cut_axes(ax, amplitudes):
     ax.set_xlabel("engine speed [rpm]")
-    if printed_unit is not None:
-        ax.set_ylabel(f"amplitude (peak) [{printed_unit}]")
-    ax.set_yscale("log")
-    ax.grid(True, which="both", lw=0.3)
+    if np.nanmax(np.asarray(amplitudes, dtype=float), initial=0.0) > 0.0:
+        ax.set_yscale("log")  # else all zero (the steering wheel in scene 1): a linear axis
+    ax.grid(True, which="major", lw=0.5, alpha=0.6)
+    ax.grid(True, which="minor", lw=0.3, alpha=0.3)
+
+
+def order_map_figure(orders: pd.DataFrame, signal: str, unit: str | None = None,
+                     cases: list[str] | None = None, title: str | None = None):
+    """Order-tracked run-up: engine order over engine speed, level in dB (each block of whole
+    revolutions is one column, every half order one row); one panel per case, one colour
+    scale."""
+    data = orders[orders.signal == signal]
+    if data.empty:
+        raise ValueError(f"no order amplitudes for {signal}")
+    cases = cases or _cases(data)
+    vmax = 5.0 * np.ceil(float(to_db(data.amplitude.max(), unit)) / 5.0)
+    fig, axes = plt.subplots(1, len(cases), figsize=(3.0 + 5.5 * len(cases), 5.5),
+                             squeeze=False, sharey=True, layout="constrained")
+    mesh = None
+    for ax, case in zip(axes[0], cases):
+        d = data[data.case.fillna("") == case].sort_values(["rpm", "order"])
+        speeds = np.sort(d.rpm.unique())
+        order_values = np.sort(d.order.unique())
+        grid = d.pivot_table(index="order", columns="rpm", values="amplitude").reindex(
+            index=order_values, columns=speeds)
+        step = order_values[1] - order_values[0] if len(order_values) > 1 else 0.5
+        order_edges = np.concatenate([order_values - step / 2, [order_values[-1] + step / 2]])
+        mesh = ax.pcolormesh(_speed_edges(speeds), order_edges, to_db(grid.to_numpy(), unit),
+                             cmap="inferno", vmin=vmax - DYNAMIC_RANGE_DB, vmax=vmax,
+                             shading="flat", rasterized=True)
+        ax.set_xlabel("engine speed [rpm]")
+        ax.set_yticks(order_values)
+        if len(cases) > 1:
+            ax.set_title(case_label(case), fontsize=10)
+    axes[0][0].set_ylabel("engine order")
+    _colour_bar(fig, mesh, list(axes[0]), unit)
+    fig.suptitle(title or f"{signal}: order map", fontsize=10)
+    return fig
 
 
 def order_map(orders: pd.DataFrame, signal: str, path: str, unit: str | None = None,
-              title: str | None = None):
-    """Order-tracked run-up: order over engine speed, level in dB (each block of whole
-    revolutions is one column; every half order is one row)."""
-    data = orders[orders.signal == signal].sort_values(["rpm", "order"])
+              cases: list[str] | None = None, title: str | None = None):
+    _save(order_map_figure(orders, signal, unit, cases, title), path)
+
+
+def side_by_side_figure(spectra: pd.DataFrame, signal: str, cases: list[str],
+                        unit: str | None = None):
+    """Waterfalls of several cases next to each other on one colour scale."""
+    data = spectra[spectra.signal == signal]
     if data.empty:
-        raise ValueError(f"no order amplitudes for {signal}")
-    speeds = np.sort(data.rpm.unique())
-    order_values = np.sort(data.order.unique())
-    grid = data.pivot_table(index="order", columns="rpm", values="amplitude").reindex(
-        index=order_values, columns=speeds)
-    levels = to_db(grid.to_numpy(), unit)
-    vmax = 5.0 * np.ceil(np.nanmax(levels) / 5.0)
-    step = order_values[1] - order_values[0] if len(order_values) > 1 else 0.5
-    order_edges = np.concatenate([order_values - step / 2, [order_values[-1] + step / 2]])
-    fig, ax = plt.subplots(figsize=(8.5, 5.5))
-    mesh = ax.pcolormesh(_speed_edges(speeds), order_edges, levels, cmap="inferno",
-                         vmin=vmax - DYNAMIC_RANGE_DB, vmax=vmax, shading="flat", rasterized=True)
-    bar = fig.colorbar(mesh, ax=ax)
-    bar.set_label(f"peak amplitude [{level_reference(unit)[1]}]")
-    ax.set_xlabel("engine speed [rpm]")
-    ax.set_ylabel("engine order")
-    ax.set_yticks(order_values)
-    ax.set_title(title or f"{signal}: order map", fontsize=10)
-    fig.tight_layout()
-    fig.savefig(path, dpi=120)
-    plt.close(fig)
+        raise ValueError(f"no spectra for {signal}")
+    top = float(data.frequency.max())
+    vmin, vmax = _level_range(data, unit)
+    fig, axes = plt.subplots(1, len(cases), figsize=(1.5 + 5.5 * len(cases), 5.5),
+                             squeeze=False, sharey=True, layout="constrained")
+    mesh = None
+    for ax, case in zip(axes[0], cases):
+        d = data[data.case == case]
+        mesh = _draw_colour_map(ax, d, unit, top, vmin, vmax) or mesh
+        ax.set_title(case_label(case), fontsize=10)
+    for ax in axes[0][1:]:
+        ax.set_ylabel("")
+    _colour_bar(fig, mesh, list(axes[0]), unit)
+    fig.suptitle(f"{signal}: waterfalls on one colour scale (order lines dashed/dotted; grey: "
+                 f"above order {HIGHEST_ORDER:g}, not analysed)", fontsize=11)
+    return fig
 
 
 def side_by_side(spectra: pd.DataFrame, orders: pd.DataFrame, signal: str, cases: list[str],
                  waterfall_path: str, order_cut_path: str, unit: str | None = None):
     """Waterfalls of several cases next to each other on one colour scale, and their order cuts
     overlaid."""
-    data = spectra[spectra.signal == signal]
-    top = float(data.frequency.max())
-    vmin, vmax = _level_range(data, unit)
-    fig, axes = plt.subplots(1, len(cases), figsize=(6.5 * len(cases), 5.5), squeeze=False)
-    mesh = None
-    for ax, case in zip(axes[0], cases):
-        d = data[data.case == case]
-        mesh = _draw_colour_map(ax, d, unit, top, vmin, vmax) or mesh
-        ax.set_title(f"{case}: {signal}", fontsize=10)
-    bar = fig.colorbar(mesh, ax=list(axes[0]), pad=0.02, fraction=0.03)
-    bar.set_label(f"peak amplitude [{level_reference(unit)[1]}]")
-    fig.savefig(waterfall_path, dpi=110, bbox_inches="tight")
-    plt.close(fig)
+    _save(side_by_side_figure(spectra, signal, cases, unit), waterfall_path)
     order_cuts(orders[orders.case.isin(cases)], signal, order_cut_path, unit=unit,
-               title=f"{signal}: order cuts, " + " vs ".join(cases))
+               title=f"{signal}: order cuts, " + " vs ".join(case_label(c) for c in cases),
+               cases=cases)
 
 
-def comfort(table: pd.DataFrame, path: str):
-    """Weighted seat and steering-wheel accelerations over engine speed, one line per case."""
+def comfort_figure(table: pd.DataFrame, cases: list[str] | None = None):
+    """Weighted seat and steering-wheel accelerations over engine speed, one line per case (in
+    the order of ``cases``: the same colours as the order cuts)."""
+    cases = cases or _cases(table)
     panels = [(c, label) for c, label in (
         ("seat_av_comfort", "seat, vibration total value a_v (ISO 2631-1, Wk/Wd, comfort)"),
         ("wheel_ahv", "steering wheel, a_hv (ISO 5349-1, Wh)")) if c in table]
     fig, axes = plt.subplots(1, len(panels), figsize=(7 * len(panels), 4.5), squeeze=False)
     for ax, (column, label) in zip(axes[0], panels):
-        for case, d in table.groupby("case"):
-            ax.plot(d.rpm, d[column], marker="o", label=case or "model")
+        for k, case in enumerate(cases):
+            d = table[table.case.fillna("") == case].sort_values("rpm")
+            ax.plot(d.rpm, d[column], label=case_label(case), **case_style(k))
         ax.set_xlabel("engine speed [rpm]")
         ax.set_ylabel("weighted RMS acceleration [m/s²]")
         ax.set_title(label, fontsize=10)
         ax.grid(True, which="both", alpha=0.4)
         ax.legend()
     fig.tight_layout()
-    fig.savefig(path, dpi=120)
-    plt.close(fig)
+    return fig
+
+
+def comfort(table: pd.DataFrame, path: str, cases: list[str] | None = None):
+    _save(comfort_figure(table, cases), path)
+
+
+# A Campbell diagram (engine orders against the model's natural frequencies) lives in
+# emc.campbell, beside the code that reads the modes from the FMU.

@@ -15,7 +15,7 @@ from fmpy.fmi2 import (FMU2Slave, calloc, fmi2CallbackAllocateMemoryTYPE,
                        fmi2CallbackFreeMemoryTYPE, fmi2CallbackFunctions, fmi2CallbackLoggerTYPE,
                        free)
 
-STATUS_LABELS = ("ok", "warning", "discard", "error", "fatal", "pending")
+STATUS_LABELS = ("info", "warning", "discard", "error", "fatal", "pending")
 
 
 class PointFailed(RuntimeError):
@@ -104,7 +104,16 @@ class Runner:
         )
         self.log: list[str] = []
         self.callbacks = logging_callbacks(self.log)
-        self.slave.instantiate(callbacks=self.callbacks)
+        try:
+            self.slave.instantiate(callbacks=self.callbacks)
+        except Exception as error:  # noqa: BLE001 - fmpy raises a bare Exception
+            shutil.rmtree(self.unzipdir, ignore_errors=True)
+            raise self.failure(f"instantiating {self.md.modelName}", error) from None
+        # Errors and warnings always reach the logger; the model set-up events (scene, chassis
+        # reduction or cache, periodic start) are cheap and tell what a failed point was doing.
+        categories = [c.name for c in self.md.logCategories or []]
+        if "logEvents" in categories:
+            self.slave.setDebugLogging(True, ["logEvents"])
         self.fresh = True
 
     def close(self):
@@ -114,6 +123,10 @@ class Runner:
             pass
         self.slave.freeInstance()
         shutil.rmtree(self.unzipdir, ignore_errors=True)
+
+    def warnings(self) -> list[str]:
+        """The FMU's warnings since the log was last cleared (a successful point may have some)."""
+        return [line for line in self.log if line.startswith("[warning]")]
 
     def failure(self, what: str, error: Exception) -> PointFailed:
         """The cause of a failed call: the FMU's error messages first, else fmpy's."""
@@ -195,19 +208,21 @@ class Runner:
         if not np.all(np.isfinite(samples)):
             raise RuntimeError(f"non-finite outputs at {point.rpm} rpm")
         return {"point": point, "dt": h, "signals": signals, "samples": samples,
-                "cpu": cpu, "wall": wall, "simulated": t}
+                "cpu": cpu, "wall": wall, "simulated": t, "warnings": self.warnings()}
 
     def run_up(self, rpm_from: float, rpm_to: float, duration: float, signals: list[str],
-               step: float = 2e-4, start_values: dict | None = None, progress=None) -> dict:
+               step: float = 2e-4, start_values: dict | None = None, progress=None,
+               case: str = "") -> dict:
         """A slow linear run-up, the speed given continuously by input derivatives; the crank
-        angle is recorded beside ``signals`` for order tracking. ``progress(fraction)`` is
-        called every 1 % of the run."""
+        angle is recorded beside ``signals`` for order tracking. ``progress(seconds)`` is
+        called with the simulated time reached, every 1 % of the run."""
         self.log.clear()
         try:
             return self._run_up(rpm_from, rpm_to, duration, signals, step, start_values,
                                 progress)
         except Exception as error:
-            raise self.failure(f"run-up {rpm_from:g}->{rpm_to:g} rpm", error) from None
+            where = f"run-up {rpm_from:g}->{rpm_to:g} rpm" + (f", case {case!r}" if case else "")
+            raise self.failure(where, error) from None
 
     def _run_up(self, rpm_from, rpm_to, duration, signals, step, start_values, progress):
         self._start({"rpm": rpm_from, **(start_values or {})})
@@ -225,12 +240,12 @@ class Runner:
             t = (k + 1) * step
             samples[k] = self.slave.getReal(vrs)
             rpm[k] = rpm_from + rate * t
-            if progress is not None and (k + 1) % tick == 0:
-                progress((k + 1) / n)
+            if progress is not None and ((k + 1) % tick == 0 or k + 1 == n):
+                progress(t)
         if not np.all(np.isfinite(samples)):
             raise RuntimeError("non-finite outputs in the run-up")
         return {"dt": step, "rpm": rpm, "signals": signals, "samples": samples[:, :-1],
-                "crank_angle": samples[:, -1]}
+                "crank_angle": samples[:, -1], "warnings": self.warnings()}
 
 
 def fmu_from_content(content: bytes, sha256: str) -> str:

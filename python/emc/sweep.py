@@ -1,18 +1,21 @@
 """Constant-speed sweeps, serial or in parallel with Dask, into tidy tables.
 
-Parallel runs follow fmpy's parameter-variation example: a Dask bag partitioned over workers,
-one FMU instance per partition, reused between points with ``reset()``. The FMU is deterministic,
-so a parallel sweep gives exactly the numbers of a serial one.
+Parallel runs follow fmpy's parameter-variation example: the points are split into partitions,
+one Dask task and one FMU instance per partition, reused between points with ``reset()``; the FMU
+itself is scattered to the workers by content. The FMU is deterministic, so a parallel sweep
+gives exactly the numbers of a serial one.
 """
 
 from __future__ import annotations
 
+import hashlib
+import logging
+import sys
+
 import numpy as np
 import pandas as pd
 
-import hashlib
-
-from .runner import OperatingPoint, Runner, fmu_from_content
+from .runner import OperatingPoint, PointFailed, Runner, fmu_from_content
 from .spectra import amplitude_spectrum, order_amplitudes
 
 ORDERS = tuple(k / 2 for k in range(1, 13))  # 0.5 … 6.0
@@ -41,61 +44,105 @@ def analyse(result: dict, case: str = "") -> tuple[list[dict], list[dict]]:
     return order_rows, spectrum_rows
 
 
-def _run_partition(fmu: tuple[bytes, str], points: list, signals: list[str] | None, case: str):
-    """One partition on a worker: the FMU arrives as its content (and checksum), so workers need
-    not share the caller's file system."""
-    rows = []
-    with Runner(fmu_from_content(*fmu)) as runner:
-        names = signals or default_signals(runner)
-        for point in points:
-            rows.append(analyse(runner.run_point(point, names, case), case))
-    return [rows]
+def _run_partition(content: bytes, sha256: str, points: list, signals: list[str] | None,
+                   case: str):
+    """One partition on a worker. The FMU arrives as its content and checksum (scattered once to
+    every worker), so workers need not share the caller's file system or working directory.
+
+    Returns (analysed points, FMU warnings, failure or None): a failed point comes back as a
+    value, with its log, so that the worker logs no error of its own and the caller reports the
+    FMU's cause first."""
+    rows, warnings = [], []
+    try:
+        with Runner(fmu_from_content(content, sha256)) as runner:
+            names = signals or default_signals(runner)
+            for point in points:
+                result = runner.run_point(point, names, case)
+                warnings += result["warnings"]
+                rows.append(analyse(result, case))
+    except PointFailed as failure:
+        return rows, warnings, failure
+    return rows, warnings, None
+
+
+def _progress_bar(total: int, case: str, enabled: bool):
+    if not enabled:
+        return None
+    from tqdm import tqdm
+
+    return tqdm(total=total, desc=case or "sweep", unit="point", file=sys.stderr)
+
+
+def _run_on_dask(fmu_path: str, points: list[OperatingPoint], signals, case: str,
+                 scheduler: str | None, workers: int, bar) -> tuple[list, list]:
+    from dask.distributed import Client, LocalCluster, as_completed
+
+    with open(fmu_path, "rb") as f:
+        content = f.read()
+    digest = hashlib.sha256(content).hexdigest()
+    cluster = None
+    if scheduler:
+        client = Client(scheduler)
+    else:
+        # Worker logs below ERROR (cancelled tasks after a failure, …) would bury the cause.
+        cluster = LocalCluster(n_workers=workers, threads_per_worker=1, processes=True,
+                               dashboard_address=None, silence_logs=logging.ERROR)
+        client = Client(cluster)
+    try:
+        # The FMU's bytes go to each worker once; every partition refers to them.
+        remote = client.scatter(content, broadcast=True, hash=False)
+        # Several points per partition reuse one FMU instance; more partitions than workers
+        # balance slow low-speed points and let the progress bar move.
+        npart = max(1, min(len(points), 3 * workers if not scheduler else len(points)))
+        bounds = np.linspace(0, len(points), npart + 1).round().astype(int)
+        chunks = [points[a:b] for a, b in zip(bounds[:-1], bounds[1:]) if b > a]
+        futures = {client.submit(_run_partition, remote, digest, chunk, signals, case,
+                                 pure=False): k for k, chunk in enumerate(chunks)}
+        parts: list = [None] * len(chunks)
+        warnings: list[str] = []
+        for future in as_completed(futures):
+            rows, part_warnings, failure = future.result()
+            if failure is not None:
+                client.cancel(list(futures))
+                raise failure
+            parts[futures[future]] = rows
+            warnings += part_warnings
+            if bar is not None:
+                bar.update(len(rows))
+    finally:
+        client.close()
+        if cluster is not None:
+            cluster.close()
+    return [r for part in parts for r in part], warnings
 
 
 def run_sweep(fmu_path: str, points: list[OperatingPoint], signals: list[str] | None = None,
               case: str = "", parallel: bool = True, scheduler: str | None = None,
-              workers: int = 2, progress: bool = True) -> tuple[pd.DataFrame, pd.DataFrame]:
-    """Runs the points; returns (order table, spectrum table)."""
-    if parallel:
-        import dask.bag as db
-        from dask.distributed import Client, LocalCluster
-
-        cluster = None
-        if scheduler:
-            client = Client(scheduler)
+              workers: int = 2, progress: bool = True,
+              warnings: list | None = None) -> tuple[pd.DataFrame, pd.DataFrame]:
+    """Runs the points; returns (order table, spectrum table). A failed point raises
+    :class:`PointFailed` (with its rpm, case and FMU log); the FMU's warnings of the points that
+    succeeded are appended to ``warnings`` if given."""
+    bar = _progress_bar(len(points), case, progress)
+    try:
+        if parallel:
+            results, fmu_warnings = _run_on_dask(fmu_path, points, signals, case, scheduler,
+                                                 workers, bar)
         else:
-            cluster = LocalCluster(n_workers=workers, threads_per_worker=1, processes=True,
-                                   dashboard_address=None)
-            client = Client(cluster)
-        try:
-            # Several points per partition reuse one FMU instance; more partitions than workers
-            # balance slow low-speed points and give the progress bar something to show.
-            npart = max(1, min(len(points), 3 * workers if not scheduler else len(points)))
-            bag = db.from_sequence(points, npartitions=npart)
-            with open(fmu_path, "rb") as f:
-                content = f.read()
-            fmu = (content, hashlib.sha256(content).hexdigest())
-            delayed_parts = bag.map_partitions(lambda part: _run_partition(fmu, list(part), signals, case))
-            futures = client.compute(delayed_parts)
-            if progress:
-                from dask.distributed import progress as dask_progress
-                dask_progress(futures, notebook=False)
-            partitions = futures.result()
-        finally:
-            client.close()
-            if cluster is not None:
-                cluster.close()
-        results = [r for part in partitions for r in part]
-    else:
-        iterator = points
-        if progress:
-            from tqdm import tqdm
-            iterator = tqdm(points, desc=case or "sweep", unit="point")
-        results = []
-        with Runner(fmu_path) as runner:
-            names = signals or default_signals(runner)
-            for point in iterator:
-                results.append(analyse(runner.run_point(point, names, case), case))
+            results, fmu_warnings = [], []
+            with Runner(fmu_path) as runner:
+                names = signals or default_signals(runner)
+                for point in points:
+                    result = runner.run_point(point, names, case)
+                    fmu_warnings += result["warnings"]
+                    results.append(analyse(result, case))
+                    if bar is not None:
+                        bar.update(1)
+    finally:
+        if bar is not None:
+            bar.close()
+    if warnings is not None:
+        warnings += fmu_warnings
     orders = pd.DataFrame([row for r in results for row in r[0]])
     spectra = pd.DataFrame([row for r in results for row in r[1]])
     sort = ["case", "signal", "rpm"]
