@@ -15,8 +15,6 @@ use super::stats::BdfStats;
 
 /// Refactor after this many steps with the same iteration matrix (CVODE msbp).
 const MSBP: u64 = 20;
-/// Re-evaluate the Jacobian after this many steps (CVODE msbj).
-const MSBJ: u64 = 50;
 /// Refactor when gamma changed by more than this fraction (CVODE dgmax_lsetup).
 const DGMAX_LSETUP: f64 = 0.3;
 /// A stale Jacobian is re-evaluated after a convergence failure only if gamma changed by less
@@ -235,7 +233,7 @@ impl Bdf {
         let w = &mut self.w;
         let dgamma = (s.gamma / s.gammap - 1.0).abs();
         let jbad = s.nst == 0
-            || s.nst >= s.lin.nstlj + MSBJ
+            || s.nst >= s.lin.nstlj + s.opts.jacobian_max_age
             || (convfail == ConvFail::BadJacobian && dgamma < DGMAX_JBAD)
             || convfail == ConvFail::Other;
         let jcur = jbad;

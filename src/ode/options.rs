@@ -50,6 +50,14 @@ pub struct BdfOptions {
     /// angle), a cap of one period keeps the *phase* accurate instead of allowing an error that
     /// grows with the number of revolutions. `None`: no cap (CVODE's weights).
     pub magnitude_cap: Option<Vec<f64>>,
+    /// Steps after which the Jacobian is re-evaluated although Newton still converges with it
+    /// (CVODE's msbj, 50 by default; convergence failures re-evaluate it earlier anyway).
+    #[serde(default = "default_jacobian_max_age")]
+    pub jacobian_max_age: u64,
+}
+
+fn default_jacobian_max_age() -> u64 {
+    50
 }
 
 impl Default for BdfOptions {
@@ -66,6 +74,7 @@ impl Default for BdfOptions {
             max_conv_fails: 10,
             stability_limit_detection: true,
             magnitude_cap: None,
+            jacobian_max_age: default_jacobian_max_age(),
         }
     }
 }
@@ -77,6 +86,9 @@ impl BdfOptions {
             |field: &'static str, message: String| Err(BdfError::InvalidOption { field, message });
         if !(self.rtol.is_finite() && self.rtol > 0.0) {
             return bad("rtol", format!("must be finite and > 0, got {}", self.rtol));
+        }
+        if self.jacobian_max_age == 0 {
+            return bad("jacobian_max_age", "must be at least 1 step".into());
         }
         match &self.atol {
             Tolerance::Scalar(a) => {
