@@ -547,15 +547,7 @@ fn rust_table(table: &Value, scalars: &[Scalar], families: &[Family], guid: &str
         r,
         "/// What the XML adds to a variable's index among its type ([`real`], [`integer`], …) to\n/// make its value reference, per type Real, Integer, Boolean, String: value references are\n/// unique across types.\npub const VR_BASE: [u32; 4] = {VR_BASE:?};"
     );
-    let _ = writeln!(
-        r,
-        "/// Log categories declared in `modelDescription.xml`.\npub const LOG_CATEGORIES: &[&str] = &{:?};",
-        table
-            .get("logCategories")
-            .and_then(Value::as_array)
-            .map(|c| c.iter().map(|x| str_field(x, "name")).collect::<Vec<_>>())
-            .unwrap_or_default()
-    );
+    r.push_str(&log_categories(table));
     for ty in TYPES {
         let module = ty.to_lowercase();
         let _ = writeln!(
@@ -614,8 +606,9 @@ fn rust_table(table: &Value, scalars: &[Scalar], families: &[Family], guid: &str
             };
             let _ = writeln!(
                 r,
-                "    Variable {{ name: {:?}, vr: {}, causality: {}, variability: {}, start: {start}, min: {}, max: {} }},",
+                "    Variable {{ name: {:?}, vr: {}, index: {}, causality: {}, variability: {}, start: {start}, min: {}, max: {} }},",
                 s.name,
+                s.vr + vr_base(s.ty),
                 s.vr,
                 rust_causality(&s.causality),
                 rust_variability(&s.variability),
@@ -627,6 +620,45 @@ fn rust_table(table: &Value, scalars: &[Scalar], families: &[Family], guid: &str
     }
     r.push_str(&parameters_struct(scalars, families));
     r
+}
+
+/// `LogCategory`: the log categories of `modelDescription.xml` as an enum (variant names are the
+/// category names without their `log` prefix), with their names in [`LOG_CATEGORIES`].
+fn log_categories(table: &Value) -> String {
+    let names: Vec<&str> = table
+        .get("logCategories")
+        .and_then(Value::as_array)
+        .map(|c| c.iter().map(|x| str_field(x, "name")).collect())
+        .unwrap_or_default();
+    let mut variants = String::new();
+    let mut all = String::new();
+    for name in &names {
+        let variant = name
+            .strip_prefix("log")
+            .unwrap_or_else(|| fail(&format!("log category {name} must start with `log`")));
+        let _ = writeln!(variants, "    /// `{name}`\n    {variant},");
+        let _ = write!(all, "LogCategory::{variant}, ");
+    }
+    format!(
+        r#"/// Log categories declared in `modelDescription.xml`, indexed by [`LogCategory`].
+pub const LOG_CATEGORIES: &[&str] = &{names:?};
+
+/// A log category of `modelDescription.xml`.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum LogCategory {{
+{variants}}}
+
+impl LogCategory {{
+    /// Every category, in the order of [`LOG_CATEGORIES`].
+    pub const ALL: &[LogCategory] = &[{all}];
+
+    /// The category's name in `modelDescription.xml`.
+    pub fn name(self) -> &'static str {{
+        LOG_CATEGORIES[self as usize]
+    }}
+}}
+"#
+    )
 }
 
 /// `Parameters`: every scalar parameter as a typed field named after its `rust` name, with the

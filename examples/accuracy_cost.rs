@@ -16,7 +16,8 @@
 use std::time::Instant;
 
 use engine_mount_chassis::cosim::{
-    BodyOptions, Counters, Effects, Inputs, Settings, Signal, Simulation, RPM_TO_RAD_PER_S,
+    BodyOptions, Counters, EffectSwitch, Inputs, SceneKind, Settings, Signal, Simulation,
+    VehicleOverrides, RPM_TO_RAD_PER_S,
 };
 
 /// One run's samples: every mount force component at each communication point in the window.
@@ -65,8 +66,7 @@ fn run(case: &Case, settings: &Settings, h: f64, interpolate: bool) -> Result<Ru
         let t = k as f64 * h;
         sim.set_inputs(&inputs_at(case, t, interpolate))?;
         let t_next = (k + 1) as f64 * h;
-        sim.advance_to(t_next)
-            .map_err(|e| format!("{} at t = {}", e.message, e.reached))?;
+        sim.advance_to(t_next).map_err(|e| e.to_string())?;
         if t_next > case.t_window + 1e-9 {
             let o = sim.outputs()?;
             times.push(t_next);
@@ -150,7 +150,7 @@ fn main() {
     let scene: i32 = arg("--scene").and_then(|s| s.parse().ok()).unwrap_or(1);
     let csv = arg("--csv");
     let base = Settings {
-        scene,
+        scene: SceneKind::from_number(scene).expect("--scene"),
         ..Settings::default()
     };
 
@@ -269,9 +269,9 @@ fn main() {
             (
                 "without gyroscopic terms".to_owned(),
                 Settings {
-                    effects: Effects {
-                        gyroscopic: false,
-                        ..base.effects
+                    vehicle: VehicleOverrides {
+                        effects: base.vehicle.effects.with(EffectSwitch::Gyroscopic, false),
+                        ..base.vehicle
                     },
                     ..base.clone()
                 },
@@ -279,9 +279,12 @@ fn main() {
             (
                 "rigid ring carriers".to_owned(),
                 Settings {
-                    effects: Effects {
-                        ring_carrier_elasticity: false,
-                        ..base.effects
+                    vehicle: VehicleOverrides {
+                        effects: base
+                            .vehicle
+                            .effects
+                            .with(EffectSwitch::RingCarrierElasticity, false),
+                        ..base.vehicle
                     },
                     ..base.clone()
                 },
@@ -303,9 +306,12 @@ fn main() {
             model_knobs.push((
                 "rigid chassis".to_owned(),
                 Settings {
-                    effects: Effects {
-                        chassis_flexibility: false,
-                        ..base.effects
+                    vehicle: VehicleOverrides {
+                        effects: base
+                            .vehicle
+                            .effects
+                            .with(EffectSwitch::ChassisFlexibility, false),
+                        ..base.vehicle
                     },
                     ..base.clone()
                 },

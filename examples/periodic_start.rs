@@ -7,7 +7,7 @@
 
 use std::time::Instant;
 
-use engine_mount_chassis::cosim::{Inputs, Settings, Simulation};
+use engine_mount_chassis::cosim::{Inputs, SceneKind, Settings, Simulation};
 
 fn main() -> Result<(), String> {
     let args: Vec<String> = std::env::args().collect();
@@ -41,7 +41,7 @@ fn main() -> Result<(), String> {
     for scene in scenes {
         for &rpm in &speeds {
             let base = Settings {
-                scene,
+                scene: SceneKind::from_number(scene)?,
                 rel_tol: rtol.unwrap_or(Settings::default().rel_tol),
                 ..Settings::default()
             };
@@ -59,7 +59,7 @@ fn main() -> Result<(), String> {
             for k in 1..=steps {
                 settled
                     .advance_to((k as f64 * 1e-3).min(end))
-                    .map_err(|e| e.message)?;
+                    .map_err(|e| e.to_string())?;
             }
             let settle_s = clock.elapsed().as_secs_f64();
             let periodic_settings = Settings {

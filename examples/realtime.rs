@@ -17,7 +17,9 @@
 
 use std::time::Instant;
 
-use engine_mount_chassis::cosim::{scene, Counters, Inputs, Settings, Simulation};
+use engine_mount_chassis::cosim::{
+    scene, Counters, EffectSwitch, Inputs, SceneKind, Settings, Simulation,
+};
 use engine_mount_chassis::model::CoupledModel;
 use engine_mount_chassis::ode::{
     BlockLowRankJacobian, BlockLowRankLu, DenseLu, OdeProblem, ProblemError,
@@ -162,7 +164,7 @@ fn main() -> Result<(), String> {
     for scene in scenes {
         for rpm in [800.0, 2000.0, 4000.0] {
             let mut settings = Settings {
-                scene,
+                scene: SceneKind::from_number(scene)?,
                 ..Settings::default()
             };
             let without = args
@@ -172,24 +174,24 @@ fn main() -> Result<(), String> {
                 .cloned()
                 .unwrap_or_default();
             for effect in without.split(',').filter(|e| !e.is_empty()) {
-                let e = &mut settings.effects;
-                match effect {
-                    "gas" => e.gas_forces = false,
-                    "mass" => e.mass_forces = false,
-                    "balance" => e.balance_shaft = false,
-                    "gyro" => e.gyroscopic = false,
-                    "ring" => e.ring_carrier_elasticity = false,
-                    "nonlinear" => e.mount_nonlinearity = false,
-                    "flex" => e.chassis_flexibility = false,
+                let switch = match effect {
+                    "gas" => EffectSwitch::GasForces,
+                    "mass" => EffectSwitch::MassForces,
+                    "balance" => EffectSwitch::BalanceShaft,
+                    "gyro" => EffectSwitch::Gyroscopic,
+                    "ring" => EffectSwitch::RingCarrierElasticity,
+                    "nonlinear" => EffectSwitch::MountNonlinearity,
+                    "flex" => EffectSwitch::ChassisFlexibility,
                     other => return Err(format!("unknown effect {other}")),
-                }
+                };
+                settings.vehicle.effects.set(switch, false);
             }
             if let Some(r) = value("--rtol") {
                 settings.rel_tol = r;
                 settings.abs_tol = r * 1e-3;
             }
             if let Some(q) = value("--max-order") {
-                settings.max_order = q as i32;
+                settings.max_order = q as usize;
             }
             if let Some(a) = value("--atol") {
                 settings.abs_tol = a;
@@ -201,7 +203,7 @@ fn main() -> Result<(), String> {
             let n_settle = (settle / h).round() as usize;
             let n_window = (window / h).round() as usize;
             for k in 1..=n_settle {
-                sim.advance_to(k as f64 * h).map_err(|e| e.message)?;
+                sim.advance_to(k as f64 * h).map_err(|e| e.to_string())?;
             }
             let mut factors = Vec::new();
             let (mut first, mut last) = (sim.counters(), sim.counters());
@@ -211,7 +213,8 @@ fn main() -> Result<(), String> {
                 let before = sim.counters();
                 let started = Instant::now();
                 for k in 1..=n_window {
-                    sim.advance_to((k0 + k) as f64 * h).map_err(|e| e.message)?;
+                    sim.advance_to((k0 + k) as f64 * h)
+                        .map_err(|e| e.to_string())?;
                     sim.outputs()?;
                 }
                 let cpu = started.elapsed().as_secs_f64();

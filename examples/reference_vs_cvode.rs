@@ -40,7 +40,7 @@ mod cvode {
 
     fn scene(number: i32) -> (Scene, Vec<f64>) {
         let settings = Settings {
-            scene: number,
+            scene: SceneKind::from_number(number).expect("scene"),
             chassis: BodyOptions {
                 mode_cutoff_hz: 100.0,
                 ..BodyOptions::default()

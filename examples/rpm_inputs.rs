@@ -9,7 +9,7 @@
 use std::path::PathBuf;
 use std::time::Instant;
 
-use engine_mount_chassis::fmi2::instance::{Instance, Status};
+use engine_mount_chassis::fmi2::instance::{Instance, Outcome, Status};
 use engine_mount_chassis::fmi2::logger::Logger;
 use engine_mount_chassis::fmi2::variables::{integer, real};
 
@@ -25,16 +25,17 @@ fn run(scene: i32, seconds: f64, h: f64, derivatives: bool) -> Result<Run, Strin
     let resources = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("resources");
     let logger = Logger::new(None, std::ptr::null_mut(), "rpm", false);
     let mut fmu = Instance::new("rpm", logger, Some(resources));
-    let ok = |s: Status, what: &str| {
-        if matches!(s, Status::Ok | Status::Warning) {
-            Ok(())
-        } else {
-            Err(format!("{what} failed"))
-        }
+    let ok = |s: Outcome, what: &str| match s {
+        Ok(Status::Ok | Status::Warning) => Ok(()),
+        Ok(other) => Err(format!("{what}: {other:?}")),
+        Err(m) => Err(format!("{what}: {m}")),
     };
-    ok(fmu.set_integer(&[integer::SCENE], &[scene]), "scene")?;
+    ok(
+        fmu.set::<i32>(&[integer::SCENE as usize], &[scene]),
+        "scene",
+    )?;
     ok(fmu.setup_experiment(0.0, None, None), "setup")?;
-    fmu.enter_initialization();
+    ok(fmu.enter_initialization(), "initialisation")?;
     ok(fmu.exit_initialization(), "initialisation")?;
     let (rpm0, rpm1) = (800.0, 2500.0);
     let rate = (rpm1 - rpm0) / seconds;
@@ -44,10 +45,13 @@ fn run(scene: i32, seconds: f64, h: f64, derivatives: bool) -> Result<Run, Strin
     let started = Instant::now();
     for k in 0..n {
         let t = k as f64 * h;
-        ok(fmu.set_real(&[real::RPM], &[rpm0 + rate * t]), "set rpm")?;
+        ok(
+            fmu.set::<f64>(&[real::RPM as usize], &[rpm0 + rate * t]),
+            "set rpm",
+        )?;
         if derivatives {
             ok(
-                fmu.set_real_input_derivatives(&[real::RPM], &[1], &[rate]),
+                fmu.set_real_input_derivatives(&[real::RPM as usize], &[1], &[rate]),
                 "set derivative",
             )?;
         }
@@ -56,8 +60,8 @@ fn run(scene: i32, seconds: f64, h: f64, derivatives: bool) -> Result<Run, Strin
             let r = &fmu.core.values.reals;
             let mut f = [0.0; 12];
             for (i, mount) in real::MOUNT_F.iter().enumerate() {
-                for (j, vr) in mount.iter().enumerate() {
-                    f[3 * i + j] = r[*vr as usize];
+                for (j, index) in mount.iter().enumerate() {
+                    f[3 * i + j] = *r.get(*index);
                 }
             }
             forces.push(f);

@@ -1,7 +1,9 @@
 //! The variable table, generated from `modelDescription/variables.json` by `build.rs`.
 //!
-//! Value references are indices into the per-type arrays [`REALS`], [`INTEGERS`], [`BOOLEANS`]
-//! and [`STRINGS`]; the constants in [`real`], [`integer`], [`boolean`] and [`string`] name them.
+//! A leaf: it knows the FMU's variables and nothing of the model. Each variable of type `T` sits at
+//! its `index` in the per-type arrays [`REALS`], [`INTEGERS`], [`BOOLEANS`] and [`STRINGS`]; the
+//! constants in [`real`], [`integer`], [`boolean`] and [`string`] are these indices. Its value
+//! reference `vr` is the index plus its type's [`VR_BASE`] (unique across types).
 
 /// FMI causality of a variable.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -27,7 +29,10 @@ pub enum Variability {
 #[derive(Debug, Clone, Copy)]
 pub struct Variable<T: 'static> {
     pub name: &'static str,
+    /// Value reference in `modelDescription.xml`.
     pub vr: u32,
+    /// Position among the variables of its type.
+    pub index: u32,
     pub causality: Causality,
     pub variability: Variability,
     pub start: T,
@@ -37,79 +42,30 @@ pub struct Variable<T: 'static> {
 
 include!(concat!(env!("OUT_DIR"), "/variables.rs"));
 
-/// What the parameters mean to the model's components. Where a parameter has a default in the
-/// model ([`crate::model::Effects`], [`crate::model::scene::BodyOptions`], the speed follower),
-/// that default is read from here, so the variable table is the one place defaults are set.
-impl Parameters {
-    /// The effect switches.
-    pub fn effects(&self) -> crate::model::Effects {
-        crate::model::Effects {
-            gas_forces: self.effect_gas_forces,
-            mass_forces: self.effect_mass_forces,
-            balance_shaft: self.effect_balance_shaft,
-            gyroscopic: self.effect_gyroscopic,
-            ring_carrier_elasticity: self.effect_ring_carrier,
-            mount_nonlinearity: self.effect_mount_nonlinearity,
-            chassis_flexibility: self.effect_chassis_flexibility,
-        }
-    }
-
-    /// How the elastic body is reduced (scene 2).
-    pub fn body_options(&self) -> Result<crate::model::scene::BodyOptions, String> {
-        use crate::cms::CacheSetting;
-        Ok(crate::model::scene::BodyOptions {
-            mode_cutoff_hz: self.chassis_mode_cutoff,
-            modal_damping_scale: self.chassis_modal_damping_scale,
-            interface_rotations: self.chassis_interface_rotations,
-            max_rpm: self.scene_max_rpm,
-            max_engine_order: self.scene_max_engine_order,
-            max_modes: usize::try_from(self.chassis_max_modes).map_err(|_| {
-                "chassis.maxModes must be >= 0 (0: select by chassis.modeCutoff)".to_string()
-            })?,
-            stiffening_bar: self.chassis_stiffening_bar,
-            stiff_front_plate: self.chassis_stiff_front_plate,
-            cache: if !self.chassis_cache_enabled {
-                CacheSetting::Disabled
-            } else {
-                match self.chassis_cache_dir.trim() {
-                    "" => CacheSetting::Default,
-                    dir => CacheSetting::Dir(std::path::PathBuf::from(dir)),
-                }
-            },
-        })
-    }
-}
-
 #[cfg(test)]
 mod tests {
     use super::*;
 
     #[test]
-    fn value_references_are_indices() {
-        for (i, v) in REALS.iter().enumerate() {
-            assert_eq!(v.vr as usize, i, "{}", v.name);
+    fn value_references_are_indices_over_their_type_base() {
+        fn check<T>(table: &[Variable<T>], base: u32) {
+            for (i, v) in table.iter().enumerate() {
+                assert_eq!(v.index as usize, i, "{}", v.name);
+                assert_eq!(v.vr, base + v.index, "{}", v.name);
+            }
         }
-        for (i, v) in INTEGERS.iter().enumerate() {
-            assert_eq!(v.vr as usize, i, "{}", v.name);
-        }
-        for (i, v) in BOOLEANS.iter().enumerate() {
-            assert_eq!(v.vr as usize, i, "{}", v.name);
-        }
-        for (i, v) in STRINGS.iter().enumerate() {
-            assert_eq!(v.vr as usize, i, "{}", v.name);
-        }
+        check(REALS, VR_BASE[0]);
+        check(INTEGERS, VR_BASE[1]);
+        check(BOOLEANS, VR_BASE[2]);
+        check(STRINGS, VR_BASE[3]);
     }
 
     #[test]
-    fn xml_and_table_agree() {
-        let xml = crate::fmi2::MODEL_DESCRIPTION_XML;
-        assert!(xml.contains(GUID));
-        for v in REALS {
-            let needle = format!("name=\"{}\" valueReference=\"{}\"", v.name, v.vr);
-            assert!(xml.contains(&needle), "{needle}");
+    fn log_categories_are_named_by_the_table() {
+        assert_eq!(LogCategory::ALL.len(), LOG_CATEGORIES.len());
+        for (c, name) in LogCategory::ALL.iter().zip(LOG_CATEGORIES) {
+            assert_eq!(c.name(), *name);
         }
-        assert_eq!(REALS[real::MOUNT_F[1][2] as usize].name, "mount[2].F[3]");
-        assert_eq!(REALS[real::RPM as usize].name, "rpm");
     }
 
     #[test]
@@ -138,28 +94,6 @@ mod tests {
                 ..defaults
             },
             p
-        );
-    }
-
-    #[test]
-    fn parameters_by_fmi_name_refuse_unknown_names() {
-        let p: Parameters =
-            serde_json::from_str(r#"{"scene": 2, "effects.gasForces": false}"#).unwrap();
-        assert_eq!(p.scene, 2);
-        assert!(!p.effect_gas_forces);
-        assert_eq!(p.solver_rel_tol, Parameters::default().solver_rel_tol);
-        let err = serde_json::from_str::<Parameters>(r#"{"solver.relTols": 1e-6}"#)
-            .unwrap_err()
-            .to_string();
-        assert!(err.contains("solver.relTols"), "{err}");
-        // The model's own defaults are the table's.
-        assert_eq!(
-            Parameters::default().effects(),
-            crate::model::Effects::default()
-        );
-        assert_eq!(
-            Parameters::default().body_options().unwrap(),
-            crate::model::scene::BodyOptions::default()
         );
     }
 }

@@ -6,17 +6,19 @@
 //! The integrator keeps its history across communication points and lands exactly on each one
 //! (a stop time, not a restart); it restarts at order 1 only where an input really jumps.
 
+pub mod error;
 pub mod periodic;
 pub mod scene;
+pub mod settings;
 mod signals;
 
 pub use crate::cms::CacheSetting;
-pub use crate::model::scene::{BodyOptions, AUTO_CUTOFF_MARGIN};
-pub use crate::model::Effects;
+pub use crate::model::scene::{BodyOption, BodyOptions, SceneKind, AUTO_CUTOFF_MARGIN};
+pub use crate::model::{EffectSwitch, Effects};
+pub use error::{Error, Input};
 pub use scene::FMU_MOUNTS;
+pub use settings::{EffectOverrides, Replaced, Settings, VehicleOverrides, VehicleSetting};
 pub use signals::{Inputs, Signal};
-
-use std::path::PathBuf;
 
 use crate::model::CoupledModel;
 use crate::ode::{Bdf, BdfOptions, BdfSnapshot, OdeProblem, Tolerance};
@@ -26,74 +28,6 @@ pub const DEFAULT_CONFIG_NAME: &str = "vehicle.json";
 
 /// rpm → rad/s.
 pub const RPM_TO_RAD_PER_S: f64 = std::f64::consts::PI / 30.0;
-
-/// Everything fixed at initialisation.
-#[derive(Debug, Clone, PartialEq)]
-pub struct Settings {
-    /// 1 = engine on rigid ground, 2 = engine in the elastic chassis.
-    pub scene: i32,
-    /// Engine configuration JSON; `None` = built-in defaults.
-    pub config_file: Option<PathBuf>,
-    pub effects: Effects,
-    /// Combustion load, 0 = idle … 1 = full load (blends the Wiebe pressure curves).
-    pub gas_load: f64,
-    /// Smooth fade-in of the engine excitation, s (0 = instantly).
-    pub fade_in_time: f64,
-    /// Crank angle at the start time, rad.
-    pub crank_start_angle: f64,
-    /// Time constant with which the crank speed follows the set-point, s (0 = directly).
-    pub speed_time_constant: f64,
-    pub rel_tol: f64,
-    pub abs_tol: f64,
-    pub max_order: i32,
-    pub stability_limit_detection: bool,
-    /// Start on the periodic steady state at the start inputs ([`periodic`]) instead of the
-    /// static equilibrium with a fade-in.
-    pub periodic_start: bool,
-    /// Used by scene 2 only.
-    pub chassis: BodyOptions,
-    /// Which of the vehicle settings above (by FMU parameter name: `engine.load`,
-    /// `excitation.fadeInTime`, `crank.startAngle`, `crank.speedTimeConstant`, `effects.*`)
-    /// replace the vehicle configuration's values. `None`: all of them (the Rust API's default:
-    /// these settings are the whole truth). The FMU passes the parameters the master set
-    /// explicitly, so a configuration file keeps its own values for the others.
-    pub explicit: Option<std::collections::BTreeSet<String>>,
-}
-
-impl Default for Settings {
-    /// The start values of the variable table, the built-in vehicle.
-    fn default() -> Self {
-        Settings::from_parameters(&crate::variables::Parameters::default(), None)
-            .expect("the variable table's start values are valid")
-    }
-}
-
-impl Settings {
-    /// The settings the FMU parameters describe, with the vehicle from `config_file` (`None`:
-    /// the built-in one). The experiment's tolerance and which parameters were set explicitly
-    /// are the FMI layer's to add.
-    pub fn from_parameters(
-        p: &crate::variables::Parameters,
-        config_file: Option<PathBuf>,
-    ) -> Result<Settings, String> {
-        Ok(Settings {
-            scene: p.scene,
-            config_file,
-            effects: p.effects(),
-            gas_load: p.engine_load,
-            fade_in_time: p.fade_in_time,
-            crank_start_angle: p.crank_start_angle,
-            speed_time_constant: p.crank_speed_time_constant,
-            rel_tol: p.solver_rel_tol,
-            abs_tol: p.solver_abs_tol,
-            max_order: p.solver_max_order,
-            stability_limit_detection: p.solver_stability_limit_detection,
-            periodic_start: p.initialization_periodic,
-            chassis: p.body_options()?,
-            explicit: None,
-        })
-    }
-}
 
 /// Results at a communication point, SI units, vehicle frame.
 #[derive(Debug, Clone, Copy, PartialEq, Default)]
@@ -129,9 +63,10 @@ pub struct Counters {
 }
 
 /// A step that could not be completed; the simulation stays at `reached`.
-#[derive(Debug, Clone, PartialEq)]
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+#[error("{error} (reached t = {reached} s)")]
 pub struct StepFailure {
-    pub message: String,
+    pub error: Error,
     pub reached: f64,
 }
 
@@ -141,6 +76,8 @@ pub struct Simulation {
     scene: CoupledModel,
     /// How the model was built (for the log).
     notes: Vec<String>,
+    /// Configuration values the settings replaced.
+    replaced: Vec<Replaced>,
     integrator: Bdf,
     restarts: u64,
     /// Communication time and the state there. The integrator steps past communication points
@@ -159,7 +96,7 @@ pub struct Simulation {
 impl Simulation {
     /// Builds the scene, finds its static equilibrium under the inputs at `t0` and starts the
     /// integrator there, or, with [`Settings::periodic_start`], on the periodic steady state.
-    pub fn new(settings: &Settings, t0: f64, inputs: &Inputs) -> Result<Simulation, String> {
+    pub fn new(settings: &Settings, t0: f64, inputs: &Inputs) -> Result<Simulation, Error> {
         let mut sim = Self::at_static_equilibrium(settings, t0, inputs)?;
         if settings.periodic_start {
             sim.start_on_periodic_orbit()?;
@@ -172,12 +109,12 @@ impl Simulation {
         settings: &Settings,
         t0: f64,
         inputs: &Inputs,
-    ) -> Result<Simulation, String> {
+    ) -> Result<Simulation, Error> {
         inputs.validate()?;
         let mut options = BdfOptions {
             rtol: settings.rel_tol,
             atol: Tolerance::Scalar(settings.abs_tol),
-            max_order: usize::try_from(settings.max_order).unwrap_or(0),
+            max_order: settings.max_order,
             stability_limit_detection: settings.stability_limit_detection,
             // The coupled model's Jacobian changes slowly over ~50 steps (one Jacobian per ~0.4
             // revolution at CVODE's 50): at 100 the Newton iterations and factorisations per
@@ -186,7 +123,11 @@ impl Simulation {
             jacobian_max_age: 100,
             ..BdfOptions::default()
         };
-        let (mut scene, notes) = scene::build_model(settings)?;
+        let scene::BuiltModel {
+            model: mut scene,
+            replaced,
+            notes,
+        } = scene::build_model(settings)?;
         scene::apply_inputs(&mut scene, inputs)?;
         options.magnitude_cap = Some(scene.magnitude_caps());
         let y0 = scene.static_equilibrium(t0).map_err(|e| e.to_string())?;
@@ -194,6 +135,7 @@ impl Simulation {
         Ok(Simulation {
             scene,
             notes,
+            replaced,
             integrator,
             time: t0,
             equilibrium: y0.clone(),
@@ -207,7 +149,7 @@ impl Simulation {
 
     /// Moves the start onto the periodic orbit at the current inputs: excitation in full from
     /// the start time, state from [`periodic::periodic_start`], integrator restarted there.
-    fn start_on_periodic_orbit(&mut self) -> Result<(), String> {
+    fn start_on_periodic_orbit(&mut self) -> Result<(), Error> {
         let t0 = self.time;
         let fade_in = self.scene.powertrain().config().excitation_fade_in;
         self.scene
@@ -235,16 +177,21 @@ impl Simulation {
         self.notes.clone()
     }
 
+    /// The vehicle configuration's values that the settings replaced.
+    pub fn replaced(&self) -> &[Replaced] {
+        &self.replaced
+    }
+
     /// Natural modes of the model linearised at its static equilibrium under the initial inputs
     /// (engine at rest, mounts at their operating points), ascending in frequency: the coupled
     /// frequencies of a Campbell diagram. Independent of how far the simulation has run.
-    pub fn natural_modes(&self) -> Result<Vec<crate::model::Mode>, String> {
+    pub fn natural_modes(&self) -> Result<Vec<crate::model::Mode>, Error> {
         let mut model = self.scene.clone();
         scene::apply_inputs(&mut model, &self.initial_inputs)?;
         model
             .set_fade_start(self.initial_time)
             .map_err(|e| e.to_string())?;
-        model.modes(&self.equilibrium)
+        Ok(model.modes(&self.equilibrium)?)
     }
 
     /// The coupled model being integrated.
@@ -270,7 +217,7 @@ impl Simulation {
     /// Applies inputs valid from the current time on. Returns whether an input jumped, in which
     /// case the integrator restarted at order 1 from the state at the communication time (its
     /// history, and any step it took past that time, describe the old inputs).
-    pub fn set_inputs(&mut self, inputs: &Inputs) -> Result<bool, String> {
+    pub fn set_inputs(&mut self, inputs: &Inputs) -> Result<bool, Error> {
         inputs.validate()?;
         let t = self.time;
         // With the speed follower the crank speed is a state: a set-point jump bends its
@@ -291,7 +238,7 @@ impl Simulation {
                 // Leave everything as it was: the old inputs still describe the integrator.
                 scene::apply_inputs(&mut self.scene, &previous)?;
                 self.inputs = previous;
-                return Err(e.to_string());
+                return Err(Error::Model(e.to_string()));
             }
             self.restarts += 1;
         }
@@ -321,14 +268,14 @@ impl Simulation {
     pub fn advance_to(&mut self, t: f64) -> Result<(), StepFailure> {
         if t < self.time {
             return Err(StepFailure {
-                message: format!("{t} is behind the current time {}", self.time),
+                error: Error::Model(format!("{t} is behind the current time {}", self.time)),
                 reached: self.time,
             });
         }
         self.integrator
             .advance_past(&mut self.scene, t, &mut self.state)
             .map_err(|e| StepFailure {
-                message: e.to_string(),
+                error: Error::Model(e.to_string()),
                 reached: self.integrator.t().min(t),
             })?;
         self.time = t;
@@ -337,7 +284,7 @@ impl Simulation {
 
     /// Outputs at the communication time, with accelerations from one evaluation of the
     /// equations of motion.
-    pub fn outputs(&mut self) -> Result<Outputs, String> {
+    pub fn outputs(&mut self) -> Result<Outputs, Error> {
         scene::outputs(&self.scene, self.time, &self.state)
     }
 
@@ -369,10 +316,12 @@ impl Simulation {
 
     /// Rebuilds a simulation from its settings and [`Simulation::dynamic_state`]; continuing it
     /// reproduces the original run bit for bit.
-    pub fn restore(settings: &Settings, saved: &SimulationState) -> Result<Simulation, String> {
+    pub fn restore(settings: &Settings, saved: &SimulationState) -> Result<Simulation, Error> {
         let times = [saved.initial_time, saved.time, saved.fade_start];
         if times.iter().chain(&saved.state).any(|x| !x.is_finite()) {
-            return Err("simulation state holds a non-finite time or state".into());
+            return Err(Error::Model(
+                "simulation state holds a non-finite time or state".into(),
+            ));
         }
         saved.initial_inputs.validate()?;
         saved.inputs.validate()?;
@@ -382,11 +331,11 @@ impl Simulation {
             .set_fade_start(saved.fade_start)
             .map_err(|e| e.to_string())?;
         if saved.state.len() != sim.state.len() {
-            return Err(format!(
+            return Err(Error::Model(format!(
                 "simulation state has {} states, this model {}",
                 saved.state.len(),
                 sim.state.len()
-            ));
+            )));
         }
         sim.integrator
             .restore(&saved.integrator)

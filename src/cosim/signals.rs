@@ -56,29 +56,21 @@ impl Inputs {
     }
 
     /// Physical admissibility of the input values (finite values are checked by the caller).
-    pub fn validate(&self) -> Result<(), String> {
-        if self.crank_speed.value < 0.0 {
-            return Err(format!(
-                "engine speed {} rpm is negative",
-                self.crank_speed.value / super::RPM_TO_RAD_PER_S
-            ));
+    pub fn validate(&self) -> Result<(), super::Error> {
+        use super::error::Input;
+        let bad = |input, value, rule| Err(super::Error::Input { input, value, rule });
+        if self.crank_speed.value.is_nan() || self.crank_speed.value < 0.0 {
+            return bad(Input::CrankSpeed, self.crank_speed.value, "is negative");
         }
         for (i, s) in self.stiffness_scale.iter().enumerate() {
             if s.value.is_nan() || s.value < 0.0 {
-                return Err(format!(
-                    "mount[{}].stiffnessScale = {} must be >= 0 (0: the mount carries nothing)",
-                    i + 1,
-                    s.value
-                ));
+                let rule = "must be >= 0 (0: the mount carries nothing)";
+                return bad(Input::StiffnessScale(i), s.value, rule);
             }
         }
         for (i, s) in self.damping_scale.iter().enumerate() {
             if s.value.is_nan() || s.value < 0.0 {
-                return Err(format!(
-                    "mount[{}].dampingScale = {} must be >= 0",
-                    i + 1,
-                    s.value
-                ));
+                return bad(Input::DampingScale(i), s.value, "must be >= 0");
             }
         }
         Ok(())
@@ -141,10 +133,13 @@ mod tests {
         assert!(a.validate().is_ok());
         let mut bad = a;
         bad.stiffness_scale[2].value = -1.0;
-        assert!(bad
-            .validate()
-            .unwrap_err()
-            .contains("mount[3].stiffnessScale"));
+        assert!(matches!(
+            bad.validate(),
+            Err(crate::cosim::Error::Input {
+                input: crate::cosim::error::Input::StiffnessScale(2),
+                ..
+            })
+        ));
         bad = a;
         bad.damping_scale[0].value = -0.5;
         assert!(bad.validate().is_err());

@@ -1,6 +1,10 @@
-//! The exported FMI 2.0 functions. Each one checks its pointers, catches panics (a panic must
-//! never unwind into the C caller) and delegates to [`Instance`]. This file is the only place
-//! with `unsafe` in the crate: every block says why it is sound.
+//! The exported FMI 2.0 functions. Every entry point that takes an instance passes one guard,
+//! [`entry`]: the instance pointer is checked, panics are caught (a panic must never unwind into
+//! the C caller), the call is checked against the state machine ([`super::state`]), and a
+//! refusal is logged once, naming the function. Inside, C arguments become slices ([`array`],
+//! [`array_mut`], null pointers refused), value references become typed positions through the
+//! one table ([`super::values::indices`]), and the instance does the rest. This file is the only
+//! place with `unsafe` in the crate: every block says why it is sound.
 
 #![allow(non_snake_case)]
 #![allow(clippy::not_unsafe_ptr_arg_deref)] // the C ABI hands us raw pointers by design
@@ -10,12 +14,13 @@ use std::panic::{catch_unwind, AssertUnwindSafe};
 
 use fmi_sys::fmi2::*;
 
-use super::instance::{Core, Instance, Status};
+use super::instance::{Core, Instance, Outcome, Status};
 use super::logger::{Level, Logger};
 use super::snapshot;
-use super::state::{self, Phase};
+use super::state::{self, Mask, Phase};
 use super::uri::resource_path;
-use super::variables::{BOOLEANS, GUID, INTEGERS, REALS, STRINGS, VR_BASE};
+use super::values::{indices, Typed};
+use super::variables::{LogCategory, GUID};
 
 /// Marks a live instance allocated by `fmi2Instantiate`; cleared when freed, so a stale or
 /// foreign pointer is recognised with high probability instead of being used.
@@ -39,20 +44,29 @@ struct StateHandle {
     core: Core,
 }
 
-/// Index of the state behind `state` among an instance's `states`.
-fn state_index(states: &[Box<StateHandle>], state: fmi2FMUstate) -> Option<usize> {
-    states
-        .iter()
-        .position(|s| std::ptr::eq(&**s, state as *const StateHandle))
-}
+impl Handle {
+    /// The state behind `state`, if this instance handed it out.
+    fn state(&self, state: fmi2FMUstate) -> Result<usize, String> {
+        self.states
+            .iter()
+            .position(|s| std::ptr::eq(&**s, state as *const StateHandle))
+            .ok_or_else(|| "not an FMU state of this instance".to_owned())
+    }
 
-/// Keeps `core` as a new state among `states` and returns its handle.
-#[allow(clippy::vec_box)] // the box gives the state the stable address the master holds
-fn new_state(states: &mut Vec<Box<StateHandle>>, core: Core) -> fmi2FMUstate {
-    let mut boxed = Box::new(StateHandle { core });
-    let ptr: *mut StateHandle = &mut *boxed;
-    states.push(boxed);
-    ptr as fmi2FMUstate
+    /// Puts `core` into the state slot the master passed: a new state for a null slot, the
+    /// same state overwritten for one of ours.
+    fn store_state(&mut self, slot: &mut fmi2FMUstate, core: Core) -> Outcome {
+        if slot.is_null() {
+            let mut boxed = Box::new(StateHandle { core });
+            let ptr: *mut StateHandle = &mut *boxed;
+            self.states.push(boxed);
+            *slot = ptr as fmi2FMUstate;
+        } else {
+            let i = self.state(*slot)?;
+            self.states[i].core = core;
+        }
+        Ok(Status::Ok)
+    }
 }
 
 fn status(s: Status) -> fmi2Status {
@@ -65,9 +79,16 @@ fn status(s: Status) -> fmi2Status {
     }
 }
 
-/// Runs `f` on the instance behind `c`, turning a null/stale pointer into fmi2Error and a panic
-/// into fmi2Fatal (the instance is then unusable).
-fn with_handle(c: fmi2Component, f: impl FnOnce(&mut Handle) -> Status) -> fmi2Status {
+/// The guard of every entry point with an instance: runs `body` on the instance behind `c` if
+/// `function` may be called in its phase (`mask`). A null or stale pointer gives fmi2Error, a
+/// refusal is logged as "`function`: reason" with fmi2Error, a panic gives fmi2Fatal (the
+/// instance is then unusable), and in the fatal phase only fmi2FreeInstance is allowed.
+fn entry(
+    c: fmi2Component,
+    function: &'static str,
+    mask: Mask,
+    body: impl FnOnce(&mut Handle) -> Outcome,
+) -> fmi2Status {
     if c.is_null() {
         return fmi2Status_fmi2Error;
     }
@@ -79,7 +100,31 @@ fn with_handle(c: fmi2Component, f: impl FnOnce(&mut Handle) -> Status) -> fmi2S
     if handle.live != LIVE {
         return fmi2Status_fmi2Error;
     }
-    match catch_unwind(AssertUnwindSafe(|| f(handle))) {
+    let result = catch_unwind(AssertUnwindSafe(|| {
+        let inst = &handle.instance;
+        inst.logger.log(Level::Info, LogCategory::Calls, function);
+        let phase = inst.phase();
+        if phase == Phase::Fatal {
+            inst.logger.log(
+                Level::Fatal,
+                LogCategory::StatusError,
+                &format!("{function}: the instance is in a fatal state; only fmi2FreeInstance is allowed"),
+            );
+            return Status::Fatal;
+        }
+        if !mask.allows(phase) {
+            inst.log_error(&format!("{function} is not allowed in phase {phase:?}"));
+            return Status::Error;
+        }
+        match body(handle) {
+            Ok(s) => s,
+            Err(message) => {
+                handle.instance.log_error(&format!("{function}: {message}"));
+                Status::Error
+            }
+        }
+    }));
+    match result {
         Ok(s) => status(s),
         Err(panic) => {
             let what = panic
@@ -91,8 +136,8 @@ fn with_handle(c: fmi2Component, f: impl FnOnce(&mut Handle) -> Status) -> fmi2S
                 handle.instance.core.phase = Phase::Fatal;
                 handle.instance.logger.log(
                     Level::Fatal,
-                    "logStatusError",
-                    &format!("internal error (bug), the instance is unusable: {what}"),
+                    LogCategory::StatusError,
+                    &format!("{function}: internal error (bug), the instance is unusable: {what}"),
                 );
             }));
             fmi2Status_fmi2Fatal
@@ -100,32 +145,43 @@ fn with_handle(c: fmi2Component, f: impl FnOnce(&mut Handle) -> Status) -> fmi2S
     }
 }
 
-/// A slice from a C array of `n` elements; `None` for a null pointer with `n > 0`.
+/// A slice from the C array `name` of `n` elements; a null pointer with `n > 0` is refused.
 ///
 /// # Safety
-/// `ptr` must point to `n` initialised elements that stay valid and unaliased for `'a`.
-unsafe fn slice<'a, T>(ptr: *const T, n: usize) -> Option<&'a [T]> {
+/// `ptr` must be null or point to `n` initialised elements that stay valid and unaliased for `'a`.
+unsafe fn array<'a, T>(ptr: *const T, n: usize, name: &str) -> Result<&'a [T], String> {
     if n == 0 {
-        Some(&[])
+        Ok(&[])
     } else if ptr.is_null() {
-        None
+        Err(format!("argument {name} is NULL"))
     } else {
         // SAFETY: guaranteed by the caller's contract above.
-        Some(unsafe { std::slice::from_raw_parts(ptr, n) })
+        Ok(unsafe { std::slice::from_raw_parts(ptr, n) })
     }
 }
 
+/// As [`array`], for writing.
+///
 /// # Safety
-/// As [`slice`], for writing.
-unsafe fn slice_mut<'a, T>(ptr: *mut T, n: usize) -> Option<&'a mut [T]> {
+/// As [`array`], and the elements must be writable.
+unsafe fn array_mut<'a, T>(ptr: *mut T, n: usize, name: &str) -> Result<&'a mut [T], String> {
     if n == 0 {
-        Some(&mut [])
+        Ok(&mut [])
     } else if ptr.is_null() {
-        None
+        Err(format!("argument {name} is NULL"))
     } else {
         // SAFETY: guaranteed by the caller's contract above.
-        Some(unsafe { std::slice::from_raw_parts_mut(ptr, n) })
+        Ok(unsafe { std::slice::from_raw_parts_mut(ptr, n) })
     }
+}
+
+/// The single writable element behind `ptr`; a null pointer is refused.
+///
+/// # Safety
+/// `ptr` must be null or point to a writable `T` valid for `'a`.
+unsafe fn place<'a, T>(ptr: *mut T, name: &str) -> Result<&'a mut T, String> {
+    // SAFETY: guaranteed by the caller's contract above.
+    unsafe { ptr.as_mut() }.ok_or_else(|| format!("argument {name} is NULL"))
 }
 
 /// A Rust string from a C string; `None` for null or invalid UTF-8.
@@ -143,8 +199,18 @@ unsafe fn text(ptr: fmi2String) -> Option<String> {
         .map(str::to_owned)
 }
 
-fn null_argument(inst: &Instance, function: &str) -> Status {
-    inst.error(&format!("{function}: a required pointer argument is NULL"))
+/// Strings from the C array `name` of `n` C strings; null or non-UTF-8 entries are refused.
+///
+/// # Safety
+/// As [`array`], each entry null or a NUL-terminated string valid for the call.
+unsafe fn texts(ptr: *const fmi2String, n: usize, name: &str) -> Result<Vec<String>, String> {
+    // SAFETY: the caller's contract.
+    let raw = unsafe { array(ptr, n, name) }?;
+    raw.iter()
+        // SAFETY: each entry is null or NUL-terminated, by the caller's contract.
+        .map(|p| unsafe { text(*p) })
+        .collect::<Option<Vec<_>>>()
+        .ok_or_else(|| format!("an entry of {name} is NULL or not UTF-8"))
 }
 
 // ----- inquiry ---------------------------------------------------------------------------------
@@ -188,7 +254,7 @@ pub extern "C" fn fmi2Instantiate(
         if instanceName.is_null() || name.is_empty() {
             logger.log(
                 Level::Error,
-                "logStatusError",
+                LogCategory::StatusError,
                 "fmi2Instantiate: instanceName is missing",
             );
             return std::ptr::null_mut();
@@ -196,7 +262,7 @@ pub extern "C" fn fmi2Instantiate(
         if fmuType != fmi2Type_fmi2CoSimulation {
             logger.log(
                 Level::Error,
-                "logStatusError",
+                LogCategory::StatusError,
                 "fmi2Instantiate: this FMU supports co-simulation only (fmuType must be fmi2CoSimulation)",
             );
             return std::ptr::null_mut();
@@ -206,7 +272,7 @@ pub extern "C" fn fmi2Instantiate(
         if guid != GUID {
             logger.log(
                 Level::Error,
-                "logStatusError",
+                LogCategory::StatusError,
                 &format!("fmi2Instantiate: GUID \"{guid}\" does not match this FMU's {GUID}"),
             );
             return std::ptr::null_mut();
@@ -216,7 +282,7 @@ pub extern "C" fn fmi2Instantiate(
             None => {
                 logger.log(
                     Level::Warning,
-                    "logStatusWarning",
+                    LogCategory::StatusWarning,
                     "fmi2Instantiate: no resource location given; the built-in vehicle is used unless configFile names an absolute path",
                 );
                 None
@@ -226,7 +292,7 @@ pub extern "C" fn fmi2Instantiate(
                 Ok(p) => {
                     logger.log(
                         Level::Error,
-                        "logStatusError",
+                        LogCategory::StatusError,
                         &format!("fmi2Instantiate: the resource location {uri} names {}, which is not a directory", p.display()),
                     );
                     return std::ptr::null_mut();
@@ -234,7 +300,7 @@ pub extern "C" fn fmi2Instantiate(
                 Err(m) => {
                     logger.log(
                         Level::Error,
-                        "logStatusError",
+                        LogCategory::StatusError,
                         &format!("fmi2Instantiate: {m}"),
                     );
                     return std::ptr::null_mut();
@@ -278,24 +344,13 @@ pub extern "C" fn fmi2SetDebugLogging(
     nCategories: usize,
     categories: *const fmi2String,
 ) -> fmi2Status {
-    with_handle(c, |h| {
-        let inst = &mut h.instance;
-        if let Err(s) = inst.allowed("fmi2SetDebugLogging", state::ANY_BUT_FATAL) {
-            return s;
-        }
+    entry(c, "fmi2SetDebugLogging", state::SET_DEBUG_LOGGING, |h| {
         // SAFETY: FMI passes an array of nCategories C strings.
-        let Some(raw) = (unsafe { slice(categories, nCategories) }) else {
-            return null_argument(inst, "fmi2SetDebugLogging");
-        };
-        // SAFETY: each entry is a NUL-terminated string (or null, rejected below).
-        let names: Option<Vec<String>> = raw.iter().map(|p| unsafe { text(*p) }).collect();
-        let Some(names) = names else {
-            return inst.error("fmi2SetDebugLogging: a category name is NULL or not UTF-8");
-        };
-        match inst.logger.set_debug_logging(loggingOn != 0, &names) {
-            Ok(()) => Status::Ok,
-            Err(m) => inst.error(&format!("fmi2SetDebugLogging: {m}")),
-        }
+        let names = unsafe { texts(categories, nCategories, "categories") }?;
+        h.instance
+            .logger
+            .set_debug_logging(loggingOn != 0, &names)?;
+        Ok(Status::Ok)
     })
 }
 const _: fmi2SetDebugLoggingTYPE = Some(fmi2SetDebugLogging);
@@ -311,12 +366,8 @@ pub extern "C" fn fmi2SetupExperiment(
     stopTimeDefined: fmi2Boolean,
     stopTime: fmi2Real,
 ) -> fmi2Status {
-    with_handle(c, |h| {
-        let inst = &mut h.instance;
-        if let Err(s) = inst.allowed("fmi2SetupExperiment", state::SETUP_EXPERIMENT) {
-            return s;
-        }
-        inst.setup_experiment(
+    entry(c, "fmi2SetupExperiment", state::SETUP_EXPERIMENT, |h| {
+        h.instance.setup_experiment(
             startTime,
             (stopTimeDefined != 0).then_some(stopTime),
             (toleranceDefined != 0).then_some(tolerance),
@@ -327,146 +378,127 @@ const _: fmi2SetupExperimentTYPE = Some(fmi2SetupExperiment);
 
 #[no_mangle]
 pub extern "C" fn fmi2EnterInitializationMode(c: fmi2Component) -> fmi2Status {
-    with_handle(c, |h| {
-        let inst = &mut h.instance;
-        if let Err(s) = inst.allowed("fmi2EnterInitializationMode", state::ENTER_INITIALIZATION) {
-            return s;
-        }
-        inst.enter_initialization()
-    })
+    entry(
+        c,
+        "fmi2EnterInitializationMode",
+        state::ENTER_INITIALIZATION,
+        |h| h.instance.enter_initialization(),
+    )
 }
 const _: fmi2EnterInitializationModeTYPE = Some(fmi2EnterInitializationMode);
 
 #[no_mangle]
 pub extern "C" fn fmi2ExitInitializationMode(c: fmi2Component) -> fmi2Status {
-    with_handle(c, |h| {
-        let inst = &mut h.instance;
-        if let Err(s) = inst.allowed("fmi2ExitInitializationMode", state::EXIT_INITIALIZATION) {
-            return s;
-        }
-        inst.exit_initialization()
-    })
+    entry(
+        c,
+        "fmi2ExitInitializationMode",
+        state::EXIT_INITIALIZATION,
+        |h| h.instance.exit_initialization(),
+    )
 }
 const _: fmi2ExitInitializationModeTYPE = Some(fmi2ExitInitializationMode);
 
 #[no_mangle]
 pub extern "C" fn fmi2Terminate(c: fmi2Component) -> fmi2Status {
-    with_handle(c, |h| {
-        let inst = &mut h.instance;
-        if let Err(s) = inst.allowed("fmi2Terminate", state::TERMINATE) {
-            return s;
-        }
-        inst.terminate()
+    entry(c, "fmi2Terminate", state::TERMINATE, |h| {
+        h.instance.terminate()
     })
 }
 const _: fmi2TerminateTYPE = Some(fmi2Terminate);
 
 #[no_mangle]
 pub extern "C" fn fmi2Reset(c: fmi2Component) -> fmi2Status {
-    with_handle(c, |h| {
-        let inst = &mut h.instance;
-        if let Err(s) = inst.allowed("fmi2Reset", state::ANY_BUT_FATAL) {
-            return s;
-        }
-        inst.reset()
-    })
+    entry(c, "fmi2Reset", state::RESET, |h| h.instance.reset())
 }
 const _: fmi2ResetTYPE = Some(fmi2Reset);
 
 // ----- getting and setting values --------------------------------------------------------------
 
-/// The FMU's variables are indexed per type inside; their value references are unique across
-/// types ([`VR_BASE`]). Maps the master's value references of one type to indices, or logs the
-/// first unknown one.
-fn indices(
-    inst: &Instance,
-    function: &str,
-    type_index: usize,
-    count: usize,
-    vrs: &[fmi2ValueReference],
-) -> Result<Vec<u32>, Status> {
-    let base = VR_BASE[type_index];
-    vrs.iter()
-        .map(|&vr| {
-            vr.checked_sub(base)
-                .filter(|i| (*i as usize) < count)
-                .ok_or_else(|| inst.error(&format!("{function}: unknown value reference {vr}")))
-        })
-        .collect()
+/// `fmi2GetXXX`: the values of type `T` behind `vr`, written to `value` through `convert`.
+fn get_values<T: Typed, C>(
+    c: fmi2Component,
+    function: &'static str,
+    vr: *const fmi2ValueReference,
+    nvr: usize,
+    value: *mut C,
+    convert: impl Fn(T) -> C,
+) -> fmi2Status {
+    entry(c, function, state::GET_VALUES, |h| {
+        // SAFETY: FMI passes arrays of nvr value references and nvr values.
+        let (vrs, out) = unsafe { (array(vr, nvr, "vr")?, array_mut(value, nvr, "value")?) };
+        let read = h.instance.get::<T>(&indices::<T>(vrs)?)?;
+        for (o, x) in out.iter_mut().zip(read) {
+            *o = convert(x);
+        }
+        Ok(Status::Ok)
+    })
 }
 
-macro_rules! get_values {
-    ($fn_name:ident, $ty:ty, $check:ident, $method:ident, $zero:expr, $conv:expr, $type_index:expr, $table:ident) => {
-        #[no_mangle]
-        pub extern "C" fn $fn_name(
-            c: fmi2Component,
-            vr: *const fmi2ValueReference,
-            nvr: usize,
-            value: *mut $ty,
-        ) -> fmi2Status {
-            with_handle(c, |h| {
-                let inst = &mut h.instance;
-                // SAFETY: FMI passes arrays of nvr value references and nvr values.
-                let (Some(vrs), Some(out)) =
-                    (unsafe { slice(vr, nvr) }, unsafe { slice_mut(value, nvr) })
-                else {
-                    return null_argument(inst, stringify!($fn_name));
-                };
-                let vrs = match indices(inst, stringify!($fn_name), $type_index, $table.len(), vrs)
-                {
-                    Ok(v) => v,
-                    Err(s) => return s,
-                };
-                let mut tmp = vec![$zero; nvr];
-                let s = inst.$method(&vrs, &mut tmp);
-                if s == Status::Ok {
-                    for (o, t) in out.iter_mut().zip(tmp) {
-                        *o = $conv(t);
-                    }
-                }
-                s
-            })
-        }
-        const _: $check = Some($fn_name);
-    };
+/// `fmi2SetXXX`: the values of type `T` behind `vr`, read from `value` through `convert`.
+fn set_values<T: Typed, C: Copy>(
+    c: fmi2Component,
+    function: &'static str,
+    vr: *const fmi2ValueReference,
+    nvr: usize,
+    value: *const C,
+    convert: impl Fn(u32, C) -> Result<T, String>,
+) -> fmi2Status {
+    entry(c, function, state::SET_VALUES, |h| {
+        // SAFETY: FMI passes arrays of nvr value references and nvr values.
+        let (vrs, given) = unsafe { (array(vr, nvr, "vr")?, array(value, nvr, "value")?) };
+        let values = vrs
+            .iter()
+            .zip(given)
+            .map(|(vr, x)| convert(*vr, *x))
+            .collect::<Result<Vec<T>, String>>()?;
+        h.instance.set::<T>(&indices::<T>(vrs)?, &values)
+    })
 }
 
-get_values!(
-    fmi2GetReal,
-    fmi2Real,
-    fmi2GetRealTYPE,
-    get_real,
-    0.0f64,
-    |x: f64| x,
-    0,
-    REALS
-);
-get_values!(
-    fmi2GetInteger,
-    fmi2Integer,
-    fmi2GetIntegerTYPE,
-    get_integer,
-    0i32,
-    |x: i32| x,
-    1,
-    INTEGERS
-);
-get_values!(
-    fmi2GetBoolean,
-    fmi2Boolean,
-    fmi2GetBooleanTYPE,
-    get_boolean,
-    false,
-    |x: bool| {
-        if x {
-            fmi2True as fmi2Boolean
-        } else {
-            fmi2False as fmi2Boolean
-        }
-    },
-    2,
-    BOOLEANS
-);
+fn boolean(vr: u32, b: fmi2Boolean) -> Result<bool, String> {
+    match b {
+        0 => Ok(false),
+        1 => Ok(true),
+        other => Err(format!(
+            "value {other} for value reference {vr} is neither fmi2True (1) nor fmi2False (0)"
+        )),
+    }
+}
+
+#[no_mangle]
+pub extern "C" fn fmi2GetReal(
+    c: fmi2Component,
+    vr: *const fmi2ValueReference,
+    nvr: usize,
+    value: *mut fmi2Real,
+) -> fmi2Status {
+    get_values::<f64, _>(c, "fmi2GetReal", vr, nvr, value, |x| x)
+}
+const _: fmi2GetRealTYPE = Some(fmi2GetReal);
+
+#[no_mangle]
+pub extern "C" fn fmi2GetInteger(
+    c: fmi2Component,
+    vr: *const fmi2ValueReference,
+    nvr: usize,
+    value: *mut fmi2Integer,
+) -> fmi2Status {
+    get_values::<i32, _>(c, "fmi2GetInteger", vr, nvr, value, |x| x)
+}
+const _: fmi2GetIntegerTYPE = Some(fmi2GetInteger);
+
+#[no_mangle]
+pub extern "C" fn fmi2GetBoolean(
+    c: fmi2Component,
+    vr: *const fmi2ValueReference,
+    nvr: usize,
+    value: *mut fmi2Boolean,
+) -> fmi2Status {
+    get_values::<bool, _>(c, "fmi2GetBoolean", vr, nvr, value, |x| {
+        fmi2Boolean::from(x)
+    })
+}
+const _: fmi2GetBooleanTYPE = Some(fmi2GetBoolean);
 
 #[no_mangle]
 pub extern "C" fn fmi2GetString(
@@ -475,29 +507,18 @@ pub extern "C" fn fmi2GetString(
     nvr: usize,
     value: *mut fmi2String,
 ) -> fmi2Status {
-    with_handle(c, |h| {
+    entry(c, "fmi2GetString", state::GET_VALUES, |h| {
         // SAFETY: FMI passes arrays of nvr value references and nvr string slots.
-        let (Some(vrs), Some(out)) = (unsafe { slice(vr, nvr) }, unsafe { slice_mut(value, nvr) })
-        else {
-            return null_argument(&h.instance, "fmi2GetString");
-        };
-        let vrs = match indices(&h.instance, "fmi2GetString", 3, STRINGS.len(), vrs) {
-            Ok(v) => v,
-            Err(s) => return s,
-        };
-        let mut strings = Vec::new();
-        let s = h.instance.get_string(&vrs, &mut strings);
-        if s != Status::Ok {
-            return s;
-        }
-        h.returned_strings = strings
+        let (vrs, out) = unsafe { (array(vr, nvr, "vr")?, array_mut(value, nvr, "value")?) };
+        let read = h.instance.get::<String>(&indices::<String>(vrs)?)?;
+        h.returned_strings = read
             .iter()
             .map(|t| CString::new(t.replace('\0', "")).unwrap_or_default())
             .collect();
         for (o, t) in out.iter_mut().zip(&h.returned_strings) {
             *o = t.as_ptr();
         }
-        Status::Ok
+        Ok(Status::Ok)
     })
 }
 const _: fmi2GetStringTYPE = Some(fmi2GetString);
@@ -509,15 +530,7 @@ pub extern "C" fn fmi2SetReal(
     nvr: usize,
     value: *const fmi2Real,
 ) -> fmi2Status {
-    with_handle(c, |h| {
-        let inst = &mut h.instance;
-        // SAFETY: FMI passes arrays of nvr value references and nvr values.
-        let (Some(vrs), Some(vals)) = (unsafe { slice(vr, nvr) }, unsafe { slice(value, nvr) })
-        else {
-            return null_argument(inst, "fmi2SetReal");
-        };
-        inst.set_real(vrs, vals)
-    })
+    set_values::<f64, _>(c, "fmi2SetReal", vr, nvr, value, |_, x| Ok(x))
 }
 const _: fmi2SetRealTYPE = Some(fmi2SetReal);
 
@@ -528,18 +541,7 @@ pub extern "C" fn fmi2SetInteger(
     nvr: usize,
     value: *const fmi2Integer,
 ) -> fmi2Status {
-    with_handle(c, |h| {
-        let inst = &mut h.instance;
-        // SAFETY: FMI passes arrays of nvr value references and nvr values.
-        let (Some(vrs), Some(vals)) = (unsafe { slice(vr, nvr) }, unsafe { slice(value, nvr) })
-        else {
-            return null_argument(inst, "fmi2SetInteger");
-        };
-        match indices(inst, "fmi2SetInteger", 1, INTEGERS.len(), vrs) {
-            Ok(vrs) => inst.set_integer(&vrs, vals),
-            Err(s) => s,
-        }
-    })
+    set_values::<i32, _>(c, "fmi2SetInteger", vr, nvr, value, |_, x| Ok(x))
 }
 const _: fmi2SetIntegerTYPE = Some(fmi2SetInteger);
 
@@ -550,24 +552,7 @@ pub extern "C" fn fmi2SetBoolean(
     nvr: usize,
     value: *const fmi2Boolean,
 ) -> fmi2Status {
-    with_handle(c, |h| {
-        let inst = &mut h.instance;
-        // SAFETY: FMI passes arrays of nvr value references and nvr values.
-        let (Some(vrs), Some(vals)) = (unsafe { slice(vr, nvr) }, unsafe { slice(value, nvr) })
-        else {
-            return null_argument(inst, "fmi2SetBoolean");
-        };
-        if let Some((vr, b)) = vrs.iter().zip(vals).find(|(_, b)| **b != 0 && **b != 1) {
-            return inst.error(&format!(
-                "fmi2SetBoolean: value {b} for value reference {vr} is neither fmi2True (1) nor fmi2False (0)"
-            ));
-        }
-        let vals: Vec<bool> = vals.iter().map(|b| *b != 0).collect();
-        match indices(inst, "fmi2SetBoolean", 2, BOOLEANS.len(), vrs) {
-            Ok(vrs) => inst.set_boolean(&vrs, &vals),
-            Err(s) => s,
-        }
-    })
+    set_values::<bool, _>(c, "fmi2SetBoolean", vr, nvr, value, boolean)
 }
 const _: fmi2SetBooleanTYPE = Some(fmi2SetBoolean);
 
@@ -578,22 +563,9 @@ pub extern "C" fn fmi2SetString(
     nvr: usize,
     value: *const fmi2String,
 ) -> fmi2Status {
-    with_handle(c, |h| {
-        let inst = &mut h.instance;
-        // SAFETY: FMI passes arrays of nvr value references and nvr C strings.
-        let (Some(vrs), Some(vals)) = (unsafe { slice(vr, nvr) }, unsafe { slice(value, nvr) })
-        else {
-            return null_argument(inst, "fmi2SetString");
-        };
-        // SAFETY: each entry is a NUL-terminated string or null.
-        let strings: Option<Vec<String>> = vals.iter().map(|p| unsafe { text(*p) }).collect();
-        let Some(strings) = strings else {
-            return inst.error("fmi2SetString: a value is NULL or not UTF-8");
-        };
-        match indices(inst, "fmi2SetString", 3, STRINGS.len(), vrs) {
-            Ok(vrs) => inst.set_string(&vrs, &strings),
-            Err(s) => s,
-        }
+    set_values::<String, _>(c, "fmi2SetString", vr, nvr, value, |_, p| {
+        // SAFETY: each entry of an FMI string array is null or NUL-terminated.
+        unsafe { text(p) }.ok_or_else(|| "a value is NULL or not UTF-8".to_owned())
     })
 }
 const _: fmi2SetStringTYPE = Some(fmi2SetString);
@@ -602,67 +574,40 @@ const _: fmi2SetStringTYPE = Some(fmi2SetString);
 
 #[no_mangle]
 pub extern "C" fn fmi2GetFMUstate(c: fmi2Component, FMUstate: *mut fmi2FMUstate) -> fmi2Status {
-    with_handle(c, |h| {
-        let inst = &mut h.instance;
-        if let Err(s) = inst.allowed("fmi2GetFMUstate", state::FMU_STATE) {
-            return s;
-        }
-        if FMUstate.is_null() {
-            return null_argument(inst, "fmi2GetFMUstate");
-        }
+    entry(c, "fmi2GetFMUstate", state::FMU_STATE, |h| {
         // SAFETY: FMUstate points to a writable fmi2FMUstate slot (FMI 2.0 §2.1.8).
-        let slot = unsafe { &mut *FMUstate };
-        let core = inst.core.clone();
-        if slot.is_null() {
-            *slot = new_state(&mut h.states, core);
-        } else if let Some(i) = state_index(&h.states, *slot) {
-            h.states[i].core = core;
-        } else {
-            return inst
-                .error("fmi2GetFMUstate: the given FMU state is not one of this instance's");
-        }
-        Status::Ok
+        let slot = unsafe { place(FMUstate, "FMUstate") }?;
+        let core = h.instance.core.clone();
+        h.store_state(slot, core)
     })
 }
 const _: fmi2GetFMUstateTYPE = Some(fmi2GetFMUstate);
 
 #[no_mangle]
 pub extern "C" fn fmi2SetFMUstate(c: fmi2Component, FMUstate: fmi2FMUstate) -> fmi2Status {
-    with_handle(c, |h| {
-        let inst = &mut h.instance;
-        if let Err(s) = inst.allowed("fmi2SetFMUstate", state::FMU_STATE) {
-            return s;
-        }
-        let Some(i) = state_index(&h.states, FMUstate) else {
-            return inst.error("fmi2SetFMUstate: not an FMU state of this instance");
-        };
-        if let Err(m) = inst.check_state_fits(&h.states[i].core) {
-            return inst.error(&format!("fmi2SetFMUstate: {m}"));
-        }
-        inst.core = h.states[i].core.clone();
-        Status::Ok
+    entry(c, "fmi2SetFMUstate", state::FMU_STATE, |h| {
+        let i = h.state(FMUstate)?;
+        h.instance.check_state_fits(&h.states[i].core)?;
+        h.instance.core = h.states[i].core.clone();
+        Ok(Status::Ok)
     })
 }
 const _: fmi2SetFMUstateTYPE = Some(fmi2SetFMUstate);
 
 #[no_mangle]
 pub extern "C" fn fmi2FreeFMUstate(c: fmi2Component, FMUstate: *mut fmi2FMUstate) -> fmi2Status {
-    with_handle(c, |h| {
-        let inst = &mut h.instance;
-        if FMUstate.is_null() {
-            return Status::Ok;
-        }
-        // SAFETY: FMUstate points to a slot holding null or a state we handed out.
-        let slot = unsafe { &mut *FMUstate };
-        if slot.is_null() {
-            return Status::Ok;
-        }
-        let Some(i) = state_index(&h.states, *slot) else {
-            return inst.error("fmi2FreeFMUstate: not an FMU state of this instance");
+    entry(c, "fmi2FreeFMUstate", state::FMU_STATE, |h| {
+        // SAFETY: FMUstate is null or points to a slot holding null or a state we handed out.
+        let Some(slot) = (unsafe { FMUstate.as_mut() }) else {
+            return Ok(Status::Ok);
         };
+        if slot.is_null() {
+            return Ok(Status::Ok);
+        }
+        let i = h.state(*slot)?;
         h.states.swap_remove(i);
         *slot = std::ptr::null_mut();
-        Status::Ok
+        Ok(Status::Ok)
     })
 }
 const _: fmi2FreeFMUstateTYPE = Some(fmi2FreeFMUstate);
@@ -673,18 +618,12 @@ pub extern "C" fn fmi2SerializedFMUstateSize(
     FMUstate: fmi2FMUstate,
     size: *mut usize,
 ) -> fmi2Status {
-    with_handle(c, |h| {
-        let inst = &mut h.instance;
-        let Some(i) = state_index(&h.states, FMUstate) else {
-            return inst.error("fmi2SerializedFMUstateSize: not an FMU state of this instance");
-        };
-        let s = &h.states[i];
-        if size.is_null() {
-            return null_argument(inst, "fmi2SerializedFMUstateSize");
-        }
-        // SAFETY: size is a non-null writable usize.
-        unsafe { *size = snapshot::serialize(&s.core).len() };
-        Status::Ok
+    entry(c, "fmi2SerializedFMUstateSize", state::FMU_STATE, |h| {
+        let i = h.state(FMUstate)?;
+        // SAFETY: size points to a writable usize.
+        let size = unsafe { place(size, "size") }?;
+        *size = snapshot::serialize(&h.states[i].core).len();
+        Ok(Status::Ok)
     })
 }
 const _: fmi2SerializedFMUstateSizeTYPE = Some(fmi2SerializedFMUstateSize);
@@ -696,25 +635,19 @@ pub extern "C" fn fmi2SerializeFMUstate(
     serializedState: *mut fmi2Byte,
     size: usize,
 ) -> fmi2Status {
-    with_handle(c, |h| {
-        let inst = &mut h.instance;
-        let Some(i) = state_index(&h.states, FMUstate) else {
-            return inst.error("fmi2SerializeFMUstate: not an FMU state of this instance");
-        };
-        let s = &h.states[i];
-        let bytes = snapshot::serialize(&s.core);
+    entry(c, "fmi2SerializeFMUstate", state::FMU_STATE, |h| {
+        let i = h.state(FMUstate)?;
+        let bytes = snapshot::serialize(&h.states[i].core);
         if bytes.len() != size {
-            return inst.error(&format!(
-                "fmi2SerializeFMUstate: buffer has {size} bytes, the state needs {}",
+            return Err(format!(
+                "buffer has {size} bytes, the state needs {}",
                 bytes.len()
             ));
         }
         // SAFETY: the caller provides a writable buffer of `size` bytes.
-        let Some(out) = (unsafe { slice_mut(serializedState as *mut u8, size) }) else {
-            return null_argument(inst, "fmi2SerializeFMUstate");
-        };
+        let out = unsafe { array_mut(serializedState as *mut u8, size, "serializedState") }?;
         out.copy_from_slice(&bytes);
-        Status::Ok
+        Ok(Status::Ok)
     })
 }
 const _: fmi2SerializeFMUstateTYPE = Some(fmi2SerializeFMUstate);
@@ -726,36 +659,19 @@ pub extern "C" fn fmi2DeSerializeFMUstate(
     size: usize,
     FMUstate: *mut fmi2FMUstate,
 ) -> fmi2Status {
-    with_handle(c, |h| {
-        let inst = &mut h.instance;
-        if let Err(s) = inst.allowed("fmi2DeSerializeFMUstate", state::FMU_STATE) {
-            return s;
-        }
-        // SAFETY: the caller provides `size` readable bytes.
-        let Some(bytes) = (unsafe { slice(serializedState as *const u8, size) }) else {
-            return null_argument(inst, "fmi2DeSerializeFMUstate");
+    entry(c, "fmi2DeSerializeFMUstate", state::FMU_STATE, |h| {
+        // SAFETY: the caller provides `size` readable bytes and a writable state slot.
+        let (bytes, slot) = unsafe {
+            (
+                array(serializedState as *const u8, size, "serializedState")?,
+                place(FMUstate, "FMUstate")?,
+            )
         };
-        if FMUstate.is_null() {
-            return null_argument(inst, "fmi2DeSerializeFMUstate");
-        }
-        let core = match snapshot::deserialize(bytes, |core, dynamic| {
+        let inst = &h.instance;
+        let core = snapshot::deserialize(bytes, |core, dynamic| {
             inst.restore_simulation(core, dynamic)
-        }) {
-            Ok(core) => core,
-            Err(m) => return inst.error(&format!("fmi2DeSerializeFMUstate: {m}")),
-        };
-        // SAFETY: FMUstate points to a writable slot.
-        let slot = unsafe { &mut *FMUstate };
-        if slot.is_null() {
-            *slot = new_state(&mut h.states, core);
-        } else if let Some(i) = state_index(&h.states, *slot) {
-            h.states[i].core = core;
-        } else {
-            return inst.error(
-                "fmi2DeSerializeFMUstate: the given FMU state slot holds a state of another instance",
-            );
-        }
-        Status::Ok
+        })?;
+        h.store_state(slot, core)
     })
 }
 const _: fmi2DeSerializeFMUstateTYPE = Some(fmi2DeSerializeFMUstate);
@@ -770,11 +686,12 @@ pub extern "C" fn fmi2GetDirectionalDerivative(
     _dvKnown: *const fmi2Real,
     _dvUnknown: *mut fmi2Real,
 ) -> fmi2Status {
-    with_handle(c, |h| {
-        h.instance.error(
-            "fmi2GetDirectionalDerivative: not provided (providesDirectionalDerivative=false)",
-        )
-    })
+    entry(
+        c,
+        "fmi2GetDirectionalDerivative",
+        state::DIRECTIONAL_DERIVATIVE,
+        |_| Err("not provided (providesDirectionalDerivative=false)".into()),
+    )
 }
 const _: fmi2GetDirectionalDerivativeTYPE = Some(fmi2GetDirectionalDerivative);
 
@@ -788,18 +705,23 @@ pub extern "C" fn fmi2SetRealInputDerivatives(
     order: *const fmi2Integer,
     value: *const fmi2Real,
 ) -> fmi2Status {
-    with_handle(c, |h| {
-        let inst = &mut h.instance;
-        // SAFETY: FMI passes three arrays of nvr elements.
-        let (Some(vrs), Some(orders), Some(vals)) = (
-            unsafe { slice(vr, nvr) },
-            unsafe { slice(order, nvr) },
-            unsafe { slice(value, nvr) },
-        ) else {
-            return null_argument(inst, "fmi2SetRealInputDerivatives");
-        };
-        inst.set_real_input_derivatives(vrs, orders, vals)
-    })
+    entry(
+        c,
+        "fmi2SetRealInputDerivatives",
+        state::SET_INPUT_DERIVATIVES,
+        |h| {
+            // SAFETY: FMI passes three arrays of nvr elements.
+            let (vrs, orders, values) = unsafe {
+                (
+                    array(vr, nvr, "vr")?,
+                    array(order, nvr, "order")?,
+                    array(value, nvr, "value")?,
+                )
+            };
+            h.instance
+                .set_real_input_derivatives(&indices::<f64>(vrs)?, orders, values)
+        },
+    )
 }
 const _: fmi2SetRealInputDerivativesTYPE = Some(fmi2SetRealInputDerivatives);
 
@@ -811,16 +733,12 @@ pub extern "C" fn fmi2GetRealOutputDerivatives(
     _order: *const fmi2Integer,
     _value: *mut fmi2Real,
 ) -> fmi2Status {
-    with_handle(c, |h| {
-        let inst = &mut h.instance;
-        if let Err(s) = inst.allowed(
-            "fmi2GetRealOutputDerivatives",
-            state::GET_OUTPUT_DERIVATIVES,
-        ) {
-            return s;
-        }
-        inst.error("fmi2GetRealOutputDerivatives: not provided (maxOutputDerivativeOrder=0)")
-    })
+    entry(
+        c,
+        "fmi2GetRealOutputDerivatives",
+        state::GET_OUTPUT_DERIVATIVES,
+        |_| Err("not provided (maxOutputDerivativeOrder=0)".into()),
+    )
 }
 const _: fmi2GetRealOutputDerivativesTYPE = Some(fmi2GetRealOutputDerivatives);
 
@@ -831,7 +749,7 @@ pub extern "C" fn fmi2DoStep(
     communicationStepSize: fmi2Real,
     _noSetFMUStatePriorToCurrentPoint: fmi2Boolean,
 ) -> fmi2Status {
-    with_handle(c, |h| {
+    entry(c, "fmi2DoStep", state::DO_STEP, |h| {
         h.instance
             .do_step(currentCommunicationPoint, communicationStepSize)
     })
@@ -840,13 +758,16 @@ const _: fmi2DoStepTYPE = Some(fmi2DoStep);
 
 #[no_mangle]
 pub extern "C" fn fmi2CancelStep(c: fmi2Component) -> fmi2Status {
-    with_handle(c, |h| {
-        h.instance.error(
-            "fmi2CancelStep: no step is in progress (fmi2DoStep always completes synchronously)",
-        )
+    entry(c, "fmi2CancelStep", state::CANCEL_STEP, |_| {
+        Err("no step is in progress (fmi2DoStep always completes synchronously)".into())
     })
 }
 const _: fmi2CancelStepTYPE = Some(fmi2CancelStep);
+
+/// The status kinds without a value of the asked type.
+fn no_status(kind: fmi2StatusKind, ty: &str) -> Outcome {
+    Err(format!("status kind {kind} has no {ty} value"))
+}
 
 #[no_mangle]
 pub extern "C" fn fmi2GetStatus(
@@ -854,14 +775,8 @@ pub extern "C" fn fmi2GetStatus(
     _s: fmi2StatusKind,
     _value: *mut fmi2Status,
 ) -> fmi2Status {
-    with_handle(c, |h| {
-        let inst = &mut h.instance;
-        if let Err(s) = inst.allowed("fmi2GetStatus", state::GET_STATUS) {
-            return s;
-        }
-        inst.error(
-            "fmi2GetStatus: no asynchronous step status exists (canRunAsynchronuously=false)",
-        )
+    entry(c, "fmi2GetStatus", state::GET_STATUS, |_| {
+        Err("no asynchronous step status exists (canRunAsynchronuously=false)".into())
     })
 }
 const _: fmi2GetStatusTYPE = Some(fmi2GetStatus);
@@ -872,22 +787,13 @@ pub extern "C" fn fmi2GetRealStatus(
     s: fmi2StatusKind,
     value: *mut fmi2Real,
 ) -> fmi2Status {
-    with_handle(c, |h| {
-        let inst = &mut h.instance;
-        if let Err(st) = inst.allowed("fmi2GetRealStatus", state::GET_STATUS) {
-            return st;
-        }
-        if value.is_null() {
-            return null_argument(inst, "fmi2GetRealStatus");
-        }
+    entry(c, "fmi2GetRealStatus", state::GET_STATUS, |h| {
         if s != fmi2StatusKind_fmi2LastSuccessfulTime {
-            return inst.error(&format!(
-                "fmi2GetRealStatus: status kind {s} has no Real value"
-            ));
+            return no_status(s, "Real");
         }
-        // SAFETY: value is a non-null writable fmi2Real.
-        unsafe { *value = inst.last_successful_time() };
-        Status::Ok
+        // SAFETY: value points to a writable fmi2Real.
+        *unsafe { place(value, "value") }? = h.instance.last_successful_time();
+        Ok(Status::Ok)
     })
 }
 const _: fmi2GetRealStatusTYPE = Some(fmi2GetRealStatus);
@@ -898,14 +804,8 @@ pub extern "C" fn fmi2GetIntegerStatus(
     s: fmi2StatusKind,
     _value: *mut fmi2Integer,
 ) -> fmi2Status {
-    with_handle(c, |h| {
-        let inst = &mut h.instance;
-        if let Err(st) = inst.allowed("fmi2GetIntegerStatus", state::GET_STATUS) {
-            return st;
-        }
-        inst.error(&format!(
-            "fmi2GetIntegerStatus: status kind {s} has no Integer value"
-        ))
+    entry(c, "fmi2GetIntegerStatus", state::GET_STATUS, |_| {
+        no_status(s, "Integer")
     })
 }
 const _: fmi2GetIntegerStatusTYPE = Some(fmi2GetIntegerStatus);
@@ -916,27 +816,13 @@ pub extern "C" fn fmi2GetBooleanStatus(
     s: fmi2StatusKind,
     value: *mut fmi2Boolean,
 ) -> fmi2Status {
-    with_handle(c, |h| {
-        let inst = &mut h.instance;
-        if let Err(st) = inst.allowed("fmi2GetBooleanStatus", state::GET_STATUS) {
-            return st;
-        }
-        if value.is_null() {
-            return null_argument(inst, "fmi2GetBooleanStatus");
-        }
+    entry(c, "fmi2GetBooleanStatus", state::GET_STATUS, |h| {
         if s != fmi2StatusKind_fmi2Terminated {
-            return inst.error(&format!(
-                "fmi2GetBooleanStatus: status kind {s} has no Boolean value"
-            ));
+            return no_status(s, "Boolean");
         }
-        let terminated = if inst.core.terminated {
-            fmi2True
-        } else {
-            fmi2False
-        };
-        // SAFETY: value is a non-null writable fmi2Boolean.
-        unsafe { *value = terminated as fmi2Boolean };
-        Status::Ok
+        // SAFETY: value points to a writable fmi2Boolean.
+        *unsafe { place(value, "value") }? = fmi2Boolean::from(h.instance.core.terminated);
+        Ok(Status::Ok)
     })
 }
 const _: fmi2GetBooleanStatusTYPE = Some(fmi2GetBooleanStatus);
@@ -947,14 +833,8 @@ pub extern "C" fn fmi2GetStringStatus(
     s: fmi2StatusKind,
     _value: *mut fmi2String,
 ) -> fmi2Status {
-    with_handle(c, |h| {
-        let inst = &mut h.instance;
-        if let Err(st) = inst.allowed("fmi2GetStringStatus", state::GET_STATUS) {
-            return st;
-        }
-        inst.error(&format!(
-            "fmi2GetStringStatus: status kind {s} has no String value"
-        ))
+    entry(c, "fmi2GetStringStatus", state::GET_STATUS, |_| {
+        no_status(s, "String")
     })
 }
 const _: fmi2GetStringStatusTYPE = Some(fmi2GetStringStatus);

@@ -6,7 +6,7 @@ use fmi_sys::fmi2::{
 };
 use std::ffi::CString;
 
-use super::variables::LOG_CATEGORIES;
+use super::variables::{LogCategory, LOG_CATEGORIES};
 
 /// How serious a message is; maps to the status passed to the callback.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -71,24 +71,20 @@ impl Logger {
         Ok(())
     }
 
-    fn category_enabled(&self, category: &str) -> bool {
-        LOG_CATEGORIES
-            .iter()
-            .position(|k| *k == category)
-            .map(|i| self.enabled[i])
-            .unwrap_or(true)
+    fn category_enabled(&self, category: LogCategory) -> bool {
+        self.enabled[category as usize]
     }
 
     /// Whether a message of `level` in `category` would reach the environment (callers skip
     /// formatting a per-step message nobody reads).
-    pub fn wants(&self, level: Level, category: &str) -> bool {
+    pub fn wants(&self, level: Level, category: LogCategory) -> bool {
         let always = matches!(level, Level::Error | Level::Fatal | Level::Warning);
         always || (self.debug_logging && self.category_enabled(category) && self.callback.is_some())
     }
 
     /// Errors and warnings always reach the environment; other categories only when debug
     /// logging is on for them.
-    pub fn log(&self, level: Level, category: &str, message: &str) {
+    pub fn log(&self, level: Level, category: LogCategory, message: &str) {
         if !self.wants(level, category) {
             return;
         }
@@ -101,7 +97,7 @@ impl Logger {
             Level::Error => fmi2Status_fmi2Error,
             Level::Fatal => fmi2Status_fmi2Fatal,
         };
-        let category = sanitized(category);
+        let category = sanitized(category.name());
         let message = sanitized(message);
         // SAFETY: the callback was supplied by the environment in fmi2Instantiate and stays valid
         // for the instance's lifetime (FMI 2.0 §2.1.5). The format is the literal "%s" and the

@@ -41,8 +41,12 @@ impl Mask {
 
 use Phase::*;
 
-/// Every phase but `Fatal`.
-pub const ANY_BUT_FATAL: Mask = Mask::of(&[
+// The masks of the co-simulation state machine (FMI 2.0 §4.2.4, Table 4.2.4; the same as the
+// Modelica Reference-FMUs'). `stepInProgress` and `stepCanceled` never occur here: fmi2DoStep
+// always completes before it returns.
+
+/// fmi2SetDebugLogging: every state with an instance.
+pub const SET_DEBUG_LOGGING: Mask = Mask::of(&[
     Instantiated,
     InitializationMode,
     StepComplete,
@@ -50,10 +54,15 @@ pub const ANY_BUT_FATAL: Mask = Mask::of(&[
     Terminated,
     Error,
 ]);
+/// fmi2FreeInstance, fmi2Reset and the FMU-state functions.
+pub const ANY_INSTANCE: Mask = SET_DEBUG_LOGGING;
+pub const RESET: Mask = ANY_INSTANCE;
+pub const FMU_STATE: Mask = ANY_INSTANCE;
 pub const SETUP_EXPERIMENT: Mask = Mask::of(&[Instantiated]);
 pub const ENTER_INITIALIZATION: Mask = Mask::of(&[Instantiated]);
 pub const EXIT_INITIALIZATION: Mask = Mask::of(&[InitializationMode]);
-pub const TERMINATE: Mask = Mask::of(&[StepComplete, StepFailed, Error]);
+pub const TERMINATE: Mask = Mask::of(&[StepComplete, StepFailed]);
+/// fmi2GetReal/Integer/Boolean/String.
 pub const GET_VALUES: Mask = Mask::of(&[
     InitializationMode,
     StepComplete,
@@ -61,9 +70,13 @@ pub const GET_VALUES: Mask = Mask::of(&[
     Terminated,
     Error,
 ]);
+/// fmi2SetReal/Integer/Boolean/String (co-simulation: no event or continuous-time mode).
 pub const SET_VALUES: Mask = Mask::of(&[Instantiated, InitializationMode, StepComplete]);
+pub const DIRECTIONAL_DERIVATIVE: Mask = GET_VALUES;
 pub const SET_INPUT_DERIVATIVES: Mask = Mask::of(&[Instantiated, InitializationMode, StepComplete]);
 pub const GET_OUTPUT_DERIVATIVES: Mask = Mask::of(&[StepComplete, StepFailed, Terminated, Error]);
 pub const DO_STEP: Mask = Mask::of(&[StepComplete]);
-pub const GET_STATUS: Mask = Mask::of(&[StepComplete, StepFailed, Terminated, Error]);
-pub const FMU_STATE: Mask = ANY_BUT_FATAL;
+/// fmi2CancelStep: only in `stepInProgress`, which never occurs.
+pub const CANCEL_STEP: Mask = Mask::of(&[]);
+/// fmi2GetStatus and its typed variants.
+pub const GET_STATUS: Mask = Mask::of(&[StepComplete, StepFailed, Terminated]);

@@ -23,9 +23,70 @@ pub struct Effects {
     pub chassis_flexibility: bool,
 }
 
-impl Default for Effects {
-    /// The start values of the `effects.*` parameters.
-    fn default() -> Self {
-        crate::variables::Parameters::default().effects()
+impl Effects {
+    /// Every effect on: the full model.
+    pub const ALL: Effects = Effects {
+        gas_forces: true,
+        mass_forces: true,
+        balance_shaft: true,
+        gyroscopic: true,
+        ring_carrier_elasticity: true,
+        mount_nonlinearity: true,
+        chassis_flexibility: true,
+    };
+
+    /// The value of one switch.
+    pub fn get(&self, switch: EffectSwitch) -> bool {
+        let mut copy = *self;
+        *copy.slot(switch)
     }
+
+    /// Sets one switch.
+    pub fn set(&mut self, switch: EffectSwitch, on: bool) {
+        *self.slot(switch) = on;
+    }
+
+    fn slot(&mut self, switch: EffectSwitch) -> &mut bool {
+        match switch {
+            EffectSwitch::GasForces => &mut self.gas_forces,
+            EffectSwitch::MassForces => &mut self.mass_forces,
+            EffectSwitch::BalanceShaft => &mut self.balance_shaft,
+            EffectSwitch::Gyroscopic => &mut self.gyroscopic,
+            EffectSwitch::RingCarrierElasticity => &mut self.ring_carrier_elasticity,
+            EffectSwitch::MountNonlinearity => &mut self.mount_nonlinearity,
+            EffectSwitch::ChassisFlexibility => &mut self.chassis_flexibility,
+        }
+    }
+}
+
+impl Default for Effects {
+    /// The full model ([`Effects::ALL`]).
+    fn default() -> Self {
+        Effects::ALL
+    }
+}
+
+/// One of the [`Effects`] switches, to name it without its value.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, PartialOrd, Ord, Hash)]
+pub enum EffectSwitch {
+    GasForces,
+    MassForces,
+    BalanceShaft,
+    Gyroscopic,
+    RingCarrierElasticity,
+    MountNonlinearity,
+    ChassisFlexibility,
+}
+
+impl EffectSwitch {
+    /// Every switch, in the order of the [`Effects`] fields.
+    pub const ALL: [EffectSwitch; 7] = [
+        EffectSwitch::GasForces,
+        EffectSwitch::MassForces,
+        EffectSwitch::BalanceShaft,
+        EffectSwitch::Gyroscopic,
+        EffectSwitch::RingCarrierElasticity,
+        EffectSwitch::MountNonlinearity,
+        EffectSwitch::ChassisFlexibility,
+    ];
 }

@@ -20,12 +20,16 @@ pub struct SpeedFollower {
     pub time_constant: f64,
 }
 
+impl SpeedFollower {
+    /// The default time constant, 5 ms: a set-point step settles in about 30 ms, far faster than
+    /// any engine speed change a drivetrain produces, far slower than the integrator's steps.
+    pub const DEFAULT_TIME_CONSTANT: f64 = 0.005;
+}
+
 impl Default for SpeedFollower {
-    /// `crank.speedTimeConstant`'s start value, 5 ms: a set-point step settles in about 30 ms, far faster than any engine speed change a
-    /// drivetrain produces, far slower than the integrator's steps.
     fn default() -> Self {
         Self {
-            time_constant: crate::variables::Parameters::default().crank_speed_time_constant,
+            time_constant: Self::DEFAULT_TIME_CONSTANT,
         }
     }
 }

@@ -49,7 +49,7 @@ pub use coupled::{
     mode_table, CoupledModel, Direction, Evaluation, Mode, ModeKind, ModelError, ModelSnapshot,
     Outputs, StaticsError,
 };
-pub use effects::Effects;
+pub use effects::{EffectSwitch, Effects};
 pub use follower::SpeedFollower;
 pub use inputs::{InputError, ModelInputs, RampInput};
 pub use mount::{MountConfig, MountCurve};

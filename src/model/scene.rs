@@ -28,6 +28,27 @@ pub enum SceneKind {
     Body,
 }
 
+impl SceneKind {
+    /// The scene by its number in the paper's Table 1 (1: rigid ground, 2: elastic body).
+    pub fn from_number(number: i32) -> Result<SceneKind, String> {
+        match number {
+            1 => Ok(SceneKind::Ground),
+            2 => Ok(SceneKind::Body),
+            other => Err(format!(
+                "scene {other} does not exist (1: engine on rigid ground, 2: engine in the elastic chassis)"
+            )),
+        }
+    }
+
+    /// The scene's number in the paper's Table 1.
+    pub fn number(self) -> i32 {
+        match self {
+            SceneKind::Ground => 1,
+            SceneKind::Body => 2,
+        }
+    }
+}
+
 /// What the scene needs of the body: mode selection, interface, damping, cache.
 #[derive(Debug, Clone, PartialEq)]
 pub struct BodyOptions {
@@ -51,11 +72,80 @@ pub struct BodyOptions {
 }
 
 impl Default for BodyOptions {
-    /// The start values of the `chassis.*` and `scene.*` parameters.
+    /// The paper's question: engine orders up to 4.5 at up to 2500 rpm (an automatic cut-off of
+    /// 225 Hz), translational interface, the ADAMS damping table, the body as designed, cached.
     fn default() -> Self {
-        crate::variables::Parameters::default()
-            .body_options()
-            .expect("the variable table's start values are valid")
+        BodyOptions {
+            mode_cutoff_hz: 0.0,
+            max_modes: 0,
+            max_rpm: 2500.0,
+            max_engine_order: 4.5,
+            interface_rotations: false,
+            modal_damping_scale: 1.0,
+            stiffening_bar: false,
+            stiff_front_plate: false,
+            cache: CacheSetting::Default,
+        }
+    }
+}
+
+/// One of the [`BodyOptions`], to name it in an error without its value.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum BodyOption {
+    ModeCutoff,
+    MaxModes,
+    MaxRpm,
+    MaxEngineOrder,
+    InterfaceRotations,
+    ModalDampingScale,
+    StiffeningBar,
+    StiffFrontPlate,
+    Cache,
+}
+
+impl std::fmt::Display for BodyOption {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        let field = match self {
+            BodyOption::ModeCutoff => "mode_cutoff_hz",
+            BodyOption::MaxModes => "max_modes",
+            BodyOption::MaxRpm => "max_rpm",
+            BodyOption::MaxEngineOrder => "max_engine_order",
+            BodyOption::InterfaceRotations => "interface_rotations",
+            BodyOption::ModalDampingScale => "modal_damping_scale",
+            BodyOption::StiffeningBar => "stiffening_bar",
+            BodyOption::StiffFrontPlate => "stiff_front_plate",
+            BodyOption::Cache => "cache",
+        };
+        write!(f, "body option {field}")
+    }
+}
+
+/// Why a scene could not be built.
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+pub enum SceneError {
+    /// A body option is outside its domain or does not apply to this vehicle's body.
+    #[error("{option} = {value} {rule}")]
+    Option {
+        option: BodyOption,
+        value: String,
+        rule: String,
+    },
+    /// The vehicle, its body or its reduction (in the configuration's terms).
+    #[error("{0}")]
+    Model(String),
+}
+
+impl From<String> for SceneError {
+    fn from(message: String) -> Self {
+        SceneError::Model(message)
+    }
+}
+
+fn option_error(option: BodyOption, value: impl std::fmt::Display, rule: &str) -> SceneError {
+    SceneError::Option {
+        option,
+        value: value.to_string(),
+        rule: rule.to_owned(),
     }
 }
 
@@ -70,37 +160,44 @@ impl BodyOptions {
     }
 
     /// Refuses the options that modify the procedural chassis for a body that is `what`.
-    fn procedural_only(&self, what: &str) -> Result<(), String> {
-        for (set, name) in [
-            (self.stiffening_bar, "chassis.stiffeningBar"),
-            (self.stiff_front_plate, "chassis.stiffFrontPlate"),
+    fn procedural_only(&self, what: &str) -> Result<(), SceneError> {
+        for (set, option) in [
+            (self.stiffening_bar, BodyOption::StiffeningBar),
+            (self.stiff_front_plate, BodyOption::StiffFrontPlate),
         ] {
             if set {
-                return Err(format!(
-                    "{name} applies to the procedural body only; this vehicle's body is {what}"
+                return Err(option_error(
+                    option,
+                    true,
+                    &format!("applies to the procedural body only; this vehicle's body is {what}"),
                 ));
             }
         }
         Ok(())
     }
 
-    fn validate(&self) -> Result<(), String> {
+    /// Checks every option against its domain.
+    pub fn validate(&self) -> Result<(), SceneError> {
         if !(self.mode_cutoff_hz.is_finite() && self.mode_cutoff_hz >= 0.0) {
-            return Err(format!(
-                "chassis.modeCutoff = {} Hz must be >= 0 and finite (0: automatic)",
-                self.mode_cutoff_hz
+            return Err(option_error(
+                BodyOption::ModeCutoff,
+                format!("{} Hz", self.mode_cutoff_hz),
+                "must be >= 0 and finite (0: automatic)",
             ));
         }
-        if !(self.max_rpm > 0.0 && self.max_engine_order > 0.0 && self.cutoff_hz().is_finite()) {
-            return Err(format!(
-                "scene.maxRpm = {} and scene.maxEngineOrder = {} must be positive",
-                self.max_rpm, self.max_engine_order
-            ));
+        for (option, value) in [
+            (BodyOption::MaxRpm, self.max_rpm),
+            (BodyOption::MaxEngineOrder, self.max_engine_order),
+        ] {
+            if !(value > 0.0 && value.is_finite()) {
+                return Err(option_error(option, value, "must be positive and finite"));
+            }
         }
         if !(self.modal_damping_scale.is_finite() && self.modal_damping_scale >= 0.0) {
-            return Err(format!(
-                "chassis.modalDampingScale = {} must be >= 0 and finite",
-                self.modal_damping_scale
+            return Err(option_error(
+                BodyOption::ModalDampingScale,
+                self.modal_damping_scale,
+                "must be >= 0 and finite",
             ));
         }
         Ok(())
@@ -118,7 +215,7 @@ pub fn build(
     vehicle: &VehicleConfig,
     scene: SceneKind,
     options: &BodyOptions,
-) -> Result<Built, String> {
+) -> Result<Built, SceneError> {
     vehicle.validate().map_err(|e| e.to_string())?;
     let (body, notes) = match scene {
         SceneKind::Ground => (ReducedChassis::rigid_ground(), Vec::new()),
@@ -136,7 +233,7 @@ pub fn build(
 pub fn reduction_spec(
     vehicle: &VehicleConfig,
     options: &BodyOptions,
-) -> Result<(ReductionSpec, String), String> {
+) -> Result<(ReductionSpec, String), SceneError> {
     options.validate()?;
     let (chassis, deck) = match &vehicle.body {
         BodyConfig::Procedural { chassis } => (chassis.as_ref().clone(), None),
@@ -152,7 +249,9 @@ pub fn reduction_spec(
             (ChassisConfig::default(), Some(deck))
         }
         BodyConfig::Reduced { .. } => {
-            return Err("the vehicle's body is already reduced".into());
+            return Err(SceneError::Model(
+                "the vehicle's body is already reduced".into(),
+            ));
         }
     };
     let interface = vehicle.interface_nodes().map_err(|e| e.to_string())?;
@@ -171,7 +270,7 @@ pub fn reduction_spec(
     } else {
         let cutoff = options.cutoff_hz();
         let origin = if options.mode_cutoff_hz > 0.0 {
-            format!("cut-off {cutoff:.0} Hz (chassis.modeCutoff)")
+            format!("cut-off {cutoff:.0} Hz (given)")
         } else {
             format!(
                 "automatic cut-off {cutoff:.0} Hz = {} rpm / 60 x order {} x margin {AUTO_CUTOFF_MARGIN}",
@@ -203,7 +302,7 @@ pub fn reduction_spec(
 pub fn body(
     vehicle: &VehicleConfig,
     options: &BodyOptions,
-) -> Result<(ReducedChassis, String), String> {
+) -> Result<(ReducedChassis, String), SceneError> {
     options.validate()?;
     let flexible = vehicle.effects.chassis_flexibility;
     let started = std::time::Instant::now();

@@ -1,7 +1,8 @@
 //! Scene-level effect switches: the automatic chassis cut-off and the rigid chassis.
 
 use engine_mount_chassis::cosim::{
-    BodyOptions, Effects, Inputs, Settings, Simulation, RPM_TO_RAD_PER_S,
+    BodyOptions, EffectSwitch, Inputs, SceneKind, Settings, Simulation, VehicleOverrides,
+    RPM_TO_RAD_PER_S,
 };
 
 /// RMS of the vertical steering-wheel acceleration over 0.3–0.5 s, and the number of states.
@@ -40,7 +41,7 @@ fn automatic_cutoff_follows_the_scene() {
     assert_eq!(explicit.cutoff_hz(), 80.0);
 
     let settings = Settings {
-        scene: 2,
+        scene: SceneKind::Body,
         chassis: BodyOptions {
             max_rpm: 1200.0,
             max_engine_order: 2.0,
@@ -57,11 +58,8 @@ fn automatic_cutoff_follows_the_scene() {
 fn a_rigid_chassis_removes_the_body_resonances_and_costs_less() {
     // 1900 rpm: the 1st order (31.7 Hz) sits on the steering-wheel modes of the elastic body.
     let elastic = Settings {
-        scene: 2,
-        effects: Effects {
-            balance_shaft: false,
-            ..Effects::default()
-        },
+        scene: SceneKind::Body,
+        vehicle: VehicleOverrides::default().with_effect(EffectSwitch::BalanceShaft, false),
         chassis: BodyOptions {
             mode_cutoff_hz: 100.0,
             ..BodyOptions::default()
@@ -69,10 +67,9 @@ fn a_rigid_chassis_removes_the_body_resonances_and_costs_less() {
         ..Settings::default()
     };
     let rigid = Settings {
-        effects: Effects {
-            chassis_flexibility: false,
-            ..elastic.effects
-        },
+        vehicle: elastic
+            .vehicle
+            .with_effect(EffectSwitch::ChassisFlexibility, false),
         ..elastic.clone()
     };
     let (a_elastic, states_elastic, _) = steering_wheel_rms(&elastic);
@@ -115,7 +112,10 @@ fn one_and_a_half_order(settings: &Settings) -> f64 {
 fn full_load_combustion_raises_the_gas_order() {
     let idle = one_and_a_half_order(&Settings::default());
     let full = one_and_a_half_order(&Settings {
-        gas_load: 1.0,
+        vehicle: VehicleOverrides {
+            gas_load: Some(1.0),
+            ..Default::default()
+        },
         ..Settings::default()
     });
     // Peak pressures 51 → 139 bar: the gas torque's 1.5 order grows by about that much.
@@ -124,11 +124,14 @@ fn full_load_combustion_raises_the_gas_order() {
         "1.5 order: full load {full} N vs idle {idle} N"
     );
     let bad = Settings {
-        gas_load: 1.5,
+        vehicle: VehicleOverrides {
+            gas_load: Some(1.5),
+            ..Default::default()
+        },
         ..Settings::default()
     };
     let Err(err) = Simulation::new(&bad, 0.0, &Inputs::steady(2000.0)) else {
         panic!("a load above 1 was accepted");
     };
-    assert!(err.contains("load"), "{err}");
+    assert!(err.to_string().contains("load"), "{err}");
 }

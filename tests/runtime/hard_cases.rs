@@ -3,7 +3,7 @@
 //! All through the co-simulation runtime the FMU uses (`cosim::Simulation`).
 
 use engine_mount_chassis::cosim::{
-    Inputs, Outputs, Settings, Signal, Simulation, RPM_TO_RAD_PER_S,
+    Inputs, Outputs, SceneKind, Settings, Signal, Simulation, VehicleOverrides, RPM_TO_RAD_PER_S,
 };
 
 /// DESIGN §8: the default powertrain weighs 180 kg; the default configuration's gravity.
@@ -44,8 +44,7 @@ fn run(
             sim.set_inputs(&at(i, t))?;
         }
         let t_next = (k + 1) as f64 * h;
-        sim.advance_to(t_next)
-            .map_err(|e| format!("{} at {}", e.message, e.reached))?;
+        sim.advance_to(t_next).map_err(|e| e.to_string())?;
         out.push((t_next, sim.outputs()?));
     }
     Ok(out)
@@ -94,7 +93,10 @@ fn tight(settings: &Settings) -> Settings {
 #[test]
 fn excitation_switched_on_instantly() {
     let s = Settings {
-        fade_in_time: 0.0,
+        vehicle: VehicleOverrides {
+            fade_in_time: Some(0.0),
+            ..Default::default()
+        },
         ..Settings::default()
     };
     let out = run(&s, inputs(2500.0, 0.0, 1.0), 1e-3, 0.3, |_| None).unwrap();
@@ -228,15 +230,12 @@ fn impossible_cases_fail_with_a_clear_error() {
     let err = Simulation::new(&s, 0.0, &inputs(800.0, 0.0, 1.0))
         .err()
         .expect("must fail");
-    assert!(err.contains("/nonexistent/engine.json"), "{err}");
+    assert!(
+        err.to_string().contains("/nonexistent/engine.json"),
+        "{err}"
+    );
     // An unknown scene.
-    let s = Settings {
-        scene: 7,
-        ..Settings::default()
-    };
-    let err = Simulation::new(&s, 0.0, &inputs(800.0, 0.0, 1.0))
-        .err()
-        .expect("must fail");
+    let err = SceneKind::from_number(7).unwrap_err();
     assert!(err.contains("scene 7"), "{err}");
     // Negative engine speed and negative stiffness scale (0 is allowed: a mount switched off).
     assert!(Simulation::new(&Settings::default(), 0.0, &inputs(-10.0, 0.0, 1.0)).is_err());
@@ -269,7 +268,7 @@ fn long_idle_does_not_drift() {
 
 fn hybrid(chassis: engine_mount_chassis::cosim::BodyOptions) -> Settings {
     Settings {
-        scene: 2,
+        scene: SceneKind::Body,
         chassis,
         ..Settings::default()
     }
@@ -357,7 +356,7 @@ fn ten_kilohertz_bracket_modes_are_integrated_stably() {
         ..BodyOptions::default()
     });
     let vehicle = vehicle_config(&settings).unwrap();
-    let (base, _) = build_model(&settings).unwrap();
+    let base = build_model(&settings).unwrap().model;
     let mut chassis = base.body().clone();
     let attached: Vec<usize> = base.body_mounts().map(|(_, _, point)| point).collect();
     let extra = 3 * attached.len();

@@ -1,11 +1,11 @@
 //! Scene 2 through the co-simulation runtime: the reduced chassis from the cache, statics,
 //! stepping, outputs and exact restore.
 
-use engine_mount_chassis::cosim::{CacheSetting, Inputs, Settings, Simulation};
+use engine_mount_chassis::cosim::{CacheSetting, Inputs, SceneKind, Settings, Simulation};
 
 fn settings(cache: &std::path::Path) -> Settings {
     let mut s = Settings {
-        scene: 2,
+        scene: SceneKind::Body,
         ..Settings::default()
     };
     s.chassis.cache = CacheSetting::Dir(cache.to_path_buf());
@@ -77,7 +77,17 @@ fn bad_chassis_settings_are_errors_naming_the_value() {
     let err = Simulation::new(&s, 0.0, &Inputs::steady(800.0))
         .err()
         .unwrap();
-    assert!(err.contains("chassis.modeCutoff = NaN"), "{err}");
+    assert!(
+        matches!(
+            &err,
+            engine_mount_chassis::cosim::Error::BodyOption {
+                option: engine_mount_chassis::cosim::BodyOption::ModeCutoff,
+                value,
+                ..
+            } if value == "NaN Hz"
+        ),
+        "{err}"
+    );
     let _ = std::fs::remove_dir_all(&dir);
 }
 

@@ -1,0 +1,357 @@
+//! The one mapping between the FMU's variables and the runtime's typed world: parameters onto
+//! [`Settings`], Real inputs onto [`cosim::Inputs`], the model's effective values back onto
+//! parameters, and the runtime's typed errors and notes into messages that name the FMU's
+//! variables. No other module names an FMU variable: they use the generated constants, and
+//! the names come from the generated table.
+
+use std::path::{Path, PathBuf};
+
+use super::input_track::InputTrack;
+use super::values::Values;
+use super::variables::{boolean, integer, real, string, Parameters, BOOLEANS, INTEGERS, REALS};
+use crate::cms::CacheSetting;
+use crate::cosim::{
+    self, BodyOption, BodyOptions, EffectSwitch, Input, Replaced, SceneKind, Settings,
+    VehicleOverrides, VehicleSetting,
+};
+
+/// The Boolean parameter of an effect switch.
+fn effect_parameter(switch: EffectSwitch) -> u32 {
+    match switch {
+        EffectSwitch::GasForces => boolean::EFFECT_GAS_FORCES,
+        EffectSwitch::MassForces => boolean::EFFECT_MASS_FORCES,
+        EffectSwitch::BalanceShaft => boolean::EFFECT_BALANCE_SHAFT,
+        EffectSwitch::Gyroscopic => boolean::EFFECT_GYROSCOPIC,
+        EffectSwitch::RingCarrierElasticity => boolean::EFFECT_RING_CARRIER,
+        EffectSwitch::MountNonlinearity => boolean::EFFECT_MOUNT_NONLINEARITY,
+        EffectSwitch::ChassisFlexibility => boolean::EFFECT_CHASSIS_FLEXIBILITY,
+    }
+}
+
+/// rpm (the `rpm` input's unit) → rad/s.
+const RPM: f64 = std::f64::consts::PI / 30.0;
+
+/// The settings the parameters in `values` describe, with the vehicle from `config_file`.
+/// Vehicle parameters the master set replace the configuration's values; the others keep them.
+/// The experiment's tolerance is the relative tolerance unless the master set `solver.relTol`.
+pub fn settings(
+    values: &Values,
+    config_file: Option<PathBuf>,
+    experiment_tolerance: Option<f64>,
+) -> Result<Settings, String> {
+    let (r, i, b, s) = (
+        &values.reals,
+        &values.integers,
+        &values.booleans,
+        &values.strings,
+    );
+    let p = Parameters::from_values(r.as_slice(), i.as_slice(), b.as_slice(), s.as_slice());
+    let scene = SceneKind::from_number(p.scene)
+        .map_err(|m| format!("{}: {m}", INTEGERS[integer::SCENE as usize].name))?;
+    let given = |index: u32| r.set_by_master(index).then(|| *r.get(index));
+    let mut vehicle = VehicleOverrides {
+        gas_load: given(real::ENGINE_LOAD),
+        fade_in_time: given(real::FADE_IN_TIME),
+        crank_start_angle: given(real::CRANK_START_ANGLE),
+        speed_time_constant: given(real::CRANK_SPEED_TIME_CONSTANT),
+        ..VehicleOverrides::default()
+    };
+    for switch in EffectSwitch::ALL {
+        let index = effect_parameter(switch);
+        if b.set_by_master(index) {
+            vehicle.effects.set(switch, *b.get(index));
+        }
+    }
+    let rel_tol = match (experiment_tolerance, r.set_by_master(real::SOLVER_REL_TOL)) {
+        (Some(tolerance), false) => tolerance,
+        _ => p.solver_rel_tol,
+    };
+    let count = |index: u32, value: i32| {
+        usize::try_from(value)
+            .map_err(|_| format!("{} = {value} must be >= 0", INTEGERS[index as usize].name))
+    };
+    Ok(Settings {
+        scene,
+        config_file,
+        vehicle,
+        rel_tol,
+        abs_tol: p.solver_abs_tol,
+        max_order: count(integer::SOLVER_MAX_ORDER, p.solver_max_order)?,
+        stability_limit_detection: p.solver_stability_limit_detection,
+        periodic_start: p.initialization_periodic,
+        chassis: BodyOptions {
+            mode_cutoff_hz: p.chassis_mode_cutoff,
+            max_modes: count(integer::CHASSIS_MAX_MODES, p.chassis_max_modes)?,
+            max_rpm: p.scene_max_rpm,
+            max_engine_order: p.scene_max_engine_order,
+            interface_rotations: p.chassis_interface_rotations,
+            modal_damping_scale: p.chassis_modal_damping_scale,
+            stiffening_bar: p.chassis_stiffening_bar,
+            stiff_front_plate: p.chassis_stiff_front_plate,
+            cache: match (p.chassis_cache_enabled, p.chassis_cache_dir.trim()) {
+                (false, _) => CacheSetting::Disabled,
+                (true, "") => CacheSetting::Default,
+                (true, dir) => CacheSetting::Dir(PathBuf::from(dir)),
+            },
+        },
+    })
+}
+
+/// The vehicle configuration `configFile` names: relative to the FMU's resources, or the
+/// FMU's own `vehicle.json` when empty (missing from an unpacked FMU is an error, not a silent
+/// switch to the built-in data); the built-in vehicle when there are no resources.
+pub fn config_file(
+    values: &Values,
+    resource_dir: Option<&Path>,
+) -> Result<Option<PathBuf>, String> {
+    let given = values.strings.get(string::CONFIG_FILE).trim();
+    if !given.is_empty() {
+        let path = PathBuf::from(given);
+        return Ok(Some(match resource_dir {
+            Some(r) if path.is_relative() => r.join(path),
+            _ => path,
+        }));
+    }
+    let Some(r) = resource_dir else {
+        return Ok(None);
+    };
+    let path = r.join(cosim::DEFAULT_CONFIG_NAME);
+    if !path.is_file() {
+        return Err(format!(
+            "the FMU's resources {} have no {} ({} is empty)",
+            r.display(),
+            cosim::DEFAULT_CONFIG_NAME,
+            super::variables::STRINGS[string::CONFIG_FILE as usize].name
+        ));
+    }
+    Ok(Some(path))
+}
+
+/// Where the relative tolerance comes from, for the log.
+pub fn tolerance_note(values: &Values, settings: &Settings, experiment: Option<f64>) -> String {
+    let name = REALS[real::SOLVER_REL_TOL as usize].name;
+    match (experiment, values.reals.set_by_master(real::SOLVER_REL_TOL)) {
+        (Some(t), false) => format!("relative tolerance {t} from fmi2SetupExperiment"),
+        (Some(t), true) => format!(
+            "relative tolerance {} from {name} (set explicitly; fmi2SetupExperiment's {t} not used)",
+            settings.rel_tol
+        ),
+        (None, _) => format!("relative tolerance {} ({name})", settings.rel_tol),
+    }
+}
+
+/// The parameters the vehicle values come from, set to the values the model uses (a
+/// configuration file's where the master did not set them), so that reading one tells the truth.
+pub fn write_effective_parameters(values: &mut Values, simulation: &cosim::Simulation) {
+    let model = simulation.model();
+    let engine = model.powertrain().config();
+    let r = &mut values.reals;
+    r.put(real::ENGINE_LOAD, engine.gas.load);
+    r.put(real::FADE_IN_TIME, engine.excitation_fade_in);
+    r.put(
+        real::CRANK_START_ANGLE,
+        engine.start_crank_angle_deg.to_radians(),
+    );
+    r.put(
+        real::CRANK_SPEED_TIME_CONSTANT,
+        model.follower().time_constant,
+    );
+    let effects = model.effects();
+    for switch in EffectSwitch::ALL {
+        values
+            .booleans
+            .put(effect_parameter(switch), effects.get(switch));
+    }
+}
+
+/// The runtime's inputs from the Real input signals, from `time` on (SI units).
+pub fn inputs_from(tracks: &[InputTrack], time: f64) -> cosim::Inputs {
+    let signal = |index: u32, scale: f64| {
+        let (value, derivative) = tracks[index as usize].preview(time);
+        cosim::Signal {
+            value: value * scale,
+            derivative: derivative * scale,
+            reference_time: time,
+        }
+    };
+    cosim::Inputs {
+        crank_speed: signal(real::RPM, RPM),
+        load_torque: signal(real::LOAD_TORQUE, 1.0),
+        stiffness_scale: real::MOUNT_STIFFNESS_SCALE.map(|i| signal(i, 1.0)),
+        damping_scale: real::MOUNT_DAMPING_SCALE.map(|i| signal(i, 1.0)),
+    }
+}
+
+/// The Real input behind a runtime input, and the factor from SI units to the input's unit.
+fn input_variable(input: Input) -> (u32, f64) {
+    match input {
+        Input::CrankSpeed => (real::RPM, 1.0 / RPM),
+        Input::LoadTorque => (real::LOAD_TORQUE, 1.0),
+        Input::StiffnessScale(i) => (real::MOUNT_STIFFNESS_SCALE[i], 1.0),
+        Input::DampingScale(i) => (real::MOUNT_DAMPING_SCALE[i], 1.0),
+    }
+}
+
+/// The FMU parameter behind a body option.
+fn body_option_name(option: BodyOption) -> &'static str {
+    let real = |i: u32| REALS[i as usize].name;
+    let boolean = |i: u32| BOOLEANS[i as usize].name;
+    match option {
+        BodyOption::ModeCutoff => real(real::CHASSIS_MODE_CUTOFF),
+        BodyOption::MaxModes => INTEGERS[integer::CHASSIS_MAX_MODES as usize].name,
+        BodyOption::MaxRpm => real(real::SCENE_MAX_RPM),
+        BodyOption::MaxEngineOrder => real(real::SCENE_MAX_ENGINE_ORDER),
+        BodyOption::InterfaceRotations => boolean(boolean::CHASSIS_INTERFACE_ROTATIONS),
+        BodyOption::ModalDampingScale => real(real::CHASSIS_MODAL_DAMPING_SCALE),
+        BodyOption::StiffeningBar => boolean(boolean::CHASSIS_STIFFENING_BAR),
+        BodyOption::StiffFrontPlate => boolean(boolean::CHASSIS_STIFF_FRONT_PLATE),
+        BodyOption::Cache => boolean(boolean::CHASSIS_CACHE_ENABLED),
+    }
+}
+
+/// The FMU parameter behind a vehicle value.
+fn vehicle_setting_name(setting: VehicleSetting) -> &'static str {
+    let real = match setting {
+        VehicleSetting::Effect(switch) => return BOOLEANS[effect_parameter(switch) as usize].name,
+        VehicleSetting::GasLoad => real::ENGINE_LOAD,
+        VehicleSetting::FadeInTime => real::FADE_IN_TIME,
+        VehicleSetting::CrankStartAngle => real::CRANK_START_ANGLE,
+        VehicleSetting::SpeedTimeConstant => real::CRANK_SPEED_TIME_CONSTANT,
+    };
+    REALS[real as usize].name
+}
+
+/// A runtime error as the FMU's user reads it: parameters and inputs by their FMU names and
+/// units.
+pub fn message(error: &cosim::Error) -> String {
+    match error {
+        cosim::Error::BodyOption {
+            option,
+            value,
+            rule,
+        } => format!("{} = {value} {rule}", body_option_name(*option)),
+        cosim::Error::Input { input, value, rule } => {
+            let (index, scale) = input_variable(*input);
+            format!("{} = {} {rule}", REALS[index as usize].name, value * scale)
+        }
+        cosim::Error::Model(m) => m.clone(),
+    }
+}
+
+/// A configuration value a parameter replaced, for the log.
+pub fn replaced_note(r: &Replaced) -> String {
+    format!(
+        "{} = {} (FMU parameter) replaces the configuration's {}",
+        vehicle_setting_name(r.setting),
+        r.value,
+        r.configured
+    )
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::model::{Effects, SpeedFollower, VehicleConfig};
+
+    /// The model's own defaults are the variable table's start values: one set of defaults.
+    #[test]
+    fn start_values_are_the_model_defaults() {
+        let start = Values::start();
+        assert_eq!(
+            settings(&start, None, None).unwrap(),
+            Settings::default(),
+            "settings"
+        );
+        let v = VehicleConfig::default();
+        let r = &start.reals;
+        assert_eq!(*r.get(real::ENGINE_LOAD), v.engine.gas.load);
+        assert_eq!(*r.get(real::FADE_IN_TIME), v.engine.excitation_fade_in);
+        assert_eq!(
+            *r.get(real::CRANK_START_ANGLE),
+            v.engine.start_crank_angle_deg.to_radians()
+        );
+        assert_eq!(
+            *r.get(real::CRANK_SPEED_TIME_CONSTANT),
+            SpeedFollower::default().time_constant
+        );
+        assert_eq!(v.speed_follower, SpeedFollower::default());
+        assert_eq!(v.effects, Effects::default());
+        for switch in EffectSwitch::ALL {
+            assert_eq!(
+                *start.booleans.get(effect_parameter(switch)),
+                Effects::default().get(switch),
+                "{switch:?}"
+            );
+        }
+    }
+
+    #[test]
+    fn only_what_the_master_set_overrides_the_configuration() {
+        let mut values = Values::start();
+        values.reals = values
+            .reals
+            .with_set(&[real::ENGINE_LOAD as usize], &[0.5], |_| Ok(()))
+            .unwrap();
+        values.booleans = values
+            .booleans
+            .with_set(&[boolean::EFFECT_GYROSCOPIC as usize], &[false], |_| Ok(()))
+            .unwrap();
+        let s = settings(&values, None, Some(1e-7)).unwrap();
+        assert_eq!(s.vehicle.gas_load, Some(0.5));
+        assert_eq!(s.vehicle.fade_in_time, None);
+        assert_eq!(s.vehicle.effects.get(EffectSwitch::Gyroscopic), Some(false));
+        assert_eq!(s.vehicle.effects.get(EffectSwitch::GasForces), None);
+        assert_eq!(s.rel_tol, 1e-7, "the experiment's tolerance");
+        values.reals = values
+            .reals
+            .with_set(&[real::SOLVER_REL_TOL as usize], &[1e-4], |_| Ok(()))
+            .unwrap();
+        let s = settings(&values, None, Some(1e-7)).unwrap();
+        assert_eq!(s.rel_tol, 1e-4, "solver.relTol set by the master wins");
+    }
+
+    #[test]
+    fn messages_name_the_fmu_variables() {
+        let e = cosim::Error::Input {
+            input: Input::CrankSpeed,
+            value: -100.0 * RPM,
+            rule: "is negative",
+        };
+        let m = message(&e);
+        assert!(
+            m.starts_with("rpm = -100") && m.ends_with("is negative"),
+            "{m}"
+        );
+        let e = cosim::Error::Input {
+            input: Input::StiffnessScale(2),
+            value: -1.0,
+            rule: "must be >= 0",
+        };
+        assert_eq!(message(&e), "mount[3].stiffnessScale = -1 must be >= 0");
+        let e: cosim::Error = BodyOptions {
+            mode_cutoff_hz: -1.0,
+            ..BodyOptions::default()
+        }
+        .validate()
+        .unwrap_err()
+        .into();
+        assert!(
+            message(&e).starts_with("chassis.modeCutoff = -1 Hz"),
+            "{}",
+            message(&e)
+        );
+        for (setting, name) in [
+            (VehicleSetting::GasLoad, "engine.load"),
+            (VehicleSetting::CrankStartAngle, "crank.startAngle"),
+            (
+                VehicleSetting::Effect(EffectSwitch::ChassisFlexibility),
+                "effects.chassisFlexibility",
+            ),
+        ] {
+            assert_eq!(vehicle_setting_name(setting), name);
+        }
+        for switch in EffectSwitch::ALL {
+            assert!(vehicle_setting_name(VehicleSetting::Effect(switch)).starts_with("effects."));
+        }
+    }
+}

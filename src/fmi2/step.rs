@@ -1,0 +1,221 @@
+//! `fmi2DoStep`: check the step, commit the inputs for it, advance the simulation, report.
+
+use super::instance::{Instance, Outcome, Status};
+use super::logger::Level;
+use super::parameters;
+use super::state::Phase;
+use super::variables::{integer, real, Causality, LogCategory, REALS};
+use crate::cosim;
+
+/// Relative tolerance on communication points: masters compute them as `t0 + n h`.
+const TIME_JITTER: f64 = 1e-9;
+
+/// Communication points are snapped to a 1 ps grid: masters compute the same instant in different
+/// ways (`t0 + n h` in seconds, integer nanoseconds), and an integrator that stops at instants one
+/// ulp apart takes different steps afterwards. On the grid, every master gets the same run.
+fn on_grid(t: f64) -> f64 {
+    const GRID: f64 = 1e12;
+    if t.abs() < 8e3 {
+        (t * GRID).round() / GRID
+    } else {
+        t
+    }
+}
+
+fn same_time(a: f64, b: f64) -> bool {
+    (a - b).abs() <= TIME_JITTER * a.abs().max(b.abs()).max(1.0)
+}
+
+impl Instance {
+    /// `fmi2DoStep` from `current` over `step`.
+    pub fn do_step(&mut self, current: f64, step: f64) -> Outcome {
+        let target = self.validate_step(current, step)?;
+        let clipped = self.commit_step_inputs(target - current)?;
+        match self.advance(target) {
+            Ok(()) => self.report(target, clipped),
+            Err(failure) => Ok(self.fail_step(current, target, failure)),
+        }
+    }
+
+    /// The end of the step, if the step is admissible here and now.
+    fn validate_step(&self, current: f64, step: f64) -> Result<f64, String> {
+        if !current.is_finite() || !step.is_finite() || step <= 0.0 {
+            return Err(format!(
+                "communication point {current} and step size {step} must be finite, step > 0"
+            ));
+        }
+        if !same_time(current, self.core.time) {
+            return Err(format!(
+                "communication point {current} s does not match the FMU time {} s \
+                 (use fmi2SetFMUstate to go back in time)",
+                self.core.time
+            ));
+        }
+        let target = on_grid(current + step);
+        if let Some(stop) = self.core.stop_time {
+            if target > stop && !same_time(target, stop) {
+                return Err(format!("step to {target} s passes the stop time {stop} s"));
+            }
+        }
+        if self.core.simulation.is_none() {
+            return Err("the model was not initialised".into());
+        }
+        Ok(target)
+    }
+
+    /// Commits the input signals for the step and hands them to the simulation. Returns whether
+    /// a ramp was bent onto a bound; on refusal nothing changed.
+    fn commit_step_inputs(&mut self, step: f64) -> Result<bool, String> {
+        let tracks_before = self.core.inputs.clone();
+        let reals_before = self.core.values.reals.clone();
+        let clipped = self.commit_inputs(step);
+        let inputs = parameters::inputs_from(&self.core.inputs, self.core.time);
+        let time = self.core.time;
+        let Some(simulation) = self.core.simulation.as_mut() else {
+            return Err("the model was not initialised".into());
+        };
+        match simulation.set_inputs(&inputs) {
+            Ok(restarted) => {
+                if restarted {
+                    self.event(&format!(
+                        "input discontinuity at t = {time} s: integrator restarted at order 1"
+                    ));
+                }
+                Ok(clipped)
+            }
+            Err(e) => {
+                self.core.inputs = tracks_before;
+                self.core.values.reals = reals_before;
+                Err(parameters::message(&e))
+            }
+        }
+    }
+
+    /// Integrates to `target`.
+    fn advance(&mut self, target: f64) -> Result<(), cosim::StepFailure> {
+        match self.core.simulation.as_mut() {
+            Some(simulation) => simulation.advance_to(target),
+            None => Err(cosim::StepFailure {
+                error: cosim::Error::Model("the model was not initialised".into()),
+                reached: self.core.time,
+            }),
+        }
+    }
+
+    /// Outputs, time and inputs at the end of a successful step.
+    fn report(&mut self, target: f64, clipped: bool) -> Outcome {
+        let Some(simulation) = self.core.simulation.as_mut() else {
+            return Err("the model was not initialised".into());
+        };
+        let counters = simulation.counters();
+        let outputs = match simulation.outputs() {
+            Ok(o) => o,
+            Err(e) => {
+                self.core.phase = Phase::Error;
+                return Err(format!(
+                    "output evaluation failed: {}",
+                    parameters::message(&e)
+                ));
+            }
+        };
+        self.write_outputs(&outputs, &counters);
+        self.core.time = target;
+        // Inputs read back as the values their signals have reached.
+        for v in REALS.iter().filter(|v| v.causality == Causality::Input) {
+            let value = self.core.inputs[v.index as usize].at(target);
+            self.core.values.reals.put(v.index, value);
+        }
+        if self.logger.wants(Level::Info, LogCategory::Solver) {
+            self.logger.log(
+                Level::Info,
+                LogCategory::Solver,
+                &format!(
+                    "t = {target} s: {} steps, {} RHS, {} Jacobians, {} factorisations",
+                    counters.steps,
+                    counters.rhs_evaluations,
+                    counters.jacobian_evaluations,
+                    counters.factorizations
+                ),
+            );
+        }
+        Ok(if clipped { Status::Warning } else { Status::Ok })
+    }
+
+    /// A step the integrator could not complete: it kept its last successful step, which is
+    /// reported, and the run stops there (`fmi2Discard`, then `fmi2GetBooleanStatus` says
+    /// terminated).
+    fn fail_step(&mut self, current: f64, target: f64, failure: cosim::StepFailure) -> Status {
+        if let Some(simulation) = self.core.simulation.as_mut() {
+            if let Ok(o) = simulation.outputs() {
+                let counters = simulation.counters();
+                self.write_outputs(&o, &counters);
+            }
+        }
+        let reached = failure.reached;
+        self.core.time = reached;
+        self.core.phase = Phase::StepFailed;
+        self.core.terminated = true;
+        self.log_error(&format!(
+            "fmi2DoStep from {current} s to {target} s failed at {reached} s: {}",
+            parameters::message(&failure.error)
+        ));
+        Status::Discard
+    }
+
+    /// Starts the step `[t, t + step]` for every input ([`super::input_track::InputTrack::commit`]):
+    /// the signals in force from now on. The input values the master reads back are the signals'
+    /// values at `t`. Returns whether a ramp had to be bent onto a declared bound (logged as a
+    /// warning).
+    pub(super) fn commit_inputs(&mut self, step: f64) -> bool {
+        let t = self.core.time;
+        let mut clipped = false;
+        for v in REALS.iter().filter(|v| v.causality == Causality::Input) {
+            let i = v.index as usize;
+            let track = &mut self.core.inputs[i];
+            let commit = track.commit(
+                t,
+                step,
+                v.min.unwrap_or(f64::NEG_INFINITY),
+                v.max.unwrap_or(f64::INFINITY),
+            );
+            let (value, slope) = (track.value, track.slope);
+            self.core.values.reals.put(v.index, value);
+            if let Some(bound) = commit.clipped {
+                clipped = true;
+                self.log_warning(&format!(
+                    "{}: the ramp from {value} with slope {slope} per s would leave the declared range within the step from {t} s; it ends on {bound} at {} s",
+                    v.name,
+                    t + step
+                ));
+            }
+        }
+        clipped
+    }
+
+    /// Writes the outputs and the solver counters.
+    pub(super) fn write_outputs(&mut self, o: &cosim::Outputs, c: &cosim::Counters) {
+        let r = &mut self.core.values.reals;
+        for (i, mount) in o.mount_force.iter().enumerate() {
+            for (j, f) in mount.iter().enumerate() {
+                r.put(real::MOUNT_F[i][j], *f);
+            }
+        }
+        r.put(real::CRANK_ANGLE, o.crank_angle);
+        for k in 0..3 {
+            r.put(real::POWERTRAIN_R[k], o.powertrain_displacement[k]);
+            r.put(real::POWERTRAIN_PHI[k], o.powertrain_rotation[k]);
+            r.put(real::POWERTRAIN_A[k], o.powertrain_acceleration[k]);
+            r.put(real::STEERING_WHEEL_A[k], o.steering_wheel_acceleration[k]);
+            r.put(real::SEAT_A[k], o.seat_acceleration[k]);
+        }
+        let n = &mut self.core.values.integers;
+        let clamp = |x: u64| x.min(i32::MAX as u64) as i32;
+        n.put(integer::SOLVER_STEPS, clamp(c.steps));
+        n.put(integer::SOLVER_RHS_EVALUATIONS, clamp(c.rhs_evaluations));
+        n.put(
+            integer::SOLVER_JACOBIAN_EVALUATIONS,
+            clamp(c.jacobian_evaluations),
+        );
+        n.put(integer::SOLVER_FACTORIZATIONS, clamp(c.factorizations));
+    }
+}
