@@ -152,6 +152,8 @@ fn reduced_eigen(k_r: &Mat<f64>, m_r: &Mat<f64>) -> Result<(Vec<f64>, Mat<f64>),
 ///
 /// K must be positive definite on the interior DOFs (the interface fixed), M positive
 /// semi-definite with the reduced mass positive definite.
+///
+/// Long on purpose: one reduction (partition, constraint modes, fixed-interface eigenproblem, projection, orthogonalisation), each step using the previous step's factors.
 pub fn craig_bampton(
     k: &SparseMat,
     m: &SparseMat,

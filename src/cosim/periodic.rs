@@ -54,6 +54,8 @@ pub struct PeriodicStart {
 
 /// The periodic orbit through the start crank angle of `y_guess` at the model's current
 /// (constant) inputs. The excitation must be fully faded in at `t0`; the caller sets that.
+///
+/// Long on purpose: one Newton shooting loop (residual, sensitivities through the integrator, damping, convergence test) over shared state.
 pub fn periodic_start(
     model: &mut CoupledModel,
     options: &BdfOptions,

@@ -57,6 +57,8 @@ fn node(mesh: &Mesh, id: usize) -> Option<Vector3<f64>> {
 }
 
 /// Geometric and topological checks of `mesh` before assembly.
+///
+/// Long on purpose: one list of short checks per entity kind that share the node lookup and the limits; read as a table.
 pub fn check_mesh(mesh: &Mesh, limits: &CheckLimits) -> Result<(), FeError> {
     let mut problems = Vec::new();
     let n = mesh.nodes.len();

@@ -175,6 +175,8 @@ fn validate(k: &SparseMat, m: &SparseMat, n_modes: usize, shift: f64) -> Result<
 ///
 /// `shift` must lie below the lowest eigenvalue (K − shift·M positive definite); for a free
 /// structure use a small negative value such as −1.
+///
+/// Long on purpose: one shift-invert Lanczos run with its restarts and convergence bookkeeping, all sharing the factorisation and the Krylov basis.
 pub fn lowest_modes(
     k: &SparseMat,
     m: &SparseMat,

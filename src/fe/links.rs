@@ -72,6 +72,7 @@ fn rigid_equations(
 
 const DOF_NAMES: [&str; 6] = ["ux", "uy", "uz", "rx", "ry", "rz"];
 
+/// Long on purpose: one RBE3 formulation (weights, centroid, rigid-body projection, dependent DOFs) in Nastran's order.
 fn interpolation_equations(
     mesh: &Mesh,
     index: usize,

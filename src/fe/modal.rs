@@ -223,6 +223,8 @@ pub fn steering_wheel_pair(descs: &[ModeDescription]) -> Option<(usize, usize)> 
 }
 
 /// Describes every mode of `modes` of the chassis `mesh` assembled as `asm`.
+///
+/// Long on purpose: one report that walks every mode with shared per-region sums.
 pub fn describe(
     mesh: &Mesh,
     asm: &Assembled,

@@ -152,6 +152,8 @@ fn covariant_shear_row(xy: &[[f64; 2]; 4], xi: f64, eta: f64, along_xi: bool) ->
 }
 
 /// Global stiffness matrix of shell `index` with corners `p`.
+///
+/// Long on purpose: one element formulation (membrane, drilling, plate bending, transformation) evaluated at shared Gauss points.
 pub fn stiffness(index: usize, shell: &Shell, p: &[Vector3<f64>; 4]) -> Result<Mat24, FeError> {
     validate(index, shell)?;
     let geo = geometry(index, p)?;

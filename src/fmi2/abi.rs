@@ -249,64 +249,45 @@ pub extern "C" fn fmi2Instantiate(
             (f.logger, f.componentEnvironment)
         };
         // SAFETY: FMI strings are NUL-terminated or null.
-        let name = unsafe { text(instanceName) }.unwrap_or_default();
+        let (name, guid, resources) = unsafe {
+            (
+                text(instanceName).unwrap_or_default(),
+                text(fmuGUID).unwrap_or_default(),
+                text(fmuResourceLocation),
+            )
+        };
         let logger = Logger::new(callback, environment, &name, loggingOn != 0);
-        if instanceName.is_null() || name.is_empty() {
-            logger.log(
-                Level::Error,
-                LogCategory::StatusError,
-                "fmi2Instantiate: instanceName is missing",
-            );
-            return std::ptr::null_mut();
+        let refuse = |logger: &Logger, message: &str| {
+            let message = format!("fmi2Instantiate: {message}");
+            logger.log(Level::Error, LogCategory::StatusError, &message);
+            std::ptr::null_mut()
+        };
+        if name.is_empty() {
+            return refuse(&logger, "instanceName is missing");
         }
         if fmuType != fmi2Type_fmi2CoSimulation {
-            logger.log(
-                Level::Error,
-                LogCategory::StatusError,
-                "fmi2Instantiate: this FMU supports co-simulation only (fmuType must be fmi2CoSimulation)",
+            return refuse(
+                &logger,
+                "this FMU supports co-simulation only (fmuType must be fmi2CoSimulation)",
             );
-            return std::ptr::null_mut();
         }
-        // SAFETY: as above.
-        let guid = unsafe { text(fmuGUID) }.unwrap_or_default();
         if guid != GUID {
-            logger.log(
-                Level::Error,
-                LogCategory::StatusError,
-                &format!("fmi2Instantiate: GUID \"{guid}\" does not match this FMU's {GUID}"),
+            return refuse(
+                &logger,
+                &format!("GUID \"{guid}\" does not match this FMU's {GUID}"),
             );
-            return std::ptr::null_mut();
         }
-        // SAFETY: as above.
-        let resource_dir = match unsafe { text(fmuResourceLocation) } {
-            None => {
-                logger.log(
-                    Level::Warning,
-                    LogCategory::StatusWarning,
-                    "fmi2Instantiate: no resource location given; the built-in vehicle is used unless configFile names an absolute path",
-                );
-                None
-            }
-            Some(uri) => match resource_path(&uri) {
-                Ok(p) if p.is_dir() => Some(p),
-                Ok(p) => {
-                    logger.log(
-                        Level::Error,
-                        LogCategory::StatusError,
-                        &format!("fmi2Instantiate: the resource location {uri} names {}, which is not a directory", p.display()),
-                    );
-                    return std::ptr::null_mut();
-                }
-                Err(m) => {
-                    logger.log(
-                        Level::Error,
-                        LogCategory::StatusError,
-                        &format!("fmi2Instantiate: {m}"),
-                    );
-                    return std::ptr::null_mut();
-                }
-            },
+        let resource_dir = match resource_dir(resources.as_deref()) {
+            Ok(dir) => dir,
+            Err(m) => return refuse(&logger, &m),
         };
+        if resource_dir.is_none() {
+            logger.log(
+                Level::Warning,
+                LogCategory::StatusWarning,
+                "fmi2Instantiate: no resource location given; the built-in vehicle is used unless configFile names an absolute path",
+            );
+        }
         let handle = Box::new(Handle {
             live: LIVE,
             instance: Instance::new(&name, logger, resource_dir),
@@ -316,6 +297,21 @@ pub extern "C" fn fmi2Instantiate(
         Box::into_raw(handle) as fmi2Component
     }));
     result.unwrap_or(std::ptr::null_mut())
+}
+
+/// The resource directory a resource location URI names (`None`: no location given).
+fn resource_dir(uri: Option<&str>) -> Result<Option<std::path::PathBuf>, String> {
+    let Some(uri) = uri else {
+        return Ok(None);
+    };
+    let path = resource_path(uri)?;
+    if !path.is_dir() {
+        return Err(format!(
+            "the resource location {uri} names {}, which is not a directory",
+            path.display()
+        ));
+    }
+    Ok(Some(path))
 }
 const _: fmi2InstantiateTYPE = Some(fmi2Instantiate);
 
@@ -838,3 +834,7 @@ pub extern "C" fn fmi2GetStringStatus(
     })
 }
 const _: fmi2GetStringStatusTYPE = Some(fmi2GetStringStatus);
+
+#[cfg(test)]
+#[path = "abi_state_table.rs"]
+mod state_table;

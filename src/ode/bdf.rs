@@ -142,6 +142,8 @@ fn problem_error(e: ProblemError) -> String {
 
 impl Bdf {
     /// Creates an integrator at `(t0, y0)`; evaluates `f(t0, y0)` (and `M`) once.
+    ///
+    /// Long on purpose: it sets up every part of the integrator state in the order of CVODE's cvInit, to be compared with it.
     pub fn new<P: OdeProblem>(
         problem: &mut P,
         t0: f64,
@@ -960,6 +962,8 @@ impl Bdf {
 
     /// Local error test failed: shrink the step, lower the order, or reload at order 1
     /// (cvDoErrorTest).
+    ///
+    /// Long on purpose: CVODE's cvDoErrorTest in one piece, kept parallel to it line by line.
     fn handle_error_test_failure<P: OdeProblem>(
         &mut self,
         problem: &mut P,
@@ -1071,6 +1075,8 @@ impl Bdf {
     }
 
     /// Chooses the next step size and order (cvPrepareNextStep, cvChooseEta, cvSetEta).
+    ///
+    /// Long on purpose: CVODE's cvPrepareNextStep/cvChooseEta/cvSetEta in one piece, kept parallel to them.
     fn prepare_next_step(&mut self, dsm: f64) {
         let qmax = self.s.zn.zn.len() - 1;
         let landed = if self.s.tn == self.s.tstop {

@@ -224,6 +224,8 @@ impl Bdf {
 
     /// Builds and factorises `M - gamma J`, re-evaluating `J` when it is judged stale (cvLsSetup).
     /// Returns whether the Jacobian is fresh.
+    ///
+    /// Long on purpose: CVODE's cvLsSetup in one piece (Jacobian age, evaluation, factorisation, structured or dense), kept parallel to it.
     fn setup<P: OdeProblem>(
         &mut self,
         problem: &mut P,

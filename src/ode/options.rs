@@ -81,6 +81,8 @@ impl Default for BdfOptions {
 
 impl BdfOptions {
     /// Checks every field against the problem dimension `n`.
+    ///
+    /// Long on purpose: a flat list of independent checks, one per field.
     pub fn validate(&self, n: usize) -> Result<(), BdfError> {
         let bad =
             |field: &'static str, message: String| Err(BdfError::InvalidOption { field, message });

@@ -70,6 +70,7 @@ impl Cards {
         Ok(())
     }
 
+    /// Long on purpose: a table, one arm per card kind.
     fn read(deck: &Deck) -> Result<Self, FeError> {
         let mut c = Cards {
             mass_scale: 1.0,
@@ -355,6 +356,7 @@ pub(crate) fn build(deck: &Deck) -> Result<NastranBody, FeError> {
     Ok(body)
 }
 
+/// Long on purpose: one arm per shell card and property kind.
 fn add_shells(c: &Cards, body: &mut NastranBody) -> Result<(), FeError> {
     for (&id, (plate, name)) in &c.plates {
         let user = format!("{name} {id}");
@@ -550,6 +552,7 @@ fn add_masses(c: &Cards, systems: &Systems, body: &mut NastranBody) -> Result<()
     Ok(())
 }
 
+/// Long on purpose: one arm per scalar spring and damper card.
 fn add_scalars(c: &Cards, body: &mut NastranBody) -> Result<(), FeError> {
     // Per node (ground) or node pair: (stiffness, damping) per DOF, summed over cards.
     let mut ground: BTreeMap<usize, ([f64; 6], [f64; 6])> = BTreeMap::new();

@@ -48,6 +48,8 @@ impl CoupledModel {
     }
 
     /// Writes `∂f/∂y` at `(t, y)` into `j` (shaped by [`Self::jacobian_shape`], zeroed).
+    ///
+    /// Long on purpose: one pass over the block structure (powertrain, mounts, body), one short section per block.
     pub fn structured(
         &self,
         t: f64,

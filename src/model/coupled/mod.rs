@@ -164,6 +164,8 @@ impl CoupledModel {
     /// Assembles the model. With a body without modes (rigid ground) every mount attaches at its
     /// ground point; otherwise at its `body_node`, which the body must provide, as must every
     /// name in `outputs`.
+    ///
+    /// Long on purpose: it checks and wires every mount against the body once; split, the partly built model would travel between the pieces.
     pub fn new(
         powertrain: Powertrain,
         mounts: &[MountConfig],

@@ -194,6 +194,8 @@ impl CoupledModel {
     }
 
     /// `x` is a mode shape over the vibration coordinates `[q, v, η, η̇]`.
+    ///
+    /// Long on purpose: one report of a mode shape, component by component.
     fn describe_mode(
         &self,
         y_eq: &[f64],

@@ -195,6 +195,8 @@ impl EccentricWeight {
 impl EngineConfig {
     /// Checks every physical parameter; the error names the field (prefixed by `at`) and its
     /// value.
+    ///
+    /// Long on purpose: a flat list of independent checks, one per field.
     pub fn validate(&self) -> Result<(), ConfigError> {
         finite("start_crank_angle_deg", &[self.start_crank_angle_deg])?;
         non_negative("excitation_fade_in", self.excitation_fade_in)?;
@@ -298,6 +300,7 @@ impl EngineConfig {
         self.crank_drive.crank_radius / self.crank_drive.conrod_length
     }
 
+    /// Long on purpose: a flat list of independent checks, one per field.
     fn validate_gas(&self) -> Result<(), ConfigError> {
         let g = &self.gas;
         let load = g.load;

@@ -309,6 +309,7 @@ impl PressureCurve {
         curve
     }
 
+    /// Long on purpose: one integration of the closed cycle (Wiebe burn, Woschni wall heat, RK4 stages on the table's grid) whose running state would otherwise be passed between pieces.
     fn integrate_wiebe(
         model: &WiebeModel,
         point: &CombustionPoint,
