@@ -14,10 +14,10 @@ use std::collections::{BTreeMap, HashMap};
 
 use nalgebra::{Matrix3, Vector3};
 
-use super::chassis_config::{ChassisConfig, SectionSpec};
+use super::chassis_config::{ChassisConfig, Geometry, SectionSpec, Sections, Thicknesses, Trim};
 use super::checks::{check_mesh, CheckLimits};
 use super::error::FeError;
-use super::mesh::{Beam, GroundSpring, Material, Mesh, PointMass, Shell};
+use super::mesh::{Beam, BeamSection, GroundSpring, Material, Mesh, PointMass, Shell};
 
 /// Engine-mount layout: the original four mounts or the paper's improved three-mount vehicle.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -44,7 +44,8 @@ pub const STEERING_WHEEL: &str = "steering_wheel";
 /// Named node of the driver's seat rail.
 pub const SEAT_RAIL: &str = "seat_rail";
 
-/// Region names used for mode descriptions.
+/// Region names of the generated mesh (node sets), which the mode descriptions ([`super::modal`])
+/// measure kinetic-energy fractions over.
 pub mod region {
     /// Steering column (above its support) and wheel.
     pub const STEERING: &str = "steering";
@@ -56,10 +57,38 @@ pub mod region {
     pub const REAR_PANEL: &str = "rear_panel";
     /// Floor panel.
     pub const FLOOR: &str = "floor";
-    /// Roof panel.
+    /// Roof panel and roof bows.
     pub const ROOF: &str = "roof";
     /// The whole body structure except the steering column.
     pub const BODY: &str = "body";
+    /// Cowl panel, cross-car beam and dash brace.
+    pub const COWL: &str = "cowl";
+    /// Rear quarter panels.
+    pub const QUARTER: &str = "quarter";
+    /// Parcel shelf and its front beam.
+    pub const SHELF: &str = "shelf";
+    /// Windscreen and rear window.
+    pub const GLASS: &str = "glass";
+    /// Side sills.
+    pub const SILL: &str = "sill";
+    /// Floor rails.
+    pub const FLOOR_RAIL: &str = "floor_rail";
+    /// Central tunnel.
+    pub const TUNNEL: &str = "tunnel";
+    /// Floor cross members.
+    pub const CROSS_MEMBER: &str = "cross_member";
+    /// Rear cross member.
+    pub const REAR_CROSS_MEMBER: &str = "rear_cross_member";
+    /// Hinge, A, B and C pillars.
+    pub const PILLAR: &str = "pillar";
+    /// Roof side rails.
+    pub const ROOF_RAIL: &str = "roof_rail";
+    /// Steering column below its support.
+    pub const COLUMN_LOWER: &str = "column_lower";
+    /// Link from the column support up to the cross-car beam.
+    pub const COLUMN_BRACKET: &str = "column_bracket";
+    /// Wheel links and wheel centres.
+    pub const SUSPENSION: &str = "suspension";
 }
 
 /// The generated body.
@@ -102,6 +131,328 @@ impl Chassis {
     }
 }
 
+/// An x position of the body, named by the [`Geometry`] field it is.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+enum X {
+    Front,
+    /// The front axle, x = 0.
+    Axle,
+    Firewall,
+    Cowl,
+    RoofFront,
+    BPillar,
+    QuarterFront,
+    Shelf,
+    RoofRear,
+    CPillarFoot,
+    Rear,
+    /// The station of a run laid at listed positions ([`Lay`]).
+    Station,
+}
+
+/// A lateral position, on the left (+y) for the rows that are mirrored to the right.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+enum Y {
+    Centre,
+    /// Body side, +half_width.
+    Left,
+    /// Body side, −half_width.
+    Right,
+    /// Girder and floor-rail line, +girder_y.
+    LeftRail,
+    /// Girder and floor-rail line, −girder_y.
+    RightRail,
+}
+
+/// A height, named by the [`Geometry`] field it is.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+enum Z {
+    Floor,
+    Girder,
+    ApronTop,
+    Shelf,
+    Cowl,
+    Roof,
+}
+
+/// A point of the body, by coordinates named in the geometry.
+#[derive(Debug, Clone, Copy)]
+struct At(X, Y, Z);
+
+impl At {
+    /// The position; `side` (±1) mirrors y, `station` is the x of [`X::Station`].
+    fn resolve(self, g: &Geometry, side: f64, station: f64) -> Vector3<f64> {
+        let x = match self.0 {
+            X::Front => g.front_x,
+            X::Axle => 0.0,
+            X::Firewall => g.firewall_x,
+            X::Cowl => g.cowl_x,
+            X::RoofFront => g.roof_front_x,
+            X::BPillar => g.b_pillar_x,
+            X::QuarterFront => g.quarter_front_x,
+            X::Shelf => g.shelf_x,
+            X::RoofRear => g.roof_rear_x,
+            X::CPillarFoot => g.c_pillar_foot_x,
+            X::Rear => g.rear_x,
+            X::Station => station,
+        };
+        let y = match self.1 {
+            Y::Centre => 0.0,
+            Y::Left => g.half_width,
+            Y::Right => -g.half_width,
+            Y::LeftRail => g.girder_y,
+            Y::RightRail => -g.girder_y,
+        };
+        let z = match self.2 {
+            Z::Floor => g.floor_z,
+            Z::Girder => g.girder_z,
+            Z::ApronTop => g.apron_top_z,
+            Z::Shelf => g.shelf_z,
+            Z::Cowl => g.cowl_z,
+            Z::Roof => g.roof_z,
+        };
+        Vector3::new(x, side * y, z)
+    }
+}
+
+/// Which trim mass ([`Trim`]) a beam run carries; each group's mass is spread uniformly over the
+/// length of its runs as laid out.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+enum TrimGroup {
+    Floor,
+    Roof,
+    Dash,
+    FrontEnd,
+    Rear,
+    Doors,
+}
+
+impl TrimGroup {
+    const ALL: [TrimGroup; 6] = [
+        TrimGroup::Floor,
+        TrimGroup::Roof,
+        TrimGroup::Dash,
+        TrimGroup::FrontEnd,
+        TrimGroup::Rear,
+        TrimGroup::Doors,
+    ];
+
+    /// The configuration field and its mass (kg).
+    fn mass(self, t: &Trim) -> (&'static str, f64) {
+        match self {
+            TrimGroup::Floor => ("trim.floor", t.floor),
+            TrimGroup::Roof => ("trim.roof", t.roof),
+            TrimGroup::Dash => ("trim.dash", t.dash),
+            TrimGroup::FrontEnd => ("trim.front_end", t.front_end),
+            TrimGroup::Rear => ("trim.rear", t.rear),
+            TrimGroup::Doors => ("trim.doors", t.doors),
+        }
+    }
+}
+
+/// How often a row of [`FRAME`] is laid.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+enum Lay {
+    /// Once as written.
+    Once,
+    /// On the right, then mirrored on the left.
+    EachSide,
+    /// At every `geometry.cross_member_x`.
+    CrossMembers,
+    /// At every `geometry.roof_bow_x`.
+    RoofBows,
+    /// At `options.stiffening_bar_x` if `options.stiffening_bar`; its left end must already be a
+    /// node of the girder.
+    StiffeningBar,
+}
+
+impl Lay {
+    fn stations(self, cfg: &ChassisConfig) -> Vec<f64> {
+        match self {
+            Lay::Once | Lay::EachSide => vec![0.0],
+            Lay::CrossMembers => cfg.geometry.cross_member_x.clone(),
+            Lay::RoofBows => cfg.geometry.roof_bow_x.clone(),
+            Lay::StiffeningBar if cfg.options.stiffening_bar => vec![cfg.options.stiffening_bar_x],
+            Lay::StiffeningBar => Vec::new(),
+        }
+    }
+}
+
+/// The [`Sections`] field of a run: its name (for errors) and how to read it.
+type SectionOf = (&'static str, fn(&Sections) -> &SectionSpec);
+
+/// A straight beam run of the body frame.
+struct Run {
+    lay: Lay,
+    region: &'static str,
+    section: SectionOf,
+    from: At,
+    to: At,
+    trim: Option<TrimGroup>,
+}
+
+/// The body frame. Mirrored rows come first and are laid as a block, right side then left side,
+/// which keeps the node and element numbering of the hand-written frame this table replaced.
+#[rustfmt::skip]
+static FRAME: [Run; 23] = [
+    Run { lay: Lay::EachSide, region: region::SILL, section: ("sill", |s| &s.sill),
+          from: At(X::Rear, Y::Left, Z::Floor), to: At(X::Firewall, Y::Left, Z::Floor), trim: Some(TrimGroup::Floor) },
+    Run { lay: Lay::EachSide, region: region::FLOOR_RAIL, section: ("floor_rail", |s| &s.floor_rail),
+          from: At(X::Rear, Y::LeftRail, Z::Floor), to: At(X::Firewall, Y::LeftRail, Z::Floor), trim: Some(TrimGroup::Floor) },
+    Run { lay: Lay::EachSide, region: region::FRONT_END, section: ("girder", |s| &s.girder),
+          from: At(X::Firewall, Y::LeftRail, Z::Girder), to: At(X::Front, Y::LeftRail, Z::Girder), trim: Some(TrimGroup::FrontEnd) },
+    Run { lay: Lay::EachSide, region: region::FIREWALL, section: ("girder_extension", |s| &s.girder_extension),
+          from: At(X::Firewall, Y::LeftRail, Z::Floor), to: At(X::Firewall, Y::LeftRail, Z::Girder), trim: None },
+    Run { lay: Lay::EachSide, region: region::FRONT_END, section: ("upper_rail", |s| &s.upper_rail),
+          from: At(X::Firewall, Y::LeftRail, Z::ApronTop), to: At(X::Front, Y::LeftRail, Z::ApronTop), trim: Some(TrimGroup::FrontEnd) },
+    // Load paths from the front end into the body: kick-down of the girder to the floor rail and
+    // continuation of the upper rail to the cross-car beam.
+    Run { lay: Lay::EachSide, region: region::FIREWALL, section: ("girder_extension", |s| &s.girder_extension),
+          from: At(X::Firewall, Y::LeftRail, Z::Girder), to: At(X::Cowl, Y::LeftRail, Z::Floor), trim: None },
+    Run { lay: Lay::EachSide, region: region::FIREWALL, section: ("upper_rail", |s| &s.upper_rail),
+          from: At(X::Firewall, Y::LeftRail, Z::ApronTop), to: At(X::Cowl, Y::LeftRail, Z::Cowl), trim: None },
+    Run { lay: Lay::EachSide, region: region::FRONT_END, section: ("fender_brace", |s| &s.fender_brace),
+          from: At(X::Axle, Y::LeftRail, Z::ApronTop), to: At(X::Firewall, Y::Left, Z::ApronTop), trim: None },
+    Run { lay: Lay::EachSide, region: region::PILLAR, section: ("hinge_pillar", |s| &s.hinge_pillar),
+          from: At(X::Firewall, Y::Left, Z::Floor), to: At(X::Firewall, Y::Left, Z::Cowl), trim: Some(TrimGroup::Doors) },
+    Run { lay: Lay::EachSide, region: region::PILLAR, section: ("a_pillar", |s| &s.a_pillar),
+          from: At(X::Cowl, Y::Left, Z::Cowl), to: At(X::RoofFront, Y::Left, Z::Roof), trim: None },
+    Run { lay: Lay::EachSide, region: region::PILLAR, section: ("b_pillar", |s| &s.b_pillar),
+          from: At(X::BPillar, Y::Left, Z::Floor), to: At(X::BPillar, Y::Left, Z::Roof), trim: Some(TrimGroup::Doors) },
+    Run { lay: Lay::EachSide, region: region::PILLAR, section: ("c_pillar", |s| &s.c_pillar),
+          from: At(X::RoofRear, Y::Left, Z::Roof), to: At(X::CPillarFoot, Y::Left, Z::Shelf), trim: None },
+    Run { lay: Lay::EachSide, region: region::ROOF_RAIL, section: ("roof_rail", |s| &s.roof_rail),
+          from: At(X::RoofRear, Y::Left, Z::Roof), to: At(X::RoofFront, Y::Left, Z::Roof), trim: Some(TrimGroup::Roof) },
+    Run { lay: Lay::Once, region: region::TUNNEL, section: ("tunnel", |s| &s.tunnel),
+          from: At(X::Rear, Y::Centre, Z::Floor), to: At(X::Firewall, Y::Centre, Z::Floor), trim: Some(TrimGroup::Floor) },
+    Run { lay: Lay::CrossMembers, region: region::CROSS_MEMBER, section: ("cross_member", |s| &s.cross_member),
+          from: At(X::Station, Y::Right, Z::Floor), to: At(X::Station, Y::Left, Z::Floor), trim: Some(TrimGroup::Floor) },
+    Run { lay: Lay::Once, region: region::REAR_CROSS_MEMBER, section: ("cross_member", |s| &s.cross_member),
+          from: At(X::Rear, Y::Right, Z::Floor), to: At(X::Rear, Y::Left, Z::Floor), trim: Some(TrimGroup::Rear) },
+    Run { lay: Lay::Once, region: region::FRONT_END, section: ("front_cross", |s| &s.front_cross),
+          from: At(X::Front, Y::RightRail, Z::Girder), to: At(X::Front, Y::LeftRail, Z::Girder), trim: Some(TrimGroup::FrontEnd) },
+    Run { lay: Lay::Once, region: region::FRONT_END, section: ("front_cross", |s| &s.front_cross),
+          from: At(X::Front, Y::RightRail, Z::ApronTop), to: At(X::Front, Y::LeftRail, Z::ApronTop), trim: Some(TrimGroup::FrontEnd) },
+    Run { lay: Lay::Once, region: region::COWL, section: ("cross_car_beam", |s| &s.cross_car_beam),
+          from: At(X::Cowl, Y::Right, Z::Cowl), to: At(X::Cowl, Y::Left, Z::Cowl), trim: Some(TrimGroup::Dash) },
+    Run { lay: Lay::Once, region: region::COWL, section: ("dash_brace", |s| &s.dash_brace),
+          from: At(X::Cowl, Y::Centre, Z::Cowl), to: At(X::Cowl, Y::Centre, Z::Floor), trim: None },
+    Run { lay: Lay::RoofBows, region: region::ROOF, section: ("roof_bow", |s| &s.roof_bow),
+          from: At(X::Station, Y::Right, Z::Roof), to: At(X::Station, Y::Left, Z::Roof), trim: Some(TrimGroup::Roof) },
+    Run { lay: Lay::Once, region: region::SHELF, section: ("shelf_beam", |s| &s.shelf_beam),
+          from: At(X::Shelf, Y::Right, Z::Shelf), to: At(X::Shelf, Y::Left, Z::Shelf), trim: None },
+    Run { lay: Lay::StiffeningBar, region: region::FRONT_END, section: ("stiffening_bar", |s| &s.stiffening_bar),
+          from: At(X::Station, Y::RightRail, Z::Girder), to: At(X::Station, Y::LeftRail, Z::Girder), trim: None },
+];
+
+/// What a panel is made of.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+enum Skin {
+    /// Body steel, beaded (bending thickness × `thickness.panel_bending_factor`).
+    Steel,
+    /// Body steel of the front plate: thickness × `options.front_plate_factor` when
+    /// `options.stiff_front_plate`.
+    FrontPlate,
+    /// Bonded glass, flat.
+    Glass,
+}
+
+/// A flat panel: the parallelogram of `corner` and the far ends of its two edges, meshed on the
+/// grid. Panels carry only their own mass: trim on the thin sheets would only create spurious
+/// local panel modes.
+struct Panel {
+    region: &'static str,
+    corner: At,
+    u_end: At,
+    v_end: At,
+    thickness: fn(&Thicknesses) -> f64,
+    skin: Skin,
+    /// Laid on the right, then mirrored on the left.
+    mirrored: bool,
+}
+
+/// The body panels: floor, roof, firewall, cowl, rear, quarters, shelf, glass, aprons, front.
+#[rustfmt::skip]
+static PANELS: [Panel; 11] = [
+    Panel { region: region::FLOOR, thickness: |t| t.floor, skin: Skin::Steel, mirrored: false,
+            corner: At(X::Rear, Y::Right, Z::Floor), u_end: At(X::Firewall, Y::Right, Z::Floor), v_end: At(X::Rear, Y::Left, Z::Floor) },
+    Panel { region: region::ROOF, thickness: |t| t.roof, skin: Skin::Steel, mirrored: false,
+            corner: At(X::RoofRear, Y::Right, Z::Roof), u_end: At(X::RoofFront, Y::Right, Z::Roof), v_end: At(X::RoofRear, Y::Left, Z::Roof) },
+    Panel { region: region::FIREWALL, thickness: |t| t.firewall, skin: Skin::FrontPlate, mirrored: false,
+            corner: At(X::Firewall, Y::Right, Z::Floor), u_end: At(X::Firewall, Y::Left, Z::Floor), v_end: At(X::Firewall, Y::Right, Z::Cowl) },
+    Panel { region: region::COWL, thickness: |t| t.cowl, skin: Skin::FrontPlate, mirrored: false,
+            corner: At(X::Cowl, Y::Right, Z::Cowl), u_end: At(X::Firewall, Y::Right, Z::Cowl), v_end: At(X::Cowl, Y::Left, Z::Cowl) },
+    Panel { region: region::REAR_PANEL, thickness: |t| t.rear_panel, skin: Skin::Steel, mirrored: false,
+            corner: At(X::Rear, Y::Right, Z::Floor), u_end: At(X::Rear, Y::Left, Z::Floor), v_end: At(X::Rear, Y::Right, Z::Shelf) },
+    Panel { region: region::QUARTER, thickness: |t| t.quarter, skin: Skin::Steel, mirrored: true,
+            corner: At(X::Rear, Y::Left, Z::Floor), u_end: At(X::QuarterFront, Y::Left, Z::Floor), v_end: At(X::Rear, Y::Left, Z::Shelf) },
+    Panel { region: region::SHELF, thickness: |t| t.shelf, skin: Skin::Steel, mirrored: false,
+            corner: At(X::Rear, Y::Right, Z::Shelf), u_end: At(X::Shelf, Y::Right, Z::Shelf), v_end: At(X::Rear, Y::Left, Z::Shelf) },
+    // Windscreen between cowl and roof, rear window between roof and shelf.
+    Panel { region: region::GLASS, thickness: |t| t.glass, skin: Skin::Glass, mirrored: false,
+            corner: At(X::Cowl, Y::Right, Z::Cowl), u_end: At(X::Cowl, Y::Left, Z::Cowl), v_end: At(X::RoofFront, Y::Right, Z::Roof) },
+    Panel { region: region::GLASS, thickness: |t| t.glass, skin: Skin::Glass, mirrored: false,
+            corner: At(X::CPillarFoot, Y::Right, Z::Shelf), u_end: At(X::CPillarFoot, Y::Left, Z::Shelf), v_end: At(X::RoofRear, Y::Right, Z::Roof) },
+    // Wheel-house aprons above the girders and the front cross panel between them.
+    Panel { region: region::FRONT_END, thickness: |t| t.apron, skin: Skin::Steel, mirrored: true,
+            corner: At(X::Firewall, Y::LeftRail, Z::Girder), u_end: At(X::Front, Y::LeftRail, Z::Girder), v_end: At(X::Firewall, Y::LeftRail, Z::ApronTop) },
+    Panel { region: region::FRONT_END, thickness: |t| t.front_panel, skin: Skin::Steel, mirrored: false,
+            corner: At(X::Front, Y::RightRail, Z::Girder), u_end: At(X::Front, Y::LeftRail, Z::Girder), v_end: At(X::Front, Y::RightRail, Z::ApronTop) },
+];
+
+/// A run of [`FRAME`] placed in the body.
+struct Placed {
+    run: &'static Run,
+    from: Vector3<f64>,
+    to: Vector3<f64>,
+}
+
+/// Every run of the frame in laying order.
+fn place_frame(cfg: &ChassisConfig) -> Vec<Placed> {
+    let g = &cfg.geometry;
+    let mirrored = FRAME.iter().filter(|r| r.lay == Lay::EachSide);
+    let sides = [-1.0, 1.0].into_iter();
+    let pairs = sides.flat_map(|side| mirrored.clone().map(move |run| (run, side, 0.0)));
+    let single = FRAME.iter().filter(|r| r.lay != Lay::EachSide);
+    let stationed = single.flat_map(|run| {
+        let stations = run.lay.stations(cfg);
+        stations.into_iter().map(move |x| (run, 1.0, x))
+    });
+    pairs
+        .chain(stationed)
+        .map(|(run, side, x)| Placed {
+            run,
+            from: run.from.resolve(g, side, x),
+            to: run.to.resolve(g, side, x),
+        })
+        .collect()
+}
+
+/// Trim mass per length (kg/m) of each [`TrimGroup`], from the lengths of its placed runs.
+fn trim_per_length(trim: &Trim, frame: &[Placed]) -> Result<[f64; 6], FeError> {
+    let mut length = [0.0; 6];
+    for p in frame {
+        if let Some(group) = p.run.trim {
+            length[group as usize] += (p.to - p.from).norm();
+        }
+    }
+    let mut per_length = [0.0; 6];
+    for group in TrimGroup::ALL {
+        let (name, mass) = group.mass(trim);
+        let l = length[group as usize];
+        per_length[group as usize] = if mass == 0.0 {
+            0.0
+        } else if l > 0.0 {
+            mass / l
+        } else {
+            return Err(FeError::InvalidInput(format!(
+                "{name} = {mass} kg has no beams of the frame to hang on"
+            )));
+        };
+    }
+    Ok(per_length)
+}
+
 fn key(p: &Vector3<f64>) -> [i64; 3] {
     // 0.1 mm: far below the grid spacing, far above round-off of the grid arithmetic.
     [
@@ -115,6 +466,21 @@ fn v3(p: [f64; 3]) -> Vector3<f64> {
     Vector3::new(p[0], p[1], p[2])
 }
 
+/// Material, section and trim of a beam line.
+struct Member {
+    material: Material,
+    section: BeamSection,
+    /// Non-structural mass per length (kg/m).
+    extra_per_length: f64,
+}
+
+/// Material and thicknesses of a panel.
+struct Sheet {
+    material: Material,
+    thickness: f64,
+    bending_thickness: f64,
+}
+
 struct Builder<'a> {
     cfg: &'a ChassisConfig,
     body: Material,
@@ -125,7 +491,7 @@ struct Builder<'a> {
 
 impl<'a> Builder<'a> {
     fn new(cfg: &'a ChassisConfig) -> Result<Self, FeError> {
-        validate(cfg)?;
+        cfg.validate()?;
         let mut body = cfg.material;
         body.youngs_modulus *= cfg.body_stiffness_scale;
         Ok(Self {
@@ -174,30 +540,13 @@ impl<'a> Builder<'a> {
         n.max(1)
     }
 
-    /// Flat body-steel panel spanned by the edge vectors `u`, `v` from `corner`, on the grid.
+    /// Flat panel spanned by `u`, `v` from `corner`, meshed on the grid.
     fn panel(
         &mut self,
         region: &str,
         corner: Vector3<f64>,
-        u: Vector3<f64>,
-        v: Vector3<f64>,
-        thickness: f64,
-        bending_factor: f64,
-    ) {
-        self.panel_of(region, corner, u, v, self.body, thickness, bending_factor);
-    }
-
-    /// Flat panel of `material` spanned by `u`, `v` from `corner`, meshed on the grid.
-    #[allow(clippy::too_many_arguments)]
-    fn panel_of(
-        &mut self,
-        region: &str,
-        corner: Vector3<f64>,
-        u: Vector3<f64>,
-        v: Vector3<f64>,
-        material: Material,
-        thickness: f64,
-        bending_factor: f64,
+        [u, v]: [Vector3<f64>; 2],
+        sheet: &Sheet,
     ) {
         let (nu, nv) = (self.divisions(&u), self.divisions(&v));
         let mut ids = vec![vec![0; nv + 1]; nu + 1];
@@ -211,31 +560,25 @@ impl<'a> Builder<'a> {
             for j in 0..nv {
                 self.mesh.shells.push(Shell {
                     nodes: [ids[i][j], ids[i + 1][j], ids[i + 1][j + 1], ids[i][j + 1]],
-                    material,
-                    thickness,
-                    bending_thickness: thickness * bending_factor,
+                    material: sheet.material,
+                    thickness: sheet.thickness,
+                    bending_thickness: sheet.bending_thickness,
                     extra_mass_per_area: 0.0,
                 });
             }
         }
     }
 
-    /// Straight beam line from `a` to `b` on the grid; returns its nodes.
-    #[allow(clippy::too_many_arguments)]
+    /// Straight beam line from `a` to `b` in `divisions` elements; returns its nodes.
     fn line(
         &mut self,
         region: &str,
-        a: Vector3<f64>,
-        b: Vector3<f64>,
-        section: &SectionSpec,
-        what: &str,
-        material: Material,
-        extra_per_length: f64,
-        divisions: Option<usize>,
-    ) -> Result<Vec<usize>, FeError> {
+        [a, b]: [Vector3<f64>; 2],
+        member: &Member,
+        divisions: usize,
+    ) -> Vec<usize> {
         let d = b - a;
-        let n = divisions.unwrap_or_else(|| self.divisions(&d)).max(1);
-        let section = section.section(what)?;
+        let n = divisions.max(1);
         let dir = d.normalize();
         let orientation = if dir.z.abs() > 0.7 {
             Vector3::new(1.0, 0.0, 0.0)
@@ -250,13 +593,13 @@ impl<'a> Builder<'a> {
         for w in ids.windows(2) {
             self.mesh.beams.push(Beam {
                 nodes: [w[0], w[1]],
-                material,
-                section,
+                material: member.material,
+                section: member.section,
                 orientation,
-                extra_mass_per_length: extra_per_length,
+                extra_mass_per_length: member.extra_per_length,
             });
         }
-        Ok(ids)
+        ids
     }
 
     fn build(mut self) -> Result<Mesh, FeError> {
@@ -278,388 +621,54 @@ impl<'a> Builder<'a> {
         Ok(mesh)
     }
 
-    /// Shell panels: floor, roof, firewall, cowl, rear, quarters, shelf, glass, aprons, front.
+    /// Lays [`PANELS`].
     fn panels(&mut self) {
         let cfg = self.cfg;
-        let g = &cfg.geometry;
-        let t = &cfg.thickness;
-        let w = g.half_width;
-        let ex = Vector3::new(1.0, 0.0, 0.0);
-        let ey = Vector3::new(0.0, 1.0, 0.0);
-        let ez = Vector3::new(0.0, 0.0, 1.0);
-        let p = Vector3::new;
-        let front_plate = if cfg.options.stiff_front_plate {
-            cfg.options.front_plate_factor
-        } else {
-            1.0
-        };
-
-        // Panels carry only their own mass; their bending thickness represents beads.
-        let bend = t.panel_bending_factor;
-        self.panel(
-            region::FLOOR,
-            p(g.rear_x, -w, g.floor_z),
-            ex * (g.firewall_x - g.rear_x),
-            ey * 2.0 * w,
-            t.floor,
-            bend,
-        );
-        self.panel(
-            region::ROOF,
-            p(g.roof_rear_x, -w, g.roof_z),
-            ex * (g.roof_front_x - g.roof_rear_x),
-            ey * 2.0 * w,
-            t.roof,
-            bend,
-        );
-        self.panel(
-            region::FIREWALL,
-            p(g.firewall_x, -w, g.floor_z),
-            ey * 2.0 * w,
-            ez * (g.cowl_z - g.floor_z),
-            t.firewall * front_plate,
-            bend,
-        );
-        self.panel(
-            "cowl",
-            p(g.cowl_x, -w, g.cowl_z),
-            ex * (g.firewall_x - g.cowl_x),
-            ey * 2.0 * w,
-            t.cowl * front_plate,
-            bend,
-        );
-        let rear_h = g.shelf_z - g.floor_z;
-        self.panel(
-            region::REAR_PANEL,
-            p(g.rear_x, -w, g.floor_z),
-            ey * 2.0 * w,
-            ez * rear_h,
-            t.rear_panel,
-            bend,
-        );
-        for side in [-1.0, 1.0] {
-            self.panel(
-                "quarter",
-                p(g.rear_x, side * w, g.floor_z),
-                ex * (g.quarter_front_x - g.rear_x),
-                ez * rear_h,
-                t.quarter,
-                bend,
-            );
-        }
-        self.panel(
-            "shelf",
-            p(g.rear_x, -w, g.shelf_z),
-            ex * (g.shelf_x - g.rear_x),
-            ey * 2.0 * w,
-            t.shelf,
-            bend,
-        );
-        // Bonded glass: windscreen between cowl and roof, rear window between roof and shelf.
         let mut glass = cfg.glass;
         glass.youngs_modulus *= cfg.body_stiffness_scale;
-        let windscreen = p(g.roof_front_x - g.cowl_x, 0.0, g.roof_z - g.cowl_z);
-        self.panel_of(
-            "glass",
-            p(g.cowl_x, -w, g.cowl_z),
-            ey * 2.0 * w,
-            windscreen,
-            glass,
-            t.glass,
-            1.0,
-        );
-        let rear_window = p(g.roof_rear_x - g.c_pillar_foot_x, 0.0, g.roof_z - g.shelf_z);
-        self.panel_of(
-            "glass",
-            p(g.c_pillar_foot_x, -w, g.shelf_z),
-            ey * 2.0 * w,
-            rear_window,
-            glass,
-            t.glass,
-            1.0,
-        );
-        let apron_l = g.front_x - g.firewall_x;
-        let apron_h = g.apron_top_z - g.girder_z;
-        for side in [-1.0, 1.0] {
-            self.panel(
-                region::FRONT_END,
-                p(g.firewall_x, side * g.girder_y, g.girder_z),
-                ex * apron_l,
-                ez * apron_h,
-                t.apron,
-                bend,
-            );
+        for panel in &PANELS {
+            let base = (panel.thickness)(&cfg.thickness);
+            let (material, thickness, bending_factor) = match panel.skin {
+                Skin::Steel => (self.body, base, cfg.thickness.panel_bending_factor),
+                Skin::FrontPlate if cfg.options.stiff_front_plate => (
+                    self.body,
+                    base * cfg.options.front_plate_factor,
+                    cfg.thickness.panel_bending_factor,
+                ),
+                Skin::FrontPlate => (self.body, base, cfg.thickness.panel_bending_factor),
+                Skin::Glass => (glass, base, 1.0),
+            };
+            let sheet = Sheet {
+                material,
+                thickness,
+                bending_thickness: thickness * bending_factor,
+            };
+            let sides: &[f64] = if panel.mirrored { &[-1.0, 1.0] } else { &[1.0] };
+            for &side in sides {
+                let at = |p: At| p.resolve(&cfg.geometry, side, 0.0);
+                let corner = at(panel.corner);
+                let edges = [at(panel.u_end) - corner, at(panel.v_end) - corner];
+                self.panel(panel.region, corner, edges, &sheet);
+            }
         }
-        self.panel(
-            region::FRONT_END,
-            p(g.front_x, -g.girder_y, g.girder_z),
-            ey * 2.0 * g.girder_y,
-            ez * apron_h,
-            t.front_panel,
-            bend,
-        );
     }
 
-    /// Beams of the body frame, with the trim spread over them, and the optional stiffening bar.
+    /// Lays [`FRAME`] with the trim spread over its runs.
     fn frame(&mut self) -> Result<(), FeError> {
-        let cfg = self.cfg;
-        let g = &cfg.geometry;
-        let s = &cfg.sections;
-        let trim = &cfg.trim;
-        let w = g.half_width;
-        let body = self.body;
-        let p = Vector3::new;
-
-        // Trim per length of each beam group.
-        let floor_l = g.firewall_x - g.rear_x;
-        let floor_trim = trim.floor / (5.0 * floor_l + 2.0 * w * g.cross_member_x.len() as f64);
-        let roof_l = g.roof_front_x - g.roof_rear_x;
-        let roof_trim = trim.roof / (2.0 * roof_l + 2.0 * w * g.roof_bow_x.len() as f64);
-        let dash_trim = trim.dash / (2.0 * w);
-        let apron_l = g.front_x - g.firewall_x;
-        let front_trim = trim.front_end / (4.0 * apron_l + 4.0 * g.girder_y);
-        let rear_trim = trim.rear / (2.0 * w);
-        let door_trim = trim.doors / (2.0 * ((g.cowl_z - g.floor_z) + (g.roof_z - g.floor_z)));
-
-        // Beams of the body frame.
-        for side in [-1.0, 1.0] {
-            let y = side * w;
-            let gy = side * g.girder_y;
-            self.line(
-                "sill",
-                p(g.rear_x, y, g.floor_z),
-                p(g.firewall_x, y, g.floor_z),
-                &s.sill,
-                "sill",
-                body,
-                floor_trim,
-                None,
-            )?;
-            self.line(
-                "floor_rail",
-                p(g.rear_x, gy, g.floor_z),
-                p(g.firewall_x, gy, g.floor_z),
-                &s.floor_rail,
-                "floor_rail",
-                body,
-                floor_trim,
-                None,
-            )?;
-            self.line(
-                region::FRONT_END,
-                p(g.firewall_x, gy, g.girder_z),
-                p(g.front_x, gy, g.girder_z),
-                &s.girder,
-                "girder",
-                body,
-                front_trim,
-                None,
-            )?;
-            self.line(
-                region::FIREWALL,
-                p(g.firewall_x, gy, g.floor_z),
-                p(g.firewall_x, gy, g.girder_z),
-                &s.girder_extension,
-                "girder_extension",
-                body,
-                0.0,
-                None,
-            )?;
-            self.line(
-                region::FRONT_END,
-                p(g.firewall_x, gy, g.apron_top_z),
-                p(g.front_x, gy, g.apron_top_z),
-                &s.upper_rail,
-                "upper_rail",
-                body,
-                front_trim,
-                None,
-            )?;
-            // Load paths from the front end into the body: kick-down of the girder to the floor
-            // rail and continuation of the upper rail to the cross-car beam.
-            self.line(
-                region::FIREWALL,
-                p(g.firewall_x, gy, g.girder_z),
-                p(g.cowl_x, gy, g.floor_z),
-                &s.girder_extension,
-                "girder_extension",
-                body,
-                0.0,
-                None,
-            )?;
-            self.line(
-                region::FIREWALL,
-                p(g.firewall_x, gy, g.apron_top_z),
-                p(g.cowl_x, gy, g.cowl_z),
-                &s.upper_rail,
-                "upper_rail",
-                body,
-                0.0,
-                None,
-            )?;
-            self.line(
-                region::FRONT_END,
-                p(0.0, gy, g.apron_top_z),
-                p(g.firewall_x, y, g.apron_top_z),
-                &s.fender_brace,
-                "fender_brace",
-                body,
-                0.0,
-                None,
-            )?;
-            self.line(
-                "pillar",
-                p(g.firewall_x, y, g.floor_z),
-                p(g.firewall_x, y, g.cowl_z),
-                &s.hinge_pillar,
-                "hinge_pillar",
-                body,
-                door_trim,
-                None,
-            )?;
-            self.line(
-                "pillar",
-                p(g.cowl_x, y, g.cowl_z),
-                p(g.roof_front_x, y, g.roof_z),
-                &s.a_pillar,
-                "a_pillar",
-                body,
-                0.0,
-                None,
-            )?;
-            self.line(
-                "pillar",
-                p(g.b_pillar_x, y, g.floor_z),
-                p(g.b_pillar_x, y, g.roof_z),
-                &s.b_pillar,
-                "b_pillar",
-                body,
-                door_trim,
-                None,
-            )?;
-            self.line(
-                "pillar",
-                p(g.roof_rear_x, y, g.roof_z),
-                p(g.c_pillar_foot_x, y, g.shelf_z),
-                &s.c_pillar,
-                "c_pillar",
-                body,
-                0.0,
-                None,
-            )?;
-            self.line(
-                "roof_rail",
-                p(g.roof_rear_x, y, g.roof_z),
-                p(g.roof_front_x, y, g.roof_z),
-                &s.roof_rail,
-                "roof_rail",
-                body,
-                roof_trim,
-                None,
-            )?;
-        }
-        self.line(
-            "tunnel",
-            p(g.rear_x, 0.0, g.floor_z),
-            p(g.firewall_x, 0.0, g.floor_z),
-            &s.tunnel,
-            "tunnel",
-            body,
-            floor_trim,
-            None,
-        )?;
-        for &x in &g.cross_member_x {
-            self.line(
-                "cross_member",
-                p(x, -w, g.floor_z),
-                p(x, w, g.floor_z),
-                &s.cross_member,
-                "cross_member",
-                body,
-                floor_trim,
-                None,
-            )?;
-        }
-        self.line(
-            "rear_cross_member",
-            p(g.rear_x, -w, g.floor_z),
-            p(g.rear_x, w, g.floor_z),
-            &s.cross_member,
-            "rear_cross_member",
-            body,
-            rear_trim,
-            None,
-        )?;
-        for z in [g.girder_z, g.apron_top_z] {
-            self.line(
-                region::FRONT_END,
-                p(g.front_x, -g.girder_y, z),
-                p(g.front_x, g.girder_y, z),
-                &s.front_cross,
-                "front_cross",
-                body,
-                front_trim,
-                None,
-            )?;
-        }
-        self.line(
-            "cowl",
-            p(g.cowl_x, -w, g.cowl_z),
-            p(g.cowl_x, w, g.cowl_z),
-            &s.cross_car_beam,
-            "cross_car_beam",
-            body,
-            dash_trim,
-            None,
-        )?;
-        self.line(
-            "cowl",
-            p(g.cowl_x, 0.0, g.cowl_z),
-            p(g.cowl_x, 0.0, g.floor_z),
-            &s.dash_brace,
-            "dash_brace",
-            body,
-            0.0,
-            None,
-        )?;
-        for &x in &g.roof_bow_x {
-            self.line(
-                region::ROOF,
-                p(x, -w, g.roof_z),
-                p(x, w, g.roof_z),
-                &s.roof_bow,
-                "roof_bow",
-                body,
-                roof_trim,
-                None,
-            )?;
-        }
-        self.line(
-            "shelf",
-            p(g.shelf_x, -w, g.shelf_z),
-            p(g.shelf_x, w, g.shelf_z),
-            &s.shelf_beam,
-            "shelf_beam",
-            body,
-            0.0,
-            None,
-        )?;
-        if cfg.options.stiffening_bar {
-            let x = cfg.options.stiffening_bar_x;
-            self.existing(
-                p(x, g.girder_y, g.girder_z),
-                "stiffening bar end (options.stiffening_bar_x)",
-            )?;
-            self.line(
-                region::FRONT_END,
-                p(x, -g.girder_y, g.girder_z),
-                p(x, g.girder_y, g.girder_z),
-                &s.stiffening_bar,
-                "stiffening_bar",
-                body,
-                0.0,
-                None,
-            )?;
+        let frame = place_frame(self.cfg);
+        let per_length = trim_per_length(&self.cfg.trim, &frame)?;
+        for p in &frame {
+            if p.run.lay == Lay::StiffeningBar {
+                self.existing(p.to, "stiffening bar end (options.stiffening_bar_x)")?;
+            }
+            let (name, spec) = p.run.section;
+            let member = Member {
+                material: self.body,
+                section: spec(&self.cfg.sections).section(name)?,
+                extra_per_length: p.run.trim.map_or(0.0, |t| per_length[t as usize]),
+            };
+            let n = self.divisions(&(p.to - p.from));
+            self.line(p.run.region, [p.from, p.to], &member, n);
         }
         Ok(())
     }
@@ -675,37 +684,19 @@ impl<'a> Builder<'a> {
         self.existing(above, "cross-car beam node above steering.column_support")?;
         let n = st.elements_per_segment.max(1);
         // The column is not scaled with the body: it has its own tuning (section, wheel mass).
-        let column = self.cfg.material;
-        self.line(
-            "column_lower",
-            base,
-            support,
-            &st.column_section,
-            "steering.column_section",
-            column,
-            0.0,
-            Some(n),
-        )?;
-        self.line(
-            region::STEERING,
-            support,
-            wheel,
-            &st.column_section,
-            "steering.column_section",
-            column,
-            0.0,
-            Some(n),
-        )?;
-        self.line(
-            "column_bracket",
-            support,
-            above,
-            &st.bracket_section,
-            "steering.bracket_section",
-            self.body,
-            0.0,
-            Some(1),
-        )?;
+        let column = Member {
+            material: self.cfg.material,
+            section: st.column_section.section("steering.column_section")?,
+            extra_per_length: 0.0,
+        };
+        let bracket = Member {
+            material: self.body,
+            section: st.bracket_section.section("steering.bracket_section")?,
+            extra_per_length: 0.0,
+        };
+        self.line(region::COLUMN_LOWER, [base, support], &column, n);
+        self.line(region::STEERING, [support, wheel], &column, n);
+        self.line(region::COLUMN_BRACKET, [support, above], &bracket, 1);
         let wheel_node = self.node(wheel, region::STEERING);
         let axis = (wheel - support).normalize();
         let [i_d, i_a] = st.wheel_inertia;
@@ -746,6 +737,11 @@ impl<'a> Builder<'a> {
             (WHEEL_CENTRES[2], 1.0, false),
             (WHEEL_CENTRES[3], -1.0, false),
         ];
+        let link = Member {
+            material: self.body,
+            section: self.cfg.sections.wheel_link.section("wheel_link")?,
+            extra_per_length: 0.0,
+        };
         for (name, side, front) in corners {
             let (centre, attach) = if front {
                 let c = su.front_wheel_centre;
@@ -761,17 +757,7 @@ impl<'a> Builder<'a> {
                 )
             };
             self.existing(attach, &format!("suspension attachment of {name}"))?;
-            let link = self.cfg.sections.wheel_link;
-            let ids = self.line(
-                "suspension",
-                attach,
-                centre,
-                &link,
-                "wheel_link",
-                self.body,
-                0.0,
-                Some(1),
-            )?;
+            let ids = self.line(region::SUSPENSION, [attach, centre], &link, 1);
             let node = ids[1];
             self.mesh.named_nodes.insert(name.into(), node);
             self.mesh.ground_springs.push(GroundSpring {
@@ -805,119 +791,54 @@ impl<'a> Builder<'a> {
     }
 }
 
-fn validate(cfg: &ChassisConfig) -> Result<(), FeError> {
-    let g = &cfg.geometry;
-    let positive = [
-        ("geometry.grid_dx", g.grid_dx),
-        ("geometry.grid_dy", g.grid_dy),
-        ("geometry.grid_dz", g.grid_dz),
-        ("geometry.half_width", g.half_width),
-        ("geometry.wheelbase", g.wheelbase),
-        ("body_stiffness_scale", cfg.body_stiffness_scale),
-        ("options.front_plate_factor", cfg.options.front_plate_factor),
-        ("steering.wheel_mass", cfg.steering.wheel_mass),
-        ("suspension.wheel_rate", cfg.suspension.wheel_rate),
-        ("suspension.tyre_rate", cfg.suspension.tyre_rate),
-    ];
-    for (name, v) in positive {
-        super::error::require_positive(name, v)?;
-    }
-    let on_grid = |name: &str, v: f64, step: f64| -> Result<(), FeError> {
-        let r = v / step;
-        if v.is_finite() && (r - r.round()).abs() < 1e-6 {
-            Ok(())
-        } else {
-            Err(FeError::InvalidInput(format!(
-                "{name} = {v} is not a multiple of the grid spacing {step}"
-            )))
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn stations_are_used_exactly_by_the_rows_laid_at_stations() {
+        for run in &FRAME {
+            let stationed = matches!(
+                run.lay,
+                Lay::CrossMembers | Lay::RoofBows | Lay::StiffeningBar
+            );
+            for end in [run.from, run.to] {
+                assert_eq!(
+                    end.0 == X::Station,
+                    stationed,
+                    "{} ({:?})",
+                    run.section.0,
+                    run.lay
+                );
+            }
         }
-    };
-    for (name, v) in [
-        ("geometry.firewall_x", g.firewall_x),
-        ("geometry.rear_x", g.rear_x),
-        ("geometry.front_x", g.front_x),
-        ("geometry.cowl_x", g.cowl_x),
-        ("geometry.roof_front_x", g.roof_front_x),
-        ("geometry.roof_rear_x", g.roof_rear_x),
-        ("geometry.b_pillar_x", g.b_pillar_x),
-        ("geometry.quarter_front_x", g.quarter_front_x),
-        ("geometry.shelf_x", g.shelf_x),
-        ("mounts.front_x", cfg.mounts.front_x),
-        ("mounts.rear_x", cfg.mounts.rear_x),
-    ] {
-        on_grid(name, v, g.grid_dx)?;
-    }
-    for (name, v) in [
-        ("geometry.half_width", g.half_width),
-        ("geometry.girder_y", g.girder_y),
-    ] {
-        on_grid(name, v, g.grid_dy)?;
-    }
-    // Heights are measured on the grid from the floor.
-    for (name, v) in [
-        ("geometry.cowl_z", g.cowl_z),
-        ("geometry.shelf_z", g.shelf_z),
-        ("geometry.girder_z", g.girder_z),
-        ("geometry.apron_top_z", g.apron_top_z),
-    ] {
-        on_grid(name, v - g.floor_z, g.grid_dz)?;
-    }
-    let ordered = [
-        ("rear_x < quarter_front_x", g.rear_x < g.quarter_front_x),
-        ("rear_x < shelf_x", g.rear_x < g.shelf_x),
-        ("roof_rear_x < roof_front_x", g.roof_rear_x < g.roof_front_x),
-        (
-            "cowl_x < firewall_x < front_x",
-            g.cowl_x < g.firewall_x && g.firewall_x < g.front_x,
-        ),
-        (
-            "floor_z < girder_z < apron_top_z",
-            g.floor_z < g.girder_z && g.girder_z < g.apron_top_z,
-        ),
-        (
-            "apron_top_z <= cowl_z < roof_z",
-            g.apron_top_z <= g.cowl_z && g.cowl_z < g.roof_z,
-        ),
-        (
-            "0 < girder_y < half_width",
-            0.0 < g.girder_y && g.girder_y < g.half_width,
-        ),
-    ];
-    for (what, ok) in ordered {
-        if !ok {
-            return Err(FeError::InvalidInput(format!(
-                "geometry must satisfy {what}"
-            )));
-        }
-    }
-    for (name, list, lo, hi) in [
-        (
-            "geometry.cross_member_x",
-            &g.cross_member_x,
-            g.rear_x,
-            g.firewall_x,
-        ),
-        (
-            "geometry.roof_bow_x",
-            &g.roof_bow_x,
-            g.roof_rear_x,
-            g.roof_front_x,
-        ),
-    ] {
-        for &x in list.iter() {
-            on_grid(name, x, g.grid_dx)?;
-            if !(lo..=hi).contains(&x) {
-                return Err(FeError::InvalidInput(format!(
-                    "{name} entry {x} lies outside its panel ({lo} ..= {hi})"
-                )));
+        for panel in &PANELS {
+            for p in [panel.corner, panel.u_end, panel.v_end] {
+                assert_ne!(p.0, X::Station, "panel of {}", panel.region);
             }
         }
     }
-    if !MOUNT_NAMES.contains(&cfg.mounts.removed_in_three_mount_layout.as_str()) {
-        return Err(FeError::InvalidInput(format!(
-            "mounts.removed_in_three_mount_layout = '{}' must be one of {MOUNT_NAMES:?}",
-            cfg.mounts.removed_in_three_mount_layout
-        )));
+
+    #[test]
+    fn trim_hangs_on_the_laid_length_of_its_group() {
+        let mut cfg = ChassisConfig::default();
+        cfg.geometry.cross_member_x.push(-2.0);
+        let g = &cfg.geometry;
+        let frame = place_frame(&cfg);
+        let per_length = trim_per_length(&cfg.trim, &frame).unwrap();
+        // Sills, floor rails and tunnel along the floor, and the four cross members across it.
+        let floor = 5.0 * (g.firewall_x - g.rear_x) + 4.0 * 2.0 * g.half_width;
+        let want = cfg.trim.floor / floor;
+        let got = per_length[TrimGroup::Floor as usize];
+        assert!((got / want - 1.0).abs() < 1e-14, "{got} vs {want}");
+        let mut laid = 0.0;
+        for p in &frame {
+            if let Some(t) = p.run.trim {
+                laid += per_length[t as usize] * (p.to - p.from).norm();
+            }
+        }
+        let t = &cfg.trim;
+        let total = t.floor + t.roof + t.dash + t.front_end + t.rear + t.doors;
+        assert!((laid / total - 1.0).abs() < 1e-14, "{laid} vs {total}");
     }
-    Ok(())
 }

@@ -12,6 +12,7 @@
 
 use serde::{Deserialize, Serialize};
 
+use super::chassis::MOUNT_NAMES;
 use super::error::FeError;
 use super::mesh::{BeamSection, Material};
 
@@ -512,5 +513,152 @@ impl ChassisConfig {
     pub fn to_json(&self) -> Result<String, FeError> {
         serde_json::to_string_pretty(self)
             .map_err(|e| FeError::InvalidInput(format!("chassis JSON: {e}")))
+    }
+}
+
+impl ChassisConfig {
+    /// Checks what serde cannot: sizes positive, positions on the grid and in order, the mount
+    /// name known. [`crate::fe::chassis::Chassis::build`] calls it first, so an error names the
+    /// field rather than a degenerate element.
+    pub fn validate(&self) -> Result<(), FeError> {
+        let g = &self.geometry;
+        let positive = [
+            ("geometry.grid_dx", g.grid_dx),
+            ("geometry.grid_dy", g.grid_dy),
+            ("geometry.grid_dz", g.grid_dz),
+            ("geometry.half_width", g.half_width),
+            ("geometry.wheelbase", g.wheelbase),
+            ("body_stiffness_scale", self.body_stiffness_scale),
+            (
+                "options.front_plate_factor",
+                self.options.front_plate_factor,
+            ),
+            ("steering.wheel_mass", self.steering.wheel_mass),
+            ("suspension.wheel_rate", self.suspension.wheel_rate),
+            ("suspension.tyre_rate", self.suspension.tyre_rate),
+        ];
+        for (name, v) in positive {
+            super::error::require_positive(name, v)?;
+        }
+        g.validate_grid(&[
+            ("mounts.front_x", self.mounts.front_x),
+            ("mounts.rear_x", self.mounts.rear_x),
+        ])?;
+        g.validate_order()?;
+        g.validate_stations()?;
+        let removed = self.mounts.removed_in_three_mount_layout.as_str();
+        if !MOUNT_NAMES.contains(&removed) {
+            return Err(FeError::InvalidInput(format!(
+                "mounts.removed_in_three_mount_layout = '{removed}' must be one of {MOUNT_NAMES:?}"
+            )));
+        }
+        Ok(())
+    }
+}
+
+fn on_grid(name: &str, v: f64, step: f64) -> Result<(), FeError> {
+    let r = v / step;
+    if v.is_finite() && (r - r.round()).abs() < 1e-6 {
+        Ok(())
+    } else {
+        Err(FeError::InvalidInput(format!(
+            "{name} = {v} is not a multiple of the grid spacing {step}"
+        )))
+    }
+}
+
+impl Geometry {
+    /// The named positions, and the `more_x` positions along x, lie on the grid.
+    fn validate_grid(&self, more_x: &[(&str, f64)]) -> Result<(), FeError> {
+        let along_x = [
+            ("geometry.firewall_x", self.firewall_x),
+            ("geometry.rear_x", self.rear_x),
+            ("geometry.front_x", self.front_x),
+            ("geometry.cowl_x", self.cowl_x),
+            ("geometry.roof_front_x", self.roof_front_x),
+            ("geometry.roof_rear_x", self.roof_rear_x),
+            ("geometry.b_pillar_x", self.b_pillar_x),
+            ("geometry.quarter_front_x", self.quarter_front_x),
+            ("geometry.shelf_x", self.shelf_x),
+        ];
+        for &(name, v) in along_x.iter().chain(more_x) {
+            on_grid(name, v, self.grid_dx)?;
+        }
+        for (name, v) in [
+            ("geometry.half_width", self.half_width),
+            ("geometry.girder_y", self.girder_y),
+        ] {
+            on_grid(name, v, self.grid_dy)?;
+        }
+        // Heights are measured on the grid from the floor.
+        for (name, v) in [
+            ("geometry.cowl_z", self.cowl_z),
+            ("geometry.shelf_z", self.shelf_z),
+            ("geometry.girder_z", self.girder_z),
+            ("geometry.apron_top_z", self.apron_top_z),
+        ] {
+            on_grid(name, v - self.floor_z, self.grid_dz)?;
+        }
+        Ok(())
+    }
+
+    /// The parts follow each other in the order the body is built from.
+    fn validate_order(&self) -> Result<(), FeError> {
+        let g = self;
+        let ordered = [
+            ("rear_x < quarter_front_x", g.rear_x < g.quarter_front_x),
+            ("rear_x < shelf_x", g.rear_x < g.shelf_x),
+            ("roof_rear_x < roof_front_x", g.roof_rear_x < g.roof_front_x),
+            (
+                "cowl_x < firewall_x < front_x",
+                g.cowl_x < g.firewall_x && g.firewall_x < g.front_x,
+            ),
+            (
+                "floor_z < girder_z < apron_top_z",
+                g.floor_z < g.girder_z && g.girder_z < g.apron_top_z,
+            ),
+            (
+                "apron_top_z <= cowl_z < roof_z",
+                g.apron_top_z <= g.cowl_z && g.cowl_z < g.roof_z,
+            ),
+            (
+                "0 < girder_y < half_width",
+                0.0 < g.girder_y && g.girder_y < g.half_width,
+            ),
+        ];
+        match ordered.iter().find(|(_, ok)| !ok) {
+            Some((what, _)) => Err(FeError::InvalidInput(format!(
+                "geometry must satisfy {what}"
+            ))),
+            None => Ok(()),
+        }
+    }
+
+    /// Cross members and roof bows lie on the grid within their panels.
+    fn validate_stations(&self) -> Result<(), FeError> {
+        for (name, list, lo, hi) in [
+            (
+                "geometry.cross_member_x",
+                &self.cross_member_x,
+                self.rear_x,
+                self.firewall_x,
+            ),
+            (
+                "geometry.roof_bow_x",
+                &self.roof_bow_x,
+                self.roof_rear_x,
+                self.roof_front_x,
+            ),
+        ] {
+            for &x in list.iter() {
+                on_grid(name, x, self.grid_dx)?;
+                if !(lo..=hi).contains(&x) {
+                    return Err(FeError::InvalidInput(format!(
+                        "{name} entry {x} lies outside its panel ({lo} ..= {hi})"
+                    )));
+                }
+            }
+        }
+        Ok(())
     }
 }

@@ -272,3 +272,175 @@ fn shipped_json_description_is_the_default() {
         ChassisConfig::default()
     );
 }
+
+/// One of today's bodies, recorded from commit abde0ff's hand-written `frame()` before the frame
+/// became a table: a regression check of that refactor (the body must not move), not a check of
+/// the physics, which the tests above do against the paper.
+struct TodaysBody {
+    nodes: usize,
+    shells: usize,
+    beams: usize,
+    /// Mass seen by a rigid translation along x, y, z (kg).
+    mass: [f64; 3],
+    /// The 30 lowest natural frequencies on the suspension (Hz).
+    frequencies: [f64; 30],
+    /// Region names and their node counts.
+    regions: [(&'static str, usize); 21],
+}
+
+fn assert_reproduces(config: &ChassisConfig, today: &TodaysBody) {
+    let chassis = Chassis::build(config).unwrap();
+    let mesh = &chassis.mesh;
+    assert_eq!(
+        (mesh.nodes.len(), mesh.shells.len(), mesh.beams.len()),
+        (today.nodes, today.shells, today.beams),
+        "nodes, shells, beams"
+    );
+    let regions: Vec<(&str, usize)> = mesh
+        .regions
+        .iter()
+        .map(|(name, ids)| (name.as_str(), ids.len()))
+        .collect();
+    assert_eq!(regions, today.regions);
+    let close = |got: f64, want: f64| (got / want - 1.0).abs() <= 1e-9;
+    let asm = assemble(mesh).unwrap();
+    for (d, &want) in today.mass.iter().enumerate() {
+        let got = translational_mass(&asm, d);
+        assert!(
+            close(got, want),
+            "mass along axis {d}: {got} kg, today {want} kg"
+        );
+    }
+    let modes = lowest_modes(&asm.k, &asm.m, 30, -1.0).unwrap();
+    for (i, (&got, &want)) in modes
+        .frequencies_hz()
+        .iter()
+        .zip(&today.frequencies)
+        .enumerate()
+    {
+        assert!(close(got, want), "mode {i}: {got} Hz, today {want} Hz");
+    }
+}
+
+const REGIONS_TODAY: [(&str, usize); 21] = [
+    ("body", 2537),
+    ("column_bracket", 2),
+    ("column_lower", 5),
+    ("cowl", 123),
+    ("cross_member", 87),
+    ("firewall", 244),
+    ("floor", 841),
+    ("floor_rail", 58),
+    ("front_end", 176),
+    ("glass", 319),
+    ("pillar", 62),
+    ("quarter", 154),
+    ("rear_cross_member", 29),
+    ("rear_panel", 203),
+    ("roof", 493),
+    ("roof_rail", 34),
+    ("shelf", 261),
+    ("sill", 58),
+    ("steering", 5),
+    ("suspension", 8),
+    ("tunnel", 29),
+];
+
+#[test]
+fn the_default_body_is_todays_body() {
+    assert_reproduces(
+        &ChassisConfig::default(),
+        &TodaysBody {
+            nodes: 2549,
+            shells: 2396,
+            beams: 636,
+            mass: [1000.0447653194659; 3],
+            frequencies: [
+                1.2361461891334637,
+                1.4890138730794302,
+                1.6519939812197812,
+                3.100244315673804,
+                3.229348481364915,
+                4.270910367050018,
+                26.471470547613237,
+                31.32346396972967,
+                32.39111014849134,
+                38.07021792144857,
+                44.50684828056241,
+                46.96961714653364,
+                48.56486873463693,
+                53.05212993782183,
+                59.09517332453419,
+                60.342098987376254,
+                63.06207665249143,
+                72.17308052895702,
+                72.46229889911449,
+                75.50267585380544,
+                75.81735373431303,
+                76.59672356845404,
+                79.14043954659388,
+                85.07771593325033,
+                88.39838125808082,
+                90.43659795853041,
+                91.1049202657218,
+                103.08134913399981,
+                103.65021904454788,
+                105.24037312017835,
+            ],
+            regions: REGIONS_TODAY,
+        },
+    );
+}
+
+#[test]
+fn the_body_with_the_paper_7_1_options_is_todays_body() {
+    let mut improved = ChassisConfig::default();
+    improved.options.stiffening_bar = true;
+    improved.options.stiff_front_plate = true;
+    // The stiffening bar adds 15 nodes and 16 beams to the front end.
+    let mut regions = REGIONS_TODAY;
+    regions[0].1 += 15;
+    regions[8].1 += 15;
+    assert_reproduces(
+        &improved,
+        &TodaysBody {
+            nodes: 2564,
+            shells: 2396,
+            beams: 652,
+            mass: [1012.8843779942484; 3],
+            frequencies: [
+                1.2346986407656118,
+                1.4807354135745912,
+                1.6305723200282936,
+                3.0970726571629936,
+                3.2107711447427625,
+                4.230115623049478,
+                26.72162229222526,
+                31.669660744867087,
+                32.66852131654992,
+                39.23504036947578,
+                45.30969770912645,
+                46.97305505344074,
+                49.45232270574175,
+                53.527922623410916,
+                59.150285491474236,
+                60.36993585022727,
+                64.66213998032046,
+                72.53086139723146,
+                73.42340763410371,
+                75.53809950545858,
+                76.31795736076147,
+                79.0599414341953,
+                79.99412060851436,
+                85.69932743232674,
+                88.9236603035322,
+                90.45261719697261,
+                92.90922461765433,
+                103.49256084317513,
+                103.96359620165585,
+                105.51424892069299,
+            ],
+            regions,
+        },
+    );
+}

@@ -10,7 +10,7 @@ use std::collections::{BTreeMap, HashMap};
 use std::fmt::Write;
 
 use crate::fe::error::FeError;
-use crate::fe::mesh::{Material, Mesh};
+use crate::fe::mesh::{Beam, Material, Mesh};
 
 /// A field of a card being written.
 enum Out {
@@ -137,130 +137,145 @@ impl Table {
     }
 }
 
-fn material(out: &mut String, table: &mut Table, m: &Material) -> Result<u64, FeError> {
-    let (id, new) = table.id(&[m.youngs_modulus, m.poisson_ratio, m.density]);
-    if new {
-        card(
-            out,
-            "MAT1",
-            &[
-                Out::Int(id),
-                Out::Real(m.youngs_modulus),
-                Out::Blank,
-                Out::Real(m.poisson_ratio),
-                Out::Real(m.density),
-            ],
-        )?;
-    }
-    Ok(id)
+/// A bulk deck being written: one method per card kind, called in the order of the module
+/// documentation, sharing the element counter and the material and property tables.
+struct Deck<'m> {
+    mesh: &'m Mesh,
+    out: String,
+    materials: Table,
+    properties: Table,
+    /// Id of the last element written.
+    eid: u64,
 }
 
-/// The PSHELL id of a shell section, written on first use (MID1 = MID2 = MID3, so Nastran also
-/// includes transverse shear, like the four-node shell).
-fn shell_property(
-    out: &mut String,
-    materials: &mut Table,
-    properties: &mut Table,
-    m: &Material,
-    thickness: f64,
-    bending_thickness: f64,
-    extra_mass_per_area: f64,
-) -> Result<u64, FeError> {
-    let mid = material(out, materials, m)?;
-    let ratio = (bending_thickness / thickness).powi(3);
-    let (pid, new) = properties.id(&[0.0, mid as f64, thickness, ratio, extra_mass_per_area]);
-    if new {
-        card(
-            out,
-            "PSHELL",
-            &[
-                Out::Int(pid),
-                Out::Int(mid),
-                Out::Real(thickness),
-                Out::Int(mid),
-                Out::Real(ratio),
-                Out::Int(mid),
-                Out::Blank,
-                Out::Real(extra_mass_per_area),
-            ],
-        )?;
+impl<'m> Deck<'m> {
+    fn new(mesh: &'m Mesh) -> Self {
+        Self {
+            mesh,
+            out: String::new(),
+            materials: Table::new(),
+            properties: Table::new(),
+            eid: 0,
+        }
     }
-    Ok(pid)
-}
 
-/// Writes `mesh` as bulk data (BEGIN BULK … ENDDATA).
-pub fn write_bulk_deck(mesh: &Mesh) -> Result<String, FeError> {
-    let mut out = String::new();
-    out.push_str("$ Nastran bulk data written by engine_mount_chassis (fe::nastran), SI units\n");
-    for (name, node) in &mesh.named_nodes {
-        let _ = writeln!(out, "$ named node {name} = GRID {}", node + 1);
+    fn card(&mut self, name: &str, fields: &[Out]) -> Result<(), FeError> {
+        card(&mut self.out, name, fields)
     }
-    out.push_str("BEGIN BULK\n");
-    for (i, p) in mesh.nodes.iter().enumerate() {
-        card(
-            &mut out,
-            "GRID",
-            &[
+
+    fn grid_id(&self, what: &str, node: usize) -> Result<Out, FeError> {
+        check_node(self.mesh, what, node).map(Out::Int)
+    }
+
+    fn next_element(&mut self) -> Out {
+        self.eid += 1;
+        Out::Int(self.eid)
+    }
+
+    fn header(&mut self) {
+        self.out.push_str(
+            "$ Nastran bulk data written by engine_mount_chassis (fe::nastran), SI units\n",
+        );
+        for (name, node) in &self.mesh.named_nodes {
+            let _ = writeln!(self.out, "$ named node {name} = GRID {}", node + 1);
+        }
+        self.out.push_str("BEGIN BULK\n");
+    }
+
+    fn grids(&mut self) -> Result<(), FeError> {
+        for (i, p) in self.mesh.nodes.iter().enumerate() {
+            let fields = [
                 Out::Int(i as u64 + 1),
                 Out::Blank,
                 Out::Real(p.x),
                 Out::Real(p.y),
                 Out::Real(p.z),
-            ],
-        )?;
-    }
-    let mut materials = Table::new();
-    let mut properties = Table::new();
-    let mut eid = 0u64;
-    for (i, s) in mesh.shells.iter().enumerate() {
-        let pid = shell_property(
-            &mut out,
-            &mut materials,
-            &mut properties,
-            &s.material,
-            s.thickness,
-            s.bending_thickness,
-            s.extra_mass_per_area,
-        )?;
-        eid += 1;
-        let mut fields = vec![Out::Int(eid), Out::Int(pid)];
-        for &n in &s.nodes {
-            fields.push(Out::Int(check_node(mesh, &format!("shell {i}"), n)?));
+            ];
+            card(&mut self.out, "GRID", &fields)?;
         }
-        card(&mut out, "CQUAD4", &fields)?;
+        Ok(())
     }
-    for (i, t) in mesh.triangles.iter().enumerate() {
-        let pid = shell_property(
-            &mut out,
-            &mut materials,
-            &mut properties,
-            &t.material,
-            t.thickness,
-            t.bending_thickness,
-            t.extra_mass_per_area,
-        )?;
-        eid += 1;
-        let mut fields = vec![Out::Int(eid), Out::Int(pid)];
-        for &n in &t.nodes {
-            fields.push(Out::Int(check_node(mesh, &format!("triangle {i}"), n)?));
-        }
-        card(&mut out, "CTRIA3", &fields)?;
-    }
-    for (i, b) in mesh.beams.iter().enumerate() {
-        let mid = material(&mut out, &mut materials, &b.material)?;
-        let s = &b.section;
-        let (pid, new) = properties.id(&[
-            1.0,
-            mid as f64,
-            s.area,
-            s.iz,
-            s.iy,
-            s.j,
-            b.extra_mass_per_length,
-        ]);
+
+    /// The MAT1 id of `m`, written on first use.
+    fn mat1(&mut self, m: &Material) -> Result<u64, FeError> {
+        let (id, new) = self
+            .materials
+            .id(&[m.youngs_modulus, m.poisson_ratio, m.density]);
         if new {
-            card(
-                &mut out,
+            self.card(
+                "MAT1",
+                &[
+                    Out::Int(id),
+                    Out::Real(m.youngs_modulus),
+                    Out::Blank,
+                    Out::Real(m.poisson_ratio),
+                    Out::Real(m.density),
+                ],
+            )?;
+        }
+        Ok(id)
+    }
+
+    /// The PSHELL id of a shell section, written on first use (MID1 = MID2 = MID3, so Nastran also
+    /// includes transverse shear, like the four-node shell).
+    fn pshell(&mut self, m: &Material, [t, bending_t, nsm]: [f64; 3]) -> Result<u64, FeError> {
+        let mid = self.mat1(m)?;
+        let ratio = (bending_t / t).powi(3);
+        let (pid, new) = self.properties.id(&[0.0, mid as f64, t, ratio, nsm]);
+        if new {
+            self.card(
+                "PSHELL",
+                &[
+                    Out::Int(pid),
+                    Out::Int(mid),
+                    Out::Real(t),
+                    Out::Int(mid),
+                    Out::Real(ratio),
+                    Out::Int(mid),
+                    Out::Blank,
+                    Out::Real(nsm),
+                ],
+            )?;
+        }
+        Ok(pid)
+    }
+
+    /// A CQUAD4 or CTRIA3 of property `pid` on `nodes`.
+    fn plate(&mut self, name: &str, what: &str, pid: u64, nodes: &[usize]) -> Result<(), FeError> {
+        let mut fields = vec![self.next_element(), Out::Int(pid)];
+        for &n in nodes {
+            fields.push(self.grid_id(what, n)?);
+        }
+        self.card(name, &fields)
+    }
+
+    fn cquad4(&mut self) -> Result<(), FeError> {
+        for (i, s) in self.mesh.shells.iter().enumerate() {
+            let sheet = [s.thickness, s.bending_thickness, s.extra_mass_per_area];
+            let pid = self.pshell(&s.material, sheet)?;
+            self.plate("CQUAD4", &format!("shell {i}"), pid, &s.nodes)?;
+        }
+        Ok(())
+    }
+
+    fn ctria3(&mut self) -> Result<(), FeError> {
+        for (i, t) in self.mesh.triangles.iter().enumerate() {
+            let sheet = [t.thickness, t.bending_thickness, t.extra_mass_per_area];
+            let pid = self.pshell(&t.material, sheet)?;
+            self.plate("CTRIA3", &format!("triangle {i}"), pid, &t.nodes)?;
+        }
+        Ok(())
+    }
+
+    /// The PBAR id of a beam's section and non-structural mass, written on first use.
+    fn pbar(&mut self, b: &Beam) -> Result<u64, FeError> {
+        let mid = self.mat1(&b.material)?;
+        let s = &b.section;
+        let nsm = b.extra_mass_per_length;
+        let values = [1.0, mid as f64, s.area, s.iz, s.iy, s.j, nsm];
+        let (pid, new) = self.properties.id(&values);
+        if new {
+            self.card(
                 "PBAR",
                 &[
                     Out::Int(pid),
@@ -269,36 +284,38 @@ pub fn write_bulk_deck(mesh: &Mesh) -> Result<String, FeError> {
                     Out::Real(s.iz),
                     Out::Real(s.iy),
                     Out::Real(s.j),
-                    Out::Real(b.extra_mass_per_length),
+                    Out::Real(nsm),
                 ],
             )?;
         }
-        eid += 1;
-        let what = format!("beam {i}");
-        card(
-            &mut out,
-            "CBAR",
-            &[
-                Out::Int(eid),
+        Ok(pid)
+    }
+
+    fn cbar(&mut self) -> Result<(), FeError> {
+        for (i, b) in self.mesh.beams.iter().enumerate() {
+            let pid = self.pbar(b)?;
+            let what = format!("beam {i}");
+            let fields = [
+                self.next_element(),
                 Out::Int(pid),
-                Out::Int(check_node(mesh, &what, b.nodes[0])?),
-                Out::Int(check_node(mesh, &what, b.nodes[1])?),
+                self.grid_id(&what, b.nodes[0])?,
+                self.grid_id(&what, b.nodes[1])?,
                 Out::Real(b.orientation.x),
                 Out::Real(b.orientation.y),
                 Out::Real(b.orientation.z),
-            ],
-        )?;
+            ];
+            self.card("CBAR", &fields)?;
+        }
+        Ok(())
     }
-    for (i, m) in mesh.masses.iter().enumerate() {
-        let j = &m.inertia;
-        eid += 1;
-        // Products of inertia are entered positive (I21 = ∫x1 x2 dm = −J21): see to_mesh.
-        card(
-            &mut out,
-            "CONM2",
-            &[
-                Out::Int(eid),
-                Out::Int(check_node(mesh, &format!("point mass {i}"), m.node)?),
+
+    fn conm2(&mut self) -> Result<(), FeError> {
+        for (i, m) in self.mesh.masses.iter().enumerate() {
+            let j = &m.inertia;
+            // Products of inertia are entered positive (I21 = ∫x1 x2 dm = −J21): see to_mesh.
+            let fields = [
+                self.next_element(),
+                self.grid_id(&format!("point mass {i}"), m.node)?,
                 Out::Blank,
                 Out::Real(m.mass),
                 Out::Blank,
@@ -311,96 +328,129 @@ pub fn write_bulk_deck(mesh: &Mesh) -> Result<String, FeError> {
                 Out::Real(-j[(2, 0)]),
                 Out::Real(-j[(2, 1)]),
                 Out::Real(j[(2, 2)]),
-            ],
-        )?;
-    }
-    let mut scalar = |out: &mut String, name: &str, value: f64, ends: &[(u64, usize)]| {
-        eid += 1;
-        let mut fields = vec![Out::Int(eid), Out::Real(value)];
-        for &(g, c) in ends {
-            fields.push(Out::Int(g));
-            fields.push(Out::Int(c as u64 + 1));
+            ];
+            self.card("CONM2", &fields)?;
         }
-        card(out, name, &fields)
-    };
-    for (i, s) in mesh.ground_springs.iter().enumerate() {
-        let g = check_node(mesh, &format!("ground spring {i}"), s.node)?;
+        Ok(())
+    }
+
+    /// CELAS2 and CDAMP2 of the non-zero components of a spring-damper between `grids` (one
+    /// grid: to ground).
+    fn scalar(
+        &mut self,
+        grids: &[u64],
+        stiffness: &[f64; 6],
+        damping: &[f64; 6],
+    ) -> Result<(), FeError> {
         for d in 0..6 {
-            if s.stiffness[d] != 0.0 {
-                scalar(&mut out, "CELAS2", s.stiffness[d], &[(g, d)])?;
-            }
-            if s.damping[d] != 0.0 {
-                scalar(&mut out, "CDAMP2", s.damping[d], &[(g, d)])?;
-            }
-        }
-    }
-    for (i, s) in mesh.springs.iter().enumerate() {
-        let what = format!("spring {i}");
-        let (a, b) = (
-            check_node(mesh, &what, s.nodes[0])?,
-            check_node(mesh, &what, s.nodes[1])?,
-        );
-        for d in 0..6 {
-            if s.stiffness[d] != 0.0 {
-                scalar(&mut out, "CELAS2", s.stiffness[d], &[(a, d), (b, d)])?;
-            }
-            if s.damping[d] != 0.0 {
-                scalar(&mut out, "CDAMP2", s.damping[d], &[(a, d), (b, d)])?;
+            for (name, value) in [("CELAS2", stiffness[d]), ("CDAMP2", damping[d])] {
+                if value != 0.0 {
+                    let mut fields = vec![self.next_element(), Out::Real(value)];
+                    for &g in grids {
+                        fields.push(Out::Int(g));
+                        fields.push(Out::Int(d as u64 + 1));
+                    }
+                    self.card(name, &fields)?;
+                }
             }
         }
+        Ok(())
     }
-    for (i, l) in mesh.rigid_links.iter().enumerate() {
-        let what = format!("rigid link {i}");
-        eid += 1;
-        let mut fields = vec![
-            Out::Int(eid),
-            Out::Int(check_node(mesh, &what, l.independent)?),
-            digits(&l.components)?,
-        ];
-        for &d in &l.dependent {
-            fields.push(Out::Int(check_node(mesh, &what, d)?));
+
+    fn celas2_cdamp2(&mut self) -> Result<(), FeError> {
+        let mesh = self.mesh;
+        for (i, s) in mesh.ground_springs.iter().enumerate() {
+            let g = check_node(mesh, &format!("ground spring {i}"), s.node)?;
+            self.scalar(&[g], &s.stiffness, &s.damping)?;
         }
-        card(&mut out, "RBE2", &fields)?;
+        for (i, s) in mesh.springs.iter().enumerate() {
+            let what = format!("spring {i}");
+            let ends = [
+                check_node(mesh, &what, s.nodes[0])?,
+                check_node(mesh, &what, s.nodes[1])?,
+            ];
+            self.scalar(&ends, &s.stiffness, &s.damping)?;
+        }
+        Ok(())
     }
-    for (i, l) in mesh.interpolation_links.iter().enumerate() {
-        let what = format!("interpolation link {i}");
-        eid += 1;
-        let mut fields = vec![
-            Out::Int(eid),
-            Out::Blank,
-            Out::Int(check_node(mesh, &what, l.reference)?),
-            digits(&l.reference_components)?,
-        ];
-        for group in &l.sources {
-            fields.push(Out::Real(group.weight));
-            fields.push(digits(&group.components)?);
-            for &n in &group.nodes {
-                fields.push(Out::Int(check_node(mesh, &what, n)?));
+
+    fn rbe2(&mut self) -> Result<(), FeError> {
+        for (i, l) in self.mesh.rigid_links.iter().enumerate() {
+            let what = format!("rigid link {i}");
+            let mut fields = vec![
+                self.next_element(),
+                self.grid_id(&what, l.independent)?,
+                digits(&l.components)?,
+            ];
+            for &d in &l.dependent {
+                fields.push(self.grid_id(&what, d)?);
             }
+            self.card("RBE2", &fields)?;
         }
-        card(&mut out, "RBE3", &fields)?;
+        Ok(())
     }
-    let mut fixed: BTreeMap<usize, [bool; 6]> = BTreeMap::new();
-    for &(node, d) in &mesh.constraints {
-        check_node(mesh, "constraint", node)?;
-        if d >= 6 {
-            return Err(FeError::Mesh(format!(
-                "constraint on node {node}: dof {d} > 5"
-            )));
+
+    fn rbe3(&mut self) -> Result<(), FeError> {
+        for (i, l) in self.mesh.interpolation_links.iter().enumerate() {
+            let what = format!("interpolation link {i}");
+            let mut fields = vec![
+                self.next_element(),
+                Out::Blank,
+                self.grid_id(&what, l.reference)?,
+                digits(&l.reference_components)?,
+            ];
+            for group in &l.sources {
+                fields.push(Out::Real(group.weight));
+                fields.push(digits(&group.components)?);
+                for &n in &group.nodes {
+                    fields.push(self.grid_id(&what, n)?);
+                }
+            }
+            self.card("RBE3", &fields)?;
         }
-        fixed.entry(node).or_insert([false; 6])[d] = true;
+        Ok(())
     }
-    let mut by_mask: BTreeMap<[bool; 6], Vec<u64>> = BTreeMap::new();
-    for (node, mask) in fixed {
-        by_mask.entry(mask).or_default().push(node as u64 + 1);
+
+    /// The constraints as SPC1 set 1, one card per component mask.
+    fn spc1(&mut self) -> Result<(), FeError> {
+        let mut fixed: BTreeMap<usize, [bool; 6]> = BTreeMap::new();
+        for &(node, d) in &self.mesh.constraints {
+            check_node(self.mesh, "constraint", node)?;
+            if d >= 6 {
+                return Err(FeError::Mesh(format!(
+                    "constraint on node {node}: dof {d} > 5"
+                )));
+            }
+            fixed.entry(node).or_insert([false; 6])[d] = true;
+        }
+        let mut by_mask: BTreeMap<[bool; 6], Vec<u64>> = BTreeMap::new();
+        for (node, mask) in fixed {
+            by_mask.entry(mask).or_default().push(node as u64 + 1);
+        }
+        for (mask, grids) in by_mask {
+            let mut fields = vec![Out::Int(1), digits(&mask)?];
+            fields.extend(grids.into_iter().map(Out::Int));
+            self.card("SPC1", &fields)?;
+        }
+        Ok(())
     }
-    for (mask, grids) in by_mask {
-        let mut fields = vec![Out::Int(1), digits(&mask)?];
-        fields.extend(grids.into_iter().map(Out::Int));
-        card(&mut out, "SPC1", &fields)?;
-    }
-    out.push_str("ENDDATA\n");
-    Ok(out)
+}
+
+/// Writes `mesh` as bulk data (BEGIN BULK … ENDDATA).
+pub fn write_bulk_deck(mesh: &Mesh) -> Result<String, FeError> {
+    let mut deck = Deck::new(mesh);
+    deck.header();
+    deck.grids()?;
+    deck.cquad4()?;
+    deck.ctria3()?;
+    deck.cbar()?;
+    deck.conm2()?;
+    deck.celas2_cdamp2()?;
+    deck.rbe2()?;
+    deck.rbe3()?;
+    deck.spc1()?;
+    deck.out.push_str("ENDDATA\n");
+    Ok(deck.out)
 }
 
 #[cfg(test)]
