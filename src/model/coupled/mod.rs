@@ -1,4 +1,4 @@
-//! The one coupled model: a powertrain on mounts in a body, as an [`OdeProblem`].
+//! The one coupled model: a powertrain on mounts in a body, as an [`OdeProblem`](crate::ode::OdeProblem).
 //!
 //! Components and what they contribute:
 //! - the powertrain ([`Powertrain`]): 1 or 2 free rigid bodies with their composite-body dynamics,

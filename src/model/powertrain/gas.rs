@@ -285,7 +285,7 @@ impl PressureCurve {
 
     /// Single-zone Wiebe pressure for one load point. The tables take milliseconds to integrate
     /// and every instance of the FMU (a sweep resets it for each speed point) asks for the same
-    /// few, so the last [`WIEBE_MEMO_SIZE`] are kept for the process.
+    /// few, so the last `WIEBE_MEMO_SIZE` are kept for the process.
     pub fn wiebe(model: &WiebeModel, point: &CombustionPoint, geometry: &CylinderGeometry) -> Self {
         type Memo = Vec<(WiebeModel, CombustionPoint, CylinderGeometry, PressureCurve)>;
         static MEMO: std::sync::OnceLock<std::sync::Mutex<Memo>> = std::sync::OnceLock::new();
