@@ -189,3 +189,28 @@ def test_the_fmu_documentation_page_links_to_nothing_outside_the_fmu(fmu_path, t
     assert names
     missing = [n for n in names if f"<code>{n}</code>" not in text]
     assert not missing, missing[:10]
+
+
+def test_the_commands_the_guide_names_exist():
+    # Every table says which command makes it: those commands must exist under these names.
+    text = "\n".join(p.read_text() for p in pages())
+    examples = set(re.findall(r"--example (\w+)", text))
+    assert {"realtime", "accuracy_cost", "engine_modes", "hybrid_modes"} <= examples
+    for name in examples:
+        assert (ROOT / "examples" / f"{name}.rs").is_file(), name
+    for script in set(re.findall(r"bash (scripts/[\w-]+\.sh|packaging/[\w-]+\.sh)", text)):
+        assert (ROOT / script).is_file(), script
+    for test in set(re.findall(r"--test (\w+)", text)):
+        assert (ROOT / "tests" / test).is_dir() or (ROOT / "tests" / f"{test}.rs").is_file(), test
+    paths = set(re.findall(r"`((?:src|tests|python|tools|resources)/[\w./-]+\.(?:rs|py|c|json))`",
+                           text))
+    assert len(paths) >= 20
+    for path in paths:
+        assert (ROOT / path).is_file(), path
+    cli = (ROOT / "python" / "emc" / "cli.py").read_text()
+    subcommands = set(re.findall(r'add_parser\("([\w-]+)"', cli))
+    subcommands |= set(re.findall(r'\("(study-[\w-]+)"', cli))
+    commands = set(re.findall(r"(?:`|bin/)emc ([a-z][\w-]+)", text))
+    assert {"sweep", "runup", "campbell", "study-mounts", "bench-realtime"} <= commands
+    for command in commands:
+        assert command in subcommands, f"emc {command}"
