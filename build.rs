@@ -758,9 +758,13 @@ fn documentation(table: &Value, scalars: &[Scalar], guid: &str) -> String {
          <h2>Units and frames</h2>\n<p>SI inside. The vehicle frame is ISO 8855: x forward, y left, z up, origin at the \
          front axle centre on the ground plane; the engine is transverse with the crank axis along y. Engine speed is given \
          in rpm (base unit rad/s); angles are in rad with display unit deg, displacements in m with display unit mm.</p>\n\
-         <h2>Inputs between communication points</h2>\n<p>Real inputs are held constant over a communication step unless \
-         their first derivative is set with <code>fmi2SetRealInputDerivatives</code>; then they change linearly. A jump of \
-         an input at a communication point restarts the integrator at order 1; continuous inputs keep its history.</p>\n",
+         <h2>Inputs between communication points</h2>\n<p>Every continuous input (<code>rpm</code>, <code>loadTorque</code>, \
+         the mount scales) is a linear signal between communication points, decided when <code>fmi2DoStep</code> starts: \
+         a value with a derivative (<code>fmi2SetRealInputDerivatives</code>) is that ramp; a derivative alone continues \
+         from the value reached; values alone get a first-order hold (if the last three lie on a line their slope \
+         continues, otherwise the value is held); nothing set keeps the signal in force. <code>rpm</code> is a speed \
+         set-point that the crank follows critically damped with time constant <code>crank.speedTimeConstant</code>, so \
+         a jump becomes a smooth speed change.</p>\n",
     );
     h.push_str("<h2>Variables</h2>\n<table><tr><th>name</th><th>type</th><th>causality</th><th>variability</th><th>start</th><th>unit</th><th>description</th></tr>\n");
     for s in scalars {

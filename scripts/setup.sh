@@ -25,6 +25,16 @@ if ! rustup target list --installed | grep -qx x86_64-pc-windows-gnu; then
   rustup target add x86_64-pc-windows-gnu
 fi
 
+# mdBook builds the user guide in docs/ (scripts/test.sh). Debian 12 does not package it, so it
+# comes from crates.io at a pinned version: a one-time compile of about 2–3 minutes on one core,
+# skipped while the installed version matches. Its `serve`/`watch` features (a local web server
+# and a file watcher) are left out: the build needs neither, and they bring tokio and axum to compile.
+mdbook_version=0.4.52
+if [ "$(mdbook --version 2>/dev/null)" != "mdbook v$mdbook_version" ]; then
+  echo "setup: installing mdbook $mdbook_version from crates.io (one-time compile)"
+  cargo install mdbook --locked --version "$mdbook_version" --no-default-features --features search
+fi
+
 # Python environment from the pinned requirements; reinstalled only when they change.
 venv="$root/.venv"
 req="$root/python/requirements.txt"

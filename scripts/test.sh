@@ -1,6 +1,8 @@
 #!/usr/bin/env bash
-# Runs every test of the project: formatting and lints, Rust unit and integration tests (release
-# build: the tests simulate stiff systems), then the Python tests on the packaged FMU.
+# Runs every test of the project: formatting and lints, Rust unit, integration and doc tests
+# (release build: the tests simulate stiff systems; the doc tests include the user guide's Rust
+# examples), the API documentation and the user guide, then the Python tests on the packaged FMU
+# (among them the guide's Python examples and its link check, python/tests/test_docs.py).
 set -euo pipefail
 root=$(cd "$(dirname "$0")/.." && pwd)
 cd "$root"
@@ -11,6 +13,10 @@ cargo clippy --release --all-targets -- -D warnings
 # The ABI tests dlopen the cdylib, which `cargo test` does not build.
 cargo build --release
 cargo test --release
+# The API documentation must build without broken intra-doc links.
+RUSTDOCFLAGS="-D rustdoc::broken_intra_doc_links" cargo doc --release --no-deps
+# The user guide (docs/book/); test_docs.py builds it again into a temporary folder to check it.
+mdbook build docs
 
 if [ -d python/tests ] && ls python/tests/test_*.py >/dev/null 2>&1; then
   bash packaging/package.sh

@@ -21,3 +21,10 @@ pub mod paper;
 pub mod saved_state;
 pub mod text_file;
 pub mod variables;
+
+/// The user guide's Rust examples (`docs/src/inside/library.md`), compiled and run by
+/// `cargo test` as doctests so that the guide cannot drift from the API. Exists only for rustdoc's
+/// doctest collection; no build of the library contains it.
+#[cfg(doctest)]
+#[doc = include_str!("../docs/src/inside/library.md")]
+pub struct UserGuideExamples;

@@ -28,6 +28,7 @@ pub struct ReducedChassis {
 }
 
 impl ReducedChassis {
+    /// Number of modes (modal coordinates).
     pub fn n_modes(&self) -> usize {
         self.omega.len()
     }
@@ -41,6 +42,7 @@ impl ReducedChassis {
         }
     }
 
+    /// The point of this name, if the body has it.
     pub fn point(&self, name: &str) -> Option<&RecoveryPoint> {
         self.points.iter().find(|p| p.name == name)
     }

@@ -45,8 +45,11 @@ pub enum ModeSelection {
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct BulkDeckBody {
+    /// The deck's file.
     pub path: std::path::PathBuf,
+    /// SHA-256 of its content (hex).
     pub sha256: String,
+    /// GRID id of every named point.
     pub points: std::collections::BTreeMap<String, u32>,
 }
 

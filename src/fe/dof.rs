@@ -136,7 +136,7 @@ impl DofMap {
         dof < DOF_PER_NODE && self.dependent.contains_key(&(node * DOF_PER_NODE + dof))
     }
 
-    /// The motion of `(node, dof)` as `(equation, coefficient)` pairs, u = Σ c q[equation]:
+    /// The motion of `(node, dof)` as `(equation, coefficient)` pairs, `u = Σ c q[equation]`:
     /// one pair with coefficient 1 for a free DOF, none for a constrained DOF, the row of T for a
     /// dependent DOF. Use it to recover output points and mount points on RBE2/RBE3 nodes.
     pub fn motion_row(&self, node: usize, dof: usize) -> Result<Vec<(usize, f64)>, FeError> {

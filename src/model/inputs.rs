@@ -6,12 +6,16 @@ use serde::{Deserialize, Serialize};
 /// A real input that varies linearly between settings: `value + rate · (t − since)`.
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
 pub struct RampInput {
+    /// Value at `since`.
     pub value: f64,
+    /// Slope (per second).
     pub rate: f64,
+    /// Time at which the ramp has `value` (s).
     pub since: f64,
 }
 
 impl RampInput {
+    /// A constant input.
     pub fn constant(value: f64) -> Self {
         Self {
             value,
@@ -20,6 +24,7 @@ impl RampInput {
         }
     }
 
+    /// The ramp's value at time `t`.
     pub fn at(&self, t: f64) -> f64 {
         self.value + self.rate * (t - self.since)
     }
@@ -37,13 +42,15 @@ pub struct ModelInputs {
     pub crank_speed: RampInput,
     /// Load torque on the housing about the crank axis +y (N m): the drivetrain reaction.
     pub load_torque: RampInput,
-    /// Per configured mount (index as in the configuration): stiffness and damping scale factors.
-    /// A ramp that reaches below zero is held at zero.
+    /// Per configured mount (index as in the configuration): stiffness scale factor. A ramp that
+    /// reaches below zero is held at zero.
     pub stiffness_scale: Vec<RampInput>,
+    /// Per configured mount: damping scale factor, held at zero like the stiffness scale.
     pub damping_scale: Vec<RampInput>,
 }
 
 impl ModelInputs {
+    /// Inputs for `mounts` configured mounts: speed and load torque zero, every scale 1.
     pub fn new(mounts: usize) -> Self {
         Self {
             crank_speed: RampInput::constant(0.0),

@@ -7,6 +7,7 @@
 pub struct ConfigError {
     /// Dotted path of the offending field, e.g. `mounts[2].curves[1].knots[0].stiffness`.
     pub field: String,
+    /// What is wrong with its value.
     pub message: String,
 }
 

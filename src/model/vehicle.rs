@@ -28,19 +28,27 @@ pub enum BodyConfig {
     /// The procedural car body ([`crate::fe::chassis`]): its mount nodes are `mount_front_left`,
     /// `mount_front_right`, `mount_rear_left`, `mount_rear_right`; other named nodes include
     /// `steering_wheel` and `seat_rail`.
-    Procedural { chassis: Box<ChassisConfig> },
+    Procedural {
+        /// The chassis's geometry, sections, materials, trim and suspension.
+        chassis: Box<ChassisConfig>,
+    },
     /// A user's body from a Nastran bulk data deck ([`crate::fe::nastran`]), reduced by
     /// Craig-Bampton like the procedural one; `points` names the GRID ids the mounts
     /// (`body_node`) and the outputs refer to. A relative path is taken from the configuration
     /// file's folder.
     Nastran {
+        /// The bulk data deck.
         path: PathBuf,
+        /// GRID id of every named point (mount body nodes, outputs).
         points: std::collections::BTreeMap<String, u32>,
     },
     /// Modal data of an already reduced body: the JSON of a [`crate::cms::ReducedChassis`]
     /// (frequencies, damping ratios, named points with their mode-shape rows). A relative path is
     /// taken from the configuration file's folder.
-    Reduced { path: PathBuf },
+    Reduced {
+        /// The JSON file of the reduced body.
+        path: PathBuf,
+    },
 }
 
 /// The complete vehicle.
@@ -49,14 +57,18 @@ pub enum BodyConfig {
 pub struct VehicleConfig {
     /// Gravitational acceleration (m/s², acting along −z).
     pub gravity: f64,
+    /// The powertrain: crank drive, balance shafts, gas forces, monoblock, housing, ring carriers.
     pub engine: EngineConfig,
     /// Engine mounts in FMU order (`mount[1]` is the first).
     pub mounts: Vec<MountConfig>,
+    /// Where the elastic body comes from (used in scene 2).
     pub body: BodyConfig,
     /// Body nodes whose motion is reported (the FMU maps `steeringWheel.*` to `steering_wheel`
     /// and `seat.*` to `seat_rail`).
     pub outputs: Vec<String>,
+    /// Default effect switches (the FMU's `effects.*` replace them when the master sets them).
     pub effects: Effects,
+    /// How the crank follows the speed set-point (`crank.speedTimeConstant` replaces it when set).
     pub speed_follower: SpeedFollower,
 }
 

@@ -124,10 +124,12 @@ impl BlockLowRankJacobian {
         }
     }
 
+    /// The block structure and rank this Jacobian was made for.
     pub fn shape(&self) -> &BlockLowRankShape {
         &self.shape
     }
 
+    /// Number of unknowns `n`.
     pub fn dim(&self) -> usize {
         self.u.nrows()
     }
@@ -142,6 +144,7 @@ impl BlockLowRankJacobian {
         )
     }
 
+    /// Diagonal block `k` (column-major, in the order of its indices in the shape), for writing.
     pub fn block_mut(&mut self, k: usize) -> MatMut<'_, f64> {
         let size = self.shape.blocks[k].len();
         MatMut::from_column_major_slice_mut(
@@ -156,6 +159,7 @@ impl BlockLowRankJacobian {
         self.u.as_ref()
     }
 
+    /// `U` (n × rank), for writing.
     pub fn u_mut(&mut self) -> MatMut<'_, f64> {
         self.u.as_mut()
     }
@@ -165,6 +169,7 @@ impl BlockLowRankJacobian {
         self.v.as_ref()
     }
 
+    /// `V` (n × rank), for writing.
     pub fn v_mut(&mut self) -> MatMut<'_, f64> {
         self.v.as_mut()
     }
@@ -267,6 +272,7 @@ fn inverse_of(lu: &DenseLu, n: usize) -> Mat<f64> {
 }
 
 impl BlockLowRankLu {
+    /// Workspace for a Newton matrix of this shape, not yet factored.
     pub fn new(shape: &BlockLowRankShape) -> Self {
         let n = shape.dim();
         let r = shape.rank;
@@ -294,6 +300,7 @@ impl BlockLowRankLu {
         }
     }
 
+    /// Whether the last factorisation succeeded (a solve needs one).
     pub fn is_factored(&self) -> bool {
         self.factored_with.is_some()
     }

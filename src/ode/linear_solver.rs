@@ -152,6 +152,7 @@ pub struct DenseLu {
 }
 
 impl DenseLu {
+    /// Workspace for an `n × n` system, not yet factored.
     pub fn new(n: usize) -> Self {
         Self {
             lu: Mat::zeros(n, n),
@@ -193,6 +194,7 @@ impl DenseLu {
         self.factored
     }
 
+    /// Whether the last [`Self::factor`] succeeded (a solve needs one).
     pub fn is_factored(&self) -> bool {
         self.factored
     }

@@ -11,9 +11,13 @@ use super::problem::{OdeProblem, ProblemError};
 /// (y0, y1) and a decay `c` in y2. Every derivative is known in closed form.
 #[derive(Debug, Clone)]
 pub struct LinearOscillator {
+    /// Real part of the oscillation's eigenvalue pair (negative: decaying).
     pub a: f64,
+    /// Imaginary part of the oscillation's eigenvalue pair (rad/s).
     pub b: f64,
+    /// Decay rate of the third component (negative: decaying).
     pub c: f64,
+    /// Initial state.
     pub y0: [f64; 3],
 }
 
@@ -80,10 +84,12 @@ impl OdeProblem for LinearOscillator {
 /// integrator use finite differences.
 #[derive(Debug, Clone)]
 pub struct Robertson {
+    /// Whether [`OdeProblem::jacobian`] supplies the exact Jacobian.
     pub analytic_jacobian: bool,
 }
 
 impl Robertson {
+    /// The initial state at t = 0.
     pub const Y0: [f64; 3] = [1.0, 0.0, 0.0];
     /// Reference solution at t = 40 (Hairer & Wanner; IVP test-set literature).
     pub const Y_AT_40: [f64; 3] = [
@@ -128,6 +134,7 @@ impl OdeProblem for Robertson {
 /// Van der Pol oscillator `y0' = y1, y1' = mu (1 - y0^2) y1 - y0`.
 #[derive(Debug, Clone)]
 pub struct VanDerPol {
+    /// Nonlinear damping parameter (large: stiff relaxation oscillations).
     pub mu: f64,
 }
 
@@ -164,16 +171,23 @@ impl OdeProblem for VanDerPol {
 /// 2 kHz mode is excited (the case in which BDF3–5 stall without stability-limit detection).
 #[derive(Debug, Clone)]
 pub struct SpringChain {
+    /// Diagonal of the mass matrix (kg).
     pub mass: Vec<f64>,
+    /// Stiffness matrix (N/m).
     pub stiffness: Mat<f64>,
+    /// Damping matrix (N s/m), `M Phi diag(2 zeta omega) Phi^T M`.
     pub damping: Mat<f64>,
     /// Mass-normalised mode shapes (columns).
     pub modes: Mat<f64>,
     /// Undamped natural circular frequencies (rad/s), ascending.
     pub omega: Vec<f64>,
+    /// Modal damping ratio of every mode.
     pub zeta: f64,
+    /// Degree of freedom the harmonic force acts on.
     pub force_dof: usize,
+    /// Amplitude of the harmonic force (N).
     pub force_amplitude: f64,
+    /// Circular frequency of the harmonic force (rad/s).
     pub force_omega: f64,
     /// Formulate as `diag(I, M) y' = f` instead of `y' = M^{-1} f`.
     pub use_mass_matrix: bool,
@@ -309,6 +323,7 @@ impl SpringChain {
         2 * self.mass.len()
     }
 
+    /// Number of degrees of freedom (masses).
     pub fn dofs(&self) -> usize {
         self.mass.len()
     }
@@ -429,15 +444,22 @@ impl OdeProblem for SpringChain {
 /// With `structured` false it declares no structure and hands out the same Jacobian dense.
 #[derive(Debug, Clone)]
 pub struct ModalChainWithAbsorber {
+    /// The 19-mass chain the absorber hangs from.
     pub chain: SpringChain,
+    /// Degree of freedom of the chain the absorber is attached to.
     pub attach: usize,
+    /// Absorber masses (kg): the first on the chain, the second on the first.
     pub masses: [f64; 2],
+    /// Spring rates (N/m) of the chain-to-first and first-to-second springs.
     pub springs: [f64; 2],
+    /// Dashpot rates (N s/m) in parallel with the springs.
     pub dashpots: [f64; 2],
+    /// Whether the problem declares its block-diagonal plus low-rank Jacobian structure.
     pub structured: bool,
 }
 
 impl ModalChainWithAbsorber {
+    /// The chain with the absorber at its middle mass (2 kHz and 700 Hz, 5 % damping).
     pub fn new(structured: bool) -> Result<Self, String> {
         let chain = SpringChain::without_stiff_mode()?;
         let attach = chain.dofs() / 2;
@@ -463,6 +485,7 @@ impl ModalChainWithAbsorber {
         self.chain.modes[(self.attach, r)]
     }
 
+    /// Block structure: the absorber's four states as one block, each mode's pair as one, rank 2.
     pub fn shape(&self) -> BlockLowRankShape {
         let m = self.modes();
         let mut blocks = vec![vec![0, 1, 2, 3]];

@@ -39,6 +39,7 @@ impl Mode {
 /// Everything one evaluation of the equations of motion produces.
 #[derive(Debug, Clone)]
 pub struct Evaluation {
+    /// Position, rotation and velocities per powertrain body.
     pub kinematics: Vec<BodyKinematics>,
     /// Mass matrix and generalised forces per powertrain body (mount forces included).
     pub dynamics: Vec<BodyDynamics>,
@@ -50,8 +51,9 @@ pub struct Evaluation {
     pub crank: CrankDriveState,
     /// Crank angle rate `φ' = ω_c − e·ω_block`.
     pub crank_rate: f64,
-    /// Crank speed and acceleration (from the follower or the set-point).
+    /// Crank speed (rad/s, from the follower or the set-point).
     pub crank_speed: f64,
+    /// Crank acceleration (rad/s², from the follower or the set-point).
     pub crank_acceleration: f64,
 }
 

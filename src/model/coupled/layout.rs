@@ -18,6 +18,8 @@ pub struct StateLayout {
 }
 
 impl StateLayout {
+    /// The layout of `bodies` powertrain bodies, the speed follower's two states if `follower`,
+    /// and `modes` body modes.
     pub fn new(bodies: usize, follower: bool, modes: usize) -> Self {
         Self {
             bodies,
@@ -73,6 +75,7 @@ impl StateLayout {
         0..self.engine_dim()
     }
 
+    /// Number of powertrain states (the engine block of the Newton matrix).
     pub fn engine_dim(&self) -> usize {
         12 * self.bodies + 1 + if self.follower { 2 } else { 0 }
     }
@@ -98,6 +101,7 @@ impl StateLayout {
             .collect()
     }
 
+    /// Number of states.
     pub fn dim(&self) -> usize {
         self.engine_dim() + 2 * self.modes
     }

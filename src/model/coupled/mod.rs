@@ -1,4 +1,4 @@
-//! The one coupled model: a powertrain on mounts in a body, as an [`OdeProblem`].
+//! The one coupled model: a powertrain on mounts in a body, as an [`OdeProblem`](crate::ode::OdeProblem).
 //!
 //! Components and what they contribute:
 //! - the powertrain ([`Powertrain`]): 1 or 2 free rigid bodies with their composite-body dynamics,
@@ -65,13 +65,16 @@ pub enum MountTarget {
 /// A mount with what it connects.
 #[derive(Debug, Clone, PartialEq)]
 pub struct ConnectedMount {
+    /// The mount: its bracket on the powertrain, curves, damping and preload.
     pub mount: Mount,
+    /// What its far end is attached to.
     pub target: MountTarget,
 }
 
 /// A named body point whose motion is an output.
 #[derive(Debug, Clone, PartialEq)]
 pub struct OutputPoint {
+    /// The point's name in the vehicle configuration (`steering_wheel`, `seat_rail`, …).
     pub name: String,
     /// Index into the body's points.
     pub point: usize,
@@ -80,8 +83,11 @@ pub struct OutputPoint {
 /// Why the coupled model could not be assembled.
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]
 pub enum ModelError {
+    /// The vehicle configuration is invalid.
     #[error(transparent)]
     Config(#[from] ConfigError),
+    /// The body is unusable: inconsistent or non-finite modal data, or a mount's body node or an
+    /// output point it lacks.
     #[error("body: {0}")]
     Body(String),
 }
@@ -291,22 +297,27 @@ impl CoupledModel {
         self.dense_newton = dense;
     }
 
+    /// The powertrain component (engine bodies, crank drive, ring carriers).
     pub fn powertrain(&self) -> &Powertrain {
         &self.powertrain
     }
 
+    /// The effect switches in force.
     pub fn effects(&self) -> &Effects {
         self.powertrain.effects()
     }
 
+    /// The reduced body (no modes and no points on rigid ground).
     pub fn body(&self) -> &ReducedChassis {
         &self.body
     }
 
+    /// Where each component's coordinates sit in the state vector.
     pub fn layout(&self) -> &StateLayout {
         &self.layout
     }
 
+    /// How the crank follows the speed set-point.
     pub fn follower(&self) -> &SpeedFollower {
         &self.follower
     }
@@ -327,10 +338,12 @@ impl CoupledModel {
         })
     }
 
+    /// The body points whose motion is reported, in output order.
     pub fn output_points(&self) -> &[OutputPoint] {
         &self.outputs
     }
 
+    /// The inputs in force (speed set-point, load torque, mount scales).
     pub fn inputs(&self) -> &ModelInputs {
         &self.inputs
     }

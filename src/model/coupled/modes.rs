@@ -75,14 +75,19 @@ pub enum ModeKind {
     /// Monoblock against housing; `bushing` is the most strained ring carrier, `direction` its
     /// most strained local direction (translations and rotations as in [`Direction`]).
     RingCarrier {
+        /// Name of the most strained ring carrier.
         bushing: String,
+        /// Its most strained local direction.
         direction: Direction,
     },
     /// Most kinetic energy in the body: `mode` is the uncoupled body mode contributing most,
     /// `point` the body point with the largest translation.
     Body {
+        /// Index of the uncoupled body mode contributing most.
         mode: usize,
+        /// That body mode's frequency alone (Hz).
         uncoupled_hz: f64,
+        /// The body point with the largest translation.
         point: String,
     },
 }
@@ -90,9 +95,13 @@ pub enum ModeKind {
 /// One eigenmode of the linearised model.
 #[derive(Debug, Clone, PartialEq)]
 pub struct Mode {
+    /// Natural frequency `|λ| / 2π` of the eigenvalue pair (Hz).
     pub frequency_hz: f64,
+    /// Damping ratio `−Re λ / |λ|`.
     pub damping_ratio: f64,
+    /// What the mode mostly is.
     pub kind: ModeKind,
+    /// Readable description (e.g. "rolling (about crank axis y) of engine assembly").
     pub description: String,
     /// Share of the kinetic energy in the powertrain (the rest is in the body).
     pub powertrain_fraction: f64,

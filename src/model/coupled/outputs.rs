@@ -15,27 +15,33 @@ pub struct BodyMotion {
     pub displacement: [f64; 3],
     /// Cardan angles `R = Rx Ry Rz` (rad).
     pub rotation: [f64; 3],
-    /// Velocity (m/s) and angular velocity (rad/s), vehicle frame.
+    /// Velocity (m/s, vehicle frame).
     pub velocity: [f64; 3],
+    /// Angular velocity (rad/s, vehicle frame).
     pub angular_velocity: [f64; 3],
-    /// Acceleration (m/s²) and angular acceleration (rad/s²), vehicle frame.
+    /// Acceleration (m/s², vehicle frame).
     pub acceleration: [f64; 3],
+    /// Angular acceleration (rad/s², vehicle frame).
     pub angular_acceleration: [f64; 3],
 }
 
 /// Motion of a named body point (vehicle frame).
 #[derive(Debug, Clone, PartialEq, Default)]
 pub struct PointMotion {
+    /// The point's name in the vehicle configuration.
     pub name: String,
-    /// Displacement (m), velocity (m/s), acceleration (m/s²).
+    /// Displacement (m).
     pub displacement: [f64; 3],
+    /// Velocity (m/s).
     pub velocity: [f64; 3],
+    /// Acceleration (m/s²).
     pub acceleration: [f64; 3],
 }
 
 /// All outputs of the coupled model at one time.
 #[derive(Debug, Clone, PartialEq, Default)]
 pub struct Outputs {
+    /// Time of the outputs (s).
     pub time: f64,
     /// Per configured mount: force on the ground/body side (N, vehicle frame); zero if removed.
     pub mount_forces: Vec<[f64; 3]>,
@@ -49,8 +55,9 @@ pub struct Outputs {
     pub monoblock: BodyMotion,
     /// Crank angle relative to the monoblock (rad, unwrapped).
     pub crank_angle: f64,
-    /// Crank speed (rad/s) and acceleration (rad/s²) — the follower's, or the set-point's.
+    /// Crank speed (rad/s) — the follower's, or the set-point's.
     pub crank_speed: f64,
+    /// Crank acceleration (rad/s²) — the follower's, or the set-point's.
     pub crank_acceleration: f64,
     /// Excitation fade-in factor.
     pub excitation: f64,

@@ -9,10 +9,13 @@ use crate::model::inputs::{InputError, ModelInputs};
 /// Everything about a model that changes after construction.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct ModelSnapshot {
+    /// The inputs in force.
     pub inputs: ModelInputs,
+    /// Start time of the excitation fade-in (s).
     pub fade_start: f64,
     /// Per configured mount (zeros for removed mounts).
     pub operating_points: Vec<[f64; 3]>,
+    /// Combustion load between idle (0) and full load (1).
     pub gas_load: f64,
 }
 

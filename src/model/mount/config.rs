@@ -9,6 +9,7 @@ use crate::model::validate::{err, finite, non_negative, ConfigError};
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct MountConfig {
+    /// The mount's name (reported in messages and mode descriptions).
     pub name: String,
     /// A removed mount (paper §7.1: 4 → 3 mounts) carries no force and costs nothing.
     #[serde(default = "default_true")]

@@ -40,6 +40,7 @@ impl MountResponse {
 /// A mount ready for evaluation.
 #[derive(Debug, Clone, PartialEq)]
 pub struct Mount {
+    /// The mount's name from the configuration.
     pub name: String,
     /// Bracket point in the vehicle frame, reference configuration.
     pub bracket: Vector3<f64>,
@@ -47,10 +48,13 @@ pub struct Mount {
     pub attachment: Vector3<f64>,
     /// Rows: local axes.
     pub axes: Matrix3<f64>,
+    /// Force-deflection curve per local axis.
     pub curves: [MountCurve; 3],
     /// The curves prepared for evaluation.
     tables: [CurveTable; 3],
+    /// Viscous damping per local axis (N s/m).
     pub damping: Vector3<f64>,
+    /// Force on the bracket at zero deflection per local axis (N): the assembly preload.
     pub preload: Vector3<f64>,
     /// Deflection of the static operating point; with the nonlinearity switched off the curves
     /// are replaced by their tangents there.

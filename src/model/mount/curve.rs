@@ -207,6 +207,7 @@ pub struct CurveTable {
 }
 
 impl CurveTable {
+    /// The curve tabulated with the force at every knot.
     pub fn new(curve: &MountCurve) -> Self {
         Self {
             knots: curve

@@ -11,9 +11,11 @@ use crate::model::effects::Effects;
 /// One free rigid body (6 coordinates) with the parts it carries.
 #[derive(Debug, Clone, PartialEq)]
 pub struct Body {
+    /// The body's name (`monoblock`, `housing`, or the rigid powertrain's).
     pub name: String,
     /// Reference point in the vehicle frame (reference configuration).
     pub reference: Vector3<f64>,
+    /// The parts it carries (fixed masses, crank-drive parts, balance weights).
     pub parts: Vec<Part>,
 }
 

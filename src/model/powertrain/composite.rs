@@ -21,9 +21,13 @@ use super::parts::Part;
 /// Pose and velocity of one body.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct BodyKinematics {
+    /// World position of the reference point (m, vehicle frame).
     pub position: Vector3<f64>,
+    /// Rotation from body axes to the vehicle frame.
     pub rotation: Matrix3<f64>,
+    /// Velocity of the reference point (m/s, vehicle frame).
     pub velocity: Vector3<f64>,
+    /// Angular velocity (rad/s, vehicle frame).
     pub omega: Vector3<f64>,
 }
 
@@ -82,11 +86,14 @@ impl CrankDriveState {
 /// Mass matrix and generalised forces of one composite body, `M v' = f`.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct BodyDynamics {
+    /// Composite 6×6 mass matrix for `v = [u', ω]`.
     pub mass: Matrix6<f64>,
+    /// Generalised forces (force and moment about the reference point, vehicle frame).
     pub force: Vector6<f64>,
 }
 
 impl BodyDynamics {
+    /// No mass and no force (the start of a sum).
     pub fn zero() -> Self {
         Self {
             mass: Matrix6::zeros(),

@@ -52,8 +52,11 @@ pub struct CrankDriveConfig {
     /// Cylinder (bore) axis, a unit vector normal to the crank axis y (default +z; an inclined
     /// engine tilts it in the x-z plane).
     pub bore_axis: [f64; 3],
+    /// Cylinder bore (m).
     pub bore: f64,
+    /// Crank radius, half the stroke (m).
     pub crank_radius: f64,
+    /// Conrod length between the pin centres (m).
     pub conrod_length: f64,
     /// Piston + oscillating conrod part per cylinder (kg).
     pub oscillating_mass: f64,
@@ -61,10 +64,13 @@ pub struct CrankDriveConfig {
     pub rotating_mass: f64,
     /// Counterweight per throw, opposite the crank pin (kg).
     pub counterweight_mass: f64,
+    /// Radius of the counterweights' centre of mass (m).
     pub counterweight_radius: f64,
-    /// Crankshaft + flywheel mass on the axis (kg) and spin inertia (kg m²).
+    /// Crankshaft + flywheel mass on the axis (kg).
     pub crank_mass: f64,
+    /// Crankshaft + flywheel spin inertia about the crank axis (kg m²).
     pub crank_axial_inertia: f64,
+    /// One entry per cylinder: position along the crank, throw and firing angle.
     pub cylinders: Vec<CylinderConfig>,
 }
 
@@ -72,8 +78,9 @@ pub struct CrankDriveConfig {
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct EccentricWeight {
-    /// Mass (kg) and distance of its centre of mass from the shaft axis (m).
+    /// Mass (kg).
     pub mass: f64,
+    /// Distance of its centre of mass from the shaft axis (m).
     pub eccentricity: f64,
     /// Position along the shaft axis, from the shaft's reference point (m).
     pub y: f64,
@@ -110,13 +117,17 @@ pub const UNBALANCE_RADIUS: f64 = 0.05;
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct BalanceShaftConfig {
+    /// The shaft's name (a residual unbalance refers to it).
     pub name: String,
     /// A point of the shaft axis in the vehicle frame; the reference of the weights' `y` (m).
     pub axis_point: [f64; 3],
+    /// Speed relative to the block as a multiple of the crank's (negative: counter-rotating).
     pub ratio: f64,
-    /// Shaft mass on the axis (kg) and spin inertia (kg m²).
+    /// Shaft mass on the axis (kg).
     pub shaft_mass: f64,
+    /// Shaft spin inertia about its axis (kg m²).
     pub shaft_axial_inertia: f64,
+    /// The eccentric weights it carries.
     pub weights: Vec<EccentricWeight>,
 }
 
@@ -124,6 +135,7 @@ pub struct BalanceShaftConfig {
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct GasConfig {
+    /// Where the cylinder pressure comes from: the Wiebe combustion model or a measured table.
     pub model: GasModel,
     /// Load between idle (0) and full load (1) for the Wiebe model.
     pub load: f64,
@@ -140,6 +152,7 @@ pub struct GasConfig {
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct BushingConfig {
+    /// The ring carrier's name (e.g. front, rear).
     pub name: String,
     /// Location in the vehicle frame (m).
     pub position: [f64; 3],
@@ -158,6 +171,7 @@ pub struct EngineConfig {
     pub start_crank_angle_deg: f64,
     /// Excitation fade-in time (s); 0 switches the excitation on at once.
     pub excitation_fade_in: f64,
+    /// Crank drive geometry, masses and cylinders.
     pub crank_drive: CrankDriveConfig,
     /// Balance shafts (effect switch `balance_shaft`).
     pub balance_shafts: Vec<BalanceShaftConfig>,
@@ -167,11 +181,13 @@ pub struct EngineConfig {
     /// Residual unbalance of the crank and the balance shafts (present whatever the effect
     /// switches say: balancing never removes it completely).
     pub residual_unbalance: Vec<ResidualUnbalance>,
+    /// Gas pressure source, load and cylinder-to-cylinder spread.
     pub gas: GasConfig,
     /// Monoblock structure (cylinders, head, main bearing frame) without the moving parts.
     pub monoblock: RigidBodyConfig,
     /// Housing + gearbox + aggregates (carries the mount brackets).
     pub housing: RigidBodyConfig,
+    /// Ring carriers between monoblock and housing (effect switch `ring_carrier_elasticity`).
     pub ring_carriers: Vec<BushingConfig>,
 }
 

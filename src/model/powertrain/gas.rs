@@ -4,9 +4,10 @@
 //! `dp/dθ = (κ−1)/V · dQ/dθ − κ p/V · dV/dθ` with a (multi-stage) Wiebe heat release
 //! `x = 1 − exp(−6.908 ((θ − θ_soc)/Δθ)^(m+1))` and a polytropic exponent that moves linearly from
 //! compression to expansion value. It is integrated once per operating point (idle, full load) on
-//! a 0.25° grid; outside the closed part the pressure blends smoothly back to the charge pressure.
-//! The load parameter interpolates linearly between the idle and full-load curves. Evaluation uses
-//! cubic Hermite interpolation, so the pressure is C¹ in the crank angle.
+//! a 0.05° grid; outside the closed part the pressure blends smoothly back to the charge pressure
+//! (the valve events decided in degrees and blended C¹). The load parameter interpolates linearly
+//! between the idle and full-load curves. Evaluation uses quintic Hermite interpolation (value,
+//! slope and curvature at every knot), so the pressure is C² in the crank angle.
 
 use serde::{Deserialize, Serialize};
 
@@ -30,6 +31,7 @@ pub struct CombustionPoint {
     pub pressure_ivc: f64,
     /// Heat released per cylinder and cycle (J).
     pub heat: f64,
+    /// The combustion stages (premixed, diffusion, …); their fractions add up to 1.
     pub stages: Vec<WiebeStage>,
 }
 
@@ -69,8 +71,11 @@ impl Default for WallHeatTransfer {
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 #[serde(default)]
 pub struct WiebeModel {
+    /// Geometric compression ratio.
     pub compression_ratio: f64,
+    /// Polytropic exponent of the compression.
     pub kappa_compression: f64,
+    /// Polytropic exponent of the expansion (the exponent moves linearly between the two).
     pub kappa_expansion: f64,
     /// Inlet valve closing (deg after firing TDC, negative).
     pub ivc_deg: f64,
@@ -78,7 +83,9 @@ pub struct WiebeModel {
     pub evo_deg: f64,
     /// Crank angle over which the pressure blows down to the charge pressure after EVO (deg).
     pub blowdown_deg: f64,
+    /// Charge and heat release at idle (load 0).
     pub idle: CombustionPoint,
+    /// Charge and heat release at full load (load 1).
     pub full_load: CombustionPoint,
     /// Wall heat loss during the closed cycle; `None` = adiabatic walls (the heat released
     /// then all goes into the gas: an indicated efficiency far above a real engine's).
@@ -130,7 +137,9 @@ impl Default for WiebeModel {
 /// User-supplied pressure over the cycle (absolute Pa at deg after firing TDC, covering 720°).
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct PressureTable {
+    /// Crank angles (deg after firing TDC), ascending.
     pub angle_deg: Vec<f64>,
+    /// Absolute pressure at each angle (Pa).
     pub pressure: Vec<f64>,
 }
 
@@ -138,7 +147,9 @@ pub struct PressureTable {
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 #[serde(tag = "kind", rename_all = "snake_case")]
 pub enum GasModel {
+    /// The single-zone Wiebe combustion model, integrated per load point.
     Wiebe(WiebeModel),
+    /// A user-supplied pressure curve (the load parameter does not change it).
     Table(PressureTable),
 }
 
@@ -151,12 +162,16 @@ impl Default for GasModel {
 /// Cylinder geometry needed by the pressure model.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct CylinderGeometry {
+    /// Cylinder bore (m).
     pub bore: f64,
+    /// Crank radius (m).
     pub crank_radius: f64,
+    /// Conrod length (m).
     pub conrod: f64,
 }
 
 impl CylinderGeometry {
+    /// Piston crown area `π bore² / 4` (m²).
     pub fn piston_area(&self) -> f64 {
         std::f64::consts::PI * 0.25 * self.bore * self.bore
     }
@@ -285,7 +300,7 @@ impl PressureCurve {
 
     /// Single-zone Wiebe pressure for one load point. The tables take milliseconds to integrate
     /// and every instance of the FMU (a sweep resets it for each speed point) asks for the same
-    /// few, so the last [`WIEBE_MEMO_SIZE`] are kept for the process.
+    /// few, so the last `WIEBE_MEMO_SIZE` are kept for the process.
     pub fn wiebe(model: &WiebeModel, point: &CombustionPoint, geometry: &CylinderGeometry) -> Self {
         type Memo = Vec<(WiebeModel, CombustionPoint, CylinderGeometry, PressureCurve)>;
         static MEMO: std::sync::OnceLock<std::sync::Mutex<Memo>> = std::sync::OnceLock::new();

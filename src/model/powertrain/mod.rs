@@ -240,14 +240,17 @@ impl Powertrain {
         })
     }
 
+    /// The engine configuration it was built from.
     pub fn config(&self) -> &EngineConfig {
         &self.config
     }
 
+    /// The effect switches it was built with.
     pub fn effects(&self) -> &Effects {
         &self.effects
     }
 
+    /// The free rigid bodies: monoblock and housing, or one rigid powertrain.
     pub fn bodies(&self) -> &[Body] {
         &self.bodies
     }
@@ -257,10 +260,12 @@ impl Powertrain {
         &self.moments[b]
     }
 
+    /// The ring carriers between monoblock and housing (none when they are rigid).
     pub fn ring_carriers(&self) -> &[RingCarrier] {
         &self.ring_carriers
     }
 
+    /// Gravitational acceleration (m/s², vehicle frame).
     pub fn gravity(&self) -> &Vector3<f64> {
         &self.gravity
     }

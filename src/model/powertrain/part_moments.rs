@@ -175,6 +175,7 @@ pub struct PartMoments {
 }
 
 impl PartMoments {
+    /// Compiles a body's parts: fixed parts and spinning inertias fold into constants here.
     pub fn new(parts: &[Part]) -> Self {
         let mut fixed_first = Vector3::zeros();
         let mut fixed_second = Matrix3::zeros();

@@ -17,25 +17,40 @@ use super::part_moments::MovingPart;
 #[derive(Debug, Clone, PartialEq)]
 pub enum PartMotion {
     /// Rigidly attached at `offset` (from the body reference point, body axes).
-    Fixed { offset: Vector3<f64> },
+    Fixed {
+        /// Position of the centre of mass from the body reference point (m, body axes).
+        offset: Vector3<f64>,
+    },
     /// Piston pin on the cylinder through `crank_centre + y·e_y` along the bore axis `bore`; exact
     /// slider-crank `s(ψ) = r cos ψ + √(l² − r² sin² ψ)`, `ψ = φ − throw`.
     Piston {
+        /// Crank centre from the body reference point (m, body axes).
         crank_centre: Vector3<f64>,
+        /// Unit bore axis (body axes).
         bore: Vector3<f64>,
+        /// Cylinder position along the crank axis (m).
         y: f64,
+        /// Throw angle of the cylinder's crank pin (rad).
         throw: f64,
+        /// Crank radius `r` (m).
         radius: f64,
+        /// Conrod length `l` (m).
         conrod: f64,
     },
     /// Point at `radius` from an axis parallel to body y through `centre`, at `y` along it, at the
     /// angle `ψ = ratio · φ + phase` measured from the bore axis `bore` towards `e_y × bore`.
     Orbit {
+        /// A point of the axis from the body reference point (m, body axes).
         centre: Vector3<f64>,
+        /// Unit bore axis, the zero of the angle (body axes).
         bore: Vector3<f64>,
+        /// Position along the axis (m).
         y: f64,
+        /// Distance from the axis (m).
         radius: f64,
+        /// Turns per crank turn relative to the body (−1: a counter-rotating balance shaft).
         ratio: f64,
+        /// Angle at crank angle 0 (rad).
         phase: f64,
     },
 }
@@ -43,11 +58,14 @@ pub enum PartMotion {
 /// One internal part: mass, inertia, motion and spin.
 #[derive(Debug, Clone, PartialEq)]
 pub struct Part {
+    /// The part's name (e.g. `piston 1`, `crankshaft`).
     pub name: String,
+    /// Mass (kg).
     pub mass: f64,
     /// Inertia tensor about the part's centre of mass in body axes. For spinning parts it must be
     /// axisymmetric about body y (only then is it independent of the spin angle).
     pub inertia: Matrix3<f64>,
+    /// How its centre of mass moves relative to the body.
     pub motion: PartMotion,
     /// Spin about body y relative to the body, as a multiple of the crank's relative speed.
     pub spin_ratio: f64,
@@ -56,8 +74,11 @@ pub struct Part {
 /// Position of a part's centre of mass in body axes and its first two derivatives in φ.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct PartPath {
+    /// Position `ρ` (m).
     pub rho: Vector3<f64>,
+    /// `dρ/dφ` (m/rad).
     pub d_rho: Vector3<f64>,
+    /// `d²ρ/dφ²` (m/rad²).
     pub dd_rho: Vector3<f64>,
 }
 

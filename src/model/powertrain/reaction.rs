@@ -11,6 +11,7 @@ use super::Powertrain;
 /// Force and moment (vehicle frame) on the monoblock.
 #[derive(Debug, Clone, Copy, PartialEq, Default)]
 pub struct Wrench {
+    /// Force (N).
     pub force: [f64; 3],
     /// About the crank centre.
     pub moment: [f64; 3],

@@ -17,28 +17,39 @@ use crate::model::kinematics::{left_jacobian_inverse_transpose, rotation_vector}
 /// A bushing ready for evaluation.
 #[derive(Debug, Clone, PartialEq)]
 pub struct RingCarrier {
+    /// The ring carrier's name from the configuration.
     pub name: String,
-    /// Bushing point relative to the monoblock and housing reference points (body axes).
+    /// Bushing point relative to the monoblock reference point (body axes).
     pub on_monoblock: Vector3<f64>,
+    /// Bushing point relative to the housing reference point (body axes).
     pub on_housing: Vector3<f64>,
+    /// Stiffness in housing axes: translations (N/m), rotations (N m/rad).
     pub stiffness: [f64; 6],
+    /// Damping in the same order (N s/m, N m s/rad).
     pub damping: [f64; 6],
 }
 
 /// Wrenches on both bodies (vehicle frame): force at the body's bushing point and moment.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct BushingWrench {
+    /// Force on the monoblock (N).
     pub monoblock_force: Vector3<f64>,
+    /// Where it acts: the monoblock's bushing point (m).
     pub monoblock_point: Vector3<f64>,
+    /// Moment on the monoblock (N m).
     pub monoblock_moment: Vector3<f64>,
+    /// Force on the housing (N).
     pub housing_force: Vector3<f64>,
+    /// Where it acts: the housing's bushing point (m).
     pub housing_point: Vector3<f64>,
+    /// Moment on the housing (N m).
     pub housing_moment: Vector3<f64>,
     /// Local deflection `[translation; rotation]` in housing axes.
     pub deflection: [f64; 6],
 }
 
 impl RingCarrier {
+    /// The bushing of `c` between bodies with these reference points (vehicle frame).
     pub fn from_config(
         c: &BushingConfig,
         monoblock_ref: &Vector3<f64>,
@@ -54,6 +65,7 @@ impl RingCarrier {
         }
     }
 
+    /// The bushing's forces and moments on both bodies in their current motion.
     pub fn wrench(&self, mb: &BodyKinematics, h: &BodyKinematics) -> BushingWrench {
         let xm = mb.point(&self.on_monoblock);
         let xh = h.point(&self.on_housing);

@@ -1,0 +1,216 @@
+"""The documentation as its readers meet it: the user guide (mdBook in docs/) builds, every link in
+it leads somewhere, every Python example in it and in the README runs against the packaged FMU,
+and the FMU's own documentation page links to nothing outside the FMU.
+
+Links are checked here, on the HTML mdBook writes, instead of by an mdBook plugin: the plugin would
+be a second crate to compile on every fresh machine, while this check needs only the standard
+library and also covers the README's links into docs/."""
+
+import html.parser
+import pathlib
+import re
+import shutil
+import subprocess
+import sys
+import urllib.parse
+import zipfile
+
+import pytest
+
+ROOT = pathlib.Path(__file__).resolve().parents[2]
+BOOK_SRC = ROOT / "docs" / "src"
+FENCE = re.compile(r"^```(\w*)[^\n]*\n(.*?)^```", re.S | re.M)
+
+
+def pages() -> list[pathlib.Path]:
+    return [ROOT / "README.md"] + sorted(BOOK_SRC.rglob("*.md"))
+
+
+def code_blocks(page: pathlib.Path, language: str) -> list[str]:
+    return [body for lang, body in FENCE.findall(page.read_text()) if lang == language]
+
+
+PYTHON_PAGES = [p for p in pages() if code_blocks(p, "python")]
+
+
+def test_the_guide_and_the_readme_carry_python_examples():
+    names = {p.relative_to(ROOT).as_posix() for p in PYTHON_PAGES}
+    assert "README.md" in names
+    assert len(names) >= 8, names
+
+
+@pytest.mark.parametrize("page", PYTHON_PAGES, ids=lambda p: p.relative_to(ROOT).as_posix())
+def test_python_examples_run_against_the_packaged_fmu(page, fmu_path):
+    # The blocks of one page run in order in one interpreter, as a reader would paste them, from
+    # the repository root where their relative paths (dist/…, resources/…) point.
+    assert fmu_path == ROOT / "dist" / "EngineMountChassis.fmu"
+    code = "\n".join(code_blocks(page, "python"))
+    run = subprocess.run([sys.executable, "-c", code], cwd=ROOT, capture_output=True, text=True,
+                         timeout=600)
+    assert run.returncode == 0, f"{page.relative_to(ROOT)}:\n{run.stdout}\n{run.stderr}"
+
+
+def test_rust_examples_of_the_guide_are_doctests():
+    # cargo test runs a page's Rust blocks only if src/lib.rs includes the page as documentation.
+    lib = (ROOT / "src" / "lib.rs").read_text()
+    included = {(ROOT / "src" / m).resolve() for m in re.findall(r'include_str!\("([^"]+)"\)', lib)}
+    with_rust = {p.resolve() for p in sorted(BOOK_SRC.rglob("*.md")) if code_blocks(p, "rust")}
+    assert with_rust, "the guide has no Rust example"
+    assert with_rust <= included, f"Rust examples not run as doctests: {with_rust - included}"
+
+
+class _Links(html.parser.HTMLParser):
+    def __init__(self):
+        super().__init__()
+        self.ids: set[str] = set()
+        self.links: list[str] = []
+
+    def handle_starttag(self, tag, attrs):
+        a = dict(attrs)
+        for key in ("id", "name"):
+            if a.get(key):
+                self.ids.add(a[key])
+        for key in ("href", "src"):
+            if a.get(key):
+                self.links.append(a[key])
+
+
+def _parse(path: pathlib.Path) -> _Links:
+    p = _Links()
+    p.feed(path.read_text(errors="replace"))
+    return p
+
+
+def broken_links(root: pathlib.Path, files: list[pathlib.Path]) -> list[str]:
+    """Every relative href/src of `files` must name an existing file under `root`, and a fragment
+    an id in that file. Links with a scheme (https:, mailto:) are returned as broken too: the
+    pages are read offline and say in words what they cite."""
+    parsed = {f: _parse(f) for f in files}
+    broken = []
+    for f, p in parsed.items():
+        for link in p.links:
+            url = urllib.parse.urlsplit(link)
+            where = f"{f.relative_to(root)}: {link}"
+            if url.scheme or link.startswith("//"):
+                if url.scheme != "data":
+                    broken.append(f"{where} (leads outside)")
+                continue
+            target = f if not url.path else (f.parent / urllib.parse.unquote(url.path)).resolve()
+            if target.is_dir():
+                target = target / "index.html"
+            if not target.is_file() or root.resolve() not in target.resolve().parents:
+                broken.append(f"{where} (no such file)")
+                continue
+            if url.fragment and target.suffix == ".html":
+                ids = parsed[target].ids if target in parsed else _parse(target).ids
+                if urllib.parse.unquote(url.fragment) not in ids:
+                    broken.append(f"{where} (no anchor #{url.fragment})")
+    return broken
+
+
+@pytest.fixture(scope="module")
+def book(tmp_path_factory) -> pathlib.Path:
+    mdbook = shutil.which("mdbook")
+    if mdbook is None:
+        pytest.fail("mdbook is not installed: run bash scripts/setup.sh")
+    out = tmp_path_factory.mktemp("book")
+    run = subprocess.run([mdbook, "build", str(ROOT / "docs"), "--dest-dir", str(out)],
+                         capture_output=True, text=True)
+    assert run.returncode == 0, run.stderr
+    # mdBook reports what it could not resolve (a missing chapter, a bad include) on stderr.
+    assert "[ERROR]" not in run.stderr and "[WARN]" not in run.stderr, run.stderr
+    return out
+
+
+def test_every_chapter_of_the_summary_is_built(book):
+    summary = (BOOK_SRC / "SUMMARY.md").read_text()
+    chapters = re.findall(r"\]\(([^)]+\.md)\)", summary)
+    assert len(chapters) >= 25
+    for chapter in chapters:
+        assert (BOOK_SRC / chapter).is_file(), chapter
+        assert (book / chapter).with_suffix(".html").is_file(), chapter
+
+
+def test_every_link_and_anchor_in_the_book_resolves(book):
+    files = sorted(book.rglob("*.html"))
+    # print.html repeats every chapter on one page with rewritten links; the chapters are checked.
+    files = [f for f in files if f.name not in ("print.html", "404.html")]
+    broken = broken_links(book, files)
+    assert not broken, "\n".join(broken)
+
+
+def test_the_checker_finds_a_broken_link_and_a_missing_anchor(tmp_path):
+    (tmp_path / "a.html").write_text('<h1 id="top">A</h1><a href="b.html#nowhere">b</a>'
+                                     '<a href="c.html">c</a><a href="#top">top</a>'
+                                     '<a href="https://example.org/">out</a>')
+    (tmp_path / "b.html").write_text('<h2 id="here">B</h2>')
+    broken = broken_links(tmp_path, [tmp_path / "a.html", tmp_path / "b.html"])
+    assert len(broken) == 3, broken
+    assert any("no anchor #nowhere" in b for b in broken)
+    assert any("c.html (no such file)" in b for b in broken)
+    assert any("leads outside" in b for b in broken)
+
+
+MD_LINK = re.compile(r"\]\(([^)\s]+)\)")
+
+
+@pytest.mark.parametrize("name", ["README.md", "CHANGELOG.md"])
+def test_front_page_links_lead_to_files_of_the_repository(name):
+    text = (ROOT / name).read_text()
+    links = [link for link in MD_LINK.findall(text) if not re.match(r"\w+:", link)]
+    if name == "README.md":
+        assert any(link.startswith("docs/src/") for link in links)
+    for link in links:
+        path = link.split("#")[0]
+        assert (ROOT / path).exists(), f"{name}: {link}"
+
+
+def test_readme_is_a_front_page():
+    text = (ROOT / "README.md").read_text()
+    assert len(text.splitlines()) <= 120
+    assert (ROOT / "LICENSE").read_text().startswith("MIT License")
+    image = re.search(r"!\[[^\]]*\]\(([^)]+)\)", text)
+    assert image and (ROOT / image.group(1)).is_file()
+    assert (ROOT / image.group(1)).stat().st_size <= 200_000
+
+
+def test_the_fmu_documentation_page_links_to_nothing_outside_the_fmu(fmu_path, tmp_path):
+    with zipfile.ZipFile(fmu_path) as z:
+        z.extractall(tmp_path)
+    docs = tmp_path / "documentation"
+    page = docs / "index.html"
+    assert page.is_file()
+    broken = broken_links(tmp_path, sorted(docs.rglob("*.html")))
+    assert not broken, "\n".join(broken)
+    # Every variable of the model description is on the page.
+    md = (tmp_path / "modelDescription.xml").read_text()
+    text = page.read_text()
+    names = re.findall(r'<ScalarVariable[^>]*\bname="([^"]+)"', md)
+    assert names
+    missing = [n for n in names if f"<code>{n}</code>" not in text]
+    assert not missing, missing[:10]
+
+
+def test_the_commands_the_guide_names_exist():
+    # Every table says which command makes it: those commands must exist under these names.
+    text = "\n".join(p.read_text() for p in pages())
+    examples = set(re.findall(r"--example (\w+)", text))
+    assert {"realtime", "accuracy_cost", "engine_modes", "hybrid_modes"} <= examples
+    for name in examples:
+        assert (ROOT / "examples" / f"{name}.rs").is_file(), name
+    for script in set(re.findall(r"bash (scripts/[\w-]+\.sh|packaging/[\w-]+\.sh)", text)):
+        assert (ROOT / script).is_file(), script
+    for test in set(re.findall(r"--test (\w+)", text)):
+        assert (ROOT / "tests" / test).is_dir() or (ROOT / "tests" / f"{test}.rs").is_file(), test
+    paths = set(re.findall(r"`((?:src|tests|python|tools|resources)/[\w./-]+\.(?:rs|py|c|json))`",
+                           text))
+    assert len(paths) >= 20
+    for path in paths:
+        assert (ROOT / path).is_file(), path
+    cli = (ROOT / "python" / "emc" / "cli.py").read_text()
+    subcommands = set(re.findall(r'add_parser\("([\w-]+)"', cli))
+    subcommands |= set(re.findall(r'\("(study-[\w-]+)"', cli))
+    commands = set(re.findall(r"(?:`|bin/)emc ([a-z][\w-]+)", text))
+    assert {"sweep", "runup", "campbell", "study-mounts", "bench-realtime"} <= commands
+    for command in commands:
+        assert command in subcommands, f"emc {command}"
