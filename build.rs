@@ -682,7 +682,7 @@ fn parameters_struct(scalars: &[Scalar], families: &[Family]) -> String {
         let unit = s
             .unit
             .as_ref()
-            .map(|u| format!(" [{u}]"))
+            .map(|u| format!(" \\[{u}\\]"))
             .unwrap_or_default();
         let _ = writeln!(
             fields,

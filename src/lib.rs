@@ -7,9 +7,14 @@
 //! - [`fe`]: finite elements, assembly and the procedural chassis.
 //! - [`model`]: engine multibody model, mounts, coupled system, outputs.
 //! - [`cosim`]: a scene with its integrator and inputs, stepped between communication points.
-//! - [`fmi2`]: the FMI 2.0 co-simulation C ABI (the only `unsafe` code).
-//! - [`variables`]: the variable table generated from `modelDescription/variables.json`, with
-//!   [`variables::Parameters`], every parameter as one typed structure (defaults in the table).
+//! - [`fmi2`]: the FMI 2.0 co-simulation C ABI (the only `unsafe` code); its
+//!   [`fmi2::parameters`] is the one mapping between FMU variables and the typed settings.
+//! - [`variables`]: the variable table generated from `modelDescription/variables.json` (a leaf:
+//!   it imports nothing from the model), with [`variables::Parameters`], every parameter as one
+//!   typed structure.
+
+#![deny(rustdoc::broken_intra_doc_links)]
+#![warn(missing_docs)]
 
 pub mod cms;
 pub mod cosim;

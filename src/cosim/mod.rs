@@ -1,6 +1,6 @@
 //! The co-simulation runtime: a scene, its integrator and its inputs, stepped from one
-//! communication point to the next. It knows the physics only through [`Scene`], and nothing of
-//! the C ABI: the FMI layer ([`crate::fmi2`]) maps variables onto [`Settings`], [`Inputs`] and
+//! communication point to the next. It knows the physics only through the coupled model
+//! ([`crate::model::CoupledModel`]), and nothing of the C ABI: the FMI layer ([`crate::fmi2`]) maps variables onto [`Settings`], [`Inputs`] and
 //! [`Outputs`].
 //!
 //! The integrator keeps its history across communication points and lands exactly on each one
