@@ -102,7 +102,7 @@ fn main() -> Result<(), String> {
     for h in [1e-4, 1e-3, 1e-2] {
         let with = run(scene, seconds, h, true)?;
         let without = run(scene, seconds, h, false)?;
-        // Relative L2 of the mount forces, the measure of the accuracy table (README).
+        // Relative L2 of the mount forces, the measure of the accuracy table (user guide, Evidence).
         let (mut num, mut den) = (0.0, 0.0);
         for (a, b) in with.forces.iter().zip(&without.forces) {
             for (x, y) in a.iter().zip(b) {

@@ -1,6 +1,8 @@
 //! The one binary format of saved states (integrator snapshots and FMU states): postcard, a
 //! documented and stable serde wire format, behind a header of an 8-byte magic and a format
-//! version, so a foreign or outdated buffer is refused before its body is decoded.
+//! version, so a foreign or outdated buffer is refused before its body is decoded, and followed
+//! by the SHA-256 of the body, so that a buffer changed after it was written (a flipped bit, a
+//! truncated copy) is refused instead of decoded into plausible but wrong numbers.
 //!
 //! Lengths inside the body come from the buffer; serde preallocates cautiously (at most about
 //! 1 MiB per sequence), so a forged length cannot make decoding allocate more than the buffer
@@ -8,6 +10,10 @@
 
 use serde::de::DeserializeOwned;
 use serde::{Deserialize, Serialize};
+use sha2::{Digest, Sha256};
+
+/// Length of the checksum after the body.
+const CHECKSUM_BYTES: usize = 32;
 
 #[derive(Serialize, Deserialize)]
 struct Header {
@@ -15,7 +21,7 @@ struct Header {
     version: u32,
 }
 
-/// `magic`, `version`, then `body`.
+/// `magic`, `version`, `body`, then the SHA-256 of the body.
 pub fn encode<T: Serialize>(magic: &[u8; 8], version: u32, body: &T) -> Vec<u8> {
     let header = Header {
         magic: *magic,
@@ -23,7 +29,10 @@ pub fn encode<T: Serialize>(magic: &[u8; 8], version: u32, body: &T) -> Vec<u8> 
     };
     let mut bytes = postcard::to_stdvec(&header).expect("a header always serialises");
     // Serialising plain data (numbers, vectors, strings, options) into memory cannot fail.
-    bytes.extend(postcard::to_stdvec(body).expect("a saved state always serialises"));
+    let body = postcard::to_stdvec(body).expect("a saved state always serialises");
+    let checksum = Sha256::digest(&body);
+    bytes.extend(body);
+    bytes.extend_from_slice(&checksum);
     bytes
 }
 
@@ -44,6 +53,15 @@ pub fn decode<T: DeserializeOwned>(
         return Err(format!(
             "{what} has format version {}, expected {version}",
             header.version
+        ));
+    }
+    let Some(split) = rest.len().checked_sub(CHECKSUM_BYTES) else {
+        return Err(format!("{what} is truncated (no checksum)"));
+    };
+    let (rest, checksum) = rest.split_at(split);
+    if Sha256::digest(rest).as_slice() != checksum {
+        return Err(format!(
+            "damaged {what}: its checksum does not match (changed or truncated after it was written)"
         ));
     }
     let (body, trailing) =
@@ -95,9 +113,21 @@ mod tests {
         longer.push(0);
         assert!(decode::<(f64, Vec<u32>)>(&longer, b"TESTTEST", 7, "x")
             .unwrap_err()
-            .contains("trailing"));
+            .contains("checksum"));
         for cut in 0..bytes.len() {
             assert!(decode::<(f64, Vec<u32>)>(&bytes[..cut], b"TESTTEST", 7, "x").is_err());
+        }
+    }
+
+    /// Issue 28: every bit flip of a scene-2 FMU state was accepted.
+    #[test]
+    fn every_flipped_bit_is_refused() {
+        let bytes = encode(b"TESTTEST", 7, &(1.5f64, vec![1u32, 2, 3], "text".to_owned()));
+        for i in 0..bytes.len() * 8 {
+            let mut flipped = bytes.clone();
+            flipped[i / 8] ^= 1 << (i % 8);
+            let result = decode::<(f64, Vec<u32>, String)>(&flipped, b"TESTTEST", 7, "x");
+            assert!(result.is_err(), "bit {i} flipped was accepted");
         }
     }
 

@@ -199,7 +199,7 @@ def test_inline_three_and_inline_four_through_the_fmu(fmu_path, config):
 def test_libcosim_run_up_with_rpm_set_at_every_step(fmu_path):
     """libcosim has no input derivatives: a master that computes the engine speed sets rpm at
     every communication step. The FMU holds the first two values and then continues their slope
-    (README, "Inputs between communication points"): the crank angle integrates the ramp up to
+    (user guide, "Inputs between communication points"): the crank angle integrates the ramp up to
     the analytic lag of those two held steps and of the speed follower, a (h² + 4 h τ + τ²)."""
     from libcosimpy.CosimExecution import CosimExecution
     from libcosimpy.CosimManipulator import CosimManipulator

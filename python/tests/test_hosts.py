@@ -6,7 +6,7 @@ deserialize, set and replay, free) and their outputs are compared.
 The two binaries use different maths libraries (glibc; mingw-w64 and msvcrt), whose results can
 differ in the last bit; the adaptive integrator then takes slightly different steps, so the
 outputs agree to the accuracy of the integration, not bit for bit. Without gas forces the error
-follows the tolerance down (README, "What accuracy costs"), so at rtol 1e-10 the binaries must
+follows the tolerance down (user guide, Evidence: "What accuracy costs"), so at rtol 1e-10 the binaries must
 agree to 1e-6; with them the error has a floor near 1e-4 (the tabulated pressure curve), so the
 full model is compared at the default rtol 1e-5 against the accuracy table's default error."""
 
@@ -113,7 +113,7 @@ def test_win64_binary_under_wine_agrees_with_linux64(unpacked):
     for scene, d in tight.items():
         assert d < 1e-6, f"scene {scene}: win64 and linux64 differ by {d:.1e} at rtol 1e-10 without gas"
     default = _difference(_linux(work, guid, vrs, 1e-5, True), _windows(work, guid, vrs, 1e-5, True))
-    # At the default tolerance: of the size of the accuracy table's default errors (README: L2
+    # At the default tolerance: of the size of the accuracy table's default errors (user guide, Evidence: L2
     # 4.9e-4 for the mount forces and 1.3e-3 for the steering wheel; here the largest deviation).
     for scene, d in default.items():
         assert d < 2e-3, f"scene {scene}: win64 and linux64 differ by {d:.1e} at rtol 1e-5"

@@ -64,7 +64,7 @@ impl Inputs {
         }
         for (i, s) in self.stiffness_scale.iter().enumerate() {
             if s.value.is_nan() || s.value < 0.0 {
-                let rule = "must be >= 0 (0: the mount carries nothing)";
+                let rule = "must be >= 0 (0: no stiffness; the mount keeps its preload)";
                 return bad(Input::StiffnessScale(i), s.value, rule);
             }
         }

@@ -16,7 +16,10 @@
 //!   derivatives but keeps sending values gets the first-order hold above.
 //!
 //! A ramp that would leave the variable's declared range within the step is bent to end on the
-//! bound at the end of the step; [`Commit::clipped`] says so, for a warning.
+//! bound at the end of the step, and stays there until the master sets something else;
+//! [`Commit::clipped`] says so, for a warning. The signal never leaves the declared range: its
+//! value is clamped to the range it was committed with, so the value read back at the end of
+//! the step is the bound itself, not a rounding error beyond it.
 
 /// Largest relative difference of two consecutive estimated slopes for which the values are taken
 /// as samples of a smooth signal and extrapolated.
@@ -37,6 +40,10 @@ pub struct InputTrack {
     pub last_set: Option<(f64, f64)>,
     /// The slope between the two values set before the last one.
     pub last_slope: Option<f64>,
+    /// The declared range the signal was committed with (it never leaves it).
+    pub lo: f64,
+    /// Upper end of that range.
+    pub hi: f64,
 }
 
 /// What a commit decided.
@@ -46,6 +53,8 @@ pub struct Commit {
     pub estimated: bool,
     /// The ramp was bent to stay in the declared range; the bound it now ends on.
     pub clipped: Option<f64>,
+    /// The slope the master asked for (or the estimate), before any bending.
+    pub requested_slope: f64,
 }
 
 impl InputTrack {
@@ -59,12 +68,19 @@ impl InputTrack {
             pending_slope: None,
             last_set: None,
             last_slope: None,
+            lo: f64::NEG_INFINITY,
+            hi: f64::INFINITY,
         }
     }
 
     /// Value at `t`.
     pub fn at(&self, t: f64) -> f64 {
-        self.value + self.slope * (t - self.since)
+        let x = self.value + self.slope * (t - self.since);
+        if x.is_nan() {
+            x
+        } else {
+            x.max(self.lo).min(self.hi)
+        }
     }
 
     /// The value the master will see after the next commit if it sets nothing else: the pending
@@ -121,7 +137,9 @@ impl InputTrack {
         self.since = t;
         self.pending_value = None;
         self.pending_slope = None;
-        let end = self.at(t + step);
+        self.lo = min;
+        self.hi = max;
+        let end = self.value + self.slope * step;
         let clipped = if step > 0.0 && end > max {
             Some(max)
         } else if step > 0.0 && end < min {
@@ -130,9 +148,13 @@ impl InputTrack {
             None
         };
         if let Some(bound) = clipped {
-            self.slope = (bound - self.value) / step;
+            self.slope = slope_onto(self.value, bound, step, min, max);
         }
-        Commit { estimated, clipped }
+        Commit {
+            estimated,
+            clipped,
+            requested_slope: slope,
+        }
     }
 
     /// First-order hold: the slope of the last two values if the last three lie on one line,
@@ -155,6 +177,22 @@ impl InputTrack {
             _ => 0.0,
         }
     }
+}
+
+/// The slope from `value` to `bound` over `step`, shortened by units in the last place until
+/// the linear ramp evaluated at the end of the step stays within `[min, max]` (rounding would
+/// otherwise leave it a few ulps beyond the bound).
+fn slope_onto(value: f64, bound: f64, step: f64, min: f64, max: f64) -> f64 {
+    let mut slope = (bound - value) / step;
+    for _ in 0..64 {
+        let end = value + slope * step;
+        if (min..=max).contains(&end) || slope == 0.0 {
+            break;
+        }
+        // One ulp toward zero, for either sign.
+        slope = f64::from_bits(slope.to_bits() - 1);
+    }
+    slope
 }
 
 #[cfg(test)]
@@ -239,11 +277,48 @@ mod tests {
         track.set_slope(1000.0);
         let c = track.commit(0.0, 0.1, 0.0, 6000.0);
         assert_eq!(c.clipped, Some(6000.0));
-        assert!((track.at(0.1) - 6000.0).abs() < 1e-9);
+        assert_eq!(c.requested_slope, 1000.0);
+        assert_eq!(track.at(0.1), 6000.0);
         let mut scale = InputTrack::constant(0.05, 0.0);
         scale.set_slope(-1.0);
         let c = scale.commit(0.0, 0.1, 0.0, 10.0);
         assert_eq!(c.clipped, Some(0.0));
-        assert!(scale.at(0.1).abs() < 1e-15);
+        assert_eq!(scale.at(0.1), 0.0);
+    }
+
+    /// Issue 28: ramps down onto 0 read back -2.2e-25 and the next step failed; upward, a huge
+    /// derivative left the value 7e-12 above the maximum.
+    #[test]
+    fn ramps_end_exactly_on_their_bound_and_stay_there() {
+        for (start, slope, h, lo, hi, bound) in [
+            (800.0, -1000.0, 1e-3, 0.0, 6000.0, 0.0),
+            (1.0, -3.0, 1e-3, 0.0, 10.0, 0.0),
+            (0.7, -1.0, 0.3, 0.0, 10.0, 0.0),
+            (5999.0, 1e9, 1e-3, 0.0, 6000.0, 6000.0),
+            (1234.5678, 7.77e7, 3.3e-4, 0.0, 6000.0, 6000.0),
+        ] {
+            let mut track = InputTrack::constant(start, 0.0);
+            track.set_value(start);
+            track.set_slope(slope);
+            let mut t = 0.0;
+            let mut reached = false;
+            for _ in 0..10_000 {
+                let c = track.commit(t, h, lo, hi);
+                // The linear ramp itself (what the model evaluates) stays in range.
+                let end = track.value + track.slope * h;
+                assert!((lo..=hi).contains(&end), "{start} {slope}: {end}");
+                t += h;
+                assert!((lo..=hi).contains(&track.at(t)), "{start} {slope}");
+                if c.clipped.is_some() || reached {
+                    reached = true;
+                    assert_eq!(track.at(t), bound, "{start} {slope}");
+                }
+                if reached && c.clipped.is_none() {
+                    assert_eq!(track.slope, 0.0, "stays on the bound");
+                    break;
+                }
+            }
+            assert!(reached, "{start} {slope} never reached its bound");
+        }
     }
 }

@@ -80,6 +80,9 @@ impl Core {
         }
         for v in REALS.iter().filter(|v| v.causality == Causality::Input) {
             let t = &self.inputs[v.index as usize];
+            if !(t.lo <= t.hi) {
+                return Err(format!("the signal of {} has no valid range", v.name));
+            }
             let numbers = [t.value, t.slope, t.since];
             let pending = [t.pending_value, t.pending_slope, t.last_slope];
             if numbers

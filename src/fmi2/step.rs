@@ -178,13 +178,16 @@ impl Instance {
                 v.min.unwrap_or(f64::NEG_INFINITY),
                 v.max.unwrap_or(f64::INFINITY),
             );
-            let (value, slope) = (track.value, track.slope);
+            let (value, lo, hi) = (track.value, track.lo, track.hi);
             self.core.values.reals.put(v.index, value);
             if let Some(bound) = commit.clipped {
                 clipped = true;
                 self.log_warning(&format!(
-                    "{}: the ramp from {value} with slope {slope} per s would leave the declared range within the step from {t} s; it ends on {bound} at {} s",
+                    "{}: the ramp from {value} with slope {} per s would leave the declared range [{}, {}] within the step from {t} s; it ends on {bound} at {} s and stays there until a new value or derivative is set",
                     v.name,
+                    commit.requested_slope,
+                    lo,
+                    hi,
                     t + step
                 ));
             }

@@ -100,6 +100,36 @@ impl TryFrom<BdfState> for BdfSnapshot {
                 s.q, s.qprime
             ));
         }
+        let scalars = [
+            ("tn", s.tn),
+            ("h", s.h),
+            ("hprime", s.hprime),
+            ("hscale", s.hscale),
+            ("eta", s.eta),
+            ("etamax", s.etamax),
+            ("hu", s.hu),
+            ("rl1", s.rl1),
+            ("gamma", s.gamma),
+            ("gammap", s.gammap),
+            ("gamrat", s.gamrat),
+            ("crate", s.crate_),
+            ("delp", s.delp),
+            ("acnrm", s.acnrm),
+            ("saved_tq5", s.saved_tq5),
+        ];
+        if let Some((name, x)) = scalars.iter().find(|(_, x)| !x.is_finite()) {
+            return Err(format!("{name} = {x} is not finite"));
+        }
+        let coefficients = s.tau.iter().chain(&s.tq).chain(&s.l);
+        if coefficients.chain(&s.acor).any(|x| !x.is_finite()) {
+            return Err("a method coefficient or correction is not finite".into());
+        }
+        if let Some(k) = s.zn.zn.iter().position(|col| col.iter().any(|x| !x.is_finite())) {
+            return Err(format!("history column {k} holds a non-finite value"));
+        }
+        if s.tstop.is_nan() || s.h_unclipped.is_some_and(|h| !h.is_finite()) {
+            return Err("the stop time or the unclipped step is not a number".into());
+        }
         if s.lin.matrix.dim() != n {
             return Err(format!(
                 "an iteration matrix of {} states for {n}",

@@ -147,9 +147,27 @@ impl CoupledModel {
             Err(NewtonFailure::NonFinite(norm)) => {
                 return Err(StaticsError(format!("residual became {norm}")))
             }
-            Err(NewtonFailure::Singular) => return Err(StaticsError(
-                "the tangent stiffness is singular: the mounts (and the body) do not hold the powertrain in every direction".into(),
-            )),
+            Err(NewtonFailure::Singular) => {
+                let unstiff: Vec<&str> = self
+                    .mounts
+                    .iter()
+                    .enumerate()
+                    .filter_map(|(i, m)| Some((i, m.as_ref()?)))
+                    .filter(|(i, _)| self.inputs.mount_scales(*i, t0).0 == 0.0)
+                    .map(|(_, m)| m.mount.name.as_str())
+                    .collect();
+                let why = if unstiff.is_empty() {
+                    String::new()
+                } else {
+                    format!(
+                        " (stiffness scale 0 on {}: such a mount keeps its preload, its static share of the weight, but has no stiffness)",
+                        unstiff.join(", ")
+                    )
+                };
+                return Err(StaticsError(format!(
+                    "the tangent stiffness is singular: the mounts (and the body) do not hold the powertrain in every direction{why}"
+                )));
+            }
             Err(NewtonFailure::NotConverged(last)) => return Err(StaticsError(format!(
                 "Newton did not converge in {MAX_ITERATIONS} iterations (residual {last:.3e} N, tolerance {tol:.3e} N); the mounts may be too soft to carry the weight"
             ))),
