@@ -122,7 +122,11 @@ mod tests {
     /// Issue 28: every bit flip of a scene-2 FMU state was accepted.
     #[test]
     fn every_flipped_bit_is_refused() {
-        let bytes = encode(b"TESTTEST", 7, &(1.5f64, vec![1u32, 2, 3], "text".to_owned()));
+        let bytes = encode(
+            b"TESTTEST",
+            7,
+            &(1.5f64, vec![1u32, 2, 3], "text".to_owned()),
+        );
         for i in 0..bytes.len() * 8 {
             let mut flipped = bytes.clone();
             flipped[i / 8] ^= 1 << (i % 8);

@@ -42,6 +42,7 @@ pub mod mount;
 pub mod orders;
 pub mod powertrain;
 pub mod scene;
+pub mod strict_json;
 mod validate;
 pub mod vehicle;
 

@@ -161,7 +161,7 @@ fn merge_patch(target: &mut serde_json::Value, patch: &serde_json::Value) {
 impl VehicleConfig {
     /// Parses a vehicle configuration (see the module doc for `extends`) and validates it.
     pub fn from_json(text: &str) -> Result<Self, ConfigError> {
-        let mut value: serde_json::Value = serde_json::from_str(text)
+        let mut value = super::strict_json::parse(text)
             .map_err(|e| err("json", format!("cannot parse the configuration: {e}")))?;
         if let Some(base) = value.as_object_mut().and_then(|o| o.remove("extends")) {
             if base != "default" {
@@ -228,7 +228,14 @@ impl VehicleConfig {
         }
         for (i, m) in self.mounts.iter().enumerate() {
             m.validate(&format!("mounts[{i}]"))?;
+            if let Some(j) = self.mounts[..i].iter().position(|o| o.name == m.name) {
+                return Err(err(
+                    format!("mounts[{i}].name"),
+                    format!("mount name '{}' is also the name of mounts[{j}]", m.name),
+                ));
+            }
         }
+        self.validate_body_points()?;
         if let Some(i) = self.outputs.iter().position(|o| o.trim().is_empty()) {
             return Err(err(
                 format!("outputs[{i}]"),
@@ -236,6 +243,31 @@ impl VehicleConfig {
             ));
         }
         self.speed_follower.validate("speed_follower")
+    }
+
+    /// Every named point of a bulk-deck body must be a node the vehicle uses (a mount's body
+    /// node or an output): a misspelt name would otherwise be ignored.
+    fn validate_body_points(&self) -> Result<(), ConfigError> {
+        let BodyConfig::Nastran { points, .. } = &self.body else {
+            return Ok(());
+        };
+        let used = |name: &str| {
+            self.outputs.iter().any(|o| o == name)
+                || self
+                    .mounts
+                    .iter()
+                    .any(|m| m.body_node.as_deref() == Some(name))
+        };
+        match points.keys().find(|name| !used(name)) {
+            Some(name) => Err(err(
+                format!("body.points.{name}"),
+                format!(
+                    "body point '{name}' is neither a mount's body_node nor an output ({})",
+                    self.outputs.join(", ")
+                ),
+            )),
+            None => Ok(()),
+        }
     }
 
     /// The body nodes the active mounts attach to, in mount order (the body's interface).

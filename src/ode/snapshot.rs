@@ -124,7 +124,11 @@ impl TryFrom<BdfState> for BdfSnapshot {
         if coefficients.chain(&s.acor).any(|x| !x.is_finite()) {
             return Err("a method coefficient or correction is not finite".into());
         }
-        if let Some(k) = s.zn.zn.iter().position(|col| col.iter().any(|x| !x.is_finite())) {
+        if let Some(k) =
+            s.zn.zn
+                .iter()
+                .position(|col| col.iter().any(|x| !x.is_finite()))
+        {
             return Err(format!("history column {k} holds a non-finite value"));
         }
         if s.tstop.is_nan() || s.h_unclipped.is_some_and(|h| !h.is_finite()) {

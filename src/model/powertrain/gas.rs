@@ -266,6 +266,11 @@ impl PressureCurve {
             .sum()
     }
 
+    /// Whether every value and slope of the table is finite.
+    pub fn is_finite(&self) -> bool {
+        self.knots.iter().flatten().all(|x| x.is_finite())
+    }
+
     /// Peak pressure over the cycle (Pa).
     pub fn peak(&self) -> f64 {
         self.knots.iter().map(|k| k[0]).fold(f64::MIN, f64::max)

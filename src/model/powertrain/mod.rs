@@ -67,6 +67,28 @@ impl LoadPoints {
         }
     }
 
+    /// Refuses curves whose peak pressure is not finite or beyond [`MAX_PEAK_PRESSURE`]: a heat
+    /// release far beyond any engine's (a mistyped exponent) would otherwise pass the set-up and
+    /// fail at the first step.
+    fn check_peaks(&self) -> Result<(), ConfigError> {
+        for (what, curves) in [("idle", &self.idle), ("full_load", &self.full)] {
+            for curve in curves {
+                let peak = curve.peak();
+                if !(curve.is_finite() && peak <= MAX_PEAK_PRESSURE) {
+                    return Err(ConfigError {
+                        field: format!("engine.gas.model.{what}.heat"),
+                        message: format!(
+                            "the {what} heat release gives a peak cylinder pressure of {:.3e} bar, beyond the {:.0} bar any engine withstands",
+                            peak / 1e5,
+                            MAX_PEAK_PRESSURE / 1e5
+                        ),
+                    });
+                }
+            }
+        }
+        Ok(())
+    }
+
     /// Per-cylinder curves at `load` (shared when the cylinders are identical).
     fn curves(&self, load: f64, cylinders: usize) -> Vec<Arc<PressureCurve>> {
         let blended: Vec<Arc<PressureCurve>> = self
@@ -81,6 +103,10 @@ impl LoadPoints {
         blended
     }
 }
+
+/// Highest peak cylinder pressure accepted, Pa: 500 bar, twice what today's diesel engines are
+/// built for.
+pub const MAX_PEAK_PRESSURE: f64 = 500e5;
 
 /// Crank speed (rad/s) from which the engine fires fully; below it the gas excitation fades out
 /// smoothly to none at standstill (the cylinders do not fire on a standing crank). 300 rpm is
@@ -130,6 +156,7 @@ impl GasExcitation {
         let (curves, load_points) = match &config.gas.model {
             GasModel::Wiebe(w) => {
                 let points = LoadPoints::new(w, &spread, &geometry);
+                points.check_peaks()?;
                 (points.curves(config.gas.load, n), Some(points))
             }
             GasModel::Table(t) => {
