@@ -44,6 +44,8 @@ pub struct InputTrack {
     pub lo: f64,
     /// Upper end of that range.
     pub hi: f64,
+    /// A ramp bent onto a bound: from this time on the signal is the bound itself.
+    pub landing: Option<(f64, f64)>,
 }
 
 /// What a commit decided.
@@ -70,11 +72,17 @@ impl InputTrack {
             last_slope: None,
             lo: f64::NEG_INFINITY,
             hi: f64::INFINITY,
+            landing: None,
         }
     }
 
     /// Value at `t`.
     pub fn at(&self, t: f64) -> f64 {
+        if let Some((time, bound)) = self.landing {
+            if t >= time - 1e-12 * time.abs().max(1.0) {
+                return bound;
+            }
+        }
         let x = self.value + self.slope * (t - self.since);
         if x.is_nan() {
             x
@@ -139,6 +147,7 @@ impl InputTrack {
         self.pending_slope = None;
         self.lo = min;
         self.hi = max;
+        self.landing = None;
         let end = self.value + self.slope * step;
         let clipped = if step > 0.0 && end > max {
             Some(max)
@@ -149,6 +158,7 @@ impl InputTrack {
         };
         if let Some(bound) = clipped {
             self.slope = slope_onto(self.value, bound, step, min, max);
+            self.landing = Some((t + step, bound));
         }
         Commit {
             estimated,

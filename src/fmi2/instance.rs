@@ -13,7 +13,7 @@ use super::input_track::InputTrack;
 use super::logger::{Level, Logger};
 use super::parameters;
 use super::state::Phase;
-use super::values::{Store, Typed, Values, VarType};
+use super::values::{Num, Store, Typed, Values, VarType};
 use super::variables::{integer, real, Causality, LogCategory, Variability, Variable, REALS};
 use crate::cosim::{self, Simulation};
 
@@ -44,6 +44,9 @@ pub struct Core {
     pub time: f64,
     pub terminated: bool,
     pub simulation: Option<Simulation>,
+    /// Why building the model failed with the current parameters and inputs: asked again
+    /// without a change, the answer is the same, without building again.
+    pub setup_failure: Option<String>,
 }
 
 impl Core {
@@ -61,6 +64,7 @@ impl Core {
             time: 0.0,
             terminated: false,
             simulation: None,
+            setup_failure: None,
         }
     }
 
@@ -84,7 +88,11 @@ impl Core {
                 return Err(format!("the signal of {} has no valid range", v.name));
             }
             let numbers = [t.value, t.slope, t.since];
+            let landing = t.landing.map(|(time, bound)| [time, bound]);
             let pending = [t.pending_value, t.pending_slope, t.last_slope];
+            if landing.iter().flatten().any(|x| !x.is_finite()) {
+                return Err(format!("the signal of {} is not finite", v.name));
+            }
             if numbers
                 .iter()
                 .chain(pending.iter().flatten())
@@ -156,23 +164,27 @@ impl Instance {
             let v = &REALS[real::SOLVER_REL_TOL as usize];
             if f64::admissible(v, &tol).is_err() {
                 return Err(format!(
-                    "tolerance {tol} is outside [{}, {}] ({}'s range)",
-                    v.min.unwrap_or(0.0),
-                    v.max.unwrap_or(f64::INFINITY),
+                    "tolerance {} is outside [{}, {}] ({}'s range)",
+                    Num(tol),
+                    Num(v.min.unwrap_or(0.0)),
+                    Num(v.max.unwrap_or(f64::INFINITY)),
                     v.name
                 ));
             }
         }
         if !start.is_finite() {
-            return Err(format!("start time {start} is not finite"));
+            return Err(format!("start time {} is not finite", Num(start)));
         }
         if let Some(stop) = stop {
             if !stop.is_finite() || stop < start {
                 return Err(format!(
-                    "stop time {stop} must be finite and >= start time {start}"
+                    "stop time {} must be finite and >= start time {}",
+                    Num(stop),
+                    Num(start)
                 ));
             }
         }
+        self.core.setup_failure = None;
         self.core.start_time = start;
         self.core.stop_time = stop;
         self.core.time = start;
@@ -202,8 +214,17 @@ impl Instance {
         if self.core.simulation.is_some() {
             return Ok(());
         }
+        if let Some(failure) = &self.core.setup_failure {
+            return Err(failure.clone());
+        }
         self.commit_inputs(0.0);
-        let mut simulation = self.build_simulation()?;
+        let mut simulation = match self.build_simulation() {
+            Ok(simulation) => simulation,
+            Err(failure) => {
+                self.core.setup_failure = Some(failure.clone());
+                return Err(failure);
+            }
+        };
         for r in simulation.replaced() {
             self.event(&parameters::replaced_note(r));
         }
@@ -338,6 +359,7 @@ impl Instance {
         if phase != Phase::StepComplete {
             // Parameters or initial inputs changed before the model started: rebuild lazily.
             self.core.simulation = None;
+            self.core.setup_failure = None;
         }
         Ok(Status::Ok)
     }
@@ -378,7 +400,7 @@ impl Instance {
                 ));
             }
             if !value.is_finite() {
-                return Err(format!("d{}/dt = {value} is not finite", v.name));
+                return Err(format!("d{}/dt = {} is not finite", v.name, Num(*value)));
             }
             candidate[i].set_slope(*value);
         }
@@ -386,6 +408,7 @@ impl Instance {
             .validate()
             .map_err(|e| parameters::message(&e))?;
         self.core.inputs = candidate;
+        self.core.setup_failure = None;
         Ok(Status::Ok)
     }
 

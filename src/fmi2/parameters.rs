@@ -232,7 +232,11 @@ pub fn message(error: &cosim::Error) -> String {
         } => format!("{} = {value} {rule}", body_option_name(*option)),
         cosim::Error::Input { input, value, rule } => {
             let (index, scale) = input_variable(*input);
-            format!("{} = {} {rule}", REALS[index as usize].name, value * scale)
+            format!(
+                "{} = {} {rule}",
+                REALS[index as usize].name,
+                super::values::Num(value * scale)
+            )
         }
         cosim::Error::Model(m) => m.clone(),
     }

@@ -76,6 +76,7 @@ pub fn deserialize(
         time: saved.time,
         terminated: saved.terminated,
         simulation: None,
+        setup_failure: None,
     };
     core.check()?;
     if let Some(dynamic) = &saved.simulation {

@@ -4,6 +4,7 @@ use super::instance::{Instance, Outcome, Status};
 use super::logger::Level;
 use super::parameters;
 use super::state::Phase;
+use super::values::Num;
 use super::variables::{integer, real, Causality, LogCategory, REALS};
 use crate::cosim;
 
@@ -41,14 +42,17 @@ impl Instance {
     fn validate_step(&self, current: f64, step: f64) -> Result<f64, String> {
         if !current.is_finite() || !step.is_finite() || step <= 0.0 {
             return Err(format!(
-                "communication point {current} and step size {step} must be finite, step > 0"
+                "communication point {} and step size {} must be finite, step > 0",
+                Num(current),
+                Num(step)
             ));
         }
         if !same_time(current, self.core.time) {
             return Err(format!(
-                "communication point {current} s does not match the FMU time {} s \
+                "communication point {} s does not match the FMU time {} s \
                  (use fmi2SetFMUstate to go back in time)",
-                self.core.time
+                Num(current),
+                Num(self.core.time)
             ));
         }
         let target = on_grid(current + step);
@@ -183,11 +187,13 @@ impl Instance {
             if let Some(bound) = commit.clipped {
                 clipped = true;
                 self.log_warning(&format!(
-                    "{}: the ramp from {value} with slope {} per s would leave the declared range [{}, {}] within the step from {t} s; it ends on {bound} at {} s and stays there until a new value or derivative is set",
+                    "{}: the ramp from {} with slope {} per s would leave the declared range [{}, {}] within the step from {t} s; it ends on {} at {} s and stays there until a new value or derivative is set",
                     v.name,
-                    commit.requested_slope,
-                    lo,
-                    hi,
+                    Num(value),
+                    Num(commit.requested_slope),
+                    Num(lo),
+                    Num(hi),
+                    Num(bound),
                     t + step
                 ));
             }

@@ -99,8 +99,24 @@ pub trait VarType: Clone + PartialEq + Serialize + DeserializeOwned + 'static {
     fn admissible(v: &Variable<Self::Start>, value: &Self) -> Result<(), String>;
 }
 
+/// A number as a message shows it: plain where that is short, in exponent form where plain
+/// decimals would run to many digits (`1.39e-160`, not 160 digits).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Num(pub f64);
+
+impl std::fmt::Display for Num {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        let x = self.0;
+        if x == 0.0 || !x.is_finite() || (1e-4..1e16).contains(&x.abs()) {
+            write!(f, "{x}")
+        } else {
+            write!(f, "{x:e}")
+        }
+    }
+}
+
 /// A value outside `[min, max]` of an input or parameter, as a message.
-fn outside_range<T: PartialOrd + std::fmt::Display + Copy>(
+fn outside_range<T: PartialOrd + Copy + Into<f64>>(
     v: &Variable<T>,
     value: T,
     lowest: T,
@@ -109,10 +125,11 @@ fn outside_range<T: PartialOrd + std::fmt::Display + Copy>(
     let ranged = matches!(v.causality, Causality::Input | Causality::Parameter);
     if ranged && (v.min.is_some_and(|m| value < m) || v.max.is_some_and(|m| value > m)) {
         return Err(format!(
-            "{} = {value} is outside [{}, {}]",
+            "{} = {} is outside [{}, {}]",
             v.name,
-            v.min.unwrap_or(lowest),
-            v.max.unwrap_or(highest)
+            Num(value.into()),
+            Num(v.min.unwrap_or(lowest).into()),
+            Num(v.max.unwrap_or(highest).into())
         ));
     }
     Ok(())
@@ -130,7 +147,7 @@ impl VarType for f64 {
     }
     fn admissible(v: &Variable<f64>, value: &f64) -> Result<(), String> {
         if !value.is_finite() {
-            return Err(format!("{} = {value} is not finite", v.name));
+            return Err(format!("{} = {} is not finite", v.name, Num(*value)));
         }
         outside_range(v, *value, f64::NEG_INFINITY, f64::INFINITY)
     }
@@ -265,6 +282,20 @@ typed!(String, strings);
 mod tests {
     use super::super::variables::{boolean, integer, real};
     use super::*;
+
+    /// Issue 28: numbers were logged as 160-digit decimals.
+    #[test]
+    fn numbers_in_messages_stay_short() {
+        assert_eq!(Num(1.39e-160).to_string(), "1.39e-160");
+        assert_eq!(Num(-2.5e300).to_string(), "-2.5e300");
+        assert_eq!(Num(0.0).to_string(), "0");
+        assert_eq!(Num(6000.0).to_string(), "6000");
+        assert_eq!(Num(1e-5).to_string(), "1e-5");
+        assert_eq!(Num(f64::NAN).to_string(), "NaN");
+        let v = &REALS[real::RPM as usize];
+        let m = f64::admissible(v, &-1.39e-160).unwrap_err();
+        assert!(m.contains("-1.39e-160 is outside"), "{m}");
+    }
 
     #[test]
     fn value_references_map_to_their_own_type_only() {

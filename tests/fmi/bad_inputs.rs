@@ -38,12 +38,70 @@ fn a_serialized_state_with_inadmissible_values_is_refused() {
     ] {
         let mut bad = bytes.clone();
         patch_f64(&mut bad, from, to);
+        // Changed after it was written: the checksum says so.
+        let (st, handle) = s.deserialize(&bad);
+        assert_eq!(st, ERROR, "{cause}");
+        assert!(handle.is_null());
+        assert!(logged(&s, "checksum does not match"), "{:?}", s.logs());
+        // Resealed with a valid checksum: the value itself is refused, by name.
+        reseal(&mut bad);
         let (st, handle) = s.deserialize(&bad);
         assert_eq!(st, ERROR, "{cause}");
         assert!(handle.is_null());
         assert!(logged(&s, cause), "{cause}: {:?}", s.logs());
     }
     s.free_state(state);
+}
+
+/// Recomputes the SHA-256 trailer of a saved state (header: 8-byte magic and a one-byte
+/// version) as a forger would, so that the value checks behind the checksum are tested.
+fn reseal(bytes: &mut [u8]) {
+    use sha2::{Digest, Sha256};
+    let end = bytes.len() - 32;
+    let checksum = Sha256::digest(&bytes[9..end]);
+    bytes[end..].copy_from_slice(&checksum);
+}
+
+/// Issue 28: a ramp down onto 0 read back -2.2e-25 and the next step failed; a ramp up with a
+/// huge derivative stopped 7e-12 above the maximum.
+#[test]
+fn ramps_onto_a_bound_end_exactly_there_and_the_run_goes_on() {
+    let fmu = Fmu::load();
+    for (vr, start, slope, bound) in [
+        (real::RPM, 800.0, -1000.0, 0.0),
+        (real::MOUNT_STIFFNESS_SCALE[0], 1.0, -3.0, 0.0),
+        (real::RPM, 5999.0, 1e9, 6000.0),
+    ] {
+        let s = fmu.instantiate("ramp-to-bound");
+        assert_eq!(s.set_real(&[vr], &[start]), OK);
+        s.initialize();
+        assert_eq!(s.set_input_derivatives(&[vr], &[slope]), OK);
+        let (h, mut t) = (1e-3, 0.0);
+        let steps = ((bound - start) / slope / h).ceil() as usize + 5;
+        let mut warned = false;
+        for _ in 0..steps {
+            let st = s.do_step(t, h);
+            assert!(
+                st == OK || st == WARNING,
+                "{vr} at {t}: {st} {:?}",
+                s.logs()
+            );
+            warned |= st == WARNING;
+            t += h;
+            let value = s.reals(&[vr])[0];
+            assert!(
+                (value - start) * slope.signum() <= (bound - start) * slope.signum(),
+                "{vr} = {value} beyond {bound}"
+            );
+        }
+        assert!(warned, "bending the ramp is a warning");
+        assert_eq!(s.reals(&[vr])[0], bound, "{vr} ends on its bound");
+        assert!(
+            logged(&s, &format!("with slope {slope} per s")),
+            "the warning names the slope asked for: {:?}",
+            s.logs()
+        );
+    }
 }
 
 #[test]
@@ -188,4 +246,41 @@ fn an_unusable_resource_location_is_an_error() {
     assert_eq!(s.exit_init(), ERROR);
     assert!(logged(&s, "have no vehicle.json"), "{:?}", s.logs());
     let _ = std::fs::remove_dir_all(&empty);
+}
+
+/// Issue 28: after a failed fmi2ExitInitializationMode every later call built the model again
+/// (10 builds for 9 calls). Unchanged parameters give the same answer without a new build; a
+/// change builds again.
+#[test]
+fn a_failed_set_up_is_not_repeated_until_something_changes() {
+    let fmu = Fmu::load();
+    let s = fmu.instantiate("failed-setup");
+    assert_eq!(
+        s.set_real(&real::MOUNT_STIFFNESS_SCALE, &[0.0; 4]),
+        OK,
+        "a stiffness scale of 0 is admissible"
+    );
+    s.log_everything();
+    assert_eq!(s.setup(0.0, None), OK);
+    assert_eq!(s.enter_init(), OK);
+    assert_eq!(s.exit_init(), ERROR);
+    assert!(
+        logged(&s, "stiffness scale 0 on"),
+        "the cause names the mounts without stiffness: {:?}",
+        s.logs()
+    );
+    for _ in 0..8 {
+        assert_eq!(s.get_real(&[real::MOUNT_F[0][2]]).0, ERROR);
+    }
+    assert_eq!(s.exit_init(), ERROR);
+    let builds = |s: &Slave| {
+        s.logs()
+            .iter()
+            .filter(|l| l.contains("building scene"))
+            .count()
+    };
+    assert_eq!(builds(&s), 1, "{:?}", s.logs());
+    assert_eq!(s.set_real(&real::MOUNT_STIFFNESS_SCALE, &[1.0; 4]), OK);
+    assert_eq!(s.exit_init(), OK);
+    assert_eq!(builds(&s), 2);
 }

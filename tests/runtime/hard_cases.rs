@@ -431,3 +431,25 @@ fn ten_kilohertz_bracket_modes_are_integrated_stably() {
         "{steps} steps with the bracket modes, {steps_without} without"
     );
 }
+
+/// Issue 28: with stiffness scales of 1e6 the start failed, blaming mounts "too soft": the
+/// static residual's tolerance did not grow with the rounding errors of stiffer mounts. The
+/// static start now succeeds; the periodic one either finds the orbit or says how far from
+/// closing it got, without blaming soft mounts.
+#[test]
+fn very_stiff_mounts_start_statically_and_periodic_failures_say_why() {
+    let stiff = inputs(1500.0, 0.0, 1e6);
+    let sim = Simulation::new(&Settings::default(), 0.0, &stiff);
+    assert!(sim.is_ok(), "static start: {:?}", sim.err());
+    let periodic = Settings {
+        periodic_start: true,
+        ..Settings::default()
+    };
+    if let Err(e) = Simulation::new(&periodic, 0.0, &stiff) {
+        let m = e.to_string();
+        assert!(
+            m.contains("no periodic orbit") && !m.contains("too soft"),
+            "{m}"
+        );
+    }
+}

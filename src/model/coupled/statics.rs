@@ -136,7 +136,12 @@ impl CoupledModel {
         let n = nq + l.modes();
         let mut y = self.reference_state();
         let mut z = vec![0.0; n];
-        let tol = 1e-9 * self.powertrain_weight().max(1.0);
+        // The forces balance to a part in 1e9 of the weight; mounts stiffened by a scale s carry
+        // rounding errors s times larger, so the tolerance grows with the stiffest scale.
+        let stiffest = (0..self.mounts.len())
+            .map(|i| self.inputs.mount_scales(i, t0).0)
+            .fold(1.0, f64::max);
+        let tol = 1e-9 * self.powertrain_weight().max(1.0) * stiffest;
         // The body's coordinates are linear and need no step limit.
         let limit = |i: usize| (i < nq).then(|| MAX_STEP[(i % 6) / 3]);
         let mut scratch = y.clone();
@@ -169,7 +174,7 @@ impl CoupledModel {
                 )));
             }
             Err(NewtonFailure::NotConverged(last)) => return Err(StaticsError(format!(
-                "Newton did not converge in {MAX_ITERATIONS} iterations (residual {last:.3e} N, tolerance {tol:.3e} N); the mounts may be too soft to carry the weight"
+                "Newton did not converge in {MAX_ITERATIONS} iterations (residual {last:.3e} N, tolerance {tol:.3e} N); the mounts may be too soft to carry the weight (stiffness scales up to {stiffest})"
             ))),
         }
         y[l.positions()].copy_from_slice(&z[..nq]);

@@ -16,6 +16,7 @@ use libloading::Library;
 pub use engine_mount_chassis::fmi2::variables::{boolean, integer, real, string, GUID};
 
 pub const OK: fmi2Status = fmi2Status_fmi2OK;
+pub const WARNING: fmi2Status = fmi2Status_fmi2Warning;
 pub const DISCARD: fmi2Status = fmi2Status_fmi2Discard;
 pub const ERROR: fmi2Status = fmi2Status_fmi2Error;
 
