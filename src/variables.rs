@@ -12,7 +12,7 @@ pub enum Causality {
     Input,
     /// Computed by the model at each communication point.
     Output,
-    /// Set by the master before initialisation (the model is built from it).
+    /// Set by the master before initialisation ends; the model is built from the parameters.
     Parameter,
     /// Computed from the parameters at initialisation (the natural modes).
     CalculatedParameter,

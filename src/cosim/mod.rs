@@ -55,7 +55,7 @@ pub struct Counters {
     pub steps: u64,
     /// Evaluations of the right-hand side (the model's equations of motion).
     pub rhs_evaluations: u64,
-    /// Evaluations of the Jacobian (by finite differences or analytically).
+    /// Evaluations of the Jacobian of the right-hand side.
     pub jacobian_evaluations: u64,
     /// LU factorisations of the Newton iteration matrix.
     pub factorizations: u64,

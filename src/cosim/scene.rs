@@ -11,7 +11,8 @@ pub const FMU_MOUNTS: usize = 4;
 
 /// Body points the FMU's outputs `steeringWheel.*` and `seat.*` report.
 pub const STEERING_WHEEL_POINT: &str = "steering_wheel";
-/// Body point (`body.points` name of the configuration) whose acceleration is `seat.a`.
+/// Name of the body point (listed under `outputs` in the vehicle configuration) whose
+/// acceleration is the FMU's `seat.a`.
 pub const SEAT_POINT: &str = "seat_rail";
 
 /// The vehicle the settings name (configuration file or built-in default), with the

@@ -234,7 +234,8 @@ const _: fmi2GetVersionTYPE = Some(fmi2GetVersion);
 /// Creates an instance and returns its handle, or null after logging why through the master's
 /// logger: a missing `instanceName`, a `fmuType` other than co-simulation, a GUID that is not
 /// this FMU's, or a resource location that is not a directory. The model itself is built only in
-/// [`fmi2ExitInitializationMode`] (or when an output is read in initialisation mode).
+/// [`fmi2ExitInitializationMode`], or earlier when an output or a calculated parameter is read
+/// in initialisation mode.
 #[no_mangle]
 pub extern "C" fn fmi2Instantiate(
     instanceName: fmi2String,
@@ -341,9 +342,9 @@ pub extern "C" fn fmi2FreeInstance(c: fmi2Component) {
 }
 const _: fmi2FreeInstanceTYPE = Some(fmi2FreeInstance);
 
-/// Switches debug logging on or off for the named categories (all categories when none are
-/// named); an unknown category name is refused with fmi2Error. Errors and warnings are always
-/// logged.
+/// Without categories, switches debug logging on or off for all of them; with categories and
+/// `loggingOn`, logs exactly those; with categories and not `loggingOn`, switches those off. An
+/// unknown category name is refused with fmi2Error. Errors and warnings are always logged.
 #[no_mangle]
 pub extern "C" fn fmi2SetDebugLogging(
     c: fmi2Component,
@@ -553,8 +554,9 @@ const _: fmi2GetStringTYPE = Some(fmi2GetString);
 
 /// Sets Real inputs and parameters. All values are checked (range, finiteness, whether the
 /// variable may be set in this phase: fixed parameters only before initialisation ends) before any
-/// is applied, so a refused call changes nothing. An input set between steps continues from the
-/// new value (a jump, which restarts the integrator at order 1).
+/// is applied, so a refused call changes nothing. An input set between steps takes effect at the
+/// next fmi2DoStep: as a ramp with a derivative set by fmi2SetRealInputDerivatives, otherwise as
+/// a first-order hold of the values set (see [`super::input_track`]).
 #[no_mangle]
 pub extern "C" fn fmi2SetReal(
     c: fmi2Component,
@@ -699,9 +701,9 @@ pub extern "C" fn fmi2SerializeFMUstate(
 }
 const _: fmi2SerializeFMUstateTYPE = Some(fmi2SerializeFMUstate);
 
-/// Creates an FMU state from bytes of [`fmi2SerializeFMUstate`] (possibly of another process
-/// or FMU build with the same GUID); the model is rebuilt from the state's own parameters.
-/// Malformed or inadmissible bytes are refused.
+/// Creates an FMU state from bytes of [`fmi2SerializeFMUstate`], possibly written by another
+/// process; bytes of an FMU with another GUID, malformed or with inadmissible values are
+/// refused. The model is rebuilt from the state's own parameters.
 #[no_mangle]
 pub extern "C" fn fmi2DeSerializeFMUstate(
     c: fmi2Component,

@@ -27,7 +27,8 @@ pub enum Status {
     Warning,
     /// fmi2Discard: the step could not be completed; the FMU stopped at the last successful time.
     Discard,
-    /// fmi2Error: the call was refused and changed nothing.
+    /// fmi2Error: the call was refused (changing nothing), or the outputs could not be evaluated
+    /// after a step.
     Error,
     /// fmi2Fatal: the instance is unusable.
     Fatal,

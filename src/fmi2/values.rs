@@ -202,8 +202,8 @@ pub fn indices<T: VarType>(vrs: &[u32]) -> Result<Vec<usize>, String> {
 /// All variable values.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct Values {
-    /// The Real variables, indexed like [`REALS`](super::variables::REALS) (SI units of the
-    /// model description).
+    /// The Real variables, indexed like [`REALS`](super::variables::REALS) (in the units of
+    /// the model description).
     pub reals: Store<f64>,
     /// The Integer variables, indexed like [`INTEGERS`](super::variables::INTEGERS).
     pub integers: Store<i32>,
