@@ -1,8 +1,8 @@
 //! The exported FMI 2.0 functions. Every entry point that takes an instance passes one guard,
-//! [`entry`]: the instance pointer is checked, panics are caught (a panic must never unwind into
+//! `entry`: the instance pointer is checked, panics are caught (a panic must never unwind into
 //! the C caller), the call is checked against the state machine ([`super::state`]), and a
-//! refusal is logged once, naming the function. Inside, C arguments become slices ([`array`],
-//! [`array_mut`], null pointers refused), value references become typed positions through the
+//! refusal is logged once, naming the function. Inside, C arguments become slices (`array`,
+//! `array_mut`, null pointers refused), value references become typed positions through the
 //! one table ([`super::values::indices`]), and the instance does the rest. This file is the only
 //! place with `unsafe` in the crate: every block says why it is sound.
 

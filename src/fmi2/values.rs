@@ -202,14 +202,13 @@ pub fn indices<T: VarType>(vrs: &[u32]) -> Result<Vec<usize>, String> {
 /// All variable values.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct Values {
-    /// The Real variables, indexed like [`REALS`](super::variables::REALS) (in the units of
-    /// the model description).
+    /// The Real variables, indexed like [`REALS`] (in the units of the model description).
     pub reals: Store<f64>,
-    /// The Integer variables, indexed like [`INTEGERS`](super::variables::INTEGERS).
+    /// The Integer variables, indexed like [`INTEGERS`].
     pub integers: Store<i32>,
-    /// The Boolean variables, indexed like [`BOOLEANS`](super::variables::BOOLEANS).
+    /// The Boolean variables, indexed like [`BOOLEANS`].
     pub booleans: Store<bool>,
-    /// The String variables, indexed like [`STRINGS`](super::variables::STRINGS).
+    /// The String variables, indexed like [`STRINGS`].
     pub strings: Store<String>,
 }
 
