@@ -80,6 +80,10 @@ struct Scalar {
 /// A table entry as written: a scalar or a family with `dims`, named for Rust by `rust`.
 struct Family {
     rust: String,
+    /// The FMI name, with `{i}`/`{j}` placeholders for an array family.
+    name: String,
+    description: String,
+    unit: Option<String>,
     ty: &'static str,
     dims: Vec<usize>,
     first_vr: usize,
@@ -211,6 +215,9 @@ fn expand(table: &Value) -> (Vec<Scalar>, Vec<Family>) {
         let first_vr = next_vr[ty];
         families.push(Family {
             rust: str_field(e, "rust").to_owned(),
+            name: str_field(e, "name").to_owned(),
+            description: str_field(e, "description").to_owned(),
+            unit: opt_str(e, "unit"),
             ty,
             dims: dims.clone(),
             first_vr,
@@ -557,6 +564,7 @@ fn rust_table(table: &Value, scalars: &[Scalar], families: &[Family], guid: &str
         );
         let _ = writeln!(r, "pub mod {module} {{");
         for f in families.iter().filter(|f| f.ty == ty) {
+            let _ = writeln!(r, "{}", family_doc(f));
             match f.dims.as_slice() {
                 [] => {
                     let _ = writeln!(r, "    pub const {}: u32 = {};", f.rust, f.first_vr);
@@ -620,6 +628,38 @@ fn rust_table(table: &Value, scalars: &[Scalar], families: &[Family], guid: &str
     }
     r.push_str(&parameters_struct(scalars, families));
     r
+}
+
+/// The `///` line(s) of a value-reference constant: the FMI name (the name pattern for an
+/// array family, whose FMI indices are 1-based while the Rust array's are 0-based), the unit
+/// and the table's description, with brackets escaped so rustdoc does not read them as links.
+fn family_doc(f: &Family) -> String {
+    let escape = |s: &str| s.replace('[', "\\[").replace(']', "\\]");
+    let unit = f
+        .unit
+        .as_ref()
+        .map(|u| format!(" \\[{u}\\]"))
+        .unwrap_or_default();
+    let mut doc = format!("    /// `{}`{unit}: {}", f.name, escape(&f.description));
+    match f.dims.as_slice() {
+        [] => {}
+        [n] => {
+            let _ = write!(
+                doc,
+                "\n    ///\n    /// Element `[i - 1]` is `{}`, i = 1..={n}.",
+                f.name
+            );
+        }
+        [n, m] => {
+            let _ = write!(
+                doc,
+                "\n    ///\n    /// Element `[i - 1][j - 1]` is `{}`, i = 1..={n}, j = 1..={m}.",
+                f.name
+            );
+        }
+        _ => unreachable!(),
+    }
+    doc
 }
 
 /// `LogCategory`: the log categories of `modelDescription.xml` as an enum (variant names are the

@@ -14,7 +14,7 @@
 //!   typed structure.
 
 #![deny(rustdoc::broken_intra_doc_links)]
-#![warn(missing_docs)]
+#![deny(missing_docs)]
 
 pub mod cms;
 pub mod cosim;

@@ -77,6 +77,7 @@ pub mod dense_matrix {
     use faer::Mat;
     use serde::{Deserialize, Deserializer, Serialize, Serializer};
 
+    /// Writes `m` as (rows, columns, column-major values).
     pub fn serialize<S: Serializer>(m: &Mat<f64>, s: S) -> Result<S::Ok, S::Error> {
         let values: Vec<f64> = (0..m.ncols())
             .flat_map(|j| m.col(j).iter().copied().collect::<Vec<_>>())
@@ -84,6 +85,8 @@ pub mod dense_matrix {
         (m.nrows(), m.ncols(), values).serialize(s)
     }
 
+    /// Reads a matrix written by [`serialize`]; refused if the number of values is not rows ×
+    /// columns.
     pub fn deserialize<'de, D: Deserializer<'de>>(d: D) -> Result<Mat<f64>, D::Error> {
         let (rows, cols, values) = <(usize, usize, Vec<f64>)>::deserialize(d)?;
         if rows.checked_mul(cols) != Some(values.len()) {

@@ -8,35 +8,51 @@
 /// FMI causality of a variable.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum Causality {
+    /// Set by the master between steps (`rpm`, `loadTorque`, the mount scales).
     Input,
+    /// Computed by the model at each communication point.
     Output,
+    /// Set by the master before initialisation ends; the model is built from the parameters.
     Parameter,
+    /// Computed from the parameters at initialisation (the natural modes).
     CalculatedParameter,
+    /// Internal; not used by this FMU's variables.
     Local,
 }
 
 /// FMI variability of a variable.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum Variability {
+    /// Never changes.
     Constant,
+    /// Fixed after initialisation.
     Fixed,
+    /// May change between steps (no tunable variable exists in this FMU).
     Tunable,
+    /// Changes only at communication points (the solver counters).
     Discrete,
+    /// Changes continuously in time (inputs and physical outputs).
     Continuous,
 }
 
 /// One scalar variable of the model description.
 #[derive(Debug, Clone, Copy)]
 pub struct Variable<T: 'static> {
+    /// FMI name, e.g. `mount[2].F[3]`.
     pub name: &'static str,
     /// Value reference in `modelDescription.xml`.
     pub vr: u32,
     /// Position among the variables of its type.
     pub index: u32,
+    /// Who sets the variable and when.
     pub causality: Causality,
+    /// When the variable can change.
     pub variability: Variability,
+    /// Start value (the value after instantiation and reset).
     pub start: T,
+    /// Lower bound of a Real or Integer (values below are refused).
     pub min: Option<T>,
+    /// Upper bound of a Real or Integer (values above are refused).
     pub max: Option<T>,
 }
 

@@ -9,15 +9,21 @@ pub enum Error {
     /// A body option is outside its domain or does not apply to the vehicle's body.
     #[error("{option} = {value} {rule}")]
     BodyOption {
+        /// The body option at fault.
         option: BodyOption,
+        /// Its value as given.
         value: String,
+        /// The rule it breaks, as a sentence ending (e.g. "must be > 0").
         rule: String,
     },
     /// An input value is outside its domain (value in SI units).
     #[error("{input} = {value} {rule}")]
     Input {
+        /// The input at fault.
         input: Input,
+        /// Its value, in SI units.
         value: f64,
+        /// The rule it breaks, as a sentence ending (e.g. "must be >= 0").
         rule: &'static str,
     },
     /// The vehicle, the model or the integrator, in their own terms.

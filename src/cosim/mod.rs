@@ -51,9 +51,13 @@ pub struct Outputs {
 /// Work counters of the integrator since initialisation.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
 pub struct Counters {
+    /// Accepted integrator steps.
     pub steps: u64,
+    /// Evaluations of the right-hand side (the model's equations of motion).
     pub rhs_evaluations: u64,
+    /// Evaluations of the Jacobian of the right-hand side.
     pub jacobian_evaluations: u64,
+    /// LU factorisations of the Newton iteration matrix.
     pub factorizations: u64,
     /// Newton iterations (one linear solve each).
     pub newton_iterations: u64,
@@ -66,7 +70,9 @@ pub struct Counters {
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]
 #[error("{error} (reached t = {reached} s)")]
 pub struct StepFailure {
+    /// Why the integrator could not go on.
     pub error: Error,
+    /// Time in s of the last successful integrator step: where the simulation now is.
     pub reached: f64,
 }
 
@@ -288,6 +294,7 @@ impl Simulation {
         scene::outputs(&self.scene, self.time, &self.state)
     }
 
+    /// The integrator's work since this simulation was built (or restored).
     pub fn counters(&self) -> Counters {
         let s = self.integrator.stats();
         Counters {

@@ -11,6 +11,8 @@ pub const FMU_MOUNTS: usize = 4;
 
 /// Body points the FMU's outputs `steeringWheel.*` and `seat.*` report.
 pub const STEERING_WHEEL_POINT: &str = "steering_wheel";
+/// Name of the body point (listed under `outputs` in the vehicle configuration) whose
+/// acceleration is the FMU's `seat.a`.
 pub const SEAT_POINT: &str = "seat_rail";
 
 /// The vehicle the settings name (configuration file or built-in default), with the
@@ -43,8 +45,11 @@ pub fn vehicle_config_with_replacements(
 /// A coupled model built for the settings, with what replaced the configuration and log
 /// lines on how it was built.
 pub struct BuiltModel {
+    /// The coupled model: engine, mounts and ground or reduced chassis.
     pub model: CoupledModel,
+    /// Configuration values the FMU parameters replaced, for the log.
     pub replaced: Vec<Replaced>,
+    /// Log lines on how the model was built, the last one describing the scene.
     pub notes: Vec<String>,
 }
 

@@ -92,16 +92,23 @@ impl EffectOverrides {
 /// A vehicle value that [`VehicleOverrides`] can replace.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum VehicleSetting {
+    /// The combustion load between idle (0) and full load (1), `engine.gas.load`.
     GasLoad,
+    /// Time in s over which the excitation fades in, `engine.excitation_fade_in`.
     FadeInTime,
+    /// Crank angle at the start time, `engine.start_crank_angle_deg` (degrees in the
+    /// configuration, radians as an FMU parameter).
     CrankStartAngle,
+    /// Time constant in s with which the crank speed follows its set-point.
     SpeedTimeConstant,
+    /// One of the model's effect switches.
     Effect(EffectSwitch),
 }
 
 /// A configuration value that an override replaced (for the log).
 #[derive(Debug, Clone, PartialEq)]
 pub struct Replaced {
+    /// Which value was replaced.
     pub setting: VehicleSetting,
     /// The configuration's value, in the configuration's units.
     pub configured: String,

@@ -4,12 +4,16 @@
 /// communication point plus the first derivative from `fmi2SetRealInputDerivatives`.
 #[derive(Debug, Clone, Copy, PartialEq, serde::Serialize, serde::Deserialize)]
 pub struct Signal {
+    /// Value at `reference_time`, in the input's SI unit.
     pub value: f64,
+    /// Rate of change from `reference_time` on, in the input's unit per s.
     pub derivative: f64,
+    /// Time in s at which the signal has `value`.
     pub reference_time: f64,
 }
 
 impl Signal {
+    /// A signal that stays at `value` for all times.
     pub fn constant(value: f64) -> Signal {
         Signal {
             value,
@@ -18,6 +22,7 @@ impl Signal {
         }
     }
 
+    /// The value at time `t` (s); also before `reference_time`, on the same line.
     pub fn at(&self, t: f64) -> f64 {
         self.value + self.derivative * (t - self.reference_time)
     }

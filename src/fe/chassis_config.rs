@@ -21,11 +21,32 @@ use super::mesh::{BeamSection, Material};
 #[serde(tag = "shape", rename_all = "snake_case")]
 pub enum SectionSpec {
     /// Thin-walled rectangular tube: width `b` (local y), height `h` (local z), wall `t` (m).
-    Box { b: f64, h: f64, t: f64 },
+    Box {
+        /// Outer width along the local y axis, m.
+        b: f64,
+        /// Outer height along the local z axis, m.
+        h: f64,
+        /// Wall thickness, m (less than half of `b` and `h`).
+        t: f64,
+    },
     /// Thin-walled circular tube: outer diameter `d`, wall `t` (m).
-    Tube { d: f64, t: f64 },
+    Tube {
+        /// Outer diameter, m.
+        d: f64,
+        /// Wall thickness, m (at most half of `d`).
+        t: f64,
+    },
     /// Explicit section properties.
-    Explicit { area: f64, iy: f64, iz: f64, j: f64 },
+    Explicit {
+        /// Cross-section area, m².
+        area: f64,
+        /// Second moment of area about the local y axis, m⁴.
+        iy: f64,
+        /// Second moment of area about the local z axis, m⁴.
+        iz: f64,
+        /// Saint-Venant torsion constant, m⁴.
+        j: f64,
+    },
 }
 
 impl SectionSpec {

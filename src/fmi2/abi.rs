@@ -1,8 +1,8 @@
 //! The exported FMI 2.0 functions. Every entry point that takes an instance passes one guard,
-//! [`entry`]: the instance pointer is checked, panics are caught (a panic must never unwind into
+//! `entry`: the instance pointer is checked, panics are caught (a panic must never unwind into
 //! the C caller), the call is checked against the state machine ([`super::state`]), and a
-//! refusal is logged once, naming the function. Inside, C arguments become slices ([`array`],
-//! [`array_mut`], null pointers refused), value references become typed positions through the
+//! refusal is logged once, naming the function. Inside, C arguments become slices (`array`,
+//! `array_mut`, null pointers refused), value references become typed positions through the
 //! one table ([`super::values::indices`]), and the instance does the rest. This file is the only
 //! place with `unsafe` in the crate: every block says why it is sound.
 
@@ -215,12 +215,14 @@ unsafe fn texts(ptr: *const fmi2String, n: usize, name: &str) -> Result<Vec<Stri
 
 // ----- inquiry ---------------------------------------------------------------------------------
 
+/// Returns `"default"`: the FMU uses the standard FMI 2.0 C types. Needs no instance.
 #[no_mangle]
 pub extern "C" fn fmi2GetTypesPlatform() -> *const c_char {
     c"default".as_ptr()
 }
 const _: fmi2GetTypesPlatformTYPE = Some(fmi2GetTypesPlatform);
 
+/// Returns `"2.0"`, the FMI version of the headers this FMU was compiled against. Needs no instance.
 #[no_mangle]
 pub extern "C" fn fmi2GetVersion() -> *const c_char {
     c"2.0".as_ptr()
@@ -229,6 +231,11 @@ const _: fmi2GetVersionTYPE = Some(fmi2GetVersion);
 
 // ----- creation and destruction ----------------------------------------------------------------
 
+/// Creates an instance and returns its handle, or null after logging why through the master's
+/// logger: a missing `instanceName`, a `fmuType` other than co-simulation, a GUID that is not
+/// this FMU's, or a resource location that is not a directory. The model itself is built only in
+/// [`fmi2ExitInitializationMode`], or earlier when an output or a calculated parameter is read
+/// in initialisation mode.
 #[no_mangle]
 pub extern "C" fn fmi2Instantiate(
     instanceName: fmi2String,
@@ -315,6 +322,8 @@ fn resource_dir(uri: Option<&str>) -> Result<Option<std::path::PathBuf>, String>
 }
 const _: fmi2InstantiateTYPE = Some(fmi2Instantiate);
 
+/// Frees the instance and every FMU state it handed out. A null or already freed handle is
+/// ignored; allowed in every phase, including after a fatal error.
 #[no_mangle]
 pub extern "C" fn fmi2FreeInstance(c: fmi2Component) {
     if c.is_null() {
@@ -333,6 +342,9 @@ pub extern "C" fn fmi2FreeInstance(c: fmi2Component) {
 }
 const _: fmi2FreeInstanceTYPE = Some(fmi2FreeInstance);
 
+/// Without categories, switches debug logging on or off for all of them; with categories and
+/// `loggingOn`, logs exactly those; with categories and not `loggingOn`, switches those off. An
+/// unknown category name is refused with fmi2Error. Errors and warnings are always logged.
 #[no_mangle]
 pub extern "C" fn fmi2SetDebugLogging(
     c: fmi2Component,
@@ -353,6 +365,9 @@ const _: fmi2SetDebugLoggingTYPE = Some(fmi2SetDebugLogging);
 
 // ----- initialisation, termination, reset ------------------------------------------------------
 
+/// Sets the start time and the optional stop time (finite, not before the start) and the
+/// optional tolerance, which becomes the integrator's relative tolerance unless `solver.relTol`
+/// was set explicitly; a tolerance outside `solver.relTol`'s range is refused.
 #[no_mangle]
 pub extern "C" fn fmi2SetupExperiment(
     c: fmi2Component,
@@ -372,6 +387,8 @@ pub extern "C" fn fmi2SetupExperiment(
 }
 const _: fmi2SetupExperimentTYPE = Some(fmi2SetupExperiment);
 
+/// Enters initialisation mode, where parameters and inputs may still be set and outputs already
+/// read (they are then those of the static equilibrium).
 #[no_mangle]
 pub extern "C" fn fmi2EnterInitializationMode(c: fmi2Component) -> fmi2Status {
     entry(
@@ -383,6 +400,10 @@ pub extern "C" fn fmi2EnterInitializationMode(c: fmi2Component) -> fmi2Status {
 }
 const _: fmi2EnterInitializationModeTYPE = Some(fmi2EnterInitializationMode);
 
+/// Builds the model from the parameters (loading the configuration and reducing or reading the
+/// cached chassis for scene 2), finds its static equilibrium (or the periodic steady state with
+/// `initialization.periodic`) and enters step mode. A model that cannot be built is refused with
+/// fmi2Error and the reason logged.
 #[no_mangle]
 pub extern "C" fn fmi2ExitInitializationMode(c: fmi2Component) -> fmi2Status {
     entry(
@@ -394,6 +415,7 @@ pub extern "C" fn fmi2ExitInitializationMode(c: fmi2Component) -> fmi2Status {
 }
 const _: fmi2ExitInitializationModeTYPE = Some(fmi2ExitInitializationMode);
 
+/// Ends the simulation: afterwards values can still be read, but no step taken.
 #[no_mangle]
 pub extern "C" fn fmi2Terminate(c: fmi2Component) -> fmi2Status {
     entry(c, "fmi2Terminate", state::TERMINATE, |h| {
@@ -402,6 +424,8 @@ pub extern "C" fn fmi2Terminate(c: fmi2Component) -> fmi2Status {
 }
 const _: fmi2TerminateTYPE = Some(fmi2Terminate);
 
+/// Returns the instance to the state just after instantiation: start values, no model, no
+/// experiment. FMU states handed out stay valid.
 #[no_mangle]
 pub extern "C" fn fmi2Reset(c: fmi2Component) -> fmi2Status {
     entry(c, "fmi2Reset", state::RESET, |h| h.instance.reset())
@@ -461,6 +485,9 @@ fn boolean(vr: u32, b: fmi2Boolean) -> Result<bool, String> {
     }
 }
 
+/// Reads Real variables. Calculated parameters (the natural modes `mode[k].*`) are computed on
+/// first read; outputs read in initialisation mode build the model first. An unknown value
+/// reference is refused.
 #[no_mangle]
 pub extern "C" fn fmi2GetReal(
     c: fmi2Component,
@@ -472,6 +499,8 @@ pub extern "C" fn fmi2GetReal(
 }
 const _: fmi2GetRealTYPE = Some(fmi2GetReal);
 
+/// Reads Integer variables (the solver counters, `modes.count` and the Integer parameters); an
+/// unknown value reference is refused.
 #[no_mangle]
 pub extern "C" fn fmi2GetInteger(
     c: fmi2Component,
@@ -483,6 +512,8 @@ pub extern "C" fn fmi2GetInteger(
 }
 const _: fmi2GetIntegerTYPE = Some(fmi2GetInteger);
 
+/// Reads Boolean variables (the effect switches and other Boolean parameters) as fmi2True or
+/// fmi2False; an unknown value reference is refused.
 #[no_mangle]
 pub extern "C" fn fmi2GetBoolean(
     c: fmi2Component,
@@ -496,6 +527,8 @@ pub extern "C" fn fmi2GetBoolean(
 }
 const _: fmi2GetBooleanTYPE = Some(fmi2GetBoolean);
 
+/// Reads String variables. The returned pointers stay valid until the next fmi2GetString on
+/// this instance or until it is freed; an unknown value reference is refused.
 #[no_mangle]
 pub extern "C" fn fmi2GetString(
     c: fmi2Component,
@@ -519,6 +552,11 @@ pub extern "C" fn fmi2GetString(
 }
 const _: fmi2GetStringTYPE = Some(fmi2GetString);
 
+/// Sets Real inputs and parameters. All values are checked (range, finiteness, whether the
+/// variable may be set in this phase: fixed parameters only before initialisation ends) before any
+/// is applied, so a refused call changes nothing. An input set between steps takes effect at the
+/// next fmi2DoStep: as a ramp with a derivative set by fmi2SetRealInputDerivatives, otherwise as
+/// a first-order hold of the values set (see [`super::input_track`]).
 #[no_mangle]
 pub extern "C" fn fmi2SetReal(
     c: fmi2Component,
@@ -530,6 +568,8 @@ pub extern "C" fn fmi2SetReal(
 }
 const _: fmi2SetRealTYPE = Some(fmi2SetReal);
 
+/// Sets Integer parameters (e.g. `scene`, `solver.maxOrder`): all checked for range and phase
+/// before any is applied; outputs and calculated parameters are refused.
 #[no_mangle]
 pub extern "C" fn fmi2SetInteger(
     c: fmi2Component,
@@ -541,6 +581,8 @@ pub extern "C" fn fmi2SetInteger(
 }
 const _: fmi2SetIntegerTYPE = Some(fmi2SetInteger);
 
+/// Sets Boolean parameters (the effect switches, …): all checked before any is applied; a value
+/// other than fmi2True (1) or fmi2False (0) is refused.
 #[no_mangle]
 pub extern "C" fn fmi2SetBoolean(
     c: fmi2Component,
@@ -552,6 +594,8 @@ pub extern "C" fn fmi2SetBoolean(
 }
 const _: fmi2SetBooleanTYPE = Some(fmi2SetBoolean);
 
+/// Sets String parameters (`configFile`, `chassis.cacheDir`): all checked before any is
+/// applied; a null or non-UTF-8 string is refused.
 #[no_mangle]
 pub extern "C" fn fmi2SetString(
     c: fmi2Component,
@@ -568,6 +612,8 @@ const _: fmi2SetStringTYPE = Some(fmi2SetString);
 
 // ----- FMU state -------------------------------------------------------------------------------
 
+/// Copies the instance's complete state (values, input signals, time and integrator history)
+/// into a new FMU state, or into the given one if `*FMUstate` is a state of this instance.
 #[no_mangle]
 pub extern "C" fn fmi2GetFMUstate(c: fmi2Component, FMUstate: *mut fmi2FMUstate) -> fmi2Status {
     entry(c, "fmi2GetFMUstate", state::FMU_STATE, |h| {
@@ -579,6 +625,8 @@ pub extern "C" fn fmi2GetFMUstate(c: fmi2Component, FMUstate: *mut fmi2FMUstate)
 }
 const _: fmi2GetFMUstateTYPE = Some(fmi2GetFMUstate);
 
+/// Restores a state this instance handed out. Refused if the state was taken with different
+/// parameters than the model this instance has built (it would silently change the model).
 #[no_mangle]
 pub extern "C" fn fmi2SetFMUstate(c: fmi2Component, FMUstate: fmi2FMUstate) -> fmi2Status {
     entry(c, "fmi2SetFMUstate", state::FMU_STATE, |h| {
@@ -590,6 +638,8 @@ pub extern "C" fn fmi2SetFMUstate(c: fmi2Component, FMUstate: fmi2FMUstate) -> f
 }
 const _: fmi2SetFMUstateTYPE = Some(fmi2SetFMUstate);
 
+/// Frees an FMU state of this instance and sets `*FMUstate` to null; a null state is ignored, a
+/// foreign pointer refused.
 #[no_mangle]
 pub extern "C" fn fmi2FreeFMUstate(c: fmi2Component, FMUstate: *mut fmi2FMUstate) -> fmi2Status {
     entry(c, "fmi2FreeFMUstate", state::FMU_STATE, |h| {
@@ -608,6 +658,7 @@ pub extern "C" fn fmi2FreeFMUstate(c: fmi2Component, FMUstate: *mut fmi2FMUstate
 }
 const _: fmi2FreeFMUstateTYPE = Some(fmi2FreeFMUstate);
 
+/// Writes the number of bytes [`fmi2SerializeFMUstate`] needs for this state.
 #[no_mangle]
 pub extern "C" fn fmi2SerializedFMUstateSize(
     c: fmi2Component,
@@ -624,6 +675,8 @@ pub extern "C" fn fmi2SerializedFMUstateSize(
 }
 const _: fmi2SerializedFMUstateSizeTYPE = Some(fmi2SerializedFMUstateSize);
 
+/// Serialises an FMU state of this instance into the caller's buffer, which must have exactly
+/// the size [`fmi2SerializedFMUstateSize`] reported.
 #[no_mangle]
 pub extern "C" fn fmi2SerializeFMUstate(
     c: fmi2Component,
@@ -648,6 +701,9 @@ pub extern "C" fn fmi2SerializeFMUstate(
 }
 const _: fmi2SerializeFMUstateTYPE = Some(fmi2SerializeFMUstate);
 
+/// Creates an FMU state from bytes of [`fmi2SerializeFMUstate`], possibly written by another
+/// process; bytes of an FMU with another GUID, malformed or with inadmissible values are
+/// refused. The model is rebuilt from the state's own parameters.
 #[no_mangle]
 pub extern "C" fn fmi2DeSerializeFMUstate(
     c: fmi2Component,
@@ -672,6 +728,8 @@ pub extern "C" fn fmi2DeSerializeFMUstate(
 }
 const _: fmi2DeSerializeFMUstateTYPE = Some(fmi2DeSerializeFMUstate);
 
+/// Always refused with fmi2Error: the model description declares
+/// `providesDirectionalDerivative="false"`.
 #[no_mangle]
 pub extern "C" fn fmi2GetDirectionalDerivative(
     c: fmi2Component,
@@ -693,6 +751,9 @@ const _: fmi2GetDirectionalDerivativeTYPE = Some(fmi2GetDirectionalDerivative);
 
 // ----- co-simulation ---------------------------------------------------------------------------
 
+/// Sets the first time derivatives of Real inputs: each input then ramps linearly over the
+/// coming steps (bent onto its declared bound, with a warning, if the ramp would leave its range).
+/// Only order 1 and inputs are accepted.
 #[no_mangle]
 pub extern "C" fn fmi2SetRealInputDerivatives(
     c: fmi2Component,
@@ -721,6 +782,8 @@ pub extern "C" fn fmi2SetRealInputDerivatives(
 }
 const _: fmi2SetRealInputDerivativesTYPE = Some(fmi2SetRealInputDerivatives);
 
+/// Always refused with fmi2Error: the model description declares
+/// `maxOutputDerivativeOrder="0"`.
 #[no_mangle]
 pub extern "C" fn fmi2GetRealOutputDerivatives(
     c: fmi2Component,
@@ -738,6 +801,10 @@ pub extern "C" fn fmi2GetRealOutputDerivatives(
 }
 const _: fmi2GetRealOutputDerivativesTYPE = Some(fmi2GetRealOutputDerivatives);
 
+/// Integrates from `currentCommunicationPoint` (which must be the FMU's time) over
+/// `communicationStepSize` (> 0, not past the stop time). Returns fmi2Warning if an input ramp was
+/// bent onto a bound, and fmi2Discard if the integrator failed: the FMU then stays at the last
+/// successful time and reports itself terminated.
 #[no_mangle]
 pub extern "C" fn fmi2DoStep(
     c: fmi2Component,
@@ -752,6 +819,8 @@ pub extern "C" fn fmi2DoStep(
 }
 const _: fmi2DoStepTYPE = Some(fmi2DoStep);
 
+/// Always refused with fmi2Error: fmi2DoStep completes before returning, so no step is ever in
+/// progress.
 #[no_mangle]
 pub extern "C" fn fmi2CancelStep(c: fmi2Component) -> fmi2Status {
     entry(c, "fmi2CancelStep", state::CANCEL_STEP, |_| {
@@ -765,6 +834,7 @@ fn no_status(kind: fmi2StatusKind, ty: &str) -> Outcome {
     Err(format!("status kind {kind} has no {ty} value"))
 }
 
+/// Always refused with fmi2Error: no asynchronous step exists whose status could be asked.
 #[no_mangle]
 pub extern "C" fn fmi2GetStatus(
     c: fmi2Component,
@@ -777,6 +847,8 @@ pub extern "C" fn fmi2GetStatus(
 }
 const _: fmi2GetStatusTYPE = Some(fmi2GetStatus);
 
+/// Gives `fmi2LastSuccessfulTime` (s), the time the FMU has reached (after a discarded step,
+/// where the integrator stopped); other status kinds are refused.
 #[no_mangle]
 pub extern "C" fn fmi2GetRealStatus(
     c: fmi2Component,
@@ -794,6 +866,7 @@ pub extern "C" fn fmi2GetRealStatus(
 }
 const _: fmi2GetRealStatusTYPE = Some(fmi2GetRealStatus);
 
+/// Always refused with fmi2Error: no status kind has an Integer value.
 #[no_mangle]
 pub extern "C" fn fmi2GetIntegerStatus(
     c: fmi2Component,
@@ -806,6 +879,8 @@ pub extern "C" fn fmi2GetIntegerStatus(
 }
 const _: fmi2GetIntegerStatusTYPE = Some(fmi2GetIntegerStatus);
 
+/// Gives `fmi2Terminated`: true after a failed step (the simulation cannot go on); other status
+/// kinds are refused.
 #[no_mangle]
 pub extern "C" fn fmi2GetBooleanStatus(
     c: fmi2Component,
@@ -823,6 +898,8 @@ pub extern "C" fn fmi2GetBooleanStatus(
 }
 const _: fmi2GetBooleanStatusTYPE = Some(fmi2GetBooleanStatus);
 
+/// Always refused with fmi2Error: `fmi2PendingStatus` needs an asynchronous step, which does not
+/// exist.
 #[no_mangle]
 pub extern "C" fn fmi2GetStringStatus(
     c: fmi2Component,

@@ -32,9 +32,11 @@ pub struct InputTrack {
     pub value: f64,
     /// Slope from `since` on (per second).
     pub slope: f64,
+    /// Time in s from which `value` and `slope` describe the signal (the last commit).
     pub since: f64,
     /// Set by the master since the last communication point.
     pub pending_value: Option<f64>,
+    /// Slope (per s) set by `fmi2SetRealInputDerivatives` since the last communication point.
     pub pending_slope: Option<f64>,
     /// The last value the master set and when (for the slope estimate).
     pub last_set: Option<(f64, f64)>,
@@ -97,10 +99,13 @@ impl InputTrack {
         self.pending_value.unwrap_or_else(|| self.at(t))
     }
 
+    /// Records a value set by `fmi2SetReal`; it takes effect at the next commit.
     pub fn set_value(&mut self, value: f64) {
         self.pending_value = Some(value);
     }
 
+    /// Records a first derivative (per s) set by `fmi2SetRealInputDerivatives`; it takes effect
+    /// at the next commit.
     pub fn set_slope(&mut self, slope: f64) {
         self.pending_slope = Some(slope);
     }

@@ -20,10 +20,17 @@ use crate::cosim::{self, Simulation};
 /// Result of an FMI call, mapped to `fmi2Status` by the ABI layer.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, PartialOrd, Ord)]
 pub enum Status {
+    /// fmi2OK.
     Ok,
+    /// fmi2Warning: the call did its work, with something logged the master should know
+    /// (e.g. an input ramp bent onto its bound).
     Warning,
+    /// fmi2Discard: the step could not be completed; the FMU stopped at the last successful time.
     Discard,
+    /// fmi2Error: the call was refused (changing nothing), or the outputs could not be evaluated
+    /// after a step.
     Error,
+    /// fmi2Fatal: the instance is unusable.
     Fatal,
 }
 
@@ -33,16 +40,24 @@ pub type Outcome = Result<Status, String>;
 /// Everything an FMU state (`fmi2GetFMUstate`) captures.
 #[derive(Clone)]
 pub struct Core {
+    /// Where the instance is in the co-simulation state machine.
     pub phase: Phase,
+    /// The current value of every variable, by type and value reference.
     pub values: Values,
     /// The signal of each Real input (indexed like the Reals; unused for non-inputs).
     pub inputs: Vec<InputTrack>,
+    /// Start time of `fmi2SetupExperiment` in s (0 if it was not called).
     pub start_time: f64,
+    /// Stop time of `fmi2SetupExperiment` in s, if defined: no step may pass it.
     pub stop_time: Option<f64>,
     /// The tolerance of `fmi2SetupExperiment`, if the master defined one.
     pub experiment_tolerance: Option<f64>,
+    /// The FMU's current time in s: the last communication point reached.
     pub time: f64,
+    /// Set when a step failed: `fmi2GetBooleanStatus(fmi2Terminated)` reports it.
     pub terminated: bool,
+    /// The built model with its integrator; `None` before initialisation ends and after a
+    /// parameter change in initialisation mode (rebuilt when next needed).
     pub simulation: Option<Simulation>,
     /// Why building the model failed with the current parameters and inputs: asked again
     /// without a change, the answer is the same, without building again.
@@ -107,13 +122,19 @@ impl Core {
 
 /// One instance of the FMU.
 pub struct Instance {
+    /// The `instanceName` of fmi2Instantiate.
     pub name: String,
+    /// The master's logger callback with the enabled categories.
     pub logger: Logger,
+    /// The FMU's `resources` directory, from `fmuResourceLocation`; relative `configFile`
+    /// paths are resolved against it.
     pub resource_dir: Option<PathBuf>,
+    /// Everything an FMU state captures; replaced as a whole by fmi2SetFMUstate.
     pub core: Core,
 }
 
 impl Instance {
+    /// A freshly instantiated instance with start values and no model.
     pub fn new(name: &str, logger: Logger, resource_dir: Option<PathBuf>) -> Instance {
         Instance {
             name: name.to_owned(),
@@ -123,6 +144,7 @@ impl Instance {
         }
     }
 
+    /// The current phase of the state machine.
     pub fn phase(&self) -> Phase {
         self.core.phase
     }
@@ -192,17 +214,21 @@ impl Instance {
         Ok(Status::Ok)
     }
 
+    /// `fmi2EnterInitializationMode`.
     pub fn enter_initialization(&mut self) -> Outcome {
         self.core.phase = Phase::InitializationMode;
         Ok(Status::Ok)
     }
 
+    /// `fmi2ExitInitializationMode`: builds the model and its initial state; refused, with the
+    /// reason, if the parameters or the configuration do not give a valid model.
     pub fn exit_initialization(&mut self) -> Outcome {
         self.ensure_simulation()?;
         self.core.phase = Phase::StepComplete;
         Ok(Status::Ok)
     }
 
+    /// `fmi2Terminate`.
     pub fn terminate(&mut self) -> Outcome {
         self.core.phase = Phase::Terminated;
         Ok(Status::Ok)
@@ -433,6 +459,7 @@ impl Instance {
         }
     }
 
+    /// `fmi2LastSuccessfulTime` in s: the time reached, also after a discarded step.
     pub fn last_successful_time(&self) -> f64 {
         self.core.time
     }

@@ -11,9 +11,14 @@ use super::variables::{LogCategory, LOG_CATEGORIES};
 /// How serious a message is; maps to the status passed to the callback.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum Level {
+    /// Progress and diagnostics (status fmi2OK); shown only when debug logging is on for its
+    /// category.
     Info,
+    /// A result the master should know about (fmi2Warning); always shown.
     Warning,
+    /// A refused call or a failed step (fmi2Error); always shown.
     Error,
+    /// The instance is unusable (fmi2Fatal); always shown.
     Fatal,
 }
 
@@ -27,6 +32,9 @@ pub struct Logger {
 }
 
 impl Logger {
+    /// A logger calling `callback` (none: messages are dropped) with `environment` and the
+    /// instance's name; `debug_logging` is `loggingOn` of fmi2Instantiate, with every category
+    /// enabled.
     pub fn new(
         callback: fmi2CallbackLogger,
         environment: fmi2ComponentEnvironment,

@@ -4,12 +4,19 @@
 /// Where an instance is in the co-simulation state machine.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, serde::Serialize, serde::Deserialize)]
 pub enum Phase {
+    /// After fmi2Instantiate or fmi2Reset: parameters may be set, the experiment set up.
     Instantiated,
+    /// Between fmi2EnterInitializationMode and fmi2ExitInitializationMode.
     InitializationMode,
+    /// The model is built and the last step (if any) succeeded: fmi2DoStep may be called.
     StepComplete,
+    /// A step was discarded: values can be read, the simulation cannot continue.
     StepFailed,
+    /// After fmi2Terminate.
     Terminated,
+    /// Output evaluation failed after a step: values can be read, nothing else done.
     Error,
+    /// A panic (a bug) made the instance unusable; only fmi2FreeInstance is allowed.
     Fatal,
 }
 
@@ -34,6 +41,7 @@ impl Mask {
         Mask(bits)
     }
 
+    /// Whether `phase` is in the set.
     pub fn allows(self, phase: Phase) -> bool {
         self.0 & phase.bit() != 0
     }
@@ -56,11 +64,17 @@ pub const SET_DEBUG_LOGGING: Mask = Mask::of(&[
 ]);
 /// fmi2FreeInstance, fmi2Reset and the FMU-state functions.
 pub const ANY_INSTANCE: Mask = SET_DEBUG_LOGGING;
+/// fmi2Reset: every phase with a usable instance.
 pub const RESET: Mask = ANY_INSTANCE;
+/// fmi2GetFMUstate, fmi2SetFMUstate, fmi2FreeFMUstate and the (de)serialisation functions.
 pub const FMU_STATE: Mask = ANY_INSTANCE;
+/// fmi2SetupExperiment: only before initialisation.
 pub const SETUP_EXPERIMENT: Mask = Mask::of(&[Instantiated]);
+/// fmi2EnterInitializationMode: only once after instantiation (or reset).
 pub const ENTER_INITIALIZATION: Mask = Mask::of(&[Instantiated]);
+/// fmi2ExitInitializationMode: only in initialisation mode.
 pub const EXIT_INITIALIZATION: Mask = Mask::of(&[InitializationMode]);
+/// fmi2Terminate: after initialisation, also after a failed step.
 pub const TERMINATE: Mask = Mask::of(&[StepComplete, StepFailed]);
 /// fmi2GetReal/Integer/Boolean/String.
 pub const GET_VALUES: Mask = Mask::of(&[
@@ -72,9 +86,13 @@ pub const GET_VALUES: Mask = Mask::of(&[
 ]);
 /// fmi2SetReal/Integer/Boolean/String (co-simulation: no event or continuous-time mode).
 pub const SET_VALUES: Mask = Mask::of(&[Instantiated, InitializationMode, StepComplete]);
+/// fmi2GetDirectionalDerivative (always refused in the body): where values can be read.
 pub const DIRECTIONAL_DERIVATIVE: Mask = GET_VALUES;
+/// fmi2SetRealInputDerivatives: wherever inputs may be set.
 pub const SET_INPUT_DERIVATIVES: Mask = Mask::of(&[Instantiated, InitializationMode, StepComplete]);
+/// fmi2GetRealOutputDerivatives (always refused in the body): after initialisation.
 pub const GET_OUTPUT_DERIVATIVES: Mask = Mask::of(&[StepComplete, StepFailed, Terminated, Error]);
+/// fmi2DoStep: only after a successful initialisation or step.
 pub const DO_STEP: Mask = Mask::of(&[StepComplete]);
 /// fmi2CancelStep: only in `stepInProgress`, which never occurs.
 pub const CANCEL_STEP: Mask = Mask::of(&[]);

@@ -219,9 +219,13 @@ pub fn indices<T: VarType>(vrs: &[u32]) -> Result<Vec<usize>, String> {
 /// All variable values.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct Values {
+    /// The Real variables, indexed like [`REALS`] (in the units of the model description).
     pub reals: Store<f64>,
+    /// The Integer variables, indexed like [`INTEGERS`].
     pub integers: Store<i32>,
+    /// The Boolean variables, indexed like [`BOOLEANS`].
     pub booleans: Store<bool>,
+    /// The String variables, indexed like [`STRINGS`].
     pub strings: Store<String>,
 }
 
@@ -257,7 +261,9 @@ impl Values {
 
 /// Where [`Values`] keeps a type's store.
 pub trait Typed: VarType {
+    /// The store of this type in `values`.
     fn store(values: &Values) -> &Store<Self>;
+    /// The store of this type in `values`, to change.
     fn store_mut(values: &mut Values) -> &mut Store<Self>;
 }
 

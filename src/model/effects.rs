@@ -69,12 +69,19 @@ impl Default for Effects {
 /// One of the [`Effects`] switches, to name it without its value.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, PartialOrd, Ord, Hash)]
 pub enum EffectSwitch {
+    /// [`Effects::gas_forces`].
     GasForces,
+    /// [`Effects::mass_forces`].
     MassForces,
+    /// [`Effects::balance_shaft`].
     BalanceShaft,
+    /// [`Effects::gyroscopic`].
     Gyroscopic,
+    /// [`Effects::ring_carrier_elasticity`].
     RingCarrierElasticity,
+    /// [`Effects::mount_nonlinearity`].
     MountNonlinearity,
+    /// [`Effects::chassis_flexibility`].
     ChassisFlexibility,
 }
 

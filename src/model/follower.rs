@@ -35,6 +35,7 @@ impl Default for SpeedFollower {
 }
 
 impl SpeedFollower {
+    /// Refuses a negative or non-finite time constant, naming it `{field}.time_constant`.
     pub fn validate(&self, field: &str) -> Result<(), ConfigError> {
         non_negative(&format!("{field}.time_constant"), self.time_constant)
     }

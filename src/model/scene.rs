@@ -57,7 +57,10 @@ pub struct BodyOptions {
     pub mode_cutoff_hz: f64,
     /// If positive: keep exactly this many fixed-interface modes instead.
     pub max_modes: usize,
+    /// Highest engine speed the scene must represent, rpm; with `max_engine_order` it sets the
+    /// automatic mode cut-off.
     pub max_rpm: f64,
+    /// Highest engine order of interest (excitation frequencies are order × rpm / 60).
     pub max_engine_order: f64,
     /// All six DOFs of the mount nodes as interface (rotational constraint modes, kHz), instead
     /// of the translations (the mounts transmit forces only).
@@ -68,6 +71,7 @@ pub struct BodyOptions {
     pub stiffening_bar: bool,
     /// Procedural body only: the stiffer front plate under the steering column.
     pub stiff_front_plate: bool,
+    /// Where the reduced body is cached, or no cache.
     pub cache: CacheSetting,
 }
 
@@ -92,14 +96,23 @@ impl Default for BodyOptions {
 /// One of the [`BodyOptions`], to name it in an error without its value.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum BodyOption {
+    /// [`BodyOptions::mode_cutoff_hz`].
     ModeCutoff,
+    /// [`BodyOptions::max_modes`].
     MaxModes,
+    /// [`BodyOptions::max_rpm`].
     MaxRpm,
+    /// [`BodyOptions::max_engine_order`].
     MaxEngineOrder,
+    /// [`BodyOptions::interface_rotations`].
     InterfaceRotations,
+    /// [`BodyOptions::modal_damping_scale`].
     ModalDampingScale,
+    /// [`BodyOptions::stiffening_bar`].
     StiffeningBar,
+    /// [`BodyOptions::stiff_front_plate`].
     StiffFrontPlate,
+    /// [`BodyOptions::cache`].
     Cache,
 }
 
@@ -126,8 +139,11 @@ pub enum SceneError {
     /// A body option is outside its domain or does not apply to this vehicle's body.
     #[error("{option} = {value} {rule}")]
     Option {
+        /// The option at fault.
         option: BodyOption,
+        /// Its value as given.
         value: String,
+        /// The rule it breaks, as a sentence ending (e.g. "must be >= 0 and finite").
         rule: String,
     },
     /// The vehicle, its body or its reduction (in the configuration's terms).
@@ -206,7 +222,9 @@ impl BodyOptions {
 
 /// A model built for a scene, with log lines on how its body was obtained.
 pub struct Built {
+    /// The coupled engine–mount–body model.
     pub model: CoupledModel,
+    /// How the body was obtained (built and reduced, or read from the cache), one log line each.
     pub notes: Vec<String>,
 }
 
