@@ -55,7 +55,7 @@ fn a_serialized_state_with_inadmissible_values_is_refused() {
 
 /// Recomputes the SHA-256 trailer of a saved state (header: 8-byte magic and a one-byte
 /// version) as a forger would, so that the value checks behind the checksum are tested.
-fn reseal(bytes: &mut [u8]) {
+pub(crate) fn reseal(bytes: &mut [u8]) {
     use sha2::{Digest, Sha256};
     let end = bytes.len() - 32;
     let checksum = Sha256::digest(&bytes[9..end]);

@@ -7,3 +7,4 @@ mod inputs;
 mod model_structure;
 mod natural_modes;
 mod precedence;
+mod properties;
