@@ -19,7 +19,7 @@ pub use signals::{Inputs, Signal};
 use std::path::PathBuf;
 
 use crate::model::CoupledModel;
-use crate::ode::{Bdf, BdfOptions, BdfSnapshot, OdeProblem, Tolerance};
+use crate::ode::{Bdf, BdfOptions, BdfSnapshot, OdeProblem};
 
 /// Name of the default configuration in the FMU's resources folder.
 pub const DEFAULT_CONFIG_NAME: &str = "vehicle.json";
@@ -44,6 +44,8 @@ pub struct Settings {
     /// Time constant with which the crank speed follows the set-point, s (0 = directly).
     pub speed_time_constant: f64,
     pub rel_tol: f64,
+    /// 0: follow `rel_tol`, `atol_i = rel_tol · nominal_i` per state
+    /// ([`CoupledModel::state_nominals`]); > 0: this absolute tolerance for every state.
     pub abs_tol: f64,
     pub max_order: i32,
     pub stability_limit_detection: bool,
@@ -176,7 +178,6 @@ impl Simulation {
         inputs.validate()?;
         let mut options = BdfOptions {
             rtol: settings.rel_tol,
-            atol: Tolerance::Scalar(settings.abs_tol),
             max_order: usize::try_from(settings.max_order).unwrap_or(0),
             stability_limit_detection: settings.stability_limit_detection,
             // The coupled model's Jacobian changes slowly over ~50 steps (one Jacobian per ~0.4
@@ -190,6 +191,7 @@ impl Simulation {
         scene::apply_inputs(&mut scene, inputs)?;
         options.magnitude_cap = Some(scene.magnitude_caps());
         let y0 = scene.static_equilibrium(t0).map_err(|e| e.to_string())?;
+        options.atol = scene.absolute_tolerance(settings.rel_tol, settings.abs_tol, t0, &y0)?;
         let integrator = Bdf::new(&mut scene, t0, &y0, options).map_err(|e| e.to_string())?;
         Ok(Simulation {
             scene,

@@ -28,6 +28,7 @@ mod evaluate;
 pub mod jacobian;
 mod layout;
 pub mod modes;
+mod nominal;
 pub mod outputs;
 pub mod snapshot;
 mod statics;
