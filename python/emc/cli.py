@@ -815,6 +815,10 @@ def build_parser() -> argparse.ArgumentParser:
     r.add_argument("--seconds", type=float, default=1.0, help="simulated time per window")
     r.add_argument("--repeats", type=int, default=3, help="windows per case (the range is reported)")
     r.set_defaults(func=cmd_bench_realtime)
+
+    from .accuracy import add_parser as add_accuracy
+
+    add_accuracy(sub)
     return parser
 
 
