@@ -187,11 +187,14 @@ impl Simulation {
             jacobian_max_age: 100,
             ..BdfOptions::default()
         };
-        let (mut scene, notes) = scene::build_model(settings)?;
+        let (mut scene, mut notes) = scene::build_model(settings)?;
         scene::apply_inputs(&mut scene, inputs)?;
         options.magnitude_cap = Some(scene.magnitude_caps());
         let y0 = scene.static_equilibrium(t0).map_err(|e| e.to_string())?;
         options.atol = scene.absolute_tolerance(settings.rel_tol, settings.abs_tol, t0, &y0)?;
+        notes.push(crate::model::coupled::describe_absolute_tolerance(
+            &options.atol,
+        ));
         let integrator = Bdf::new(&mut scene, t0, &y0, options).map_err(|e| e.to_string())?;
         Ok(Simulation {
             scene,

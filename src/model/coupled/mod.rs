@@ -36,6 +36,7 @@ mod statics;
 pub use evaluate::Evaluation;
 pub use layout::StateLayout;
 pub use modes::{mode_table, Direction, Mode, ModeKind};
+pub use nominal::{describe_absolute_tolerance, FALLBACK_NOMINAL, RESOLVED_FRACTION};
 pub use outputs::{BodyMotion, Outputs, PointMotion};
 pub use snapshot::ModelSnapshot;
 pub use statics::StaticsError;
