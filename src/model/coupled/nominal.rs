@@ -236,8 +236,8 @@ pub fn describe_absolute_tolerance(atol: &Tolerance) -> String {
                 (lo.min(*a), hi.max(*a))
             });
             format!(
-                "absolute tolerance follows the relative one: rtol times each state's nominal \
-                 magnitude ({lo:.1e} to {hi:.1e} in state units)"
+                "absolute tolerance follows the relative one (solver.absTol = 0): rtol times \
+                 each state's nominal magnitude, {lo:.1e} to {hi:.1e} in state units"
             )
         }
     }
