@@ -68,7 +68,12 @@ impl CoupledModel {
         let l = self.layout;
         let n = l.dim();
         let omega = self.inputs.crank_speed.at(t).abs().max(MIN_NOMINAL_SPEED);
-        let cycle = self.powertrain.cycle_angle().map_err(ProblemError::Fatal)?;
+        // A balance shaft without a whole number of turns per cycle leaves the excitation without
+        // a period; two revolutions still sample it well enough for a scale.
+        let cycle = self
+            .powertrain
+            .cycle_angle()
+            .unwrap_or(4.0 * std::f64::consts::PI);
         // The excitation in full: the fade-in is over at `t` when it started long before.
         let fade_start = self.fade_start;
         self.fade_start = t - self.powertrain.config().excitation_fade_in - 1.0;
