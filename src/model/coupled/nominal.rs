@@ -29,9 +29,9 @@
 //!   `max(ω_k, ω)²` (quasi-static below the mode, mass-controlled above it), and `ω` times that
 //!   for the modal rates (the forced response at the excitation frequency).
 //!
-//! A nominal the excitation does not reach (an effect set without excitation, a mode the mounts
-//! do not load) falls back to a fixed fraction of the largest nominal of its kind, or to
-//! [`FALLBACK_NOMINAL`], so that every weight stays finite.
+//! A nominal the excitation does not reach falls back so that every weight stays finite: a
+//! powertrain coordinate of an engine without excitation to [`FALLBACK_NOMINAL`], a mode the
+//! mounts hardly load to a millionth of the largest modal nominal.
 
 use super::CoupledModel;
 use crate::model::RampInput;
@@ -51,9 +51,9 @@ const CYCLE_SAMPLES: usize = 48;
 /// The nominal as a fraction of the forced-vibration amplitude: the error of a state is held
 /// relative to its value down to a tenth of its amplitude (through the zero crossings of the
 /// oscillation) and absolute below. Measured at the default rtol 1e-5 (docs-draft/accuracy.md)
-/// against the former fixed absolute tolerance of 1e-8: scene 2 takes ~5 % more steps for
-/// 0.5–1× its mount-force error, scene 1 ~30 % fewer for ~1.6×; 1/20 cost scene 2 12 % more
-/// steps, 1/5 gave scene 1 2.7× the error in a run-up.
+/// against the former fixed absolute tolerance of 1e-8: scene 2 takes −2 … +11 % steps for
+/// 0.5–1× its mount-force error, scene 1 3–36 % fewer for 1.6–2.8×; 1/20 cost scene 2 12 % more
+/// steps, 1/5 was within the scatter of 1/10.
 pub const RESOLVED_FRACTION: f64 = 0.1;
 
 /// Smallest modal nominal relative to the largest: the modes the mounts hardly load.
