@@ -5,6 +5,7 @@ Examples:
     emc sweep ... --case "with shaft" --case "no shaft:effects.balanceShaft=off"
     emc sweep ... --scheduler tcp://10.0.0.5:8786        # a running Dask cluster
     emc runup --fmu dist/EngineMountChassis.fmu --rpm 800 2500 --duration 20 --out out/runup
+    emc accuracy --set configFile=/path/my_car.json --out out/accuracy  # what accuracy costs
 
 Every command runs scene 2 (the engine in the elastic body) unless --set scene=1. A case is
 --case NAME or --case NAME:name=value,name=value (repeatable; the common --set values apply to
@@ -815,6 +816,10 @@ def build_parser() -> argparse.ArgumentParser:
     r.add_argument("--seconds", type=float, default=1.0, help="simulated time per window")
     r.add_argument("--repeats", type=int, default=3, help="windows per case (the range is reported)")
     r.set_defaults(func=cmd_bench_realtime)
+
+    from .accuracy import add_parser as add_accuracy
+
+    add_accuracy(sub)
     return parser
 
 

@@ -51,7 +51,10 @@ def relative_change(runs, name, torque=0.0):
 def test_gas_forces_carry_the_one_and_a_half_order(runs):
     base, off = runs[("base", 0.0)]["orders"], runs[("gas off", 0.0)]["orders"]
     assert off[1.5] < 1e-3 * base[1.5]
-    assert runs[("gas off", 0.0)]["steps"] < runs[("base", 0.0)]["steps"]
+    # The absolute tolerance follows the vibration's own amplitude (solver.absTol = 0), so the
+    # smaller vibration without gas is resolved to the same relative accuracy: not cheaper, but
+    # not more expensive either.
+    assert runs[("gas off", 0.0)]["steps"] < 1.05 * runs[("base", 0.0)]["steps"]
 
 
 def test_mass_forces_carry_the_second_order(runs):

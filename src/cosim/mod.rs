@@ -21,7 +21,7 @@ pub use settings::{EffectOverrides, Replaced, Settings, VehicleOverrides, Vehicl
 pub use signals::{Inputs, Signal};
 
 use crate::model::CoupledModel;
-use crate::ode::{Bdf, BdfOptions, BdfSnapshot, OdeProblem, Tolerance};
+use crate::ode::{Bdf, BdfOptions, BdfSnapshot, OdeProblem};
 
 /// Name of the default configuration in the FMU's resources folder.
 pub const DEFAULT_CONFIG_NAME: &str = "vehicle.json";
@@ -119,7 +119,6 @@ impl Simulation {
         inputs.validate()?;
         let mut options = BdfOptions {
             rtol: settings.rel_tol,
-            atol: Tolerance::Scalar(settings.abs_tol),
             max_order: settings.max_order,
             stability_limit_detection: settings.stability_limit_detection,
             // The coupled model's Jacobian changes slowly over ~50 steps (one Jacobian per ~0.4
@@ -132,11 +131,15 @@ impl Simulation {
         let scene::BuiltModel {
             model: mut scene,
             replaced,
-            notes,
+            mut notes,
         } = scene::build_model(settings)?;
         scene::apply_inputs(&mut scene, inputs)?;
         options.magnitude_cap = Some(scene.magnitude_caps());
         let y0 = scene.static_equilibrium(t0).map_err(|e| e.to_string())?;
+        options.atol = scene.absolute_tolerance(settings.rel_tol, settings.abs_tol, t0, &y0)?;
+        notes.push(crate::model::coupled::describe_absolute_tolerance(
+            &options.atol,
+        ));
         let integrator = Bdf::new(&mut scene, t0, &y0, options).map_err(|e| e.to_string())?;
         Ok(Simulation {
             scene,

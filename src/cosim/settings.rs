@@ -17,7 +17,9 @@ pub struct Settings {
     pub vehicle: VehicleOverrides,
     /// Relative tolerance of the integrator.
     pub rel_tol: f64,
-    /// Absolute tolerance of the integrator, in state units.
+    /// Absolute tolerance of the integrator: 0 follows `rel_tol` (`atol_i = rel_tol ·
+    /// nominal_i` per state, [`crate::model::CoupledModel::state_nominals`]); > 0 is one
+    /// absolute tolerance for every state, in state units.
     pub abs_tol: f64,
     /// Highest BDF order (1..=5).
     pub max_order: usize,
@@ -38,7 +40,7 @@ impl Default for Settings {
             config_file: None,
             vehicle: VehicleOverrides::default(),
             rel_tol: 1e-5,
-            abs_tol: 1e-8,
+            abs_tol: 0.0,
             max_order: 5,
             stability_limit_detection: true,
             periodic_start: false,

@@ -99,7 +99,7 @@ impl Core {
         }
         for v in REALS.iter().filter(|v| v.causality == Causality::Input) {
             let t = &self.inputs[v.index as usize];
-            if !(t.lo <= t.hi) {
+            if t.lo.partial_cmp(&t.hi).is_none_or(|o| o.is_gt()) {
                 return Err(format!("the signal of {} has no valid range", v.name));
             }
             let numbers = [t.value, t.slope, t.since];
