@@ -187,8 +187,8 @@ fn main() -> Result<(), String> {
                 settings.vehicle.effects.set(switch, false);
             }
             if let Some(r) = value("--rtol") {
+                // The absolute tolerance follows (as in the FMU) unless --atol is given.
                 settings.rel_tol = r;
-                settings.abs_tol = r * 1e-3;
             }
             if let Some(q) = value("--max-order") {
                 settings.max_order = q as usize;
