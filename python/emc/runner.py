@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import dataclasses
 import math
+import re
 import time
 import shutil
 import tempfile
@@ -130,7 +131,8 @@ class Runner:
 
     def failure(self, what: str, error: Exception) -> PointFailed:
         """The cause of a failed call: the FMU's error messages first, else fmpy's."""
-        errors = [line.split(": ", 1)[1] for line in self.log
+        # The FMU names the refused function first ("fmi2DoStep: ..."); the user reads the cause.
+        errors = [re.sub(r"^fmi2\w+: ", "", line.split(": ", 1)[1]) for line in self.log
                   if line.startswith(("[error]", "[fatal]")) and ": " in line]
         cause = "; ".join(errors) if errors else str(error)
         return PointFailed(f"{what}: {cause}", tuple(self.log))

@@ -13,6 +13,7 @@ mod inline_four;
 mod rhs_allocations;
 mod scene_effects;
 mod torque_path;
+mod vehicle_json_properties;
 mod wrench_orders;
 
 use std::alloc::{GlobalAlloc, Layout, System};
