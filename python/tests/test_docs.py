@@ -202,13 +202,14 @@ def test_the_commands_the_guide_names_exist():
         assert (ROOT / script).is_file(), script
     for test in set(re.findall(r"--test (\w+)", text)):
         assert (ROOT / "tests" / test).is_dir() or (ROOT / "tests" / f"{test}.rs").is_file(), test
-    paths = set(re.findall(r"`((?:src|tests|python|tools|resources)/[\w./-]+\.(?:rs|py|c|json))`",
-                           text))
+    paths = set(re.findall(
+        r"`((?:src|tests|python|tools|resources|scripts)/[\w./-]+\.(?:rs|py|c|json))`", text))
     assert len(paths) >= 20
     for path in paths:
         assert (ROOT / path).is_file(), path
-    cli = (ROOT / "python" / "emc" / "cli.py").read_text()
-    subcommands = set(re.findall(r'add_parser\("([\w-]+)"', cli))
+    # Subcommands are registered in cli.py and by modules that add their own parser (accuracy.py).
+    cli = "\n".join(p.read_text() for p in sorted((ROOT / "python" / "emc").glob("*.py")))
+    subcommands = set(re.findall(r'add_parser\(\s*"([\w-]+)"', cli))
     subcommands |= set(re.findall(r'\("(study-[\w-]+)"', cli))
     commands = set(re.findall(r"(?:`|bin/)emc ([a-z][\w-]+)", text))
     assert {"sweep", "runup", "campbell", "study-mounts", "bench-realtime"} <= commands

@@ -50,10 +50,10 @@ const CYCLE_SAMPLES: usize = 48;
 
 /// The nominal as a fraction of the forced-vibration amplitude: the error of a state is held
 /// relative to its value down to a tenth of its amplitude (through the zero crossings of the
-/// oscillation) and absolute below. Measured at the default rtol 1e-5 (docs-draft/accuracy.md)
-/// against the former fixed absolute tolerance of 1e-8: scene 2 takes −2 … +11 % steps for
-/// 0.5–1× its mount-force error, scene 1 3–36 % fewer for 1.6–2.8×; 1/20 cost scene 2 12 % more
-/// steps, 1/5 was within the scatter of 1/10.
+/// oscillation) and absolute below. Measured at the default rtol 1e-5
+/// (`docs/src/evidence/accuracy.md`) against the former fixed absolute tolerance of 1e-8: scene 2
+/// takes −2 … +11 % steps for 0.5–1× its mount-force error, scene 1 3–36 % fewer for 1.6–2.8×;
+/// 1/20 cost scene 2 12 % more steps, 1/5 was within the scatter of 1/10.
 pub const RESOLVED_FRACTION: f64 = 0.1;
 
 /// Smallest modal nominal relative to the largest: the modes the mounts hardly load.
