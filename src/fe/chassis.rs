@@ -122,10 +122,10 @@ impl Chassis {
 
     /// Engine-mount nodes `(name, node id)` of a layout.
     pub fn mount_nodes(&self, layout: MountLayout) -> Result<Vec<(String, usize)>, FeError> {
-        let removed = &self.config.mounts.removed_in_three_mount_layout;
+        let removed = self.config.mounts.removed_in_three_mount_layout.name();
         MOUNT_NAMES
             .iter()
-            .filter(|n| layout == MountLayout::Four || **n != removed.as_str())
+            .filter(|n| layout == MountLayout::Four || **n != removed)
             .map(|n| Ok((format!("mount_{n}"), self.node(&format!("mount_{n}"))?)))
             .collect()
     }

@@ -20,7 +20,7 @@ use super::snapshot;
 use super::state::{self, Mask, Phase};
 use super::uri::resource_path;
 use super::values::{indices, Typed};
-use super::variables::{LogCategory, GUID};
+use super::variables::{string, LogCategory, GUID, STRINGS};
 
 /// Marks a live instance allocated by `fmi2Instantiate`; cleared when freed, so a stale or
 /// foreign pointer is recognised with high probability instead of being used.
@@ -289,10 +289,11 @@ pub extern "C" fn fmi2Instantiate(
             Err(m) => return refuse(&logger, &m),
         };
         if resource_dir.is_none() {
+            let config = STRINGS[string::CONFIG_FILE as usize].name;
             logger.log(
                 Level::Warning,
                 LogCategory::StatusWarning,
-                "fmi2Instantiate: no resource location given; the built-in vehicle is used unless configFile names an absolute path",
+                &format!("fmi2Instantiate: no resource location given; the built-in vehicle is used unless {config} names an absolute path"),
             );
         }
         let handle = Box::new(Handle {

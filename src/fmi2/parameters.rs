@@ -127,17 +127,24 @@ pub fn config_file(
     Ok(Some(path))
 }
 
-/// Where the relative tolerance comes from, for the log.
+/// Where the tolerances come from, for the log.
 pub fn tolerance_note(values: &Values, settings: &Settings, experiment: Option<f64>) -> String {
     let name = REALS[real::SOLVER_REL_TOL as usize].name;
-    match (experiment, values.reals.set_by_master(real::SOLVER_REL_TOL)) {
+    let absolute = REALS[real::SOLVER_ABS_TOL as usize].name;
+    let absolute = if settings.abs_tol > 0.0 {
+        format!("; {absolute} = {} for every state", settings.abs_tol)
+    } else {
+        format!("; {absolute} = 0: the absolute tolerance follows the relative one")
+    };
+    let relative = match (experiment, values.reals.set_by_master(real::SOLVER_REL_TOL)) {
         (Some(t), false) => format!("relative tolerance {t} from fmi2SetupExperiment"),
         (Some(t), true) => format!(
             "relative tolerance {} from {name} (set explicitly; fmi2SetupExperiment's {t} not used)",
             settings.rel_tol
         ),
         (None, _) => format!("relative tolerance {} ({name})", settings.rel_tol),
-    }
+    };
+    relative + &absolute
 }
 
 /// The parameters the vehicle values come from, set to the values the model uses (a

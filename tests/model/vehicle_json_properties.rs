@@ -56,7 +56,11 @@ fn apply(root: &mut Value, change: &Change) {
         let last = depth + 1 == path.len();
         let child = match node {
             Value::Object(map) if !map.is_empty() => {
-                let key = map.keys().nth(choice % map.len()).cloned().unwrap_or_default();
+                let key = map
+                    .keys()
+                    .nth(choice % map.len())
+                    .cloned()
+                    .unwrap_or_default();
                 if last {
                     match &replacement {
                         Some(v) => {

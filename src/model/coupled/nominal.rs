@@ -235,14 +235,14 @@ fn forced_response(a: &[f64], omega: f64) -> [f64; 2] {
 /// One log line on the absolute tolerance in use.
 pub fn describe_absolute_tolerance(atol: &Tolerance) -> String {
     match atol {
-        Tolerance::Scalar(a) => format!("absolute tolerance {a:e} for every state (solver.absTol)"),
+        Tolerance::Scalar(a) => format!("absolute tolerance {a:e} for every state (as given)"),
         Tolerance::Vector(v) => {
             let (lo, hi) = v.iter().fold((f64::INFINITY, 0.0f64), |(lo, hi), a| {
                 (lo.min(*a), hi.max(*a))
             });
             format!(
-                "absolute tolerance follows the relative one (solver.absTol = 0): rtol times \
-                 each state's nominal magnitude, {lo:.1e} to {hi:.1e} in state units"
+                "absolute tolerance follows the relative one: rtol times each state's nominal \
+                 magnitude, {lo:.1e} to {hi:.1e} in state units"
             )
         }
     }
