@@ -35,20 +35,19 @@
 
 mod cards;
 mod lexer;
+mod reader;
 mod to_mesh;
 mod writer;
 
 use std::collections::BTreeMap;
 use std::path::Path;
 
-pub use lexer::{classify, parse_real, Value};
+pub use lexer::{classify, lex, parse_real, Deck, Field, Loc, RawCard, Value};
+pub use reader::{DeckLimits, DeckOptions};
 pub use writer::write_bulk_deck;
 
 use super::error::FeError;
 use super::mesh::Mesh;
-
-/// Largest bulk data file read (bytes).
-pub const MAX_FILE_BYTES: u64 = 256 * 1024 * 1024;
 
 /// Nastran ids of the mesh entities, in mesh order (`beams[i]` is the CBAR/CBEAM id of
 /// `mesh.beams[i]`, …). A CONM2 with an offset appears in `masses` and in `rigid_links`.
@@ -117,17 +116,65 @@ impl NastranBody {
     }
 }
 
-/// Parses bulk data text (see the module documentation for what is accepted).
+/// Parses bulk data text (see the module documentation for what is accepted; `INCLUDE` needs
+/// a file: [`read_bulk_deck`]).
 pub fn parse_str(text: &str) -> Result<NastranBody, FeError> {
-    to_mesh::build(&lexer::lex(text)?)
+    parse_reader(text.as_bytes(), &DeckLimits::default())
 }
 
-/// Reads a bulk data file: a regular file of at most [`MAX_FILE_BYTES`], UTF-8/ASCII text.
+/// Parses bulk data from a reader, line by line (no `INCLUDE`: there is no folder to resolve
+/// it against).
+pub fn parse_reader(
+    input: impl std::io::Read,
+    limits: &DeckLimits,
+) -> Result<NastranBody, FeError> {
+    let mut cards = to_mesh::Collector::new();
+    let info = reader::read_from(input, limits, &mut cards)?;
+    to_mesh::build(cards, info.spc_selection)
+}
+
+/// Reads a bulk data file and its `INCLUDE`s with the default [`DeckOptions`].
 pub fn read_bulk_deck(path: &Path) -> Result<NastranBody, FeError> {
-    let text = crate::text_file::read_limited(path, MAX_FILE_BYTES)
-        .map_err(|e| FeError::Io(format!("bulk data file: {e}")))?;
-    parse_str(&text).map_err(|e| match e {
+    read_bulk_deck_with(path, &DeckOptions::default()).map(|(body, _)| body)
+}
+
+fn prefixed(path: &Path, e: FeError) -> FeError {
+    match e {
         FeError::InvalidInput(m) => FeError::InvalidInput(format!("{}: {m}", path.display())),
         other => other,
-    })
+    }
+}
+
+/// Reads a bulk data file streaming: a regular file of UTF-8/ASCII text, its `INCLUDE 'file'`
+/// statements (bulk data only) resolved relative to the including file and confined to
+/// `options.include_root` (default: the deck's folder), within `options.limits`. Returns the
+/// body and the deck's SHA-256 ([`deck_digest`]).
+pub fn read_bulk_deck_with(
+    path: &Path,
+    options: &DeckOptions,
+) -> Result<(NastranBody, String), FeError> {
+    let mut cards = to_mesh::Collector::new();
+    let info = reader::read_file(path, options, &mut cards).map_err(|e| prefixed(path, e))?;
+    let body = to_mesh::build(cards, info.spc_selection).map_err(|e| prefixed(path, e))?;
+    Ok((body, info.sha256))
+}
+
+/// SHA-256 (hex) of a deck and its `INCLUDE`s, read streaming with the same rules as
+/// [`read_bulk_deck_with`] (so a deck that does not lex is refused here already): of the file
+/// itself when it includes nothing, else of the list of (file relative to the deck's folder,
+/// SHA-256 of the file) in include order.
+pub fn deck_digest(path: &Path, options: &DeckOptions) -> Result<String, FeError> {
+    reader::read_file(path, options, &mut reader::Discard)
+        .map(|info| info.sha256)
+        .map_err(|e| prefixed(path, e))
+}
+
+/// Lexes bulk data from a reader without building a body and returns the largest line
+/// buffer used (bytes): lets tests check that memory does not follow line or file length.
+#[doc(hidden)]
+pub fn lex_reader_peak_line_bytes(
+    input: impl std::io::Read,
+    limits: &DeckLimits,
+) -> Result<usize, FeError> {
+    reader::read_from(input, limits, &mut reader::Discard).map(|info| info.peak_line_bytes)
 }
