@@ -110,7 +110,7 @@ fn an_endless_line_is_refused_after_reading_the_cap() {
         ..DeckLimits::default()
     };
     // 100 MB on one line (here: endless) after two good lines.
-    let (input, pulled) = counting(SPRING[..17].as_bytes().chain(std::io::repeat(b'x')));
+    let (input, pulled) = counting((&SPRING.as_bytes()[..17]).chain(std::io::repeat(b'x')));
     let err = parse_reader(input, &limits).unwrap_err().to_string();
     assert!(
         err.contains("line 2") && err.contains("longer than the 1000 bytes"),

@@ -310,8 +310,7 @@ impl<'a, 's> DeckReader<'a, 's> {
                     ),
                 ));
             }
-            let text = text.trim_end_matches('\r').to_owned();
-            if let Flow::End = self.line(&text, loc)? {
+            if let Flow::End = self.line(text.trim_end_matches('\r'), loc)? {
                 // The rest of every open file is not bulk data, but the digest covers whole
                 // files.
                 while let Some(source) = self.stack.last_mut() {

@@ -52,7 +52,7 @@ fn insert_unique<T>(
     value: T,
 ) -> Result<(), FeError> {
     if map.insert(id, value).is_some() {
-        return Err(mesh_error(&line, format!("{what} {id} is defined twice")));
+        return Err(mesh_error(line, format!("{what} {id} is defined twice")));
     }
     Ok(())
 }
@@ -62,7 +62,7 @@ impl Cards {
     fn element_id(&mut self, id: u32, line: &Loc, name: &str) -> Result<(), FeError> {
         if let Some((first, other)) = self.element_lines.get(&id) {
             return Err(mesh_error(
-                &line,
+                line,
                 format!("{name} {id}: element id already used by {other} at line {first}"),
             ));
         }
@@ -290,7 +290,7 @@ impl Systems {
     ) -> Result<&(Vector3<f64>, Matrix3<f64>), FeError> {
         self.resolved.get(&id).ok_or_else(|| {
             mesh_error(
-                &line,
+                line,
                 format!("{user}: coordinate system {id} not found (CORD2R)"),
             )
         })
@@ -301,7 +301,7 @@ fn material_named(c: &Cards, mid: u32, line: &Loc, user: &str) -> Result<cards::
     c.materials
         .get(&mid)
         .cloned()
-        .ok_or_else(|| mesh_error(&line, format!("{user}: material MAT1 {mid} not found")))
+        .ok_or_else(|| mesh_error(line, format!("{user}: material MAT1 {mid} not found")))
 }
 
 /// E and G of a MAT1 by Nastran's rule for the missing one (E = 2 (1 + ν) G).
@@ -332,7 +332,7 @@ fn node_of(body: &NastranBody, grid: u32, line: &Loc, user: &str) -> Result<usiz
     body.grid_index
         .get(&grid)
         .copied()
-        .ok_or_else(|| mesh_error(&line, format!("{user}: GRID {grid} not found")))
+        .ok_or_else(|| mesh_error(line, format!("{user}: GRID {grid} not found")))
 }
 
 fn mask_nodes(mask: [bool; 6]) -> impl Iterator<Item = usize> {
@@ -400,7 +400,7 @@ fn add_shells(c: &Cards, body: &mut NastranBody) -> Result<(), FeError> {
         let line = &plate.line;
         let p = c.shell_properties.get(&plate.pid).ok_or_else(|| {
             mesh_error(
-                &line,
+                line,
                 format!("{user}: property PSHELL {} not found", plate.pid),
             )
         })?;
@@ -456,7 +456,7 @@ fn add_shells(c: &Cards, body: &mut NastranBody) -> Result<(), FeError> {
         let nodes = plate
             .grids
             .iter()
-            .map(|&g| node_of(body, g, &line, &user))
+            .map(|&g| node_of(body, g, line, &user))
             .collect::<Result<Vec<_>, _>>()?;
         let material = Material {
             youngs_modulus: e,
@@ -494,13 +494,13 @@ fn add_beams(c: &Cards, body: &mut NastranBody) -> Result<(), FeError> {
         let line = &bar.line;
         let (p, kind) = c.beam_properties.get(&bar.pid).ok_or_else(|| {
             mesh_error(
-                &line,
+                line,
                 format!("{user}: property PBAR/PBEAM {} not found", bar.pid),
             )
         })?;
         if (c.element_lines[&id].1 == "CBAR") != (*kind == "PBAR") {
             return Err(mesh_error(
-                &line,
+                line,
                 format!("{user}: property {} is a {kind}", bar.pid),
             ));
         }
@@ -517,12 +517,12 @@ fn add_beams(c: &Cards, body: &mut NastranBody) -> Result<(), FeError> {
                 ),
             ));
         }
-        let a = node_of(body, bar.ga, &line, &user)?;
-        let b = node_of(body, bar.gb, &line, &user)?;
+        let a = node_of(body, bar.ga, line, &user)?;
+        let b = node_of(body, bar.gb, line, &user)?;
         let orientation = match bar.orientation {
             Orientation::Vector(v) => Vector3::from(v),
             Orientation::Node(g0) => {
-                body.mesh.nodes[node_of(body, g0, &line, &format!("{user} G0"))?]
+                body.mesh.nodes[node_of(body, g0, line, &format!("{user} G0"))?]
                     - body.mesh.nodes[a]
             }
         };
@@ -758,7 +758,7 @@ fn check_dependents(c: &Cards, body: &NastranBody) -> Result<(), FeError> {
         };
         if let Some((card, line)) = owner.get(&(*grid, d)) {
             return Err(mesh_error(
-                &*line,
+                *line,
                 format!(
                     "GRID {grid} component {} is dependent in {card} and also constrained \
                      (SPC or GRID PS); constrain the independent grid instead",
@@ -798,7 +798,7 @@ fn add_supports(c: &Cards, selected: Option<u32>, body: &mut NastranBody) -> Res
             continue;
         }
         let nodes: Vec<usize> = match grids {
-            cards::Grids::One(grid) => vec![node_of(body, grid, &line, &format!("SPC set {sid}"))?],
+            cards::Grids::One(grid) => vec![node_of(body, grid, line, &format!("SPC set {sid}"))?],
             cards::Grids::Range(from, to) => {
                 body.grid_index.range(from..=to).map(|(_, &n)| n).collect()
             }
