@@ -1,9 +1,27 @@
 //! Nastran bulk data input and output: a user's car body as a [`Mesh`].
 //!
-//! Reading: [`read_bulk_deck`] / [`parse_str`] → [`NastranBody`] (mesh + GRID id → node index).
+//! Reading: [`read_bulk_deck`] / [`read_bulk_deck_with`] / [`parse_str`] / [`parse_reader`] →
+//! [`NastranBody`] (mesh + GRID id → node index).
 //! Formats: small field, large field (`*`), free field (commas), continuations (`+`, `*`,
-//! blank first field), `$` comments, optional executive and case control before `BEGIN BULK`
-//! (only `SPC = n` is read from it), `ENDDATA`. Units are taken as given (use SI: m, kg, s, N).
+//! blank first field; a continuation marker must repeat field 10 of the line before, and the
+//! last card may not end with a marker), `$` comments, optional executive and case control
+//! before `BEGIN BULK` (only `SPC = n` is read from it; a deck without `BEGIN BULK` is all bulk
+//! data), `ENDDATA`. Units are taken as given (use SI: m, kg, s, N).
+//!
+//! The reader streams: one physical line at a time (at most [`DeckLimits::max_line_bytes`],
+//! a longer line is refused without reading its rest), each card handed to the model as soon as
+//! it is complete, so memory follows the model, which [`DeckLimits`] bounds (cards, fields per
+//! card), not the length of a line or a file. NUL and other control bytes, non-UTF-8 text and
+//! non-ASCII bulk data are refused at their line.
+//!
+//! `INCLUDE 'file'` (quoted, the name may continue over lines; or one unquoted word) in the
+//! bulk data reads `file` in place, relative to the including file's folder. Every file must lie
+//! in [`DeckOptions::include_root`] (default: the top deck's folder), checked on the resolved
+//! path (no `..` or symbolic link out of it); cycles and nesting deeper than
+//! [`DeckLimits::max_include_depth`] are refused naming the chain; `INCLUDE` before `BEGIN BULK`
+//! is refused (Nastran would read it as control statements, which this reader skips); a card
+//! does not continue across files. Errors name the line and, in an included file, the file
+//! (`line 12 of sub/grids.bdf`).
 //!
 //! Cards and how they map:
 //! - GRID (CP → CORD2R, coordinates converted to basic; CD must be 0/blank; PS → supports),
