@@ -231,6 +231,22 @@ pub(super) struct SplitLine {
     pub marker: String,
 }
 
+/// Field 1 must be a card name (letters and digits, `*` for large field) or a continuation
+/// marker (blank, `+…`, `*…`). Checked before the data fields, so a file that is no deck gets
+/// at most its first field repeated in the message.
+fn check_first(first: &str, loc: &Loc) -> Result<(), FeError> {
+    let name = first.trim_end_matches('*');
+    let is_name = !name.is_empty() && name.chars().all(|c| c.is_ascii_alphanumeric());
+    if first.is_empty() || first.starts_with(['+', '*']) || is_name {
+        Ok(())
+    } else {
+        Err(lex_error(
+            loc,
+            format!("'{}' is not a card name", shown(first)),
+        ))
+    }
+}
+
 /// Splits one bulk data line into its first field, data fields and continuation field.
 pub(super) fn split_line(line: &str, loc: &Loc) -> Result<SplitLine, FeError> {
     if line.contains(',') {
@@ -239,6 +255,7 @@ pub(super) fn split_line(line: &str, loc: &Loc) -> Result<SplitLine, FeError> {
             .map(|p| p.trim().to_ascii_uppercase())
             .collect();
         let first = parts[0].clone();
+        check_first(&first, loc)?;
         let per_line = if first.ends_with('*') { 4 } else { 8 };
         let data = &parts[1..];
         // The field after the data fields is the continuation field; beyond it the line is
@@ -266,6 +283,7 @@ pub(super) fn split_line(line: &str, loc: &Loc) -> Result<SplitLine, FeError> {
     }
     let chars: Vec<char> = expand_tabs(line).chars().collect();
     let first = column_slice(&chars, 0, 8);
+    check_first(&first, loc)?;
     let (per_line, width) = if first.ends_with('*') {
         (4, 16)
     } else {
@@ -277,11 +295,11 @@ pub(super) fn split_line(line: &str, loc: &Loc) -> Result<SplitLine, FeError> {
         if text.contains(char::is_whitespace) {
             return Err(lex_error(
                 loc,
+                // The field's text is not repeated: the file may be no deck at all.
                 format!(
-                    "field {} '{}' contains a blank (fixed-format fields are {width} columns \
-                     wide; check the alignment)",
-                    k + 2,
-                    shown(&text)
+                    "field {} contains a blank (fixed-format fields are {width} columns wide; \
+                     check the alignment)",
+                    k + 2
                 ),
             ));
         }

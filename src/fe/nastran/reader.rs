@@ -629,6 +629,17 @@ impl<'a, 's> DeckReader<'a, 's> {
     }
 
     fn include(&mut self, raw: &str, loc: Loc) -> Result<(), FeError> {
+        // Counted like a card: a deck of endless INCLUDE lines is bounded like one of cards.
+        self.cards += 1;
+        if self.cards > self.limits.max_cards {
+            return Err(lex_error(
+                &loc,
+                format!(
+                    "more than {} cards and INCLUDEs: the model exceeds DeckLimits::max_cards",
+                    self.limits.max_cards
+                ),
+            ));
+        }
         let name = self.include_name(raw, &loc)?;
         let (Some(root), Some(dir)) = (
             self.root.clone(),
