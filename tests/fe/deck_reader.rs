@@ -399,3 +399,45 @@ fn a_file_that_is_not_a_deck_is_not_echoed() {
     }
     let _ = std::fs::remove_dir_all(&dir);
 }
+
+#[test]
+fn symbolic_links_out_of_the_root_and_cards_across_files_are_refused() {
+    let dir = folder("links");
+    let model = dir.join("model");
+    write(&dir.join("outside.bdf"), "CONM2,2,1,,1.\n");
+    std::fs::create_dir_all(&model).unwrap();
+    std::os::unix::fs::symlink(dir.join("outside.bdf"), model.join("link.bdf")).unwrap();
+    let main = model.join("main.bdf");
+    write(&main, "GRID,1,,0.,0.,0.\nINCLUDE 'link.bdf'\n");
+    let err = read_bulk_deck(&main).unwrap_err().to_string();
+    assert!(err.contains("line 2") && err.contains("outside"), "{err}");
+    // A card may not continue in another file, and BEGIN BULK belongs to the deck itself.
+    write(&model.join("tail.bdf"), "+M1,0.1,,0.2,,,0.3\n");
+    write(
+        &main,
+        "GRID,1,,0.,0.,0.\nCONM2,2,1,,1.,,,,,+M1\nINCLUDE 'tail.bdf'\n",
+    );
+    let err = read_bulk_deck(&main).unwrap_err().to_string();
+    assert!(
+        err.contains("line 3") && err.contains("'+M1'") && err.contains("across an INCLUDE"),
+        "{err}"
+    );
+    write(&model.join("tail.bdf"), "CONM2,2,1,,1.\n");
+    write(
+        &main,
+        "GRID,1,,0.,0.,0.\nINCLUDE 'tail.bdf'\n,0.1,,0.2,,,0.3\n",
+    );
+    let err = read_bulk_deck(&main).unwrap_err().to_string();
+    assert!(
+        err.contains("line 3") && err.contains("line 1 of tail.bdf") && err.contains("across"),
+        "{err}"
+    );
+    write(&model.join("bulk.bdf"), "BEGIN BULK\nCONM2,2,1,,1.\n");
+    write(&main, "GRID,1,,0.,0.,0.\nINCLUDE 'bulk.bdf'\n");
+    let err = read_bulk_deck(&main).unwrap_err().to_string();
+    assert!(
+        err.contains("line 1 of bulk.bdf") && err.contains("BEGIN BULK"),
+        "{err}"
+    );
+    let _ = std::fs::remove_dir_all(&dir);
+}

@@ -422,6 +422,18 @@ impl<'a, 's> DeckReader<'a, 's> {
             return Ok(Flow::End);
         }
         if starts_with_word(head, "INCLUDE") {
+            if let Some(open) = self.open.as_ref().filter(|o| !o.marker.is_empty()) {
+                return Err(lex_error(
+                    &loc,
+                    format!(
+                        "the {} card at line {} ends with the continuation marker '{}' but an \
+                         INCLUDE follows: a card cannot continue across an INCLUDE",
+                        open.card.name,
+                        open.card.loc(),
+                        shown(&open.marker)
+                    ),
+                ));
+            }
             self.flush()?;
             self.include(raw, loc)?;
             return Ok(Flow::Continue);
