@@ -325,6 +325,10 @@ pub(super) fn is_begin_bulk(line: &str) -> bool {
 
 /// `SPC = n` in a case control line.
 pub(super) fn case_control_spc(line: &str, loc: &Loc) -> Result<Option<u32>, FeError> {
+    let head = line.trim_start().as_bytes();
+    if head.len() < 3 || !head[..3].eq_ignore_ascii_case(b"SPC") {
+        return Ok(None);
+    }
     let upper = strip_comment(line).trim().to_ascii_uppercase();
     let Some(rest) = upper.strip_prefix("SPC") else {
         return Ok(None);

@@ -153,7 +153,11 @@ pub fn parse_reader(
 
 /// Reads a bulk data file and its `INCLUDE`s with the default [`DeckOptions`].
 pub fn read_bulk_deck(path: &Path) -> Result<NastranBody, FeError> {
-    read_bulk_deck_with(path, &DeckOptions::default()).map(|(body, _)| body)
+    let mut cards = to_mesh::Collector::new();
+    let options = DeckOptions::default();
+    let info =
+        reader::read_file(path, &options, &mut cards, false).map_err(|e| prefixed(path, e))?;
+    to_mesh::build(cards, info.spc_selection).map_err(|e| prefixed(path, e))
 }
 
 fn prefixed(path: &Path, e: FeError) -> FeError {
@@ -172,7 +176,7 @@ pub fn read_bulk_deck_with(
     options: &DeckOptions,
 ) -> Result<(NastranBody, String), FeError> {
     let mut cards = to_mesh::Collector::new();
-    let info = reader::read_file(path, options, &mut cards).map_err(|e| prefixed(path, e))?;
+    let info = reader::read_file(path, options, &mut cards, true).map_err(|e| prefixed(path, e))?;
     let body = to_mesh::build(cards, info.spc_selection).map_err(|e| prefixed(path, e))?;
     Ok((body, info.sha256))
 }
@@ -182,7 +186,7 @@ pub fn read_bulk_deck_with(
 /// itself when it includes nothing, else of the list of (file relative to the deck's folder,
 /// SHA-256 of the file) in include order.
 pub fn deck_digest(path: &Path, options: &DeckOptions) -> Result<String, FeError> {
-    reader::read_file(path, options, &mut reader::Discard)
+    reader::read_file(path, options, &mut reader::Discard, true)
         .map(|info| info.sha256)
         .map_err(|e| prefixed(path, e))
 }

@@ -58,22 +58,25 @@ pub(crate) struct DeckInfo {
     /// `SPC = n` of the case control, if any.
     pub spc_selection: Option<u32>,
     /// SHA-256 (hex) of the deck: of the file itself when it includes nothing, else of the
-    /// list of (file, SHA-256 of the file) in the order the files were opened.
+    /// list of (file, SHA-256 of the file) in the order the files were opened ("" unless
+    /// hashing was asked for).
     pub sha256: String,
     /// Largest line buffer used (bytes): evidence that memory does not follow line length.
     pub peak_line_bytes: usize,
 }
 
-/// Hashes every byte read through it.
+/// Hashes every byte read through it (if asked to: hashing costs as much as lexing).
 struct Hashing<R> {
     inner: R,
-    hasher: Sha256,
+    hasher: Option<Sha256>,
 }
 
 impl<R: Read> Read for Hashing<R> {
     fn read(&mut self, buf: &mut [u8]) -> std::io::Result<usize> {
         let n = self.inner.read(buf)?;
-        self.hasher.update(&buf[..n]);
+        if let Some(h) = &mut self.hasher {
+            h.update(&buf[..n]);
+        }
         Ok(n)
     }
 }
@@ -97,13 +100,13 @@ struct Source<'a> {
 }
 
 impl<'a> Source<'a> {
-    fn new(read: Box<dyn Read + 'a>, name: Option<Arc<str>>, label: String) -> Self {
+    fn new(read: Box<dyn Read + 'a>, name: Option<Arc<str>>, label: String, hash: bool) -> Self {
         Self {
             reader: BufReader::with_capacity(
                 64 << 10,
                 Hashing {
                     inner: read,
-                    hasher: Sha256::new(),
+                    hasher: hash.then(Sha256::new),
                 },
             ),
             name,
@@ -206,6 +209,8 @@ struct DeckReader<'a, 's> {
     control_error: Option<FeError>,
     first_include: Option<Loc>,
     peak_line_bytes: usize,
+    /// Whether files are hashed for the digest.
+    hash: bool,
 }
 
 fn io_error(source: &Source, e: std::io::Error) -> FeError {
@@ -241,6 +246,7 @@ impl<'a, 's> DeckReader<'a, 's> {
             control_error: None,
             first_include: None,
             peak_line_bytes: 0,
+            hash: false,
         }
     }
 
@@ -252,8 +258,8 @@ impl<'a, 's> DeckReader<'a, 's> {
 
     fn pop(&mut self) {
         if let Some(source) = self.stack.pop() {
-            let digest = hex(&source.reader.into_inner().hasher.finalize());
-            self.digests[source.slot].1 = Some(digest);
+            let hasher = source.reader.into_inner().hasher;
+            self.digests[source.slot].1 = hasher.map(|h| hex(&h.finalize()));
         }
     }
 
@@ -296,10 +302,13 @@ impl<'a, 's> DeckReader<'a, 's> {
             }
             let text = std::str::from_utf8(&buf)
                 .map_err(|_| lex_error(&loc, "not UTF-8 text: not a text bulk data deck"))?;
-            if let Some((column, c)) = text
-                .chars()
-                .enumerate()
-                .find(|(_, c)| c.is_control() && !matches!(c, '\t' | '\r' | '\x0c'))
+            let control = |c: &char| c.is_control() && !matches!(c, '\t' | '\r' | '\x0c');
+            let ascii_clean = buf
+                .iter()
+                .all(|&b| (b >= 0x20 && b != 0x7f) || matches!(b, b'\t' | b'\r' | 0x0c));
+            if let Some((column, c)) = (!ascii_clean)
+                .then(|| text.chars().enumerate().find(|(_, c)| control(c)))
+                .flatten()
             {
                 return Err(lex_error(
                     &loc,
@@ -311,6 +320,9 @@ impl<'a, 's> DeckReader<'a, 's> {
                 ));
             }
             if let Flow::End = self.line(text.trim_end_matches('\r'), loc)? {
+                if !self.hash {
+                    self.stack.clear();
+                }
                 // The rest of every open file is not bulk data, but the digest covers whole
                 // files.
                 while let Some(source) = self.stack.last_mut() {
@@ -338,6 +350,7 @@ impl<'a, 's> DeckReader<'a, 's> {
             }
         }
         let sha256 = match self.digests.as_slice() {
+            _ if !self.hash => String::new(),
             [(_, Some(one))] => one.clone(),
             all => {
                 let mut h = Sha256::new();
@@ -361,6 +374,9 @@ impl<'a, 's> DeckReader<'a, 's> {
         let Mode::Unknown { bulk_ended } = self.mode else {
             return self.bulk_line(raw, loc);
         };
+        if strip_comment(raw).trim().is_empty() {
+            return Ok(Flow::Continue);
+        }
         if is_begin_bulk(raw) {
             if loc.file.is_some() {
                 return Err(lex_error(
@@ -712,7 +728,12 @@ impl<'a, 's> DeckReader<'a, 's> {
             ));
         }
         let file = open_regular(&path).map_err(|m| lex_error(&loc, format!("INCLUDE: {m}")))?;
-        let mut source = Source::new(Box::new(file), Some(label.as_str().into()), label);
+        let mut source = Source::new(
+            Box::new(file),
+            Some(label.as_str().into()),
+            label,
+            self.hash,
+        );
         source.path = Some(path);
         self.push(source);
         Ok(())
@@ -748,7 +769,7 @@ pub(crate) fn read_from<'a>(
     sink: &mut dyn CardSink,
 ) -> Result<DeckInfo, FeError> {
     let mut reader = DeckReader::new(limits, sink);
-    reader.push(Source::new(Box::new(input), None, "deck".into()));
+    reader.push(Source::new(Box::new(input), None, "deck".into(), false));
     reader.run()
 }
 
@@ -757,6 +778,7 @@ pub(crate) fn read_file(
     path: &Path,
     options: &DeckOptions,
     sink: &mut dyn CardSink,
+    hash: bool,
 ) -> Result<DeckInfo, FeError> {
     let io = |m: String| FeError::Io(format!("bulk data file: {m}"));
     let file = open_regular(path).map_err(io)?;
@@ -788,8 +810,9 @@ pub(crate) fn read_file(
         .unwrap_or_else(|| path.display().to_string());
     let mut reader = DeckReader::new(&options.limits, sink);
     reader.root = Some(root);
+    reader.hash = hash;
     reader.top_dir = Some(top_dir);
-    let mut source = Source::new(Box::new(file), None, label);
+    let mut source = Source::new(Box::new(file), None, label, hash);
     source.path = Some(canonical);
     reader.push(source);
     reader.run()
