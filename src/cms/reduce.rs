@@ -103,17 +103,18 @@ pub fn reduce_detailed(spec: &ReductionSpec) -> Result<Reduction, CmsError> {
 /// The body of a bulk data deck, its points named; the content must still be what the spec's
 /// checksum says (the cache key was made from it).
 fn deck_body(deck: &BulkDeckBody) -> Result<Chassis, CmsError> {
-    let text = crate::text_file::read_limited(&deck.path, crate::text_file::DATA_LIMIT)
+    let options = crate::fe::nastran::DeckOptions {
+        include_root: deck.include_root.clone(),
+        ..Default::default()
+    };
+    let (mut body, sha256) = crate::fe::nastran::read_bulk_deck_with(&deck.path, &options)
         .map_err(|e| CmsError::InvalidInput(format!("bulk data deck: {e}")))?;
-    if super::hash::sha256_hex(text.as_bytes()) != deck.sha256 {
+    if sha256 != deck.sha256 {
         return Err(CmsError::InvalidInput(format!(
-            "bulk data deck {} changed after its checksum was taken",
+            "bulk data deck {} (or a file it includes) changed after its checksum was taken",
             deck.path.display()
         )));
     }
-    let mut body = crate::fe::nastran::parse_str(&text).map_err(|e| {
-        CmsError::InvalidInput(format!("bulk data deck {}: {e}", deck.path.display()))
-    })?;
     body.name_points(&deck.points)?;
     crate::fe::checks::check_mesh(&body.mesh, &crate::fe::checks::CheckLimits::default())?;
     Ok(Chassis {

@@ -47,10 +47,14 @@ pub enum ModeSelection {
 pub struct BulkDeckBody {
     /// The deck's file.
     pub path: std::path::PathBuf,
-    /// SHA-256 of its content (hex).
+    /// SHA-256 (hex) of its content and of its INCLUDE files
+    /// ([`crate::fe::nastran::deck_digest`]).
     pub sha256: String,
     /// GRID id of every named point.
     pub points: std::collections::BTreeMap<String, u32>,
+    /// The folder the deck's INCLUDE files are confined to (`None`: the deck's folder).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub include_root: Option<std::path::PathBuf>,
 }
 
 /// Everything the reduction depends on.

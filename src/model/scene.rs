@@ -255,14 +255,25 @@ pub fn reduction_spec(
     options.validate()?;
     let (chassis, deck) = match &vehicle.body {
         BodyConfig::Procedural { chassis } => (chassis.as_ref().clone(), None),
-        BodyConfig::Nastran { path, points } => {
+        BodyConfig::Nastran {
+            path,
+            points,
+            include_root,
+        } => {
             options.procedural_only("a bulk data deck")?;
-            let text = crate::text_file::read_limited(path, crate::text_file::DATA_LIMIT)
+            // Streaming over the deck and its INCLUDEs: the key follows every file's content
+            // without holding any of them in memory.
+            let deck_options = crate::fe::nastran::DeckOptions {
+                include_root: include_root.clone(),
+                ..Default::default()
+            };
+            let sha256 = crate::fe::nastran::deck_digest(path, &deck_options)
                 .map_err(|e| format!("bulk data deck: {e}"))?;
             let deck = BulkDeckBody {
                 path: path.clone(),
-                sha256: crate::cms::sha256_hex(text.as_bytes()),
+                sha256,
                 points: points.clone(),
+                include_root: include_root.clone(),
             };
             (ChassisConfig::default(), Some(deck))
         }

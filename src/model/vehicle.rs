@@ -35,12 +35,18 @@ pub enum BodyConfig {
     /// A user's body from a Nastran bulk data deck ([`crate::fe::nastran`]), reduced by
     /// Craig-Bampton like the procedural one; `points` names the GRID ids the mounts
     /// (`body_node`) and the outputs refer to. A relative path is taken from the configuration
-    /// file's folder.
+    /// file's folder. Read from a file, the configuration confines the deck to its own folder
+    /// (or below), or to `include_root` if given; the deck's INCLUDE files are confined to the
+    /// deck's folder, or to `include_root`.
     Nastran {
         /// The bulk data deck.
         path: PathBuf,
         /// GRID id of every named point (mount body nodes, outputs).
         points: std::collections::BTreeMap<String, u32>,
+        /// The folder the deck and its INCLUDE files may lie in (relative: to the
+        /// configuration file's folder).
+        #[serde(default, skip_serializing_if = "Option::is_none")]
+        include_root: Option<PathBuf>,
     },
     /// Modal data of an already reduced body: the JSON of a [`crate::cms::ReducedChassis`]
     /// (frequencies, damping ratios, named points with their mode-shape rows). A relative path is
@@ -49,6 +55,37 @@ pub enum BodyConfig {
         /// The JSON file of the reduced body.
         path: PathBuf,
     },
+}
+
+/// A deck named by a configuration file must lie in `root` (checked on the resolved paths, so
+/// neither `..` nor a symbolic link leads out of it) before anything of it is read.
+fn confine_deck(deck: &std::path::Path, root: &std::path::Path) -> Result<(), ConfigError> {
+    let root_dir = if root.as_os_str().is_empty() {
+        std::path::Path::new(".")
+    } else {
+        root
+    };
+    let root = std::fs::canonicalize(root_dir).map_err(|e| {
+        err(
+            "body.include_root",
+            format!("folder {} cannot be used: {e}", root_dir.display()),
+        )
+    })?;
+    let canonical = std::fs::canonicalize(deck)
+        .map_err(|e| err("body.path", format!("cannot read {}: {e}", deck.display())))?;
+    if canonical.starts_with(&root) {
+        Ok(())
+    } else {
+        Err(err(
+            "body.path",
+            format!(
+                "the deck {} is outside {}, the folder decks are confined to (set \
+                 body.include_root to allow another folder)",
+                deck.display(),
+                root.display()
+            ),
+        ))
+    }
 }
 
 /// The complete vehicle.
@@ -189,14 +226,24 @@ impl VehicleConfig {
         let text = crate::text_file::read_limited(path, crate::text_file::CONFIG_LIMIT)
             .map_err(|e| err("file", e))?;
         let mut config = Self::from_json(&text)?;
+        let dir = path.parent().unwrap_or(std::path::Path::new(""));
         if let BodyConfig::Reduced { path: body } | BodyConfig::Nastran { path: body, .. } =
             &mut config.body
         {
             if body.is_relative() {
-                if let Some(dir) = path.parent() {
-                    *body = dir.join(&*body);
-                }
+                *body = dir.join(&*body);
             }
+        }
+        if let BodyConfig::Nastran {
+            path: deck,
+            include_root,
+            ..
+        } = &mut config.body
+        {
+            if let Some(root) = include_root.as_mut().filter(|r| r.is_relative()) {
+                *root = dir.join(&*root);
+            }
+            confine_deck(deck, include_root.as_deref().unwrap_or(dir))?;
         }
         Ok(config)
     }

@@ -57,6 +57,7 @@ fn the_procedural_chassis_as_a_bulk_deck_gives_the_same_coupled_modes() {
     from_deck.body = BodyConfig::Nastran {
         path: path.clone(),
         points,
+        include_root: None,
     };
     let (a, b) = (modes(&procedural), modes(&from_deck));
     assert_eq!(a.len(), b.len());

@@ -1,6 +1,8 @@
 //! Integration tests of the finite elements and the procedural chassis (`src/fe`) against analytic results.
 
 mod chassis;
+mod deck_properties;
+mod deck_reader;
 mod eigen;
 mod elements;
 mod nastran;

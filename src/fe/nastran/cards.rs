@@ -1,7 +1,7 @@
 //! Typed bulk data cards: each supported card's fields read by position with Nastran's types
 //! and defaults; every malformed field is an error naming the line, field number and meaning.
 
-use super::lexer::{classify, RawCard, Value};
+use super::lexer::{classify, Loc, RawCard, Value};
 use crate::fe::error::FeError;
 
 /// Typed access to the fields of one card.
@@ -19,10 +19,10 @@ impl<'a> Reader<'a> {
     }
 
     /// Where data field `i` is (or would be): line and Nastran field number.
-    fn place(&self, i: usize) -> (usize, usize) {
+    fn place(&self, i: usize) -> (Loc, usize) {
         match self.card.fields.get(i) {
-            Some(f) => (f.line, f.position),
-            None => (self.card.line, i % 8 + 2),
+            Some(f) => (self.card.loc_of_line(f.line), f.position),
+            None => (self.card.loc(), i % 8 + 2),
         }
     }
 
@@ -31,7 +31,8 @@ impl<'a> Reader<'a> {
         FeError::InvalidInput(format!(
             "Nastran bulk data line {line}: {} (card at line {}) field {position} ({name}): \
              {message}",
-            self.card.name, self.card.line
+            self.card.name,
+            self.card.loc()
         ))
     }
 
@@ -39,7 +40,8 @@ impl<'a> Reader<'a> {
     pub(crate) fn card_error(&self, message: impl std::fmt::Display) -> FeError {
         FeError::InvalidInput(format!(
             "Nastran bulk data line {}: {}: {message}",
-            self.card.line, self.card.name
+            self.card.loc(),
+            self.card.name
         ))
     }
 
@@ -186,7 +188,7 @@ pub struct Grid {
     pub cp: Option<u32>,
     pub x: [f64; 3],
     pub ps: [bool; 6],
-    pub line: usize,
+    pub line: Loc,
 }
 
 pub(crate) fn grid(r: &Reader) -> Result<Grid, FeError> {
@@ -211,7 +213,7 @@ pub(crate) fn grid(r: &Reader) -> Result<Grid, FeError> {
             r.real_or(4, "X3", 0.0)?,
         ],
         ps,
-        line: r.card().line,
+        line: r.card().loc(),
     })
 }
 
@@ -223,7 +225,7 @@ pub struct Cord2r {
     pub a: [f64; 3],
     pub b: [f64; 3],
     pub c: [f64; 3],
-    pub line: usize,
+    pub line: Loc,
 }
 
 pub(crate) fn cord2r(r: &Reader) -> Result<Cord2r, FeError> {
@@ -241,7 +243,7 @@ pub(crate) fn cord2r(r: &Reader) -> Result<Cord2r, FeError> {
         a: p(2, "A")?,
         b: p(5, "B")?,
         c: p(8, "C")?,
-        line: r.card().line,
+        line: r.card().loc(),
     })
 }
 
@@ -253,7 +255,7 @@ pub struct Mat1 {
     pub g: Option<f64>,
     pub nu: Option<f64>,
     pub rho: f64,
-    pub line: usize,
+    pub line: Loc,
 }
 
 pub(crate) fn mat1(r: &Reader) -> Result<Mat1, FeError> {
@@ -277,7 +279,7 @@ pub(crate) fn mat1(r: &Reader) -> Result<Mat1, FeError> {
         g: r.opt_real(2, "G")?,
         nu: r.opt_real(3, "NU")?,
         rho: r.real_or(4, "RHO", 0.0)?,
-        line: r.card().line,
+        line: r.card().loc(),
     })
 }
 
@@ -292,7 +294,7 @@ pub struct Pshell {
     pub mid3: Option<u32>,
     pub ts_t: f64,
     pub nsm: f64,
-    pub line: usize,
+    pub line: Loc,
 }
 
 pub(crate) fn pshell(r: &Reader) -> Result<Pshell, FeError> {
@@ -309,7 +311,7 @@ pub(crate) fn pshell(r: &Reader) -> Result<Pshell, FeError> {
         mid3: r.opt_id(5, "MID3")?,
         ts_t: r.real_or(6, "TS/T", 0.833333)?,
         nsm: r.real_or(7, "NSM", 0.0)?,
-        line: r.card().line,
+        line: r.card().loc(),
     })
 }
 
@@ -323,7 +325,7 @@ pub struct BeamProperty {
     pub i2: f64,
     pub j: f64,
     pub nsm: f64,
-    pub line: usize,
+    pub line: Loc,
 }
 
 pub(crate) fn pbar(r: &Reader) -> Result<BeamProperty, FeError> {
@@ -354,7 +356,7 @@ pub(crate) fn pbar(r: &Reader) -> Result<BeamProperty, FeError> {
         i2: r.real_or(4, "I2", 0.0)?,
         j: r.real_or(5, "J", 0.0)?,
         nsm: r.real_or(6, "NSM", 0.0)?,
-        line: r.card().line,
+        line: r.card().loc(),
     })
 }
 
@@ -367,7 +369,7 @@ pub(crate) fn pbeam(r: &Reader) -> Result<BeamProperty, FeError> {
         i2: r.real_or(4, "I2(A)", 0.0)?,
         j: r.real_or(6, "J(A)", 0.0)?,
         nsm: r.real_or(7, "NSM(A)", 0.0)?,
-        line: r.card().line,
+        line: r.card().loc(),
     };
     r.require_blank(5, "I12(A)", "unsymmetric sections are not supported")?;
     for k in 8..16 {
@@ -456,7 +458,7 @@ pub struct Bar {
     pub ga: u32,
     pub gb: u32,
     pub orientation: Orientation,
-    pub line: usize,
+    pub line: Loc,
 }
 
 pub(crate) fn bar(r: &Reader, is_beam: bool) -> Result<Bar, FeError> {
@@ -517,7 +519,7 @@ pub(crate) fn bar(r: &Reader, is_beam: bool) -> Result<Bar, FeError> {
         ga: r.id(2, "GA")?,
         gb: r.id(3, "GB")?,
         orientation,
-        line: r.card().line,
+        line: r.card().loc(),
     })
 }
 
@@ -527,7 +529,7 @@ pub struct Plate {
     pub id: u32,
     pub pid: u32,
     pub grids: Vec<u32>,
-    pub line: usize,
+    pub line: Loc,
 }
 
 pub(crate) fn plate(r: &Reader, corners: usize) -> Result<Plate, FeError> {
@@ -549,7 +551,7 @@ pub(crate) fn plate(r: &Reader, corners: usize) -> Result<Plate, FeError> {
         id,
         pid: r.opt_id(1, "PID")?.unwrap_or(id),
         grids,
-        line: r.card().line,
+        line: r.card().loc(),
     })
 }
 
@@ -564,7 +566,7 @@ pub struct Conm2 {
     pub x: [f64; 3],
     /// I11, I21, I22, I31, I32, I33 as entered.
     pub inertia: [f64; 6],
-    pub line: usize,
+    pub line: Loc,
 }
 
 pub(crate) fn conm2(r: &Reader) -> Result<Conm2, FeError> {
@@ -590,7 +592,7 @@ pub(crate) fn conm2(r: &Reader) -> Result<Conm2, FeError> {
             r.real_or(6, "X3", 0.0)?,
         ],
         inertia,
-        line: r.card().line,
+        line: r.card().loc(),
     })
 }
 
@@ -609,7 +611,7 @@ pub struct Scalar {
     pub id: u32,
     pub value: ScalarValue,
     pub ends: Vec<(u32, usize)>,
-    pub line: usize,
+    pub line: Loc,
 }
 
 pub(crate) fn scalar(r: &Reader, direct: bool, spring: bool) -> Result<Scalar, FeError> {
@@ -645,7 +647,7 @@ pub(crate) fn scalar(r: &Reader, direct: bool, spring: bool) -> Result<Scalar, F
         id,
         value,
         ends,
-        line: r.card().line,
+        line: r.card().loc(),
     })
 }
 
@@ -676,7 +678,7 @@ pub struct Rbe2 {
     pub independent: u32,
     pub components: [bool; 6],
     pub dependent: Vec<u32>,
-    pub line: usize,
+    pub line: Loc,
 }
 
 pub(crate) fn rbe2(r: &Reader) -> Result<Rbe2, FeError> {
@@ -704,7 +706,7 @@ pub(crate) fn rbe2(r: &Reader) -> Result<Rbe2, FeError> {
         independent: r.id(1, "GN")?,
         components: r.components(2, "CM")?,
         dependent,
-        line: r.card().line,
+        line: r.card().loc(),
     })
 }
 
@@ -716,7 +718,7 @@ pub struct Rbe3 {
     pub reference_components: [bool; 6],
     /// (weight, components, grids).
     pub groups: Vec<(f64, [bool; 6], Vec<u32>)>,
-    pub line: usize,
+    pub line: Loc,
 }
 
 pub(crate) fn rbe3(r: &Reader) -> Result<Rbe3, FeError> {
@@ -767,7 +769,7 @@ pub(crate) fn rbe3(r: &Reader) -> Result<Rbe3, FeError> {
         reference: r.id(2, "REFGRID")?,
         reference_components: r.components(3, "REFC")?,
         groups,
-        line: r.card().line,
+        line: r.card().loc(),
     })
 }
 

@@ -2,7 +2,28 @@
 //! free field (commas), continuation lines (`+`, `*` or blank first field), `$` comments,
 //! optional executive/case control before `BEGIN BULK`, `ENDDATA`. Also Nastran's number forms.
 
+use std::sync::Arc;
+
 use crate::fe::error::FeError;
+
+/// Where a card or field is: line, and the included file it is in (`None`: the deck itself).
+/// Displays as `12` or `12 of sub/b.bdf`, so messages read "line 12 of sub/b.bdf".
+#[derive(Debug, Clone, PartialEq, Eq, Default)]
+pub struct Loc {
+    /// 1-based line number in its file.
+    pub line: usize,
+    /// The included file, relative to the top deck's folder.
+    pub file: Option<Arc<str>>,
+}
+
+impl std::fmt::Display for Loc {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        match &self.file {
+            None => write!(f, "{}", self.line),
+            Some(file) => write!(f, "{} of {file}", self.line),
+        }
+    }
+}
 
 /// One data field with where it came from.
 #[derive(Debug, Clone, PartialEq)]
@@ -23,8 +44,46 @@ pub struct RawCard {
     pub name: String,
     /// 1-based line of the card's first line.
     pub line: usize,
+    /// The included file the card is in (`None`: the deck itself).
+    pub file: Option<Arc<str>>,
     /// Data fields in order.
     pub fields: Vec<Field>,
+}
+
+impl RawCard {
+    /// Where the card starts.
+    pub fn loc(&self) -> Loc {
+        self.loc_of_line(self.line)
+    }
+
+    /// Line `line` of the card's file.
+    pub fn loc_of_line(&self, line: usize) -> Loc {
+        Loc {
+            line,
+            file: self.file.clone(),
+        }
+    }
+}
+
+/// Receives cards one at a time as the deck is read, so only the model built from them stays in
+/// memory.
+pub(crate) trait CardSink {
+    /// One complete card (continuations joined, trailing blank fields removed).
+    fn card(&mut self, card: RawCard) -> Result<(), FeError>;
+    /// Forgets every card so far: lines read before `BEGIN BULK` turned out to be control
+    /// sections, not bulk data.
+    fn reset(&mut self);
+}
+
+impl CardSink for Vec<RawCard> {
+    fn card(&mut self, card: RawCard) -> Result<(), FeError> {
+        self.push(card);
+        Ok(())
+    }
+
+    fn reset(&mut self) {
+        self.clear();
+    }
 }
 
 /// The bulk data cards and what the case control selects.
@@ -112,7 +171,7 @@ pub fn parse_real(text: &str) -> Option<f64> {
     value.is_finite().then_some(value)
 }
 
-fn strip_comment(line: &str) -> &str {
+pub(super) fn strip_comment(line: &str) -> &str {
     match line.find('$') {
         Some(p) => &line[..p],
         None => line,
@@ -143,25 +202,67 @@ fn column_slice(chars: &[char], from: usize, width: usize) -> String {
         .to_ascii_uppercase()
 }
 
-fn lex_error(line: usize, message: impl std::fmt::Display) -> FeError {
-    FeError::InvalidInput(format!("Nastran bulk data line {line}: {message}"))
+pub(super) fn lex_error(loc: &Loc, message: impl std::fmt::Display) -> FeError {
+    FeError::InvalidInput(format!("Nastran bulk data line {loc}: {message}"))
 }
 
-/// Splits one bulk data line into its first field and data fields `(text, position)`.
-fn split_line(line: &str, lineno: usize) -> Result<(String, Vec<(String, usize)>), FeError> {
+/// `text` for a message about a file that may not be a deck at all: at most 16 characters,
+/// anything but printable ASCII shown as `?`, so a wrong path cannot make the error repeat the
+/// content of an unrelated file.
+pub(super) fn shown(text: &str) -> String {
+    let mut out: String = text
+        .chars()
+        .take(16)
+        .map(|c| if c.is_ascii_graphic() { c } else { '?' })
+        .collect();
+    if text.chars().count() > 16 {
+        out.push_str("...");
+    }
+    out
+}
+
+/// One bulk data line cut into fields.
+pub(super) struct SplitLine {
+    /// Field 1: card name or continuation marker.
+    pub first: String,
+    /// Data fields `(text, Nastran field number)`.
+    pub fields: Vec<(String, usize)>,
+    /// Field 10: the continuation marker the next line must repeat ("" if blank).
+    pub marker: String,
+}
+
+/// Field 1 must be a card name (letters and digits, `*` for large field) or a continuation
+/// marker (blank, `+…`, `*…`). Checked before the data fields, so a file that is no deck gets
+/// at most its first field repeated in the message.
+fn check_first(first: &str, loc: &Loc) -> Result<(), FeError> {
+    let name = first.trim_end_matches('*');
+    let is_name = !name.is_empty() && name.chars().all(|c| c.is_ascii_alphanumeric());
+    if first.is_empty() || first.starts_with(['+', '*']) || is_name {
+        Ok(())
+    } else {
+        Err(lex_error(
+            loc,
+            format!("'{}' is not a card name", shown(first)),
+        ))
+    }
+}
+
+/// Splits one bulk data line into its first field, data fields and continuation field.
+pub(super) fn split_line(line: &str, loc: &Loc) -> Result<SplitLine, FeError> {
     if line.contains(',') {
         let parts: Vec<String> = line
             .split(',')
             .map(|p| p.trim().to_ascii_uppercase())
             .collect();
         let first = parts[0].clone();
+        check_first(&first, loc)?;
         let per_line = if first.ends_with('*') { 4 } else { 8 };
         let data = &parts[1..];
-        // The field after the data fields is the (ignored) continuation field; beyond it the
-        // line is malformed.
+        // The field after the data fields is the continuation field; beyond it the line is
+        // malformed.
         if data.len() > per_line + 1 {
             return Err(lex_error(
-                lineno,
+                loc,
                 format!(
                     "free-field line has {} data fields, at most {per_line} plus a continuation \
                      field are allowed",
@@ -173,10 +274,16 @@ fn split_line(line: &str, lineno: usize) -> Result<(String, Vec<(String, usize)>
         let fields = (0..per_line)
             .map(|k| (data.get(k).cloned().unwrap_or_default(), k + 2))
             .collect();
-        return Ok((first, fields));
+        let marker = data.get(per_line).cloned().unwrap_or_default();
+        return Ok(SplitLine {
+            first,
+            fields,
+            marker,
+        });
     }
     let chars: Vec<char> = expand_tabs(line).chars().collect();
     let first = column_slice(&chars, 0, 8);
+    check_first(&first, loc)?;
     let (per_line, width) = if first.ends_with('*') {
         (4, 16)
     } else {
@@ -187,30 +294,41 @@ fn split_line(line: &str, lineno: usize) -> Result<(String, Vec<(String, usize)>
         let text = column_slice(&chars, 8 + k * width, width);
         if text.contains(char::is_whitespace) {
             return Err(lex_error(
-                lineno,
+                loc,
+                // The field's text is not repeated: the file may be no deck at all.
                 format!(
-                    "field {} '{text}' contains a blank (fixed-format fields are {width} columns \
-                     wide; check the alignment)",
+                    "field {} contains a blank (fixed-format fields are {width} columns wide; \
+                     check the alignment)",
                     k + 2
                 ),
             ));
         }
         fields.push((text, k + 2));
     }
-    Ok((first, fields))
+    let marker = column_slice(&chars, 72, 8);
+    Ok(SplitLine {
+        first,
+        fields,
+        marker,
+    })
 }
 
-fn is_begin_bulk(line: &str) -> bool {
+pub(super) fn is_begin_bulk(line: &str) -> bool {
     let compact: String = strip_comment(line)
         .chars()
         .filter(|c| !c.is_whitespace() && *c != ',')
+        .take(9)
         .collect::<String>()
         .to_ascii_uppercase();
     compact.starts_with("BEGINBULK")
 }
 
 /// `SPC = n` in a case control line.
-fn case_control_spc(line: &str, lineno: usize) -> Result<Option<u32>, FeError> {
+pub(super) fn case_control_spc(line: &str, loc: &Loc) -> Result<Option<u32>, FeError> {
+    let head = line.trim_start().as_bytes();
+    if head.len() < 3 || !head[..3].eq_ignore_ascii_case(b"SPC") {
+        return Ok(None);
+    }
     let upper = strip_comment(line).trim().to_ascii_uppercase();
     let Some(rest) = upper.strip_prefix("SPC") else {
         return Ok(None);
@@ -220,85 +338,20 @@ fn case_control_spc(line: &str, lineno: usize) -> Result<Option<u32>, FeError> {
     };
     value.trim().parse::<u32>().map(Some).map_err(|_| {
         lex_error(
-            lineno,
-            format!("case control '{}' is not SPC = <set id>", upper),
+            loc,
+            format!("case control '{}' is not SPC = <set id>", shown(&upper)),
         )
     })
 }
 
-/// Splits `text` into cards.
+/// Splits `text` into cards (an in-memory deck: `INCLUDE` is refused, there is no folder to
+/// resolve it against).
 pub fn lex(text: &str) -> Result<Deck, FeError> {
-    let has_begin_bulk = text.lines().any(is_begin_bulk);
-    let mut in_bulk = !has_begin_bulk;
-    let mut spc_selection: Option<u32> = None;
     let mut cards: Vec<RawCard> = Vec::new();
-    for (k, raw) in text.lines().enumerate() {
-        let lineno = k + 1;
-        if !in_bulk {
-            if is_begin_bulk(raw) {
-                in_bulk = true;
-            } else if let Some(set) = case_control_spc(raw, lineno)? {
-                if spc_selection.is_some_and(|s| s != set) {
-                    return Err(lex_error(
-                        lineno,
-                        "subcases select different SPC sets; one body needs one set of supports",
-                    ));
-                }
-                spc_selection = Some(set);
-            }
-            continue;
-        }
-        let line = strip_comment(raw.trim_end_matches('\r'));
-        if line.trim().is_empty() {
-            continue;
-        }
-        let head = line.trim_start().to_ascii_uppercase();
-        if head.starts_with("ENDDATA") {
-            break;
-        }
-        if head.starts_with("INCLUDE") {
-            return Err(lex_error(
-                lineno,
-                "INCLUDE is not supported: merge the included file into one bulk data file",
-            ));
-        }
-        if !line.is_ascii() {
-            return Err(lex_error(lineno, "non-ASCII character in bulk data"));
-        }
-        let (first, data) = split_line(line, lineno)?;
-        let fields = data.into_iter().map(|(text, position)| Field {
-            text,
-            line: lineno,
-            position,
-        });
-        if first.is_empty() || first.starts_with('+') || first.starts_with('*') {
-            let Some(card) = cards.last_mut() else {
-                return Err(lex_error(
-                    lineno,
-                    "continuation line without a card before it",
-                ));
-            };
-            card.fields.extend(fields);
-        } else {
-            let name = first.trim_end_matches('*').to_string();
-            if name.is_empty() || !name.chars().all(|c| c.is_ascii_alphanumeric()) {
-                return Err(lex_error(lineno, format!("'{first}' is not a card name")));
-            }
-            cards.push(RawCard {
-                name,
-                line: lineno,
-                fields: fields.collect(),
-            });
-        }
-    }
-    for card in &mut cards {
-        while card.fields.last().is_some_and(|f| f.text.is_empty()) {
-            card.fields.pop();
-        }
-    }
+    let info = super::reader::read_text(text, &super::reader::DeckLimits::default(), &mut cards)?;
     Ok(Deck {
         cards,
-        spc_selection,
+        spc_selection: info.spc_selection,
     })
 }
 

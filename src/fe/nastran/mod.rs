@@ -1,9 +1,27 @@
 //! Nastran bulk data input and output: a user's car body as a [`Mesh`].
 //!
-//! Reading: [`read_bulk_deck`] / [`parse_str`] → [`NastranBody`] (mesh + GRID id → node index).
+//! Reading: [`read_bulk_deck`] / [`read_bulk_deck_with`] / [`parse_str`] / [`parse_reader`] →
+//! [`NastranBody`] (mesh + GRID id → node index).
 //! Formats: small field, large field (`*`), free field (commas), continuations (`+`, `*`,
-//! blank first field), `$` comments, optional executive and case control before `BEGIN BULK`
-//! (only `SPC = n` is read from it), `ENDDATA`. Units are taken as given (use SI: m, kg, s, N).
+//! blank first field; a continuation marker must repeat field 10 of the line before, and the
+//! last card may not end with a marker), `$` comments, optional executive and case control
+//! before `BEGIN BULK` (only `SPC = n` is read from it; a deck without `BEGIN BULK` is all bulk
+//! data), `ENDDATA`. Units are taken as given (use SI: m, kg, s, N).
+//!
+//! The reader streams: one physical line at a time (at most [`DeckLimits::max_line_bytes`],
+//! a longer line is refused without reading its rest), each card handed to the model as soon as
+//! it is complete, so memory follows the model, which [`DeckLimits`] bounds (cards, fields per
+//! card), not the length of a line or a file. NUL and other control bytes, non-UTF-8 text and
+//! non-ASCII bulk data are refused at their line.
+//!
+//! `INCLUDE 'file'` (quoted, the name may continue over lines; or one unquoted word) in the
+//! bulk data reads `file` in place, relative to the including file's folder. Every file must lie
+//! in [`DeckOptions::include_root`] (default: the top deck's folder), checked on the resolved
+//! path (no `..` or symbolic link out of it); cycles and nesting deeper than
+//! [`DeckLimits::max_include_depth`] are refused naming the chain; `INCLUDE` before `BEGIN BULK`
+//! is refused (Nastran would read it as control statements, which this reader skips); a card
+//! does not continue across files. Errors name the line and, in an included file, the file
+//! (`line 12 of sub/grids.bdf`).
 //!
 //! Cards and how they map:
 //! - GRID (CP → CORD2R, coordinates converted to basic; CD must be 0/blank; PS → supports),
@@ -35,20 +53,19 @@
 
 mod cards;
 mod lexer;
+mod reader;
 mod to_mesh;
 mod writer;
 
 use std::collections::BTreeMap;
 use std::path::Path;
 
-pub use lexer::{classify, parse_real, Value};
+pub use lexer::{classify, lex, parse_real, Deck, Field, Loc, RawCard, Value};
+pub use reader::{DeckLimits, DeckOptions};
 pub use writer::write_bulk_deck;
 
 use super::error::FeError;
 use super::mesh::Mesh;
-
-/// Largest bulk data file read (bytes).
-pub const MAX_FILE_BYTES: u64 = 256 * 1024 * 1024;
 
 /// Nastran ids of the mesh entities, in mesh order (`beams[i]` is the CBAR/CBEAM id of
 /// `mesh.beams[i]`, …). A CONM2 with an offset appears in `masses` and in `rigid_links`.
@@ -117,17 +134,69 @@ impl NastranBody {
     }
 }
 
-/// Parses bulk data text (see the module documentation for what is accepted).
+/// Parses bulk data text (see the module documentation for what is accepted; `INCLUDE` needs
+/// a file: [`read_bulk_deck`]).
 pub fn parse_str(text: &str) -> Result<NastranBody, FeError> {
-    to_mesh::build(&lexer::lex(text)?)
+    parse_reader(text.as_bytes(), &DeckLimits::default())
 }
 
-/// Reads a bulk data file: a regular file of at most [`MAX_FILE_BYTES`], UTF-8/ASCII text.
+/// Parses bulk data from a reader, line by line (no `INCLUDE`: there is no folder to resolve
+/// it against).
+pub fn parse_reader(
+    input: impl std::io::Read,
+    limits: &DeckLimits,
+) -> Result<NastranBody, FeError> {
+    let mut cards = to_mesh::Collector::new();
+    let info = reader::read_from(input, limits, &mut cards)?;
+    to_mesh::build(cards, info.spc_selection)
+}
+
+/// Reads a bulk data file and its `INCLUDE`s with the default [`DeckOptions`].
 pub fn read_bulk_deck(path: &Path) -> Result<NastranBody, FeError> {
-    let text = crate::text_file::read_limited(path, MAX_FILE_BYTES)
-        .map_err(|e| FeError::Io(format!("bulk data file: {e}")))?;
-    parse_str(&text).map_err(|e| match e {
+    let mut cards = to_mesh::Collector::new();
+    let options = DeckOptions::default();
+    let info =
+        reader::read_file(path, &options, &mut cards, false).map_err(|e| prefixed(path, e))?;
+    to_mesh::build(cards, info.spc_selection).map_err(|e| prefixed(path, e))
+}
+
+fn prefixed(path: &Path, e: FeError) -> FeError {
+    match e {
         FeError::InvalidInput(m) => FeError::InvalidInput(format!("{}: {m}", path.display())),
         other => other,
-    })
+    }
+}
+
+/// Reads a bulk data file streaming: a regular file of UTF-8/ASCII text, its `INCLUDE 'file'`
+/// statements (bulk data only) resolved relative to the including file and confined to
+/// `options.include_root` (default: the deck's folder), within `options.limits`. Returns the
+/// body and the deck's SHA-256 ([`deck_digest`]).
+pub fn read_bulk_deck_with(
+    path: &Path,
+    options: &DeckOptions,
+) -> Result<(NastranBody, String), FeError> {
+    let mut cards = to_mesh::Collector::new();
+    let info = reader::read_file(path, options, &mut cards, true).map_err(|e| prefixed(path, e))?;
+    let body = to_mesh::build(cards, info.spc_selection).map_err(|e| prefixed(path, e))?;
+    Ok((body, info.sha256))
+}
+
+/// SHA-256 (hex) of a deck and its `INCLUDE`s, read streaming with the same rules as
+/// [`read_bulk_deck_with`] (so a deck that does not lex is refused here already): of the file
+/// itself when it includes nothing, else of the list of (file relative to the deck's folder,
+/// SHA-256 of the file) in include order.
+pub fn deck_digest(path: &Path, options: &DeckOptions) -> Result<String, FeError> {
+    reader::read_file(path, options, &mut reader::Discard, true)
+        .map(|info| info.sha256)
+        .map_err(|e| prefixed(path, e))
+}
+
+/// Lexes bulk data from a reader without building a body and returns the largest line
+/// buffer used (bytes): lets tests check that memory does not follow line or file length.
+#[doc(hidden)]
+pub fn lex_reader_peak_line_bytes(
+    input: impl std::io::Read,
+    limits: &DeckLimits,
+) -> Result<usize, FeError> {
+    reader::read_from(input, limits, &mut reader::Discard).map(|info| info.peak_line_bytes)
 }

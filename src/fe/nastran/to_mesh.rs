@@ -6,7 +6,7 @@ use std::collections::{BTreeMap, BTreeSet};
 use nalgebra::{Matrix3, Vector3};
 
 use super::cards::{self, Orientation, Reader, ScalarValue};
-use super::lexer::{Deck, Value};
+use super::lexer::{CardSink, Loc, RawCard, Value};
 use super::NastranBody;
 use crate::fe::error::FeError;
 use crate::fe::mesh::{
@@ -19,7 +19,7 @@ const IGNORED_PARAMS: [&str; 8] = [
     "POST", "GRDPNT", "AUTOSPC", "PRGPST", "MAXRATIO", "OGEOM", "NOCOMPS", "BAILOUT",
 ];
 
-fn mesh_error(line: usize, message: impl std::fmt::Display) -> FeError {
+fn mesh_error(line: impl std::fmt::Display, message: impl std::fmt::Display) -> FeError {
     FeError::InvalidInput(format!("Nastran bulk data line {line}: {message}"))
 }
 
@@ -30,8 +30,8 @@ struct Cards {
     materials: BTreeMap<u32, cards::Mat1>,
     shell_properties: BTreeMap<u32, cards::Pshell>,
     beam_properties: BTreeMap<u32, (cards::BeamProperty, &'static str)>,
-    spring_properties: BTreeMap<u32, (f64, usize)>,
-    damper_properties: BTreeMap<u32, (f64, usize)>,
+    spring_properties: BTreeMap<u32, (f64, Loc)>,
+    damper_properties: BTreeMap<u32, (f64, Loc)>,
     bars: BTreeMap<u32, cards::Bar>,
     plates: BTreeMap<u32, (cards::Plate, &'static str)>,
     masses: BTreeMap<u32, cards::Conm2>,
@@ -39,8 +39,8 @@ struct Cards {
     dampers: BTreeMap<u32, cards::Scalar>,
     rigid: BTreeMap<u32, cards::Rbe2>,
     interpolation: BTreeMap<u32, cards::Rbe3>,
-    supports: Vec<(cards::Support, usize)>,
-    element_lines: BTreeMap<u32, (usize, String)>,
+    supports: Vec<(cards::Support, Loc)>,
+    element_lines: BTreeMap<u32, (Loc, String)>,
     mass_scale: f64,
 }
 
@@ -48,7 +48,7 @@ fn insert_unique<T>(
     map: &mut BTreeMap<u32, T>,
     what: &str,
     id: u32,
-    line: usize,
+    line: &Loc,
     value: T,
 ) -> Result<(), FeError> {
     if map.insert(id, value).is_some() {
@@ -59,42 +59,47 @@ fn insert_unique<T>(
 
 impl Cards {
     /// Element ids are unique over all element cards, as in Nastran.
-    fn element_id(&mut self, id: u32, line: usize, name: &str) -> Result<(), FeError> {
+    fn element_id(&mut self, id: u32, line: &Loc, name: &str) -> Result<(), FeError> {
         if let Some((first, other)) = self.element_lines.get(&id) {
             return Err(mesh_error(
                 line,
                 format!("{name} {id}: element id already used by {other} at line {first}"),
             ));
         }
-        self.element_lines.insert(id, (line, name.to_string()));
+        self.element_lines
+            .insert(id, (line.clone(), name.to_string()));
         Ok(())
     }
 
     /// Long on purpose: a table, one arm per card kind.
-    fn read(deck: &Deck) -> Result<Self, FeError> {
-        let mut c = Cards {
+    fn new() -> Self {
+        Cards {
             mass_scale: 1.0,
             ..Cards::default()
-        };
-        for raw in &deck.cards {
+        }
+    }
+
+    fn add(&mut self, raw: &RawCard) -> Result<(), FeError> {
+        let c = self;
+        {
             let r = Reader::new(raw);
-            let line = raw.line;
+            let line = raw.loc();
             match raw.name.as_str() {
                 "GRID" => {
                     let g = cards::grid(&r)?;
-                    insert_unique(&mut c.grids, "GRID", g.id, line, g)?;
+                    insert_unique(&mut c.grids, "GRID", g.id, &line, g)?;
                 }
                 "CORD2R" => {
                     let s = cards::cord2r(&r)?;
-                    insert_unique(&mut c.systems, "CORD2R", s.id, line, s)?;
+                    insert_unique(&mut c.systems, "CORD2R", s.id, &line, s)?;
                 }
                 "MAT1" => {
                     let m = cards::mat1(&r)?;
-                    insert_unique(&mut c.materials, "MAT1", m.id, line, m)?;
+                    insert_unique(&mut c.materials, "MAT1", m.id, &line, m)?;
                 }
                 "PSHELL" => {
                     let p = cards::pshell(&r)?;
-                    insert_unique(&mut c.shell_properties, "property", p.id, line, p)?;
+                    insert_unique(&mut c.shell_properties, "property", p.id, &line, p)?;
                 }
                 "PBAR" | "PBEAM" => {
                     let p = if raw.name == "PBAR" {
@@ -102,21 +107,33 @@ impl Cards {
                     } else {
                         (cards::pbeam(&r)?, "PBEAM")
                     };
-                    insert_unique(&mut c.beam_properties, "property", p.0.id, line, p)?;
+                    insert_unique(&mut c.beam_properties, "property", p.0.id, &line, p)?;
                 }
                 "PELAS" => {
                     for (pid, k) in cards::scalar_properties(&r, 4)? {
-                        insert_unique(&mut c.spring_properties, "PELAS", pid, line, (k, line))?;
+                        insert_unique(
+                            &mut c.spring_properties,
+                            "PELAS",
+                            pid,
+                            &line,
+                            (k, line.clone()),
+                        )?;
                     }
                 }
                 "PDAMP" => {
                     for (pid, b) in cards::scalar_properties(&r, 2)? {
-                        insert_unique(&mut c.damper_properties, "PDAMP", pid, line, (b, line))?;
+                        insert_unique(
+                            &mut c.damper_properties,
+                            "PDAMP",
+                            pid,
+                            &line,
+                            (b, line.clone()),
+                        )?;
                     }
                 }
                 "CBAR" | "CBEAM" => {
                     let b = cards::bar(&r, raw.name == "CBEAM")?;
-                    c.element_id(b.id, line, &raw.name)?;
+                    c.element_id(b.id, &line, &raw.name)?;
                     c.bars.insert(b.id, b);
                 }
                 "CQUAD4" | "CTRIA3" => {
@@ -126,32 +143,32 @@ impl Cards {
                         (3, "CTRIA3")
                     };
                     let p = cards::plate(&r, corners)?;
-                    c.element_id(p.id, line, name)?;
+                    c.element_id(p.id, &line, name)?;
                     c.plates.insert(p.id, (p, name));
                 }
                 "CONM2" => {
                     let m = cards::conm2(&r)?;
-                    c.element_id(m.id, line, "CONM2")?;
+                    c.element_id(m.id, &line, "CONM2")?;
                     c.masses.insert(m.id, m);
                 }
                 "CELAS1" | "CELAS2" => {
                     let s = cards::scalar(&r, raw.name == "CELAS2", true)?;
-                    c.element_id(s.id, line, &raw.name)?;
+                    c.element_id(s.id, &line, &raw.name)?;
                     c.springs.insert(s.id, s);
                 }
                 "CDAMP1" | "CDAMP2" => {
                     let s = cards::scalar(&r, raw.name == "CDAMP2", false)?;
-                    c.element_id(s.id, line, &raw.name)?;
+                    c.element_id(s.id, &line, &raw.name)?;
                     c.dampers.insert(s.id, s);
                 }
                 "RBE2" => {
                     let e = cards::rbe2(&r)?;
-                    c.element_id(e.id, line, "RBE2")?;
+                    c.element_id(e.id, &line, "RBE2")?;
                     c.rigid.insert(e.id, e);
                 }
                 "RBE3" => {
                     let e = cards::rbe3(&r)?;
-                    c.element_id(e.id, line, "RBE3")?;
+                    c.element_id(e.id, &line, "RBE3")?;
                     c.interpolation.insert(e.id, e);
                 }
                 "SPC1" | "SPC" => {
@@ -160,14 +177,15 @@ impl Cards {
                     } else {
                         cards::spc(&r)?
                     };
-                    c.supports.extend(list.into_iter().map(|s| (s, line)));
+                    c.supports
+                        .extend(list.into_iter().map(|s| (s, line.clone())));
                 }
                 "PARAM" => c.param(&r)?,
                 // Eigenvalue extraction requests: the caller chooses the modes.
                 "EIGRL" | "EIGR" => {}
                 other => {
                     return Err(mesh_error(
-                        line,
+                        &line,
                         format!(
                             "card {other} is not supported (supported: GRID, CORD2R, MAT1, \
                              PSHELL, PBAR, PBEAM, PELAS, PDAMP, CQUAD4, CTRIA3, CBAR, CBEAM, \
@@ -178,7 +196,7 @@ impl Cards {
                 }
             }
         }
-        Ok(c)
+        Ok(())
     }
 
     fn param(&mut self, r: &Reader) -> Result<(), FeError> {
@@ -222,14 +240,14 @@ impl Systems {
                     Some(rid) if !resolved.contains_key(&rid) => {
                         if chain.contains(&rid) {
                             return Err(mesh_error(
-                                defs[&id].line,
+                                &defs[&id].line,
                                 format!("CORD2R {id}: reference systems form a cycle"),
                             ));
                         }
                         if !defs.contains_key(&rid) {
                             let d = &defs[chain.last().unwrap_or(&id)];
                             return Err(mesh_error(
-                                d.line,
+                                &d.line,
                                 format!("CORD2R {}: reference system RID {rid} not found", d.id),
                             ));
                         }
@@ -252,7 +270,7 @@ impl Systems {
                 let x = (c - a) - z * (z.dot(&(c - a)) / z.norm_squared());
                 if !(z.norm() > 0.0 && x.norm() > 1e-12 * z.norm() && x.norm().is_finite()) {
                     return Err(mesh_error(
-                        d.line,
+                        &d.line,
                         format!("CORD2R {cid}: points A, B, C are coincident or collinear"),
                     ));
                 }
@@ -267,7 +285,7 @@ impl Systems {
     fn get(
         &self,
         id: u32,
-        line: usize,
+        line: &Loc,
         user: &str,
     ) -> Result<&(Vector3<f64>, Matrix3<f64>), FeError> {
         self.resolved.get(&id).ok_or_else(|| {
@@ -279,7 +297,7 @@ impl Systems {
     }
 }
 
-fn material_named(c: &Cards, mid: u32, line: usize, user: &str) -> Result<cards::Mat1, FeError> {
+fn material_named(c: &Cards, mid: u32, line: &Loc, user: &str) -> Result<cards::Mat1, FeError> {
     c.materials
         .get(&mid)
         .cloned()
@@ -288,7 +306,7 @@ fn material_named(c: &Cards, mid: u32, line: usize, user: &str) -> Result<cards:
 
 /// E and G of a MAT1 by Nastran's rule for the missing one (E = 2 (1 + ν) G).
 fn moduli(m: &cards::Mat1, user: &str) -> Result<(f64, f64, f64), FeError> {
-    let fail = |why: &str| mesh_error(m.line, format!("MAT1 {} (used by {user}): {why}", m.id));
+    let fail = |why: &str| mesh_error(&m.line, format!("MAT1 {} (used by {user}): {why}", m.id));
     let (e, g, nu) = match (m.e, m.g, m.nu) {
         (Some(e), Some(g), Some(nu)) => (e, g, nu),
         (Some(e), Some(g), None) => (e, g, e / (2.0 * g) - 1.0),
@@ -310,7 +328,7 @@ fn moduli(m: &cards::Mat1, user: &str) -> Result<(f64, f64, f64), FeError> {
     Ok((e, g, nu))
 }
 
-fn node_of(body: &NastranBody, grid: u32, line: usize, user: &str) -> Result<usize, FeError> {
+fn node_of(body: &NastranBody, grid: u32, line: &Loc, user: &str) -> Result<usize, FeError> {
     body.grid_index
         .get(&grid)
         .copied()
@@ -321,9 +339,28 @@ fn mask_nodes(mask: [bool; 6]) -> impl Iterator<Item = usize> {
     (0..6).filter(move |&d| mask[d])
 }
 
-/// Builds the body from the lexed deck.
-pub(crate) fn build(deck: &Deck) -> Result<NastranBody, FeError> {
-    let c = Cards::read(deck)?;
+/// Collects the cards of a deck as they are read.
+pub(crate) struct Collector(Cards);
+
+impl Collector {
+    pub(crate) fn new() -> Self {
+        Self(Cards::new())
+    }
+}
+
+impl CardSink for Collector {
+    fn card(&mut self, card: RawCard) -> Result<(), FeError> {
+        self.0.add(&card)
+    }
+
+    fn reset(&mut self) {
+        self.0 = Cards::new();
+    }
+}
+
+/// Builds the body from the cards read and the SPC set the case control selects.
+pub(crate) fn build(cards: Collector, spc_selection: Option<u32>) -> Result<NastranBody, FeError> {
+    let c = cards.0;
     let systems = Systems::new(&c.systems)?;
     let mut body = NastranBody {
         mesh: Mesh::default(),
@@ -336,7 +373,7 @@ pub(crate) fn build(deck: &Deck) -> Result<NastranBody, FeError> {
         let p = match g.cp {
             None => x,
             Some(cp) => {
-                let (o, r) = systems.get(cp, g.line, &format!("GRID {id} CP"))?;
+                let (o, r) = systems.get(cp, &g.line, &format!("GRID {id} CP"))?;
                 o + r * x
             }
         };
@@ -351,7 +388,7 @@ pub(crate) fn build(deck: &Deck) -> Result<NastranBody, FeError> {
     add_masses(&c, &systems, &mut body)?;
     add_scalars(&c, &mut body)?;
     add_links(&c, &mut body)?;
-    add_supports(&c, deck.spc_selection, &mut body)?;
+    add_supports(&c, spc_selection, &mut body)?;
     check_dependents(&c, &body)?;
     Ok(body)
 }
@@ -360,7 +397,7 @@ pub(crate) fn build(deck: &Deck) -> Result<NastranBody, FeError> {
 fn add_shells(c: &Cards, body: &mut NastranBody) -> Result<(), FeError> {
     for (&id, (plate, name)) in &c.plates {
         let user = format!("{name} {id}");
-        let line = plate.line;
+        let line = &plate.line;
         let p = c.shell_properties.get(&plate.pid).ok_or_else(|| {
             mesh_error(
                 line,
@@ -368,11 +405,11 @@ fn add_shells(c: &Cards, body: &mut NastranBody) -> Result<(), FeError> {
             )
         })?;
         let fail =
-            |why: String| mesh_error(p.line, format!("PSHELL {} (used by {user}): {why}", p.id));
+            |why: String| mesh_error(&p.line, format!("PSHELL {} (used by {user}): {why}", p.id));
         let mid1 = p.mid1.ok_or_else(|| {
             fail("MID1 is blank: shells without membrane stiffness are not supported".into())
         })?;
-        let m = material_named(c, mid1, p.line, &format!("PSHELL {}", p.id))?;
+        let m = material_named(c, mid1, &p.line, &format!("PSHELL {}", p.id))?;
         let same_material = |mid2: i64| {
             mid2 == mid1 as i64
                 || (mid2 > 0
@@ -407,7 +444,7 @@ fn add_shells(c: &Cards, body: &mut NastranBody) -> Result<(), FeError> {
         let (e, g, nu) = moduli(&m, &user)?;
         if (g / (e / (2.0 * (1.0 + nu))) - 1.0).abs() > 0.01 {
             return Err(mesh_error(
-                m.line,
+                &m.line,
                 format!(
                     "MAT1 {} (used by {user}): G = {g} differs from E / 2(1 + NU) = {} by more \
                      than 1 %; the isotropic shell needs consistent E, G, NU",
@@ -454,7 +491,7 @@ fn add_shells(c: &Cards, body: &mut NastranBody) -> Result<(), FeError> {
 fn add_beams(c: &Cards, body: &mut NastranBody) -> Result<(), FeError> {
     for (&id, bar) in &c.bars {
         let user = format!("{} {id}", c.element_lines[&id].1);
-        let line = bar.line;
+        let line = &bar.line;
         let (p, kind) = c.beam_properties.get(&bar.pid).ok_or_else(|| {
             mesh_error(
                 line,
@@ -467,13 +504,13 @@ fn add_beams(c: &Cards, body: &mut NastranBody) -> Result<(), FeError> {
                 format!("{user}: property {} is a {kind}", bar.pid),
             ));
         }
-        let m = material_named(c, p.mid, p.line, &format!("{kind} {}", p.id))?;
+        let m = material_named(c, p.mid, &p.line, &format!("{kind} {}", p.id))?;
         let (e, g, _) = moduli(&m, &user)?;
         // The beam takes G through ν = E/2G − 1, so a MAT1 with all three values keeps its G.
         let nu_for_g = e / (2.0 * g) - 1.0;
         if !(nu_for_g > -1.0 && nu_for_g < 0.5) {
             return Err(mesh_error(
-                m.line,
+                &m.line,
                 format!(
                     "MAT1 {} (used by {user}): E/2G − 1 = {nu_for_g} outside (-1, 0.5)",
                     m.id
@@ -514,7 +551,7 @@ fn add_beams(c: &Cards, body: &mut NastranBody) -> Result<(), FeError> {
 fn add_masses(c: &Cards, systems: &Systems, body: &mut NastranBody) -> Result<(), FeError> {
     for (&id, m) in &c.masses {
         let user = format!("CONM2 {id}");
-        let node = node_of(body, m.grid, m.line, &user)?;
+        let node = node_of(body, m.grid, &m.line, &user)?;
         let [i11, i21, i22, i31, i32, i33] = m.inertia;
         // Nastran enters the products of inertia as I21 = ∫ x1 x2 dm etc. and supplies the
         // minus signs itself (MSC/NX QRG, CONM2 remark): the tensor is
@@ -524,7 +561,7 @@ fn add_masses(c: &Cards, systems: &Systems, body: &mut NastranBody) -> Result<()
             -1 => (Vector3::from(m.x) - body.mesh.nodes[node], local),
             0 => (Vector3::from(m.x), local),
             cid => {
-                let (_, r) = systems.get(cid as u32, m.line, &user)?;
+                let (_, r) = systems.get(cid as u32, &m.line, &user)?;
                 (r * Vector3::from(m.x), r * local * r.transpose())
             }
         };
@@ -570,7 +607,7 @@ fn add_scalars(c: &Cards, body: &mut NastranBody) -> Result<(), FeError> {
                     };
                     table.get(&pid).map(|(v, _)| *v).ok_or_else(|| {
                         mesh_error(
-                            s.line,
+                            &s.line,
                             format!(
                                 "{user}: property {} {pid} not found",
                                 if is_damper { "PDAMP" } else { "PELAS" }
@@ -582,14 +619,14 @@ fn add_scalars(c: &Cards, body: &mut NastranBody) -> Result<(), FeError> {
             let slot = usize::from(is_damper);
             match s.ends.as_slice() {
                 [(g, comp)] => {
-                    let n = node_of(body, *g, s.line, &user)?;
+                    let n = node_of(body, *g, &s.line, &user)?;
                     let e = ground.entry(n).or_insert(([0.0; 6], [0.0; 6]));
                     [&mut e.0, &mut e.1][slot][*comp] += value;
                 }
                 [(g1, c1), (g2, c2)] => {
                     if c1 != c2 {
                         return Err(mesh_error(
-                            s.line,
+                            &s.line,
                             format!(
                                 "{user}: components C1 = {} and C2 = {} differ; only springs \
                                  and dampers acting along one direction are supported",
@@ -599,12 +636,12 @@ fn add_scalars(c: &Cards, body: &mut NastranBody) -> Result<(), FeError> {
                         ));
                     }
                     let (n1, n2) = (
-                        node_of(body, *g1, s.line, &user)?,
-                        node_of(body, *g2, s.line, &user)?,
+                        node_of(body, *g1, &s.line, &user)?,
+                        node_of(body, *g2, &s.line, &user)?,
                     );
                     if n1 == n2 {
                         return Err(mesh_error(
-                            s.line,
+                            &s.line,
                             format!("{user}: both ends on GRID {g1}"),
                         ));
                     }
@@ -615,7 +652,7 @@ fn add_scalars(c: &Cards, body: &mut NastranBody) -> Result<(), FeError> {
                 }
                 _ => {
                     return Err(mesh_error(
-                        s.line,
+                        &s.line,
                         format!("{user}: needs one or two grids"),
                     ))
                 }
@@ -642,11 +679,11 @@ fn add_scalars(c: &Cards, body: &mut NastranBody) -> Result<(), FeError> {
 fn add_links(c: &Cards, body: &mut NastranBody) -> Result<(), FeError> {
     for (&id, e) in &c.rigid {
         let user = format!("RBE2 {id}");
-        let independent = node_of(body, e.independent, e.line, &user)?;
+        let independent = node_of(body, e.independent, &e.line, &user)?;
         let dependent = e
             .dependent
             .iter()
-            .map(|&g| node_of(body, g, e.line, &user))
+            .map(|&g| node_of(body, g, &e.line, &user))
             .collect::<Result<Vec<_>, _>>()?;
         body.mesh.rigid_links.push(RigidLink {
             independent,
@@ -657,19 +694,19 @@ fn add_links(c: &Cards, body: &mut NastranBody) -> Result<(), FeError> {
     }
     for (&id, e) in &c.interpolation {
         let user = format!("RBE3 {id}");
-        let reference = node_of(body, e.reference, e.line, &user)?;
+        let reference = node_of(body, e.reference, &e.line, &user)?;
         let mut sources = Vec::new();
         for (weight, components, grids) in &e.groups {
             if weight.is_nan() || *weight <= 0.0 {
                 return Err(mesh_error(
-                    e.line,
+                    &e.line,
                     format!("{user}: weight {weight} must be > 0"),
                 ));
             }
             sources.push(InterpolationSource {
                 nodes: grids
                     .iter()
-                    .map(|&g| node_of(body, g, e.line, &user))
+                    .map(|&g| node_of(body, g, &e.line, &user))
                     .collect::<Result<Vec<_>, _>>()?,
                 weight: *weight,
                 components: *components,
@@ -689,18 +726,18 @@ fn add_links(c: &Cards, body: &mut NastranBody) -> Result<(), FeError> {
 /// enforces it too, but here the message can name the cards).
 fn check_dependents(c: &Cards, body: &NastranBody) -> Result<(), FeError> {
     let names = ["1", "2", "3", "4", "5", "6"];
-    let mut owner: BTreeMap<(u32, usize), (String, usize)> = BTreeMap::new();
+    let mut owner: BTreeMap<(u32, usize), (String, &Loc)> = BTreeMap::new();
     let dependents = c
         .rigid
         .iter()
         .flat_map(|(id, e)| {
             e.dependent.iter().flat_map(move |&g| {
-                mask_nodes(e.components).map(move |d| (g, d, format!("RBE2 {id}"), e.line))
+                mask_nodes(e.components).map(move |d| (g, d, format!("RBE2 {id}"), &e.line))
             })
         })
         .chain(c.interpolation.iter().flat_map(|(id, e)| {
             mask_nodes(e.reference_components)
-                .map(move |d| (e.reference, d, format!("RBE3 {id}"), e.line))
+                .map(move |d| (e.reference, d, format!("RBE3 {id}"), &e.line))
         }));
     for (grid, d, card, line) in dependents {
         if let Some((first, _)) = owner.get(&(grid, d)) {
@@ -755,7 +792,8 @@ fn add_supports(c: &Cards, selected: Option<u32>, body: &mut NastranBody) -> Res
     };
     body.spc_set = set;
     let mut seen = BTreeSet::new();
-    for &((sid, grids, mask), line) in &c.supports {
+    for ((sid, grids, mask), line) in &c.supports {
+        let (sid, grids, mask) = (*sid, *grids, *mask);
         if Some(sid) != set {
             continue;
         }
