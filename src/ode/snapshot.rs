@@ -150,6 +150,20 @@ mod tests {
     use crate::ode::test_problems::SpringChain;
     use crate::ode::BdfOptions;
 
+    /// Issue 28: NaN in the integrator's history passed a saved state's checks.
+    #[test]
+    fn a_non_finite_history_or_time_is_refused() {
+        let good = advanced_snapshot();
+        let mut history = good.state.clone();
+        history.zn.zn[2][7] = f64::NAN;
+        let e = BdfSnapshot::try_from(history).unwrap_err();
+        assert!(e.contains("history column 2"), "{e}");
+        let mut time = good.state.clone();
+        time.tn = f64::INFINITY;
+        let e = BdfSnapshot::try_from(time).unwrap_err();
+        assert!(e.contains("tn = inf"), "{e}");
+    }
+
     fn advanced_snapshot() -> BdfSnapshot {
         let mut p = SpringChain::standard(false).expect("standard chain");
         let mut bdf = Bdf::new(&mut p, 0.0, &[0.0; 40], BdfOptions::default()).unwrap();

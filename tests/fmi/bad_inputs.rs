@@ -284,3 +284,27 @@ fn a_failed_set_up_is_not_repeated_until_something_changes() {
     assert_eq!(s.exit_init(), OK);
     assert_eq!(builds(&s), 2);
 }
+
+/// Issue 28: NaN in a saved state's time field passed deserialisation and the next step failed.
+#[test]
+fn a_saved_state_with_a_non_finite_time_is_refused() {
+    let fmu = Fmu::load();
+    let s = fmu.instantiate("nan-time");
+    s.initialize();
+    let h = 1.234_567e-3;
+    for k in 0..3 {
+        assert_eq!(s.do_step(k as f64 * h, h), OK);
+    }
+    let state = s.get_state();
+    let mut bytes = s.serialize(state);
+    s.free_state(state);
+    let t = s
+        .real_status(fmi_sys::fmi2::fmi2StatusKind_fmi2LastSuccessfulTime)
+        .1;
+    patch_f64(&mut bytes, t, f64::NAN);
+    reseal(&mut bytes);
+    let (st, handle) = s.deserialize(&bytes);
+    assert_eq!(st, ERROR);
+    assert!(handle.is_null());
+    assert!(logged(&s, "not finite"), "{:?}", s.logs());
+}
