@@ -129,9 +129,9 @@ fn implausible_heat_duplicate_mounts_and_unused_body_points_are_refused() {
         r#"{"extends": "default", "engine": {"gas": {"model": {"full_load": {"heat": 1e30}}}}}"#,
     )
     .expect("a positive heat passes the field checks");
-    let e = CoupledModel::on_ground(&hot)
-        .err()
-        .expect("refused at set-up");
+    let Err(e) = CoupledModel::on_ground(&hot) else {
+        panic!("a heat release of 1e30 J was accepted at set-up");
+    };
     assert!(
         e.to_string().contains("peak cylinder pressure"),
         "the cause is named: {e}"
