@@ -193,11 +193,19 @@ pub struct Grid {
 
 pub(crate) fn grid(r: &Reader) -> Result<Grid, FeError> {
     r.at_most(8)?;
-    r.require_blank(
-        5,
-        "CD",
-        "non-basic displacement coordinate systems are not supported; set CD blank or 0",
-    )?;
+    // The assembly numbers every node's DOFs in basic axes (springs, supports and links act on
+    // basic components), so a grid's own displacement system would need a per-node rotation
+    // through all of them: refused rather than half supported.
+    if !matches!(r.value(5, "CD")?, Value::Blank | Value::Int(0)) {
+        let grid = r.opt_int(0, "ID")?.unwrap_or(0);
+        return Err(r.error(
+            5,
+            "CD",
+            format!(
+                "GRID {grid}: non-basic displacement coordinate systems are not supported (DOFs,                  SPC and spring components are basic); set CD blank or 0"
+            ),
+        ));
+    }
     r.require_blank(7, "SEID", "superelements are not supported")?;
     let ps = if r.opt_int(6, "PS")?.is_some() {
         r.components(6, "PS")?
@@ -217,9 +225,33 @@ pub(crate) fn grid(r: &Reader) -> Result<Grid, FeError> {
     })
 }
 
-/// CORD2R: rectangular system by three points in the system RID.
+/// Kind of a coordinate system defined by three points.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum SystemKind {
+    /// CORD2R: x1, x2, x3 Cartesian.
+    Rectangular,
+    /// CORD2C: r, θ (degrees, from x about z), z.
+    Cylindrical,
+    /// CORD2S: r, θ (degrees, from z), φ (degrees, from x about z).
+    Spherical,
+}
+
+impl SystemKind {
+    /// The card that defines this kind.
+    pub fn card(self) -> &'static str {
+        match self {
+            SystemKind::Rectangular => "CORD2R",
+            SystemKind::Cylindrical => "CORD2C",
+            SystemKind::Spherical => "CORD2S",
+        }
+    }
+}
+
+/// CORD2R / CORD2C / CORD2S: a system by three points (A origin, B on z, C in the x-z plane)
+/// given in the system RID.
 #[derive(Debug, Clone, PartialEq)]
 pub struct Cord2r {
+    pub kind: SystemKind,
     pub id: u32,
     pub rid: Option<u32>,
     pub a: [f64; 3],
@@ -228,7 +260,7 @@ pub struct Cord2r {
     pub line: Loc,
 }
 
-pub(crate) fn cord2r(r: &Reader) -> Result<Cord2r, FeError> {
+pub(crate) fn cord2(r: &Reader, kind: SystemKind) -> Result<Cord2r, FeError> {
     r.at_most(11)?;
     let p = |k: usize, n: &str| -> Result<[f64; 3], FeError> {
         Ok([
@@ -238,6 +270,7 @@ pub(crate) fn cord2r(r: &Reader) -> Result<Cord2r, FeError> {
         ])
     };
     Ok(Cord2r {
+        kind,
         id: r.id(0, "CID")?,
         rid: r.opt_id_or_zero(1, "RID")?,
         a: p(2, "A")?,

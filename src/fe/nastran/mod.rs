@@ -24,8 +24,11 @@
 //! (`line 12 of sub/grids.bdf`).
 //!
 //! Cards and how they map:
-//! - GRID (CP → CORD2R, coordinates converted to basic; CD must be 0/blank; PS → supports),
-//!   CORD2R (RID chains).
+//! - GRID (CP → CORD2R/CORD2C/CORD2S, coordinates converted to basic; CD must be 0/blank:
+//!   the assembly's DOFs, supports, springs and links are in basic components, a non-basic CD
+//!   is refused naming the GRID and line; PS → supports), CORD2R, CORD2C (r, θ°, z), CORD2S
+//!   (r, θ°, φ°) by three points in RID (RID chains, any kind). Users with fixed directions
+//!   (CONM2/CONM1 CID, CBUSH CID) take rectangular systems only.
 //! - MAT1: two of E, G, NU given, the third by E = 2(1+ν)G (Nastran's rule); all three given:
 //!   beams keep E and G, shells need G within 1 % of E/2(1+ν). RHO; GE/A/TREF ignored
 //!   (structural damping is added modally by the caller).

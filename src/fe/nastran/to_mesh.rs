@@ -5,7 +5,7 @@ use std::collections::{BTreeMap, BTreeSet};
 
 use nalgebra::{Matrix3, Vector3};
 
-use super::cards::{self, Orientation, Reader, ScalarValue};
+use super::cards::{self, Orientation, Reader, ScalarValue, SystemKind};
 use super::lexer::{CardSink, Loc, RawCard, Value};
 use super::NastranBody;
 use crate::fe::error::FeError;
@@ -89,9 +89,14 @@ impl Cards {
                     let g = cards::grid(&r)?;
                     insert_unique(&mut c.grids, "GRID", g.id, &line, g)?;
                 }
-                "CORD2R" => {
-                    let s = cards::cord2r(&r)?;
-                    insert_unique(&mut c.systems, "CORD2R", s.id, &line, s)?;
+                "CORD2R" | "CORD2C" | "CORD2S" => {
+                    let kind = match raw.name.as_str() {
+                        "CORD2R" => SystemKind::Rectangular,
+                        "CORD2C" => SystemKind::Cylindrical,
+                        _ => SystemKind::Spherical,
+                    };
+                    let s = cards::cord2(&r, kind)?;
+                    insert_unique(&mut c.systems, "coordinate system", s.id, &line, s)?;
                 }
                 "MAT1" => {
                     let m = cards::mat1(&r)?;
@@ -187,7 +192,8 @@ impl Cards {
                     return Err(mesh_error(
                         &line,
                         format!(
-                            "card {other} is not supported (supported: GRID, CORD2R, MAT1, \
+                            "card {other} is not supported (supported: GRID, CORD2R, CORD2C, \
+                             CORD2S, MAT1, \
                              PSHELL, PBAR, PBEAM, PELAS, PDAMP, CQUAD4, CTRIA3, CBAR, CBEAM, \
                              CONM2, CELAS1, CELAS2, CDAMP1, CDAMP2, RBE2, RBE3, SPC1, SPC, \
                              PARAM, EIGRL, EIGR)"
@@ -223,14 +229,42 @@ impl Cards {
     }
 }
 
-/// Resolved rectangular systems: origin and rotation (columns: axes in basic).
+/// A resolved system: origin and rotation (columns: axes in basic) of its Cartesian frame.
+#[derive(Debug, Clone, Copy)]
+struct System {
+    kind: SystemKind,
+    origin: Vector3<f64>,
+    axes: Matrix3<f64>,
+}
+
+impl System {
+    /// Basic position of a point given by its coordinates in this system (angles in degrees,
+    /// as Nastran enters them).
+    fn to_basic(&self, p: [f64; 3]) -> Vector3<f64> {
+        let local = match self.kind {
+            SystemKind::Rectangular => Vector3::from(p),
+            SystemKind::Cylindrical => {
+                let (s, c) = p[1].to_radians().sin_cos();
+                Vector3::new(p[0] * c, p[0] * s, p[2])
+            }
+            SystemKind::Spherical => {
+                let (st, ct) = p[1].to_radians().sin_cos();
+                let (sp, cp) = p[2].to_radians().sin_cos();
+                Vector3::new(p[0] * st * cp, p[0] * st * sp, p[0] * ct)
+            }
+        };
+        self.origin + self.axes * local
+    }
+}
+
+/// Resolved systems by id.
 struct Systems {
-    resolved: BTreeMap<u32, (Vector3<f64>, Matrix3<f64>)>,
+    resolved: BTreeMap<u32, System>,
 }
 
 impl Systems {
     fn new(defs: &BTreeMap<u32, cards::Cord2r>) -> Result<Self, FeError> {
-        let mut resolved = BTreeMap::new();
+        let mut resolved: BTreeMap<u32, System> = BTreeMap::new();
         for &id in defs.keys() {
             let mut chain = vec![id];
             // Walk down to a resolved or basic system, then back up.
@@ -238,17 +272,21 @@ impl Systems {
                 let cur = defs[chain.last().unwrap_or(&id)].rid;
                 match cur {
                     Some(rid) if !resolved.contains_key(&rid) => {
+                        let d = &defs[chain.last().unwrap_or(&id)];
                         if chain.contains(&rid) {
                             return Err(mesh_error(
                                 &defs[&id].line,
-                                format!("CORD2R {id}: reference systems form a cycle"),
+                                format!("{} {id}: reference systems form a cycle", d.kind.card()),
                             ));
                         }
                         if !defs.contains_key(&rid) {
-                            let d = &defs[chain.last().unwrap_or(&id)];
                             return Err(mesh_error(
                                 &d.line,
-                                format!("CORD2R {}: reference system RID {rid} not found", d.id),
+                                format!(
+                                    "{} {}: reference system RID {rid} not found",
+                                    d.kind.card(),
+                                    d.id
+                                ),
                             ));
                         }
                         chain.push(rid);
@@ -258,11 +296,11 @@ impl Systems {
             }
             while let Some(cid) = chain.pop() {
                 let d = &defs[&cid];
+                // A, B, C are coordinates in RID, whatever its kind.
                 let to_basic = |p: [f64; 3]| -> Vector3<f64> {
-                    let v = Vector3::from(p);
                     match d.rid.and_then(|rid| resolved.get(&rid)) {
-                        Some((o, r)) => o + r * v,
-                        None => v,
+                        Some(s) => s.to_basic(p),
+                        None => Vector3::from(p),
                     }
                 };
                 let (a, b, c) = (to_basic(d.a), to_basic(d.b), to_basic(d.c));
@@ -271,29 +309,57 @@ impl Systems {
                 if !(z.norm() > 0.0 && x.norm() > 1e-12 * z.norm() && x.norm().is_finite()) {
                     return Err(mesh_error(
                         &d.line,
-                        format!("CORD2R {cid}: points A, B, C are coincident or collinear"),
+                        format!(
+                            "{} {cid}: points A, B, C are coincident or collinear",
+                            d.kind.card()
+                        ),
                     ));
                 }
                 let (ez, ex) = (z.normalize(), x.normalize());
-                let r = Matrix3::from_columns(&[ex, ez.cross(&ex), ez]);
-                resolved.insert(cid, (a, r));
+                let axes = Matrix3::from_columns(&[ex, ez.cross(&ex), ez]);
+                resolved.insert(
+                    cid,
+                    System {
+                        kind: d.kind,
+                        origin: a,
+                        axes,
+                    },
+                );
             }
         }
         Ok(Self { resolved })
     }
 
-    fn get(
+    fn get(&self, id: u32, line: &Loc, user: &str) -> Result<&System, FeError> {
+        self.resolved.get(&id).ok_or_else(|| {
+            mesh_error(
+                line,
+                format!("{user}: coordinate system {id} not found (CORD2R/CORD2C/CORD2S)"),
+            )
+        })
+    }
+
+    /// Origin and axes of a rectangular system: users whose directions are fixed (mass offsets
+    /// and inertia, element axes) cannot take a curvilinear system, whose axes depend on the
+    /// point.
+    fn rectangular(
         &self,
         id: u32,
         line: &Loc,
         user: &str,
-    ) -> Result<&(Vector3<f64>, Matrix3<f64>), FeError> {
-        self.resolved.get(&id).ok_or_else(|| {
-            mesh_error(
+    ) -> Result<(Vector3<f64>, Matrix3<f64>), FeError> {
+        let s = self.get(id, line, user)?;
+        if s.kind != SystemKind::Rectangular {
+            return Err(mesh_error(
                 line,
-                format!("{user}: coordinate system {id} not found (CORD2R)"),
-            )
-        })
+                format!(
+                    "{user}: coordinate system {id} is a {}; only rectangular (CORD2R) systems \
+                     are supported here",
+                    s.kind.card()
+                ),
+            ));
+        }
+        Ok((s.origin, s.axes))
     }
 }
 
@@ -372,10 +438,9 @@ pub(crate) fn build(cards: Collector, spc_selection: Option<u32>) -> Result<Nast
         let x = Vector3::from(g.x);
         let p = match g.cp {
             None => x,
-            Some(cp) => {
-                let (o, r) = systems.get(cp, &g.line, &format!("GRID {id} CP"))?;
-                o + r * x
-            }
+            Some(cp) => systems
+                .get(cp, &g.line, &format!("GRID {id} CP"))?
+                .to_basic(g.x),
         };
         let node = body.mesh.add_node(p);
         body.grid_index.insert(id, node);
@@ -561,7 +626,7 @@ fn add_masses(c: &Cards, systems: &Systems, body: &mut NastranBody) -> Result<()
             -1 => (Vector3::from(m.x) - body.mesh.nodes[node], local),
             0 => (Vector3::from(m.x), local),
             cid => {
-                let (_, r) = systems.get(cid as u32, &m.line, &user)?;
+                let (_, r) = systems.rectangular(cid as u32, &m.line, &user)?;
                 (r * Vector3::from(m.x), r * local * r.transpose())
             }
         };
