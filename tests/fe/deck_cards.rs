@@ -1,7 +1,6 @@
 //! Bulk data cards CORD2C/CORD2S, CONM1 and CBUSH/PBUSH against closed forms: grid positions
 //! in curvilinear systems, rigid-body mass properties, rotated bush stiffness, oscillators.
 
-use std::f64::consts::PI;
 use std::fmt::Write;
 
 use engine_mount_chassis::fe::assembly::{assemble, Assembled};
@@ -135,6 +134,190 @@ fn a_non_basic_displacement_system_is_refused_naming_the_grid_and_line() {
     );
     assert!(
         err.contains("CONM2 3") && err.contains("CORD2S") && err.contains("line 5"),
+        "{err}"
+    );
+}
+
+// ---------------------------------------------------------------------------------------------
+// CONM1.
+
+/// The 6 × 6 matrix of a rigid body of mass m, centre of gravity r and inertia jc about it,
+/// at the reference point: u(r) = u + θ × r.
+fn rigid_matrix(m: f64, r: Vector3<f64>, jc: Matrix3<f64>) -> DMatrix<f64> {
+    let rx = r.cross_matrix();
+    let mut out = DMatrix::zeros(6, 6);
+    for i in 0..3 {
+        out[(i, i)] = m;
+        for j in 0..3 {
+            out[(3 + i, j)] = m * rx[(i, j)];
+            out[(j, 3 + i)] = m * rx[(i, j)];
+            out[(3 + i, 3 + j)] =
+                jc[(i, j)] + m * (r.norm_squared() * f64::from(u8::from(i == j)) - r[i] * r[j]);
+        }
+    }
+    out
+}
+
+fn conm1_card(id: u32, grid: u32, cid: u32, m: &DMatrix<f64>) -> String {
+    let mut fields = vec![format!("CONM1,{id},{grid},{cid}")];
+    for i in 0..6 {
+        for j in 0..=i {
+            fields.push(format!("{:e}", m[(i, j)]));
+        }
+    }
+    // Free field: 8 data fields on the first line, then continuation lines of 8.
+    // fields[0] holds the name and 3 data fields.
+    let mut out = fields[..6].join(",");
+    for chunk in fields[6..].chunks(8) {
+        out.push_str("\n,");
+        out.push_str(&chunk.join(","));
+    }
+    out.push('\n');
+    out
+}
+
+/// Φᵀ M Φ with Φ the six rigid-body motions about the basic origin (translations, rotations).
+fn rigid_body_mass(body: &NastranBody, asm: &Assembled) -> DMatrix<f64> {
+    let owners = asm.dofs.owners();
+    let mut phi = DMatrix::zeros(owners.len(), 6);
+    for (g, &(node, d)) in owners.iter().enumerate() {
+        let x = body.mesh.nodes[node];
+        if d < 3 {
+            phi[(g, d)] = 1.0;
+            // u = θ × x: component d of θ × x is −[x]× θ.
+            let xm = -x.cross_matrix();
+            for k in 0..3 {
+                phi[(g, 3 + k)] = xm[(d, k)];
+            }
+        } else {
+            phi[(g, d)] = 1.0;
+        }
+    }
+    let m = asm.m.to_dense();
+    let md = DMatrix::from_fn(m.nrows(), m.ncols(), |i, j| m[(i, j)]);
+    phi.transpose() * md * phi
+}
+
+/// Rotation of CORD2R 7 used below: about basic z by 90°, then the frame origin elsewhere
+/// (irrelevant to directions): x7 = basic y, y7 = −basic x, z7 = basic z.
+const CORD2R_7: &str = "CORD2R,7,,5.,6.,7.,5.,6.,8.\n,5.,7.,7.\n";
+
+fn cord7() -> Matrix3<f64> {
+    Matrix3::new(0.0, -1.0, 0.0, 1.0, 0.0, 0.0, 0.0, 0.0, 1.0)
+}
+
+#[test]
+fn a_free_body_of_conm1_masses_has_the_hand_summed_rigid_body_mass_properties() {
+    let grids = [
+        (1, Vector3::new(0.0, 0.0, 0.0)),
+        (2, Vector3::new(1.5, -0.5, 0.25)),
+        (3, Vector3::new(-0.7, 2.0, 1.0)),
+    ];
+    // Per grid: mass, offset of the centre of gravity (in the CONM1's system), inertia about it.
+    let jc = |a: f64, b: f64, c: f64, p: f64| Matrix3::new(a, p, 0.0, p, b, -p, 0.0, -p, c);
+    let bodies = [
+        (
+            1,
+            0,
+            12.0,
+            Vector3::new(0.1, -0.2, 0.3),
+            jc(2.0, 3.0, 4.0, 0.1),
+        ),
+        (
+            2,
+            7,
+            3.5,
+            Vector3::new(-0.4, 0.0, 0.2),
+            jc(0.5, 0.7, 0.9, -0.05),
+        ),
+        (3, 0, 0.0, Vector3::zeros(), jc(1.0, 1.0, 2.0, 0.0)),
+    ];
+    let mut deck = String::from("BEGIN BULK\n");
+    deck.push_str(CORD2R_7);
+    for (g, x) in grids {
+        let _ = writeln!(deck, "GRID,{g},,{:e},{:e},{:e}", x.x, x.y, x.z);
+    }
+    // Hand sum: each matrix turned to basic (T = diag(R, R)), then moved to the origin by
+    // Φ_g = [I −[x_g]×; 0 I].
+    let mut expected = DMatrix::zeros(6, 6);
+    for (k, &(g, cid, m, r, j)) in bodies.iter().enumerate() {
+        let local = rigid_matrix(m, r, j);
+        deck.push_str(&conm1_card(10 + k as u32, g, cid, &local));
+        let rot = if cid == 7 {
+            cord7()
+        } else {
+            Matrix3::identity()
+        };
+        let mut t = DMatrix::zeros(6, 6);
+        let mut phi = DMatrix::identity(6, 6);
+        let xg = grids[g as usize - 1].1;
+        let xm = -xg.cross_matrix();
+        for i in 0..3 {
+            for jj in 0..3 {
+                t[(i, jj)] = rot[(i, jj)];
+                t[(3 + i, 3 + jj)] = rot[(i, jj)];
+                phi[(i, 3 + jj)] = xm[(i, jj)];
+            }
+        }
+        let basic = &t * local * t.transpose();
+        expected += phi.transpose() * basic * phi;
+    }
+    deck.push_str("ENDDATA\n");
+    let body = parse_str(&deck).unwrap();
+    let asm = assemble(&body.mesh).unwrap();
+    let got = rigid_body_mass(&body, &asm);
+    let scale = expected.abs().max();
+    println!("rigid-body mass about the origin:\n{got:.6}hand sum:\n{expected:.6}");
+    println!(
+        "mass {} (hand 15.5), max |difference| / max entry {:e}",
+        got[(0, 0)],
+        (&got - &expected).abs().max() / scale
+    );
+    assert!((got[(0, 0)] - 15.5).abs() < 1e-12 * 15.5);
+    assert!((&got - &expected).abs().max() <= 1e-12 * scale);
+}
+
+#[test]
+fn a_conm1_equal_to_a_conm2_gives_the_same_mass_matrix() {
+    let (m, x) = (7.0, Vector3::new(0.3, -0.1, 0.25));
+    let [i11, i21, i22, i31, i32, i33] = [0.9, 0.05, 1.1, -0.02, 0.03, 1.4];
+    // CONM2's products of inertia carry Nastran's minus signs.
+    let j = Matrix3::new(i11, -i21, -i31, -i21, i22, -i32, -i31, -i32, i33);
+    let head = format!("BEGIN BULK\n{CORD2R_7}GRID,4,,1.,2.,3.\n");
+    for cid in [0, 7] {
+        let conm2 = format!(
+            "{head}CONM2,1,4,{cid},{m:e},{:e},{:e},{:e}\n,{i11:e},{i21:e},{i22:e},{i31:e},{i32:e},{i33:e}\n",
+            x.x, x.y, x.z
+        );
+        let conm1 = format!("{head}{}", conm1_card(1, 4, cid, &rigid_matrix(m, x, j)));
+        let a = assemble(&parse_str(&conm2).unwrap().mesh)
+            .unwrap()
+            .m
+            .to_dense();
+        let b = assemble(&parse_str(&conm1).unwrap().mesh)
+            .unwrap()
+            .m
+            .to_dense();
+        let mut worst: f64 = 0.0;
+        for r in 0..a.nrows() {
+            for c in 0..a.ncols() {
+                worst = worst.max((a[(r, c)] - b[(r, c)]).abs());
+            }
+        }
+        println!("CID {cid}: max |M(CONM1) − M(CONM2)| = {worst:e}");
+        assert_eq!((a.nrows(), a.ncols()), (6, 6));
+        assert!(worst <= 1e-12 * 7.0, "CID {cid}: {worst}");
+    }
+}
+
+#[test]
+fn a_conm1_that_is_not_a_rigid_body_is_refused_naming_card_and_line() {
+    let mut m = rigid_matrix(2.0, Vector3::zeros(), Matrix3::identity());
+    m[(1, 1)] = 3.0;
+    let deck = format!("BEGIN BULK\nGRID,4,,0.,0.,0.\n{}", conm1_card(9, 4, 0, &m));
+    let err = error_of(&deck);
+    assert!(
+        err.contains("CONM1 9") && err.contains("line 3") && err.contains("M22"),
         "{err}"
     );
 }

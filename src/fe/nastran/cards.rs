@@ -629,6 +629,41 @@ pub(crate) fn conm2(r: &Reader) -> Result<Conm2, FeError> {
     })
 }
 
+/// CONM1: 6 × 6 mass matrix at a grid, in the grid's system or a CORD2R.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Conm1 {
+    pub id: u32,
+    pub grid: u32,
+    /// 0/blank: basic; > 0: a CORD2R.
+    pub cid: Option<u32>,
+    /// The symmetric matrix (ux uy uz rx ry rz), from the lower triangle as entered.
+    pub matrix: [[f64; 6]; 6],
+    pub line: Loc,
+}
+
+pub(crate) fn conm1(r: &Reader) -> Result<Conm1, FeError> {
+    r.at_most(24)?;
+    let mut matrix = [[0.0; 6]; 6];
+    for i in 0..6 {
+        for j in 0..=i {
+            let v = r.real_or(
+                3 + i * (i + 1) / 2 + j,
+                &format!("M{}{}", i + 1, j + 1),
+                0.0,
+            )?;
+            matrix[i][j] = v;
+            matrix[j][i] = v;
+        }
+    }
+    Ok(Conm1 {
+        id: r.id(0, "EID")?,
+        grid: r.id(1, "G")?,
+        cid: r.opt_id_or_zero(2, "CID")?,
+        matrix,
+        line: r.card().loc(),
+    })
+}
+
 /// Magnitude of a scalar element: a property reference or a value on the card.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub enum ScalarValue {

@@ -43,6 +43,10 @@
 //!   I2 → `iy`.
 //! - CONM2 (CID −1, 0 or a CORD2R; offset masses sit on an extra node rigidly linked to the
 //!   grid, so the translation–rotation coupling is exact; products of inertia as in the QRG).
+//! - CONM1 (lower triangle, CID blank/0 or a CORD2R): the matrix must be that of a rigid body
+//!   (M11 = M22 = M33 = m, no translational coupling, rotation–translation block m[r]×), which
+//!   becomes a CONM2-like mass at offset r with inertia M(4..6) − m(|r|²I − r rᵀ); any other
+//!   6 × 6 matrix is refused naming the card and line.
 //! - CELAS1/PELAS, CELAS2, CDAMP1/PDAMP, CDAMP2: one component, to ground or between two grids
 //!   along the same component. Merged per node / node pair.
 //! - RBE2 → [`crate::fe::mesh::RigidLink`], RBE3 (no UM) → [`crate::fe::mesh::InterpolationLink`],
@@ -71,7 +75,7 @@ use super::error::FeError;
 use super::mesh::Mesh;
 
 /// Nastran ids of the mesh entities, in mesh order (`beams[i]` is the CBAR/CBEAM id of
-/// `mesh.beams[i]`, …). A CONM2 with an offset appears in `masses` and in `rigid_links`.
+/// `mesh.beams[i]`, …). A CONM2/CONM1 with an offset appears in `masses` and in `rigid_links`.
 #[derive(Debug, Clone, Default, PartialEq)]
 pub struct ElementIds {
     /// CBAR / CBEAM ids.
@@ -80,9 +84,9 @@ pub struct ElementIds {
     pub shells: Vec<u32>,
     /// CTRIA3 ids.
     pub triangles: Vec<u32>,
-    /// CONM2 ids.
+    /// CONM2 ids, then CONM1 ids.
     pub masses: Vec<u32>,
-    /// RBE2 ids (and CONM2 ids of offset masses).
+    /// RBE2 ids (and CONM2/CONM1 ids of offset masses).
     pub rigid_links: Vec<u32>,
     /// RBE3 ids.
     pub interpolation_links: Vec<u32>,

@@ -35,6 +35,7 @@ struct Cards {
     bars: BTreeMap<u32, cards::Bar>,
     plates: BTreeMap<u32, (cards::Plate, &'static str)>,
     masses: BTreeMap<u32, cards::Conm2>,
+    general_masses: BTreeMap<u32, cards::Conm1>,
     springs: BTreeMap<u32, cards::Scalar>,
     dampers: BTreeMap<u32, cards::Scalar>,
     rigid: BTreeMap<u32, cards::Rbe2>,
@@ -156,6 +157,11 @@ impl Cards {
                     c.element_id(m.id, &line, "CONM2")?;
                     c.masses.insert(m.id, m);
                 }
+                "CONM1" => {
+                    let m = cards::conm1(&r)?;
+                    c.element_id(m.id, &line, "CONM1")?;
+                    c.general_masses.insert(m.id, m);
+                }
                 "CELAS1" | "CELAS2" => {
                     let s = cards::scalar(&r, raw.name == "CELAS2", true)?;
                     c.element_id(s.id, &line, &raw.name)?;
@@ -195,7 +201,7 @@ impl Cards {
                             "card {other} is not supported (supported: GRID, CORD2R, CORD2C, \
                              CORD2S, MAT1, \
                              PSHELL, PBAR, PBEAM, PELAS, PDAMP, CQUAD4, CTRIA3, CBAR, CBEAM, \
-                             CONM2, CELAS1, CELAS2, CDAMP1, CDAMP2, RBE2, RBE3, SPC1, SPC, \
+                             CONM1, CONM2, CELAS1, CELAS2, CDAMP1, CDAMP2, RBE2, RBE3, SPC1, SPC, \
                              PARAM, EIGRL, EIGR)"
                         ),
                     ))
@@ -630,28 +636,113 @@ fn add_masses(c: &Cards, systems: &Systems, body: &mut NastranBody) -> Result<()
                 (r * Vector3::from(m.x), r * local * r.transpose())
             }
         };
-        let mass_node = if offset.norm() == 0.0 {
-            node
-        } else {
-            // The offset mass sits on its own node carried rigidly by the grid: exact coupling
-            // of translation and rotation, no lumping approximation.
-            let cg = body.mesh.add_node(body.mesh.nodes[node] + offset);
-            body.mesh.rigid_links.push(RigidLink {
-                independent: node,
-                dependent: vec![cg],
-                components: [true; 6],
-            });
-            body.element_ids.rigid_links.push(id);
-            cg
+        place_mass(body, id, node, m.mass, offset, inertia, c.mass_scale);
+    }
+    for (&id, m) in &c.general_masses {
+        let user = format!("CONM1 {id}");
+        let node = node_of(body, m.grid, &m.line, &user)?;
+        let mut local = nalgebra::Matrix6::<f64>::zeros();
+        for i in 0..6 {
+            for j in 0..6 {
+                local[(i, j)] = m.matrix[i][j];
+            }
+        }
+        let basic = match m.cid {
+            None => local,
+            Some(cid) => {
+                let (_, r) = systems.rectangular(cid, &m.line, &user)?;
+                let mut t = nalgebra::Matrix6::<f64>::zeros();
+                t.fixed_view_mut::<3, 3>(0, 0).copy_from(&r);
+                t.fixed_view_mut::<3, 3>(3, 3).copy_from(&r);
+                t * local * t.transpose()
+            }
         };
-        body.mesh.masses.push(PointMass {
-            node: mass_node,
-            mass: m.mass * c.mass_scale,
-            inertia: inertia * c.mass_scale,
-        });
-        body.element_ids.masses.push(id);
+        let (mass, offset, inertia) = rigid_body_form(&basic).map_err(|why| {
+            mesh_error(
+                &m.line,
+                format!(
+                    "{user}: {why}; only the mass matrix of a rigid body is supported (M11 = M22 \
+                     = M33 = m, no coupling between translations, translation-rotation block \
+                     m[r]× for a centre of gravity at r)"
+                ),
+            )
+        })?;
+        place_mass(body, id, node, mass, offset, inertia, c.mass_scale);
     }
     Ok(())
+}
+
+/// Mass m, centre-of-gravity offset r and inertia about the centre of gravity of a 6 × 6 mass
+/// matrix at a node, which must be the matrix of a rigid body: m I for translations, m [r]×
+/// between rotations and translations (from u(r) = u + θ × r), J + m (|r|² I − r rᵀ) for
+/// rotations.
+fn rigid_body_form(
+    m6: &nalgebra::Matrix6<f64>,
+) -> Result<(f64, Vector3<f64>, Matrix3<f64>), String> {
+    let tol = 1e-9 * m6.abs().max();
+    if (m6 - m6.transpose()).abs().max() > tol || m6.iter().any(|v| !v.is_finite()) {
+        return Err("the matrix is not symmetric and finite".into());
+    }
+    let m = m6[(0, 0)];
+    let tt: Matrix3<f64> = m6.fixed_view::<3, 3>(0, 0).into();
+    if (tt - Matrix3::identity() * m).abs().max() > tol {
+        return Err(format!(
+            "the translational block is not m I (M11 = {m}, M22 = {}, M33 = {}, M21 = {}, \
+             M31 = {}, M32 = {})",
+            tt[(1, 1)],
+            tt[(2, 2)],
+            tt[(1, 0)],
+            tt[(2, 0)],
+            tt[(2, 1)]
+        ));
+    }
+    let coupling: Matrix3<f64> = m6.fixed_view::<3, 3>(3, 0).into();
+    let r = if m > 0.0 {
+        Vector3::new(coupling[(2, 1)], coupling[(0, 2)], coupling[(1, 0)]) / m
+    } else {
+        Vector3::zeros()
+    };
+    if (coupling - r.cross_matrix() * m).abs().max() > tol {
+        return Err(format!(
+            "the rotation-translation block (M41 … M63) {:?} is not m [r]× for any r",
+            coupling.as_slice()
+        ));
+    }
+    let rot: Matrix3<f64> = m6.fixed_view::<3, 3>(3, 3).into();
+    let inertia = rot - m * (r.norm_squared() * Matrix3::identity() - r * r.transpose());
+    Ok((m, r, inertia))
+}
+
+/// Puts a mass with inertia about its centre of gravity at `offset` from `node`.
+fn place_mass(
+    body: &mut NastranBody,
+    id: u32,
+    node: usize,
+    mass: f64,
+    offset: Vector3<f64>,
+    inertia: Matrix3<f64>,
+    scale: f64,
+) {
+    let mass_node = if offset.norm() == 0.0 {
+        node
+    } else {
+        // The offset mass sits on its own node carried rigidly by the grid: exact coupling
+        // of translation and rotation, no lumping approximation.
+        let cg = body.mesh.add_node(body.mesh.nodes[node] + offset);
+        body.mesh.rigid_links.push(RigidLink {
+            independent: node,
+            dependent: vec![cg],
+            components: [true; 6],
+        });
+        body.element_ids.rigid_links.push(id);
+        cg
+    };
+    body.mesh.masses.push(PointMass {
+        node: mass_node,
+        mass: mass * scale,
+        inertia: inertia * scale,
+    });
+    body.element_ids.masses.push(id);
 }
 
 /// Long on purpose: one arm per scalar spring and damper card.
