@@ -151,6 +151,17 @@ pub fn assemble(mesh: &Mesh) -> Result<Assembled, FeError> {
         k.scatter(&s.nodes, &ks);
         c.scatter(&s.nodes, &cs);
     }
+    for (i, bush) in mesh.bushes.iter().enumerate() {
+        let what = format!("bush {i}");
+        let xa = mesh.position(&what, bush.a)?;
+        let (nodes, xb) = match bush.b {
+            Some(b) => (vec![bush.a, b], Some(mesh.position(&what, b)?)),
+            None => (vec![bush.a], None),
+        };
+        let (kb, cb) = spring::bush_matrices(i, bush, &xa, xb.as_ref())?;
+        k.scatter(&nodes, &kb);
+        c.scatter(&nodes, &cb);
+    }
     Ok(Assembled {
         k: k.finish(n, "K")?,
         m: m.finish(n, "M")?,

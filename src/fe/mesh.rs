@@ -150,6 +150,25 @@ pub struct Spring {
     pub damping: [f64; 6],
 }
 
+/// Generalised spring-damper (Nastran CBUSH): six uncoupled stiffnesses and dampers along the
+/// axes of its own frame, acting on the relative motion of a point carried rigidly by both ends
+/// (by end `a` alone and ground for a bush to ground).
+#[derive(Debug, Clone, PartialEq)]
+pub struct Bush {
+    /// First end.
+    pub a: usize,
+    /// Second end; `None`: the bush connects `a` to ground.
+    pub b: Option<usize>,
+    /// Element axes in global coordinates (columns x, y, z; orthonormal).
+    pub frame: Matrix3<f64>,
+    /// Global position of the spring point (the lever arms run from each end to it).
+    pub point: Vector3<f64>,
+    /// Stiffness along/about the element axes x, y, z (N/m), then rx, ry, rz (N m/rad).
+    pub stiffness: [f64; 6],
+    /// Viscous damping along/about the element axes (N s/m), (N m s/rad).
+    pub damping: [f64; 6],
+}
+
 /// Rigid element (Nastran RBE2): the listed components of every dependent node follow the
 /// small-displacement rigid-body motion of the independent node,
 /// u_d = u_i + θ_i × (x_d − x_i), θ_d = θ_i. Eliminated exactly in assembly.
@@ -204,6 +223,8 @@ pub struct Mesh {
     pub ground_springs: Vec<GroundSpring>,
     /// Two-node springs.
     pub springs: Vec<Spring>,
+    /// Spring-dampers in their own axes (CBUSH).
+    pub bushes: Vec<Bush>,
     /// Fixed DOFs `(node, local dof 0..5)`.
     pub constraints: Vec<(usize, usize)>,
     /// Rigid elements (dependent DOFs eliminated in assembly).

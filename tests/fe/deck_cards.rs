@@ -1,6 +1,7 @@
 //! Bulk data cards CORD2C/CORD2S, CONM1 and CBUSH/PBUSH against closed forms: grid positions
 //! in curvilinear systems, rigid-body mass properties, rotated bush stiffness, oscillators.
 
+use std::f64::consts::PI;
 use std::fmt::Write;
 
 use engine_mount_chassis::fe::assembly::{assemble, Assembled};
@@ -320,4 +321,196 @@ fn a_conm1_that_is_not_a_rigid_body_is_refused_naming_card_and_line() {
         err.contains("CONM1 9") && err.contains("line 3") && err.contains("M22"),
         "{err}"
     );
+}
+
+// ---------------------------------------------------------------------------------------------
+// CBUSH / PBUSH.
+
+/// Rotation Rz(30°) Rx(20°) (columns: the axes of CORD2R 8 in basic) and its CORD2R card.
+fn cord8() -> (Matrix3<f64>, String) {
+    let (sz, cz) = 30f64.to_radians().sin_cos();
+    let (sx, cx) = 20f64.to_radians().sin_cos();
+    let rz = Matrix3::new(cz, -sz, 0.0, sz, cz, 0.0, 0.0, 0.0, 1.0);
+    let rx = Matrix3::new(1.0, 0.0, 0.0, 0.0, cx, -sx, 0.0, sx, cx);
+    let r = rz * rx;
+    let o = Vector3::new(-1.0, 0.5, 2.0);
+    let (b, c) = (o + r.column(2), o + r.column(0));
+    let card = format!(
+        "CORD2R,8,,{:e},{:e},{:e},{:e},{:e},{:e}\n,{:e},{:e},{:e}\n",
+        o.x, o.y, o.z, b.x, b.y, b.z, c.x, c.y, c.z
+    );
+    (r, card)
+}
+
+const K: [f64; 6] = [1.0e5, 2.0e5, 3.5e5, 4.0e3, 5.0e3, 7.0e3];
+const B: [f64; 6] = [11.0, 12.0, 13.0, 1.4, 1.5, 1.6];
+
+fn pbush_card() -> String {
+    let k: Vec<String> = K.iter().map(|v| format!("{v:e}")).collect();
+    let b: Vec<String> = B.iter().map(|v| format!("{v:e}")).collect();
+    format!("PBUSH,3,K,{}\n,,B,{}\n", k.join(","), b.join(","))
+}
+
+/// T diag(v) Tᵀ with T = diag(R, R): a diagonal element matrix turned to basic.
+fn rotated(r: &Matrix3<f64>, v: &[f64; 6]) -> DMatrix<f64> {
+    let mut t = DMatrix::zeros(6, 6);
+    for i in 0..3 {
+        for j in 0..3 {
+            t[(i, j)] = r[(i, j)];
+            t[(3 + i, 3 + j)] = r[(i, j)];
+        }
+    }
+    let d = DMatrix::from_diagonal(&nalgebra::DVector::from_row_slice(v));
+    &t * d * t.transpose()
+}
+
+/// Dense matrix of `asm` indexed by (node, dof) of the given nodes, in that order.
+fn by_nodes(asm: &Assembled, a: &nalgebra::DMatrix<f64>, nodes: &[usize]) -> DMatrix<f64> {
+    let owners = asm.dofs.owners();
+    let index = |n: usize, d: usize| owners.iter().position(|&o| o == (n, d)).unwrap();
+    let size = 6 * nodes.len();
+    DMatrix::from_fn(size, size, |i, j| {
+        a[(index(nodes[i / 6], i % 6), index(nodes[j / 6], j % 6))]
+    })
+}
+
+fn dense(m: &engine_mount_chassis::fe::assembly::SparseMat) -> DMatrix<f64> {
+    let d = m.to_dense();
+    DMatrix::from_fn(d.nrows(), d.ncols(), |i, j| d[(i, j)])
+}
+
+#[test]
+fn a_two_node_bush_in_a_rotated_system_has_stiffness_and_damping_rotated_from_its_axes() {
+    let (r, cord) = cord8();
+    let deck = format!(
+        "BEGIN BULK\n{cord}{}GRID,1,,0.3,0.2,0.1\nGRID,2,,0.3,0.2,0.1\nCBUSH,5,3,1,2,,,,8\n",
+        pbush_card()
+    );
+    let body = parse_str(&deck).unwrap();
+    let asm = assemble(&body.mesh).unwrap();
+    let nodes = [body.node(1).unwrap(), body.node(2).unwrap()];
+    for (what, got, v) in [
+        ("K", by_nodes(&asm, &dense(&asm.k), &nodes), &K),
+        ("C", by_nodes(&asm, &dense(&asm.c), &nodes), &B),
+    ] {
+        let g = rotated(&r, v);
+        // Relative motion only: [G −G; −G G].
+        let mut expected = DMatrix::zeros(12, 12);
+        for i in 0..6 {
+            for j in 0..6 {
+                expected[(i, j)] = g[(i, j)];
+                expected[(6 + i, 6 + j)] = g[(i, j)];
+                expected[(i, 6 + j)] = -g[(i, j)];
+                expected[(6 + i, j)] = -g[(i, j)];
+            }
+        }
+        let err = (&got - &expected).abs().max() / expected.abs().max();
+        println!("{what}: max |assembled − T diag Tᵀ| / max entry = {err:e}");
+        assert!(err <= 1e-12, "{what}: {err}");
+    }
+}
+
+#[test]
+fn a_bush_with_apart_ends_resists_no_rigid_motion_and_its_line_axes_equal_the_same_cid() {
+    // GA → GB along the x axis of CORD2R 8, orientation vector its y axis: the element axes
+    // are those of CORD2R 8, so the CID form must give the same matrix.
+    let (r, cord) = cord8();
+    let (xa, len) = (Vector3::new(0.3, 0.2, 0.1), 0.4);
+    let xb = xa + r.column(0) * len;
+    let y = r.column(1);
+    let grids = format!(
+        "GRID,1,,{:e},{:e},{:e}\nGRID,2,,{:e},{:e},{:e}\n",
+        xa.x, xa.y, xa.z, xb.x, xb.y, xb.z
+    );
+    let head = format!("BEGIN BULK\n{cord}{}{grids}", pbush_card());
+    let line = format!("{head}CBUSH,5,3,1,2,{:e},{:e},{:e},\n,0.3\n", y.x, y.y, y.z);
+    let cid = format!("{head}CBUSH,5,3,1,2,,,,8\n,0.3\n");
+    let k = |deck: &str| {
+        let body = parse_str(deck).unwrap();
+        let asm = assemble(&body.mesh).unwrap();
+        let nodes = [body.node(1).unwrap(), body.node(2).unwrap()];
+        by_nodes(&asm, &dense(&asm.k), &nodes)
+    };
+    let (kl, kc) = (k(&line), k(&cid));
+    let scale = kc.abs().max();
+    let same = (&kl - &kc).abs().max() / scale;
+    // Six rigid-body motions of both ends: u = t + θ × x.
+    let mut worst: f64 = 0.0;
+    for mode in 0..6 {
+        let mut u = DMatrix::zeros(12, 1);
+        for (n, x) in [xa, xb].iter().enumerate() {
+            if mode < 3 {
+                u[(6 * n + mode, 0)] = 1.0;
+            } else {
+                let mut theta = Vector3::zeros();
+                theta[mode - 3] = 1.0;
+                let v = theta.cross(x);
+                for d in 0..3 {
+                    u[(6 * n + d, 0)] = v[d];
+                }
+                u[(6 * n + mode, 0)] = 1.0;
+            }
+        }
+        worst = worst.max((&kc * u).abs().max() / scale);
+    }
+    println!("line axes vs CID: {same:e}; max |K u_rigid| / max |K| = {worst:e}");
+    assert!(same <= 1e-12, "{same}");
+    assert!(worst <= 1e-12, "{worst}");
+}
+
+#[test]
+fn a_mass_on_a_grounded_bush_oscillates_at_the_square_root_of_k_over_m_per_direction() {
+    let (m, j) = (4.0, 0.25);
+    let (_, cord) = cord8();
+    for cid in ["", "8", "0"] {
+        let deck = format!(
+            "BEGIN BULK\n{cord}{}GRID,1,,0.3,0.2,0.1\nCONM2,9,1,,{m:e},,,,\n,{j:e},,{j:e},,,{j:e}\nCBUSH,5,3,1,,,,,{cid}\n",
+            pbush_card()
+        );
+        let body = parse_str(&deck).unwrap();
+        let asm = assemble(&body.mesh).unwrap();
+        let f = lowest_modes(&asm.k, &asm.m, 6, -1.0)
+            .unwrap()
+            .frequencies_hz();
+        let mut expected: Vec<f64> = (0..6)
+            .map(|d| (K[d] / if d < 3 { m } else { j }).sqrt() / (2.0 * PI))
+            .collect();
+        expected.sort_by(f64::total_cmp);
+        for (a, b) in f.iter().zip(&expected) {
+            println!("CID '{cid}': {a:.9} Hz, sqrt(k/m)/2π = {b:.9} Hz");
+            assert!((a / b - 1.0).abs() < 1e-9, "CID '{cid}': {a} vs {b}");
+        }
+    }
+}
+
+#[test]
+fn unsupported_bush_features_are_refused_naming_card_field_and_line() {
+    let head = format!(
+        "BEGIN BULK\n{}GRID,1,,0.,0.,0.\nGRID,2,,1.,0.,0.\n",
+        pbush_card()
+    );
+    // Head: PBUSH on lines 2-3, grids on 4-5; the CBUSH starts on line 6.
+    let cases = [
+        (
+            "CBUSH,5,3,1,2,0.,1.,0.\n,0.5,7\n",
+            vec!["CBUSH", "OCID", "line 7"],
+        ),
+        (
+            "CBUSH,5,3,1,2,0.,1.,0.\n,0.5,-1,0.1\n",
+            vec!["CBUSH", "S1", "line 7"],
+        ),
+        ("CBUSH,5,3,1,2\n", vec!["CBUSH 5", "orientation", "line 6"]),
+        ("PBUSH,4,K,1.\n,,GE,0.02\n", vec!["PBUSH", "GE1", "line 7"]),
+        ("PBUSH,4,K,1.\n,,M,2.\n", vec!["PBUSH", "keyword", "line 7"]),
+        (
+            "CBUSH,5,4,1,2,0.,1.,0.\n",
+            vec!["CBUSH 5", "PBUSH 4", "line 6"],
+        ),
+    ];
+    for (card, words) in cases {
+        let err = error_of(&format!("{head}{card}"));
+        for w in words {
+            assert!(err.contains(w), "{card}: '{w}' missing in {err}");
+        }
+    }
 }

@@ -47,6 +47,12 @@
 //!   (M11 = M22 = M33 = m, no translational coupling, rotation–translation block m[r]×), which
 //!   becomes a CONM2-like mass at offset r with inertia M(4..6) − m(|r|²I − r rᵀ); any other
 //!   6 × 6 matrix is refused naming the card and line.
+//! - CBUSH/PBUSH → [`crate::fe::mesh::Bush`]: K1..K6 and B1..B6 (viscous, into the damping
+//!   matrix) along the element axes, which are CID (0 basic or a CORD2R), else x from GA to GB
+//!   with y in the plane of X1..X3 / GO (like CBAR), else basic when GA and GB coincide or GB is
+//!   blank (ground). The spring point lies at S (default 0.5) along GA–GB, carried rigidly by
+//!   both ends. Refused: OCID other than −1, S1..S3, non-zero PBUSH GE; the RCV line (stress
+//!   recovery) is read and not used. Bushes are not written back.
 //! - CELAS1/PELAS, CELAS2, CDAMP1/PDAMP, CDAMP2: one component, to ground or between two grids
 //!   along the same component. Merged per node / node pair.
 //! - RBE2 → [`crate::fe::mesh::RigidLink`], RBE3 (no UM) → [`crate::fe::mesh::InterpolationLink`],
@@ -90,6 +96,8 @@ pub struct ElementIds {
     pub rigid_links: Vec<u32>,
     /// RBE3 ids.
     pub interpolation_links: Vec<u32>,
+    /// CBUSH ids.
+    pub bushes: Vec<u32>,
 }
 
 /// A body read from bulk data.

@@ -10,7 +10,7 @@ use super::lexer::{CardSink, Loc, RawCard, Value};
 use super::NastranBody;
 use crate::fe::error::FeError;
 use crate::fe::mesh::{
-    Beam, BeamSection, GroundSpring, InterpolationLink, InterpolationSource, Material, Mesh,
+    Beam, BeamSection, Bush, GroundSpring, InterpolationLink, InterpolationSource, Material, Mesh,
     PointMass, RigidLink, Shell, Spring, TriShell,
 };
 
@@ -36,6 +36,8 @@ struct Cards {
     plates: BTreeMap<u32, (cards::Plate, &'static str)>,
     masses: BTreeMap<u32, cards::Conm2>,
     general_masses: BTreeMap<u32, cards::Conm1>,
+    bush_properties: BTreeMap<u32, cards::Pbush>,
+    bushes: BTreeMap<u32, cards::Cbush>,
     springs: BTreeMap<u32, cards::Scalar>,
     dampers: BTreeMap<u32, cards::Scalar>,
     rigid: BTreeMap<u32, cards::Rbe2>,
@@ -162,6 +164,15 @@ impl Cards {
                     c.element_id(m.id, &line, "CONM1")?;
                     c.general_masses.insert(m.id, m);
                 }
+                "PBUSH" => {
+                    let p = cards::pbush(&r)?;
+                    insert_unique(&mut c.bush_properties, "PBUSH", p.id, &line, p)?;
+                }
+                "CBUSH" => {
+                    let b = cards::cbush(&r)?;
+                    c.element_id(b.id, &line, "CBUSH")?;
+                    c.bushes.insert(b.id, b);
+                }
                 "CELAS1" | "CELAS2" => {
                     let s = cards::scalar(&r, raw.name == "CELAS2", true)?;
                     c.element_id(s.id, &line, &raw.name)?;
@@ -201,7 +212,7 @@ impl Cards {
                             "card {other} is not supported (supported: GRID, CORD2R, CORD2C, \
                              CORD2S, MAT1, \
                              PSHELL, PBAR, PBEAM, PELAS, PDAMP, CQUAD4, CTRIA3, CBAR, CBEAM, \
-                             CONM1, CONM2, CELAS1, CELAS2, CDAMP1, CDAMP2, RBE2, RBE3, SPC1, SPC, \
+                             CONM1, CONM2, CBUSH, PBUSH, CELAS1, CELAS2, CDAMP1, CDAMP2, RBE2, RBE3, SPC1, SPC, \
                              PARAM, EIGRL, EIGR)"
                         ),
                     ))
@@ -458,6 +469,7 @@ pub(crate) fn build(cards: Collector, spc_selection: Option<u32>) -> Result<Nast
     add_beams(&c, &mut body)?;
     add_masses(&c, &systems, &mut body)?;
     add_scalars(&c, &mut body)?;
+    add_bushes(&c, &systems, &mut body)?;
     add_links(&c, &mut body)?;
     add_supports(&c, spc_selection, &mut body)?;
     check_dependents(&c, &body)?;
@@ -743,6 +755,66 @@ fn place_mass(
         inertia: inertia * scale,
     });
     body.element_ids.masses.push(id);
+}
+
+fn add_bushes(c: &Cards, systems: &Systems, body: &mut NastranBody) -> Result<(), FeError> {
+    for (&id, e) in &c.bushes {
+        let user = format!("CBUSH {id}");
+        let line = &e.line;
+        let p = c.bush_properties.get(&e.pid).ok_or_else(|| {
+            mesh_error(line, format!("{user}: property PBUSH {} not found", e.pid))
+        })?;
+        let a = node_of(body, e.ga, line, &user)?;
+        let b = match e.gb {
+            Some(g) => Some(node_of(body, g, line, &format!("{user} GB"))?),
+            None => None,
+        };
+        let xa = body.mesh.nodes[a];
+        let along = b.map_or_else(Vector3::zeros, |b| body.mesh.nodes[b] - xa);
+        let frame = match e.axes {
+            cards::BushAxes::System(0) => Matrix3::identity(),
+            cards::BushAxes::System(cid) => systems.rectangular(cid, line, &user)?.1,
+            // Coincident ends (or ground) and no CID: the element axes are basic.
+            cards::BushAxes::Line(_) if along.norm() == 0.0 => Matrix3::identity(),
+            cards::BushAxes::Line(None) => {
+                return Err(mesh_error(
+                    line,
+                    format!(
+                        "{user}: GA and GB are apart, so the element axes need an orientation \
+                         vector X1..X3, a grid GO or a CID"
+                    ),
+                ))
+            }
+            cards::BushAxes::Line(Some(o)) => {
+                let v = match o {
+                    Orientation::Vector(v) => Vector3::from(v),
+                    Orientation::Node(g0) => {
+                        body.mesh.nodes[node_of(body, g0, line, &format!("{user} GO"))?] - xa
+                    }
+                };
+                let ex = along.normalize();
+                let y = v - ex * ex.dot(&v);
+                if !(y.norm() > 1e-9 * v.norm() && y.norm().is_finite()) {
+                    return Err(mesh_error(
+                        line,
+                        format!("{user}: the orientation vector is parallel to GA-GB"),
+                    ));
+                }
+                let ey = y.normalize();
+                Matrix3::from_columns(&[ex, ey, ex.cross(&ey)])
+            }
+        };
+        body.mesh.bushes.push(Bush {
+            a,
+            b,
+            frame,
+            point: xa + along * e.s,
+            stiffness: p.k,
+            damping: p.b,
+        });
+        body.element_ids.bushes.push(id);
+    }
+    Ok(())
 }
 
 /// Long on purpose: one arm per scalar spring and damper card.

@@ -438,6 +438,12 @@ impl<'m> Deck<'m> {
 
 /// Writes `mesh` as bulk data (BEGIN BULK … ENDDATA).
 pub fn write_bulk_deck(mesh: &Mesh) -> Result<String, FeError> {
+    if !mesh.bushes.is_empty() {
+        return Err(FeError::Mesh(format!(
+            "the mesh has {} bushes (CBUSH); writing them is not supported",
+            mesh.bushes.len()
+        )));
+    }
     let mut deck = Deck::new(mesh);
     deck.header();
     deck.grids()?;
