@@ -644,16 +644,12 @@ pub struct Conm1 {
 pub(crate) fn conm1(r: &Reader) -> Result<Conm1, FeError> {
     r.at_most(24)?;
     let mut matrix = [[0.0; 6]; 6];
-    for i in 0..6 {
-        for j in 0..=i {
-            let v = r.real_or(
-                3 + i * (i + 1) / 2 + j,
-                &format!("M{}{}", i + 1, j + 1),
-                0.0,
-            )?;
-            matrix[i][j] = v;
-            matrix[j][i] = v;
-        }
+    // Lower triangle by rows: M11, M21, M22, M31, … from field index 3 on.
+    let entries = (0..6).flat_map(|i| (0..=i).map(move |j| (i, j)));
+    for (k, (i, j)) in entries.enumerate() {
+        let v = r.real_or(3 + k, &format!("M{}{}", i + 1, j + 1), 0.0)?;
+        matrix[i][j] = v;
+        matrix[j][i] = v;
     }
     Ok(Conm1 {
         id: r.id(0, "EID")?,

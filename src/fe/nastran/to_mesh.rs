@@ -257,7 +257,7 @@ struct System {
 impl System {
     /// Basic position of a point given by its coordinates in this system (angles in degrees,
     /// as Nastran enters them).
-    fn to_basic(&self, p: [f64; 3]) -> Vector3<f64> {
+    fn to_basic(self, p: [f64; 3]) -> Vector3<f64> {
         let local = match self.kind {
             SystemKind::Rectangular => Vector3::from(p),
             SystemKind::Cylindrical => {
