@@ -167,6 +167,14 @@ pub fn check_mesh(mesh: &Mesh, limits: &CheckLimits) -> Result<(), FeError> {
             }
         }
     }
+    for (i, b) in mesh.bushes.iter().enumerate() {
+        for k in std::iter::once(b.a).chain(b.b) {
+            match connected.get_mut(k) {
+                Some(c) => *c = true,
+                None => problems.push(format!("bush {i}: node {k} does not exist")),
+            }
+        }
+    }
     // A node tied by a rigid or interpolation link is held by the link (or holds it): count it
     // as structurally connected; a link on a node without any real stiffness shows up as a
     // singular DOF in `check_assembled`.
@@ -254,6 +262,11 @@ fn disconnected_parts(
         .chain(mesh.shells.iter().map(|s| s.nodes.to_vec()))
         .chain(mesh.triangles.iter().map(|t| t.nodes.to_vec()))
         .chain(mesh.springs.iter().map(|s| s.nodes.to_vec()))
+        .chain(
+            mesh.bushes
+                .iter()
+                .map(|b| std::iter::once(b.a).chain(b.b).collect()),
+        )
         .chain(link_node_sets(mesh).into_iter().map(|(_, nodes)| nodes));
     for nodes in links {
         for w in nodes.windows(2) {

@@ -514,3 +514,17 @@ fn unsupported_bush_features_are_refused_naming_card_field_and_line() {
         }
     }
 }
+
+#[test]
+fn beams_joined_only_by_a_bush_pass_the_mesh_checks_as_one_part() {
+    use engine_mount_chassis::fe::checks::{check_mesh, CheckLimits};
+    // Two cantilever segments whose facing ends coincide and are joined by a CBUSH alone.
+    let deck = format!(
+        "BEGIN BULK\nMAT1,1,2.1+11,,0.3,7850.\nPBAR,5,1,3.-4,4.-8,1.-8,5.-8\n{}\
+         GRID,1,,0.,0.,0.\nGRID,2,,0.5,0.,0.\nGRID,3,,0.5,0.,0.\nGRID,4,,1.,0.,0.\n\
+         CBAR,1,5,1,2,0.,1.,0.\nCBAR,2,5,3,4,0.,1.,0.\nCBUSH,6,3,2,3\nSPC1,1,123456,1\n",
+        pbush_card()
+    );
+    let body = parse_str(&deck).unwrap();
+    check_mesh(&body.mesh, &CheckLimits::default()).unwrap();
+}

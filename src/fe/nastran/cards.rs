@@ -196,7 +196,10 @@ pub(crate) fn grid(r: &Reader) -> Result<Grid, FeError> {
     // The assembly numbers every node's DOFs in basic axes (springs, supports and links act on
     // basic components), so a grid's own displacement system would need a per-node rotation
     // through all of them: refused rather than half supported.
-    if !matches!(r.value(5, "CD")?, Value::Blank | Value::Int(0)) {
+    if !matches!(
+        r.value(5, "CD")?,
+        Value::Blank | Value::Int(0) | Value::Real(0.0)
+    ) {
         let grid = r.opt_int(0, "ID")?.unwrap_or(0);
         return Err(r.error(
             5,
