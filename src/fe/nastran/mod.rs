@@ -44,7 +44,7 @@
 //! - CONM2 (CID −1, 0 or a CORD2R; offset masses sit on an extra node rigidly linked to the
 //!   grid, so the translation–rotation coupling is exact; products of inertia as in the QRG).
 //! - CONM1 (lower triangle, CID blank/0 or a CORD2R): the matrix must be that of a rigid body
-//!   (M11 = M22 = M33 = m, no translational coupling, rotation–translation block m[r]×), which
+//!   (M11 = M22 = M33 = m, no translational coupling, rotation–translation block m·\[r\]×), which
 //!   becomes a CONM2-like mass at offset r with inertia M(4..6) − m(|r|²I − r rᵀ); any other
 //!   6 × 6 matrix is refused naming the card and line.
 //! - CBUSH/PBUSH → [`crate::fe::mesh::Bush`]: K1..K6 and B1..B6 (viscous, into the damping
