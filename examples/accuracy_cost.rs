@@ -20,7 +20,7 @@ use std::time::Instant;
 
 use engine_mount_chassis::cosim::{
     BodyOptions, Counters, EffectSwitch, Inputs, SceneKind, Settings, Signal, Simulation,
-    VehicleOverrides, RPM_TO_RAD_PER_S,
+    RPM_TO_RAD_PER_S,
 };
 
 /// One run's samples: every mount force component at each communication point in the window.
@@ -288,23 +288,16 @@ fn main() {
             (
                 "without gyroscopic terms".to_owned(),
                 Settings {
-                    vehicle: VehicleOverrides {
-                        effects: base.vehicle.effects.with(EffectSwitch::Gyroscopic, false),
-                        ..base.vehicle
-                    },
+                    vehicle: base.vehicle.with_effect(EffectSwitch::Gyroscopic, false),
                     ..base.clone()
                 },
             ),
             (
                 "rigid ring carriers".to_owned(),
                 Settings {
-                    vehicle: VehicleOverrides {
-                        effects: base
-                            .vehicle
-                            .effects
-                            .with(EffectSwitch::RingCarrierElasticity, false),
-                        ..base.vehicle
-                    },
+                    vehicle: base
+                        .vehicle
+                        .with_effect(EffectSwitch::RingCarrierElasticity, false),
                     ..base.clone()
                 },
             ),
@@ -327,13 +320,9 @@ fn main() {
             model_knobs.push((
                 "rigid chassis".to_owned(),
                 Settings {
-                    vehicle: VehicleOverrides {
-                        effects: base
-                            .vehicle
-                            .effects
-                            .with(EffectSwitch::ChassisFlexibility, false),
-                        ..base.vehicle
-                    },
+                    vehicle: base
+                        .vehicle
+                        .with_effect(EffectSwitch::ChassisFlexibility, false),
                     ..base.clone()
                 },
             ));

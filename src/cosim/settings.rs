@@ -83,12 +83,6 @@ impl EffectOverrides {
     pub fn set(&mut self, switch: EffectSwitch, on: bool) {
         self.0[switch as usize] = Some(on);
     }
-
-    /// These overrides with `switch` set to `on`.
-    pub fn with(mut self, switch: EffectSwitch, on: bool) -> Self {
-        self.set(switch, on);
-        self
-    }
 }
 
 /// A vehicle value that [`VehicleOverrides`] can replace.
