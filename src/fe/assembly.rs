@@ -6,18 +6,18 @@ use nalgebra::{Dim, Matrix, RawStorage};
 use super::dof::{DofMap, Expansion, DOF_PER_NODE};
 use super::error::FeError;
 use super::mesh::Mesh;
-use super::{beam, links, mass, shell, shell3, spring};
+use super::{beam, links, mass, shell, shell3, solid, spring};
 
 /// Sparse symmetric matrix type of the FE model (both triangles stored).
 pub type SparseMat = SparseColMat<usize, f64>;
 
-/// The assembled system: stiffness, lumped mass and viscous damping on the free DOFs. With
+/// The assembled system: stiffness, mass (lumped, consistent for solids) and viscous damping on the free DOFs. With
 /// rigid/interpolation links the matrices are Tᵀ K T etc. on the independent DOFs (u = T q).
 #[derive(Debug, Clone)]
 pub struct Assembled {
     /// Stiffness matrix (N/m, N m/rad).
     pub k: SparseMat,
-    /// Lumped mass matrix (kg, kg m²).
+    /// Mass matrix (kg, kg m²): lumped, consistent for solids.
     pub m: SparseMat,
     /// Viscous damping of the discrete dampers (N s/m) (structural damping is added modally).
     pub c: SparseMat,
@@ -69,11 +69,6 @@ impl TripletSink<'_> {
             }
         }
     }
-
-    fn finish(self, n: usize, what: &str) -> Result<SparseMat, FeError> {
-        SparseColMat::try_new_from_triplets(n, n, &self.entries)
-            .map_err(|e| FeError::Numerical(format!("building sparse {what}: {e:?}")))
-    }
 }
 
 /// The `(equation, coefficient)` terms of one DOF (the slow path: only for dependent DOFs).
@@ -87,12 +82,8 @@ fn terms(e: Expansion<'_>) -> Vec<(usize, f64)> {
 
 /// Assembles K, M, C of `mesh` on the DOFs left free by `mesh.constraints`.
 pub fn assemble(mesh: &Mesh) -> Result<Assembled, FeError> {
-    let dofs = DofMap::with_links(
-        mesh.nodes.len(),
-        &mesh.constraints,
-        &links::equations(mesh)?,
-    )?;
-    let n = dofs.n_free();
+    let equations = links::equations(mesh)?;
+    let dofs = DofMap::with_links(mesh.nodes.len(), &mesh.constraints, &equations)?;
     let mut k = TripletSink {
         dofs: &dofs,
         entries: Vec::new(),
@@ -162,10 +153,22 @@ pub fn assemble(mesh: &Mesh) -> Result<Assembled, FeError> {
         k.scatter(&nodes, &kb);
         c.scatter(&nodes, &cb);
     }
+    for i in 0..mesh.solids.len() {
+        let (ks, ms) = solid::assembly_matrices(mesh, i)?;
+        k.scatter(&mesh.solids[i].nodes, &ks);
+        m.scatter(&mesh.solids[i].nodes, &ms);
+    }
+    let entries = [k.entries, m.entries, c.entries];
+    let (dofs, [k, m, c]) = solid::remove_free_rotations(mesh, dofs, &equations, entries)?;
+    let n = dofs.n_free();
+    let finish = |entries: Vec<Triplet<usize, usize, f64>>, what: &str| {
+        SparseColMat::try_new_from_triplets(n, n, &entries)
+            .map_err(|e| FeError::Numerical(format!("building sparse {what}: {e:?}")))
+    };
     Ok(Assembled {
-        k: k.finish(n, "K")?,
-        m: m.finish(n, "M")?,
-        c: c.finish(n, "C")?,
+        k: finish(k, "K")?,
+        m: finish(m, "M")?,
+        c: finish(c, "C")?,
         dofs,
     })
 }

@@ -147,6 +147,20 @@ pub fn check_mesh(mesh: &Mesh, limits: &CheckLimits) -> Result<(), FeError> {
             has_stiffness[k] = true;
         }
     }
+    for (i, s) in mesh.solids.iter().enumerate() {
+        let pts: Option<Vec<Vector3<f64>>> = s.nodes.iter().map(|&k| node(mesh, k)).collect();
+        let Some(pts) = pts else {
+            problems.push(format!("solid {i}: node {:?} does not exist", s.nodes));
+            continue;
+        };
+        if let Err(why) = super::solid::check_geometry(&pts) {
+            problems.push(format!("solid {i}: {why}"));
+        }
+        for &k in &s.nodes {
+            connected[k] = true;
+            has_stiffness[k] = true;
+        }
+    }
     for (i, m) in mesh.masses.iter().enumerate() {
         match connected.get_mut(m.node) {
             Some(c) => *c = true,
@@ -261,6 +275,7 @@ fn disconnected_parts(
         .map(|b| b.nodes.to_vec())
         .chain(mesh.shells.iter().map(|s| s.nodes.to_vec()))
         .chain(mesh.triangles.iter().map(|t| t.nodes.to_vec()))
+        .chain(mesh.solids.iter().map(|s| s.nodes.clone()))
         .chain(mesh.springs.iter().map(|s| s.nodes.to_vec()))
         .chain(
             mesh.bushes

@@ -117,6 +117,16 @@ pub struct TriShell {
     pub extra_mass_per_area: f64,
 }
 
+/// Solid element (Nastran CTETRA, CPENTA, CHEXA) with translational stiffness and consistent
+/// mass only; the formulation follows the node count (see [`crate::fe::solid`]).
+#[derive(Debug, Clone, PartialEq)]
+pub struct Solid {
+    /// Nodes in Nastran order: 4 or 10 (tetrahedron), 6 (wedge), 8 (hexahedron).
+    pub nodes: Vec<usize>,
+    /// Material.
+    pub material: Material,
+}
+
 /// Point mass with rotary inertia (global axes) at a node.
 #[derive(Debug, Clone, PartialEq)]
 pub struct PointMass {
@@ -217,6 +227,8 @@ pub struct Mesh {
     pub shells: Vec<Shell>,
     /// Three-node shell elements.
     pub triangles: Vec<TriShell>,
+    /// Solid elements.
+    pub solids: Vec<Solid>,
     /// Point masses.
     pub masses: Vec<PointMass>,
     /// Springs to ground.

@@ -32,7 +32,7 @@
 //!
 //! Elements: [`beam`] (Euler-Bernoulli, 12 DOF, HRZ-lumped mass), [`shell`] (QM6 membrane
 //! with Hughes–Brezzi drilling rotation + MITC4 plate, lumped mass), [`shell3`] (CST membrane +
-//! DKT plate), [`mass`] (point mass with
+//! DKT plate), [`solid`] (tetrahedra, wedge, hexahedron; consistent mass), [`mass`] (point mass with
 //! rotary inertia), [`spring`] (grounded and two-node spring-dampers).
 
 pub mod assembly;
@@ -51,6 +51,7 @@ pub mod modal;
 pub mod nastran;
 pub mod shell;
 pub mod shell3;
+pub mod solid;
 pub mod spring;
 
 pub use error::FeError;

@@ -67,6 +67,7 @@
 mod cards;
 mod lexer;
 mod reader;
+mod solid_cards;
 mod to_mesh;
 mod writer;
 
@@ -98,6 +99,8 @@ pub struct ElementIds {
     pub interpolation_links: Vec<u32>,
     /// CBUSH ids.
     pub bushes: Vec<u32>,
+    /// CTETRA / CPENTA / CHEXA ids.
+    pub solids: Vec<u32>,
 }
 
 /// A body read from bulk data.

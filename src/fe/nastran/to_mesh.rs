@@ -7,6 +7,7 @@ use nalgebra::{Matrix3, Vector3};
 
 use super::cards::{self, Orientation, Reader, ScalarValue, SystemKind};
 use super::lexer::{CardSink, Loc, RawCard, Value};
+use super::solid_cards;
 use super::NastranBody;
 use crate::fe::error::FeError;
 use crate::fe::mesh::{
@@ -42,6 +43,8 @@ struct Cards {
     dampers: BTreeMap<u32, cards::Scalar>,
     rigid: BTreeMap<u32, cards::Rbe2>,
     interpolation: BTreeMap<u32, cards::Rbe3>,
+    solids: BTreeMap<u32, solid_cards::SolidElement>,
+    solid_properties: BTreeMap<u32, solid_cards::Psolid>,
     supports: Vec<(cards::Support, Loc)>,
     element_lines: BTreeMap<u32, (Loc, String)>,
     mass_scale: f64,
@@ -202,6 +205,19 @@ impl Cards {
                     c.supports
                         .extend(list.into_iter().map(|s| (s, line.clone())));
                 }
+                "CTETRA" | "CPENTA" | "CHEXA" => {
+                    let name = ["CTETRA", "CPENTA", "CHEXA"]
+                        .into_iter()
+                        .find(|n| *n == raw.name)
+                        .unwrap_or("CHEXA");
+                    let e = solid_cards::element(&r, name)?;
+                    c.element_id(e.id, &line, name)?;
+                    c.solids.insert(e.id, e);
+                }
+                "PSOLID" => {
+                    let p = solid_cards::psolid(&r)?;
+                    insert_unique(&mut c.solid_properties, "PSOLID", p.id, &line, p)?;
+                }
                 "PARAM" => c.param(&r)?,
                 // Eigenvalue extraction requests: the caller chooses the modes.
                 "EIGRL" | "EIGR" => {}
@@ -212,7 +228,7 @@ impl Cards {
                             "card {other} is not supported (supported: GRID, CORD2R, CORD2C, \
                              CORD2S, MAT1, \
                              PSHELL, PBAR, PBEAM, PELAS, PDAMP, CQUAD4, CTRIA3, CBAR, CBEAM, \
-                             CONM1, CONM2, CBUSH, PBUSH, CELAS1, CELAS2, CDAMP1, CDAMP2, RBE2, RBE3, SPC1, SPC, \
+                             CONM1, CONM2, CBUSH, PBUSH, CTETRA, CPENTA, CHEXA, PSOLID, CELAS1, CELAS2, CDAMP1, CDAMP2, RBE2, RBE3, SPC1, SPC, \
                              PARAM, EIGRL, EIGR)"
                         ),
                     ))
@@ -467,6 +483,7 @@ pub(crate) fn build(cards: Collector, spc_selection: Option<u32>) -> Result<Nast
     }
     add_shells(&c, &mut body)?;
     add_beams(&c, &mut body)?;
+    add_solids(&c, &systems, &mut body)?;
     add_masses(&c, &systems, &mut body)?;
     add_scalars(&c, &mut body)?;
     add_bushes(&c, &systems, &mut body)?;
@@ -569,6 +586,27 @@ fn add_shells(c: &Cards, body: &mut NastranBody) -> Result<(), FeError> {
         }
     }
     Ok(())
+}
+
+/// Solids take an isotropic MAT1 (E, G, NU consistent within 1 %, as shells need).
+fn add_solids(c: &Cards, systems: &Systems, body: &mut NastranBody) -> Result<(), FeError> {
+    let material = |mid: u32, line: &Loc, user: &str| -> Result<Material, FeError> {
+        let m = material_named(c, mid, line, user)?;
+        let (e, g, nu) = moduli(&m, user)?;
+        if (g / (e / (2.0 * (1.0 + nu))) - 1.0).abs() > 0.01 {
+            return Err(mesh_error(
+                &m.line,
+                format!("MAT1 {mid} (used by {user}): G = {g} differs from E / 2(1 + NU) by more than 1 %"),
+            ));
+        }
+        Ok(Material {
+            youngs_modulus: e,
+            poisson_ratio: nu,
+            density: m.rho * c.mass_scale,
+        })
+    };
+    let system = |cid: u32, line: &Loc, user: &str| systems.get(cid, line, user).map(|_| ());
+    solid_cards::add_solids(&c.solids, &c.solid_properties, &material, &system, body)
 }
 
 fn add_beams(c: &Cards, body: &mut NastranBody) -> Result<(), FeError> {
