@@ -155,11 +155,7 @@ fn shape(kind: SolidKind, p: [f64; 3]) -> Shape {
             let mut n = Vec::with_capacity(8);
             let mut dn = Vec::with_capacity(8);
             for c in HEXA_CORNERS {
-                let f = [
-                    1.0 + c[0] * p[0],
-                    1.0 + c[1] * p[1],
-                    1.0 + c[2] * p[2],
-                ];
+                let f = [1.0 + c[0] * p[0], 1.0 + c[1] * p[1], 1.0 + c[2] * p[2]];
                 n.push(0.125 * f[0] * f[1] * f[2]);
                 dn.push(Vector3::new(
                     0.125 * c[0] * f[1] * f[2],
@@ -242,7 +238,11 @@ fn tetra_rule_14() -> Rule {
 fn triangle_rule(degree: usize) -> Vec<([f64; 2], f64)> {
     if degree <= 2 {
         let (a, b) = (1.0 / 6.0, 2.0 / 3.0);
-        vec![([a, a], 1.0 / 6.0), ([b, a], 1.0 / 6.0), ([a, b], 1.0 / 6.0)]
+        vec![
+            ([a, a], 1.0 / 6.0),
+            ([b, a], 1.0 / 6.0),
+            ([a, b], 1.0 / 6.0),
+        ]
     } else {
         let mut out = Vec::new();
         for (a, w) in [
@@ -374,10 +374,7 @@ fn classify(x: &[Vector3<f64>]) -> Result<Checked, String> {
     if x.iter().any(|p| p.iter().any(|c| !c.is_finite())) {
         return Err("a node has non-finite coordinates".into());
     }
-    let size = x
-        .iter()
-        .map(|p| (p - x[0]).norm())
-        .fold(0.0f64, f64::max);
+    let size = x.iter().map(|p| (p - x[0]).norm()).fold(0.0f64, f64::max);
     let tol = 1e-9 * size.powi(3);
     let mut points = node_points(kind);
     points.extend(stiffness_rule(kind).into_iter().map(|(p, _)| p));
@@ -600,7 +597,11 @@ pub fn strains(
     let c = checked(index, solid, x)?;
     let fail = |why: String| FeError::Mesh(format!("solid {index}: {why}"));
     if u.len() != x.len() {
-        return Err(fail(format!("{} displacements for {} nodes", u.len(), x.len())));
+        return Err(fail(format!(
+            "{} displacements for {} nodes",
+            u.len(),
+            x.len()
+        )));
     }
     let ue = DVector::from_iterator(3 * u.len(), u.iter().flat_map(|v| v.iter().copied()));
     let (_, kua, kaa) = stiffness_parts(c, &solid.material, x).map_err(fail)?;
@@ -728,8 +729,8 @@ mod tests {
             for a in 0..=degree {
                 for b in 0..=degree - a {
                     for c in 0..=degree - a - b {
-                        let exact = factorial(a) * factorial(b) * factorial(c)
-                            / factorial(a + b + c + 3);
+                        let exact =
+                            factorial(a) * factorial(b) * factorial(c) / factorial(a + b + c + 3);
                         let q: f64 = rule
                             .iter()
                             .map(|(p, w)| {

@@ -169,7 +169,10 @@ pub(crate) fn add_solids(
     for (&id, e) in elements {
         let user = format!("{} {id}", e.card);
         let p = properties.get(&e.pid).ok_or_else(|| {
-            mesh_error(&e.line, format!("{user}: property PSOLID {} not found", e.pid))
+            mesh_error(
+                &e.line,
+                format!("{user}: property PSOLID {} not found", e.pid),
+            )
         })?;
         let m = match materials.get(&p.id) {
             Some(m) => *m,

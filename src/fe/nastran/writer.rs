@@ -2,7 +2,7 @@
 //! more significant digits; most values of a generated mesh are written exactly).
 //!
 //! GRID ids are node index + 1; elements are numbered from 1 in the order CQUAD4, CTRIA3, CBAR, CONM2,
-//! CELAS2, CDAMP2, RBE2, RBE3. Supports are SPC1 set 1 (a Nastran run needs `SPC = 1` in its
+//! CELAS2, CDAMP2, RBE2, RBE3, CTETRA/CPENTA/CHEXA. Supports are SPC1 set 1 (a Nastran run needs `SPC = 1` in its
 //! case control; [`super::parse_str`] applies the only set present). Named nodes are listed in
 //! comments.
 
@@ -11,6 +11,7 @@ use std::fmt::Write;
 
 use crate::fe::error::FeError;
 use crate::fe::mesh::{Beam, Material, Mesh};
+use crate::fe::solid::SolidKind;
 
 /// A field of a card being written.
 enum Out {
@@ -411,6 +412,27 @@ impl<'m> Deck<'m> {
         Ok(())
     }
 
+    /// CTETRA / CPENTA / CHEXA with a PSOLID per material (defaults: IN, ISOP, FCTN blank).
+    fn solids(&mut self) -> Result<(), FeError> {
+        for (i, s) in self.mesh.solids.iter().enumerate() {
+            let what = format!("solid {i}");
+            let kind = SolidKind::from_node_count(s.nodes.len()).ok_or_else(|| {
+                FeError::Mesh(format!("{what}: {} nodes (4, 6, 8 or 10)", s.nodes.len()))
+            })?;
+            let mid = self.mat1(&s.material)?;
+            let (pid, new) = self.properties.id(&[2.0, mid as f64]);
+            if new {
+                self.card("PSOLID", &[Out::Int(pid), Out::Int(mid)])?;
+            }
+            let mut fields = vec![self.next_element(), Out::Int(pid)];
+            for &n in &s.nodes {
+                fields.push(self.grid_id(&what, n)?);
+            }
+            self.card(kind.card(), &fields)?;
+        }
+        Ok(())
+    }
+
     /// The constraints as SPC1 set 1, one card per component mask.
     fn spc1(&mut self) -> Result<(), FeError> {
         let mut fixed: BTreeMap<usize, [bool; 6]> = BTreeMap::new();
@@ -454,6 +476,7 @@ pub fn write_bulk_deck(mesh: &Mesh) -> Result<String, FeError> {
     deck.celas2_cdamp2()?;
     deck.rbe2()?;
     deck.rbe3()?;
+    deck.solids()?;
     deck.spc1()?;
     deck.out.push_str("ENDDATA\n");
     Ok(deck.out)
