@@ -28,6 +28,7 @@
 //! receive no rotational stiffness from anything ([`remove_free_rotations`]), as Nastran's
 //! AUTOSPC does.
 
+use faer::sparse::Triplet;
 use nalgebra::{DMatrix, DVector, Matrix3, Matrix6, Vector3};
 
 use super::dof::{DofMap, DOF_PER_NODE};
@@ -167,6 +168,12 @@ fn shape(kind: SolidKind, p: [f64; 3]) -> Shape {
         }
     }
 }
+
+/// Stiffness on the nodal DOFs K_uu, coupling K_ua and K_aa of the incompatible modes.
+type StiffnessParts = (DMatrix<f64>, DMatrix<f64>, DMatrix<f64>);
+
+/// Assembly triplets of K, M and C.
+type Triplets = [Vec<Triplet<usize, usize, f64>>; 3];
 
 /// An integration rule: natural points and weights.
 type Rule = Vec<([f64; 3], f64)>;
@@ -388,7 +395,7 @@ fn classify(x: &[Vector3<f64>]) -> Result<Checked, String> {
         1.0
     };
     let worst = dets.iter().map(|d| d * sign).fold(f64::INFINITY, f64::min);
-    if !(worst > tol) {
+    if worst.is_nan() || worst <= tol {
         let (lo, hi) = dets
             .iter()
             .fold((f64::INFINITY, f64::NEG_INFINITY), |(lo, hi), &d| {
@@ -485,11 +492,7 @@ fn centre_jacobian(c: Checked, x: &[Vector3<f64>]) -> Result<Option<(Matrix3<f64
 
 /// Stiffness on the nodal DOFs and, for the hexahedron, the pieces of the condensation
 /// (K_ua, K_aa).
-fn stiffness_parts(
-    c: Checked,
-    m: &Material,
-    x: &[Vector3<f64>],
-) -> Result<(DMatrix<f64>, DMatrix<f64>, DMatrix<f64>), String> {
+fn stiffness_parts(c: Checked, m: &Material, x: &[Vector3<f64>]) -> Result<StiffnessParts, String> {
     let d = DMatrix::from_iterator(6, 6, elasticity(m).iter().copied());
     let j0 = centre_jacobian(c, x)?;
     let nd = 3 * x.len();
@@ -666,8 +669,8 @@ pub(crate) fn remove_free_rotations(
     mesh: &Mesh,
     dofs: DofMap,
     links: &[LinkEquation],
-    triplets: [Vec<faer::sparse::Triplet<usize, usize, f64>>; 3],
-) -> Result<(DofMap, [Vec<faer::sparse::Triplet<usize, usize, f64>>; 3]), FeError> {
+    triplets: Triplets,
+) -> Result<(DofMap, Triplets), FeError> {
     if mesh.solids.is_empty() {
         return Ok((dofs, triplets));
     }
@@ -702,10 +705,10 @@ pub(crate) fn remove_free_rotations(
         .iter()
         .map(|&(node, d)| reduced.global(node, d))
         .collect();
-    let renumber = |list: Vec<faer::sparse::Triplet<usize, usize, f64>>| {
+    let renumber = |list: Vec<Triplet<usize, usize, f64>>| {
         list.into_iter()
             .filter_map(|t| match (new_index[t.row], new_index[t.col]) {
-                (Some(i), Some(j)) => Some(faer::sparse::Triplet::new(i, j, t.val)),
+                (Some(i), Some(j)) => Some(Triplet::new(i, j, t.val)),
                 _ => None,
             })
             .collect()

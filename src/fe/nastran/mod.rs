@@ -41,6 +41,18 @@
 //!   X1..X3 or G0, no pins or offsets. The element is Euler-Bernoulli: shear flexibility (PBAR/
 //!   PBEAM K1, K2) is not modelled. I1 bends in Nastran's plane 1 (element x-y) → `iz`,
 //!   I2 → `iy`.
+//! - CTETRA (4 or 10 grids: mid-edge grids all given or all blank), CPENTA (6 grids), CHEXA
+//!   (8 grids) with PSOLID (MID: an isotropic MAT1, E, G, NU consistent within 1 %; CORDM
+//!   blank, 0, −1 or an existing system, irrelevant for an isotropic material; IN blank, 0 or
+//!   BUBBLE; STRESS read and not used; ISOP blank; FCTN blank or SMECH; anything else refused
+//!   naming the field) → [`crate::fe::mesh::Solid`] ([`crate::fe::solid`]: constant-strain and
+//!   quadratic tetrahedra, linear wedge, hexahedron with incompatible modes in place of
+//!   Nastran's bubble functions; consistent mass). 15-node CPENTA and 20-node CHEXA are refused.
+//!   A zero-volume, inverted or folded element (Jacobian vanishing or changing sign at a node or
+//!   integration point) is refused naming the card and line; a mirrored but valid numbering is
+//!   accepted, as in Nastran. Solid grids have no rotational stiffness: assembly removes the
+//!   rotations of grids that no element, spring or link holds (Nastran's AUTOSPC), so a CONM2
+//!   inertia on such a grid is dropped as in Nastran.
 //! - CONM2 (CID −1, 0 or a CORD2R; offset masses sit on an extra node rigidly linked to the
 //!   grid, so the translation–rotation coupling is exact; products of inertia as in the QRG).
 //! - CONM1 (lower triangle, CID blank/0 or a CORD2R): the matrix must be that of a rigid body
@@ -62,7 +74,8 @@
 //! - PARAM WTMASS (scales all mass), PARAM POST/GRDPNT/… (output only) and EIGRL/EIGR
 //!   (extraction requests) are accepted; any other card is an error naming card and line.
 //!
-//! Writing: [`write_bulk_deck`] emits large-field cards for a mesh of the supported elements.
+//! Writing: [`write_bulk_deck`] emits large-field cards for a mesh of the supported elements
+//! (solids as CTETRA/CPENTA/CHEXA with one PSOLID per material).
 
 mod cards;
 mod lexer;
