@@ -251,6 +251,7 @@ impl<'m> Deck<'m> {
 
     fn cquad4(&mut self) -> Result<(), FeError> {
         for (i, s) in self.mesh.shells.iter().enumerate() {
+            no_section(&format!("shell {i}"), s.section.is_some())?;
             let sheet = [s.thickness, s.bending_thickness, s.extra_mass_per_area];
             let pid = self.pshell(&s.material, sheet)?;
             self.plate("CQUAD4", &format!("shell {i}"), pid, &s.nodes)?;
@@ -260,6 +261,7 @@ impl<'m> Deck<'m> {
 
     fn ctria3(&mut self) -> Result<(), FeError> {
         for (i, t) in self.mesh.triangles.iter().enumerate() {
+            no_section(&format!("triangle {i}"), t.section.is_some())?;
             let sheet = [t.thickness, t.bending_thickness, t.extra_mass_per_area];
             let pid = self.pshell(&t.material, sheet)?;
             self.plate("CTRIA3", &format!("triangle {i}"), pid, &t.nodes)?;
@@ -457,6 +459,19 @@ pub fn write_bulk_deck(mesh: &Mesh) -> Result<String, FeError> {
     deck.spc1()?;
     deck.out.push_str("ENDDATA\n");
     Ok(deck.out)
+}
+
+
+/// The writer emits isotropic PSHELL/MAT1 sheets only; a general section (MAT2/MAT8, MID2/MID3
+/// materials, offsets) would be written wrong, so it is refused.
+fn no_section(what: &str, has_section: bool) -> Result<(), FeError> {
+    if has_section {
+        return Err(FeError::InvalidInput(format!(
+            "{what}: shells with a general section (anisotropic materials, separate bending or \
+             shear material, offset) are not written"
+        )));
+    }
+    Ok(())
 }
 
 #[cfg(test)]
