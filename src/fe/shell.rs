@@ -146,10 +146,7 @@ pub(crate) fn rotate_shear(c: &Matrix2<f64>, angle: f64) -> Matrix2<f64> {
 
 /// The rigid offset of the reference plane by `offset` along the local normal for `nodes`
 /// corners (local DOFs u v w θx θy θz): u_ref = u + offset θy, v_ref = v − offset θx.
-pub(crate) fn offset_transform<const D: usize>(
-    nodes: usize,
-    offset: f64,
-) -> SMatrix<f64, D, D> {
+pub(crate) fn offset_transform<const D: usize>(nodes: usize, offset: f64) -> SMatrix<f64, D, D> {
     let mut t = SMatrix::<f64, D, D>::identity();
     for i in 0..nodes {
         t[(6 * i, 6 * i + 4)] = offset;
@@ -396,7 +393,12 @@ pub fn stiffness(index: usize, shell: &Shell, p: &[Vector3<f64>; 4]) -> Result<M
         ))
     })?;
     k += k_membrane - k_coupling * internal_inv * k_coupling.transpose();
-    if let Some(offset) = shell.section.as_ref().map(|s| s.offset).filter(|&z| z != 0.0) {
+    if let Some(offset) = shell
+        .section
+        .as_ref()
+        .map(|s| s.offset)
+        .filter(|&z| z != 0.0)
+    {
         let t = offset_transform::<24>(4, offset);
         k = t.transpose() * k * t;
     }
@@ -423,7 +425,12 @@ fn constitutive(
         let dm = iso * (e * t / (1.0 - nu * nu));
         let db = iso * (e * tb.powi(3) / (12.0 * (1.0 - nu * nu)));
         let ds = SHEAR_CORRECTION * g * tb;
-        return (dm, db, TransverseShear::Isotropic(ds), DRILLING_FACTOR * g * t);
+        return (
+            dm,
+            db,
+            TransverseShear::Isotropic(ds),
+            DRILLING_FACTOR * g * t,
+        );
     };
     // THETA is measured from the side G1 → G2, not from this element's e1 (the line joining
     // the side midpoints), so the angle between the two is added.
@@ -467,7 +474,12 @@ pub fn lumped_mass(index: usize, shell: &Shell, p: &[Vector3<f64>; 4]) -> Result
             m[(6 * i + 3 + d, 6 * i + 3 + d)] = rotary * share[i];
         }
     }
-    match shell.section.as_ref().map(|s| s.offset).filter(|&z| z != 0.0) {
+    match shell
+        .section
+        .as_ref()
+        .map(|s| s.offset)
+        .filter(|&z| z != 0.0)
+    {
         // The lumped mass sits on the reference plane; the corners carry it rigidly, which
         // couples translation and rotation and adds m z0² of rotary inertia.
         Some(offset) => {
@@ -481,7 +493,6 @@ pub fn lumped_mass(index: usize, shell: &Shell, p: &[Vector3<f64>; 4]) -> Result
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::fe::mesh::Material;
 
     fn plate() -> Shell {
         Shell {
@@ -536,6 +547,78 @@ mod tests {
             zero, 6,
             "a single shell must have exactly six zero-energy modes"
         );
+    }
+
+    #[test]
+    fn isotropic_section_in_any_orientation_is_the_plain_sheet() {
+        let p = corners();
+        let plain = plate();
+        let mut general = plate();
+        let mut section = ShellSection::isotropic(&plain.material, 0.002, 0.002);
+        section.material_angle = 0.7;
+        general.section = Some(Box::new(section));
+        let (a, b) = (
+            stiffness(0, &plain, &p).unwrap(),
+            stiffness(0, &general, &p).unwrap(),
+        );
+        assert!((a - b).abs().max() < 1e-12 * a.abs().max());
+    }
+
+    #[test]
+    fn orthotropic_matrix_turned_by_ninety_degrees_swaps_its_axes() {
+        let c = Matrix3::new(9.0, 2.0, 0.0, 2.0, 4.0, 0.0, 0.0, 0.0, 3.0);
+        let r = rotate_plane(&c, std::f64::consts::FRAC_PI_2);
+        let swapped = Matrix3::new(4.0, 2.0, 0.0, 2.0, 9.0, 0.0, 0.0, 0.0, 3.0);
+        assert!((r - swapped).abs().max() < 1e-12, "{r}");
+        let s = rotate_shear(
+            &Matrix2::new(5.0, 0.0, 0.0, 1.0),
+            std::f64::consts::FRAC_PI_2,
+        );
+        assert!(
+            (s - Matrix2::new(1.0, 0.0, 0.0, 5.0)).abs().max() < 1e-12,
+            "{s}"
+        );
+    }
+
+    #[test]
+    fn offset_shell_keeps_six_rigid_modes_and_its_mass_moves_rigidly() {
+        let p = corners();
+        let mut s = plate();
+        let mut section = ShellSection::isotropic(&s.material, 0.002, 0.002);
+        section.offset = 0.013;
+        s.section = Some(Box::new(section));
+        let k = stiffness(0, &s, &p).unwrap();
+        let scale = k.abs().max();
+        let eig = k.symmetric_eigenvalues();
+        assert_eq!(eig.iter().filter(|v| v.abs() < 1e-9 * scale).count(), 6);
+        assert!(eig.iter().all(|v| *v > -1e-9 * scale));
+        // The mass sits on the plane offset by z0 n: its first moment, seen as the coupling of
+        // a unit x translation with a rigid rotation ω, is m (ω × (c + z0 n))ₓ.
+        let m = lumped_mass(0, &s, &p).unwrap();
+        let geo = geometry(0, &p).unwrap();
+        let n = geo.frame.row(2).transpose();
+        let mass = s.material.density * s.thickness * geo.area;
+        let mut translate = SMatrix::<f64, 24, 1>::zeros();
+        for i in 0..4 {
+            translate[6 * i] = 1.0;
+        }
+        let omega = Vector3::new(0.0, 1.0, 0.0);
+        let mut rotate = SMatrix::<f64, 24, 1>::zeros();
+        for (i, x) in p.iter().enumerate() {
+            let v = omega.cross(x);
+            for d in 0..3 {
+                rotate[6 * i + d] = v[d];
+                rotate[6 * i + 3 + d] = omega[d];
+            }
+        }
+        // c: centroid of the corner masses on the grid plane.
+        let c: Vector3<f64> = (0..4)
+            .map(|i| p[i] * m[(6 * i, 6 * i)])
+            .fold(Vector3::zeros(), |a, b| a + b)
+            / mass;
+        let expected = mass * omega.cross(&(c + n * 0.013))[0];
+        let got = (translate.transpose() * m * rotate)[0];
+        assert!((got - expected).abs() < 1e-12 * mass, "{got} vs {expected}");
     }
 
     #[test]

@@ -218,7 +218,11 @@ pub fn stiffness(index: usize, tri: &TriShell, p: &[Vector3<f64>; 3]) -> Result<
             let iso = Matrix3::new(1.0, nu, 0.0, nu, 1.0, 0.0, 0.0, 0.0, (1.0 - nu) / 2.0);
             let dm = iso * (e * tri.thickness / (1.0 - nu * nu));
             let db = iso * (e * tri.bending_thickness.powi(3) / (12.0 * (1.0 - nu * nu)));
-            (dm, db, DRILLING_FACTOR * mat.shear_modulus() * tri.thickness)
+            (
+                dm,
+                db,
+                DRILLING_FACTOR * mat.shear_modulus() * tri.thickness,
+            )
         }
         // e1 runs along G1 → G2, from which Nastran measures THETA; the DKT has no transverse
         // shear, so the section's shear matrix is not used.

@@ -7,3 +7,4 @@ mod deck_reader;
 mod eigen;
 mod elements;
 mod nastran;
+mod shell_cards;

@@ -461,7 +461,6 @@ pub fn write_bulk_deck(mesh: &Mesh) -> Result<String, FeError> {
     Ok(deck.out)
 }
 
-
 /// The writer emits isotropic PSHELL/MAT1 sheets only; a general section (MAT2/MAT8, MID2/MID3
 /// materials, offsets) would be written wrong, so it is refused.
 fn no_section(what: &str, has_section: bool) -> Result<(), FeError> {

@@ -144,7 +144,7 @@ fn resolve(c: &Cards, p: &Pshell, field: &str, mid: u32, user: &str) -> Result<R
         )),
         (None, None) => Err(mesh_error(
             &p.line,
-            format!("{who}: material {mid} not found (no MAT1, MAT2 or MAT8 with that id)"),
+            format!("{who}: material {mid} not found: no MAT1 {mid}, MAT2 {mid} or MAT8 {mid}"),
         )),
         (Some(m), None) => {
             let (e, g, nu) = moduli(m, user)?;
@@ -204,7 +204,7 @@ fn resolve(c: &Cards, p: &Pshell, field: &str, mid: u32, user: &str) -> Result<R
         ) => {
             let nu21 = nu12 * e2 / e1;
             let den = 1.0 - nu12 * nu21;
-            if !(den > 0.0) {
+            if den.is_nan() || den <= 0.0 {
                 return Err(mesh_error(
                     line,
                     format!(
@@ -297,7 +297,10 @@ pub(super) fn add_shells(c: &Cards, body: &mut NastranBody) -> Result<(), FeErro
             ));
         }
         if !(plate.theta.is_finite() && plate.zoffs.is_finite()) {
-            return Err(mesh_error(line, format!("{user}: THETA and ZOFFS must be finite")));
+            return Err(mesh_error(
+                line,
+                format!("{user}: THETA and ZOFFS must be finite"),
+            ));
         }
         let bending_thickness = p.t * p.bending_ratio.cbrt();
         // The sheet the mesh has always had: one MAT1 for membrane, bending and shear, shear
