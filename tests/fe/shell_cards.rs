@@ -27,6 +27,8 @@ struct Strip {
     across: bool,
     /// (PID, THETA°, ZOFFS) of each layer of elements on the same grids.
     layers: Vec<(u32, f64, f64)>,
+    /// MCID in place of THETA.
+    mcid: Option<u32>,
 }
 
 impl Strip {
@@ -38,6 +40,7 @@ impl Strip {
             triangles: false,
             across: false,
             layers: vec![(1, 0.0, 0.0)],
+            mcid: None,
         }
     }
 
@@ -52,14 +55,17 @@ impl Strip {
         }
         let mut eid = 1;
         for &(pid, theta, zoffs) in &self.layers {
+            let theta = match self.mcid {
+                Some(id) => id.to_string(),
+                None => format!("{theta:?}"),
+            };
             for i in 0..self.n {
                 let (a, b, c, e) = (2 * i + 1, 2 * i + 3, 2 * i + 4, 2 * i + 2);
                 if self.triangles {
                     // Both triangles have G1 → G2 along the strip (+x and −x): THETA means the
                     // same material axes in both.
                     for [g1, g2, g3] in [[a, b, c], [c, e, a]] {
-                        writeln!(d, "CTRIA3,{eid},{pid},{g1},{g2},{g3},{theta:?},{zoffs:?}")
-                            .unwrap();
+                        writeln!(d, "CTRIA3,{eid},{pid},{g1},{g2},{g3},{theta},{zoffs:?}").unwrap();
                         eid += 1;
                     }
                 } else {
@@ -70,7 +76,7 @@ impl Strip {
                     };
                     writeln!(
                         d,
-                        "CQUAD4,{eid},{pid},{},{},{},{},{theta:?},{zoffs:?}",
+                        "CQUAD4,{eid},{pid},{},{},{},{},{theta},{zoffs:?}",
                         g[0], g[1], g[2], g[3]
                     )
                     .unwrap();
@@ -269,6 +275,23 @@ fn orthotropic_strip_bends_with_e1_along_axis_1_and_e2_along_axis_2() {
         let theory = force * length.powi(3) / (3.0 * modulus * inertia);
         within(&format!("MAT8 {case}: tip"), w, theory, 0.015);
     }
+    // MCID: the x axis of the system projected onto the element: basic x (MCID 0), and a
+    // CORD2R with x along (0, 1, 1)/√2, which projects onto basic y.
+    let tilted = "CORD2R,5,,0.,0.,0.,0.,-1.,1.\n,0.,1.,1.\n";
+    for (mcid, triangles, modulus) in [(0, false, e1), (5, false, e2), (5, true, e2)] {
+        let mut strip = Strip::new(40, length, width);
+        strip.triangles = triangles;
+        strip.mcid = Some(mcid);
+        let body = parse_str(&strip.deck(&cards, tilted)).unwrap();
+        let w = strip.tip(&body, 2, force);
+        let theory = force * length.powi(3) / (3.0 * modulus * inertia);
+        within(
+            &format!("MAT8 MCID {mcid} (triangles: {triangles}): tip"),
+            w,
+            theory,
+            0.015,
+        );
+    }
     // Stretching sees the same moduli: axial compliance S₁₁ = 1/E1 at THETA 0, 1/E2 at 90°.
     for (theta, modulus) in [(0.0, e1), (90.0, e2)] {
         let mut strip = Strip::new(40, length, width);
@@ -366,7 +389,7 @@ fn error_of(deck: &str) -> String {
 }
 
 #[test]
-fn unknown_material_mid4_and_mcid_with_an_orthotropic_material_name_card_and_line() {
+fn unknown_material_mid4_bad_mcid_and_half_given_mat8_shear_name_card_and_line() {
     let strip = Strip::new(2, 1.0, 0.1);
     // PSHELL is on line 12 (BEGIN BULK, 6 grids, 2 quads, SPC1, MAT1).
     let missing = strip.deck("MAT1,1,2.1e11,,0.3,7850.\nPSHELL,1,1,0.01,99,,1\n", "");
@@ -386,12 +409,20 @@ fn unknown_material_mid4_and_mcid_with_an_orthotropic_material_name_card_and_lin
         "{err}"
     );
 
+    // MCID names a missing system, then a cylindrical one (material axes need a fixed x).
     let mut with_mcid = strip.deck("MAT8,8,1.4e11,1.0e10,0.3,5.0e9\nPSHELL,1,8,0.01,8\n", "");
     with_mcid = with_mcid.replace("CQUAD4,2,1,3,5,6,4,0.0,", "CQUAD4,2,1,3,5,6,4,7,");
     let err = error_of(&with_mcid);
     println!("{err}");
     assert!(
-        err.contains("line 9") && err.contains("CQUAD4 2") && err.contains("MCID"),
+        err.contains("line 9") && err.contains("CQUAD4 2 MCID") && err.contains("system 7"),
+        "{err}"
+    );
+    let err =
+        error_of(&with_mcid.replace("ENDDATA", "CORD2C,7,,0.,0.,0.,0.,0.,1.\n,1.,0.,0.\nENDDATA"));
+    println!("{err}");
+    assert!(
+        err.contains("line 9") && err.contains("CQUAD4 2 MCID") && err.contains("rectangular"),
         "{err}"
     );
     // With an isotropic material the orientation is irrelevant and MCID is accepted.

@@ -476,7 +476,7 @@ pub(crate) fn build(cards: Collector, spc_selection: Option<u32>) -> Result<Nast
             .constraints
             .extend(mask_nodes(g.ps).map(|d| (node, d)));
     }
-    shell_cards::add_shells(&c, &mut body)?;
+    shell_cards::add_shells(&c, &systems, &mut body)?;
     add_beams(&c, &mut body)?;
     add_masses(&c, &systems, &mut body)?;
     add_scalars(&c, &mut body)?;

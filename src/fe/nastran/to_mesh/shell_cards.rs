@@ -2,11 +2,11 @@
 //! ZOFFS of CQUAD4/CTRIA3 → [`Shell`] / [`TriShell`] (with a [`ShellSection`] unless the
 //! element is the plain isotropic sheet the mesh has always had).
 
-use nalgebra::{Matrix2, Matrix3};
+use nalgebra::{Matrix2, Matrix3, Vector3};
 
 use super::super::cards::{Pshell, Reader};
 use super::super::lexer::Loc;
-use super::{mesh_error, moduli, node_of, Cards, NastranBody};
+use super::{mesh_error, moduli, node_of, Cards, NastranBody, Systems};
 use crate::fe::error::FeError;
 use crate::fe::mesh::{Material, Shell, TriShell};
 use crate::fe::shell::ShellSection;
@@ -246,8 +246,54 @@ fn resolve(c: &Cards, p: &Pshell, field: &str, mid: u32, user: &str) -> Result<R
     }
 }
 
+/// THETA (rad) equivalent to MCID: the angle about the element normal from the side G1 → G2
+/// to the x axis of system `mcid` (0: basic) projected onto the element plane.
+fn mcid_angle(
+    systems: &Systems,
+    mcid: i64,
+    corners: &[Vector3<f64>],
+    line: &Loc,
+    user: &str,
+) -> Result<f64, FeError> {
+    let x = if mcid == 0 {
+        Vector3::x()
+    } else {
+        let id = u32::try_from(mcid)
+            .map_err(|_| mesh_error(line, format!("{user}: MCID {mcid} is out of range")))?;
+        systems
+            .rectangular(id, line, &format!("{user} MCID"))?
+            .1
+            .column(0)
+            .into_owned()
+    };
+    // The shells' own normals: diagonals for the quadrilateral, the first two sides for the
+    // triangle.
+    let normal = match corners {
+        [a, b, c, d] => (c - a).cross(&(d - b)),
+        [a, b, c] => (b - a).cross(&(c - a)),
+        _ => Vector3::zeros(),
+    };
+    let n = normal.normalize();
+    let project = |v: Vector3<f64>| v - n * n.dot(&v);
+    let (side, axis) = (project(corners[1] - corners[0]), project(x));
+    if !(axis.norm() > 1e-6 * x.norm() && n.iter().all(|v| v.is_finite())) {
+        return Err(mesh_error(
+            line,
+            format!(
+                "{user}: the x axis of MCID {mcid} is normal to the element: it defines no \
+                 material direction in its plane"
+            ),
+        ));
+    }
+    Ok(side.cross(&axis).dot(&n).atan2(side.dot(&axis)))
+}
+
 /// Long on purpose: one pass over the PSHELL rules, then one arm per element kind.
-pub(super) fn add_shells(c: &Cards, body: &mut NastranBody) -> Result<(), FeError> {
+pub(super) fn add_shells(
+    c: &Cards,
+    systems: &Systems,
+    body: &mut NastranBody,
+) -> Result<(), FeError> {
     for (&id, (plate, name)) in &c.plates {
         let user = format!("{name} {id}");
         let line = &plate.line;
@@ -286,16 +332,19 @@ pub(super) fn add_shells(c: &Cards, body: &mut NastranBody) -> Result<(), FeErro
         let isotropic = m1.isotropic.is_some()
             && m2.isotropic.is_some()
             && m3.as_ref().is_none_or(|m| m.isotropic.is_some());
-        if let (Some(mcid), false) = (plate.mcid, isotropic) {
-            return Err(mesh_error(
-                line,
-                format!(
-                    "{user}: MCID = {mcid} (material axes from a coordinate system) is not \
-                     supported with the MAT2/MAT8 materials of PSHELL {}; give THETA",
-                    p.id
-                ),
-            ));
-        }
+        let nodes = plate
+            .grids
+            .iter()
+            .map(|&g| node_of(body, g, line, &user))
+            .collect::<Result<Vec<_>, _>>()?;
+        // An isotropic sheet has no material direction: its MCID is not even looked up.
+        let material_angle = match plate.mcid {
+            Some(mcid) if !isotropic => {
+                let corners: Vec<_> = nodes.iter().map(|&k| body.mesh.nodes[k]).collect();
+                mcid_angle(systems, mcid, &corners, line, &user)?
+            }
+            _ => plate.theta.to_radians(),
+        };
         if !(plate.theta.is_finite() && plate.zoffs.is_finite()) {
             return Err(mesh_error(
                 line,
@@ -319,7 +368,7 @@ pub(super) fn add_shells(c: &Cards, body: &mut NastranBody) -> Result<(), FeErro
                     .as_ref()
                     .and_then(|m| m.shear)
                     .map(|s| s * (p.ts_t * p.t)),
-                material_angle: plate.theta.to_radians(),
+                material_angle,
                 offset: plate.zoffs,
             })
         });
@@ -336,11 +385,6 @@ pub(super) fn add_shells(c: &Cards, body: &mut NastranBody) -> Result<(), FeErro
             poisson_ratio: nu,
             density: m1.rho * c.mass_scale,
         };
-        let nodes = plate
-            .grids
-            .iter()
-            .map(|&g| node_of(body, g, line, &user))
-            .collect::<Result<Vec<_>, _>>()?;
         let extra_mass_per_area = p.nsm * c.mass_scale;
         if let [a, b, cc, d] = nodes[..] {
             body.mesh.shells.push(Shell {
