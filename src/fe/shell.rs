@@ -144,15 +144,25 @@ pub(crate) fn rotate_shear(c: &Matrix2<f64>, angle: f64) -> Matrix2<f64> {
     r.transpose() * c * r
 }
 
-/// The rigid offset of the reference plane by `offset` along the local normal for `nodes`
-/// corners (local DOFs u v w θx θy θz): u_ref = u + offset θy, v_ref = v − offset θx.
-pub(crate) fn offset_transform<const D: usize>(nodes: usize, offset: f64) -> SMatrix<f64, D, D> {
-    let mut t = SMatrix::<f64, D, D>::identity();
+/// Tᵀ A T for the rigid offset T of the reference plane by `offset` along the local normal,
+/// for `nodes` corners (local DOFs u v w θx θy θz): u_ref = u + offset θy, v_ref = v − offset
+/// θx. T is the identity plus two entries per corner, so the product is done by column and row
+/// updates instead of two dense products (this runs for every offset shell of a large deck).
+pub(crate) fn apply_offset<const D: usize>(a: &mut SMatrix<f64, D, D>, nodes: usize, offset: f64) {
     for i in 0..nodes {
-        t[(6 * i, 6 * i + 4)] = offset;
-        t[(6 * i + 1, 6 * i + 3)] = -offset;
+        let (u, v, rx, ry) = (6 * i, 6 * i + 1, 6 * i + 3, 6 * i + 4);
+        for r in 0..D {
+            a[(r, ry)] += offset * a[(r, u)];
+            a[(r, rx)] -= offset * a[(r, v)];
+        }
     }
-    t
+    for i in 0..nodes {
+        let (u, v, rx, ry) = (6 * i, 6 * i + 1, 6 * i + 3, 6 * i + 4);
+        for c in 0..D {
+            a[(ry, c)] += offset * a[(u, c)];
+            a[(rx, c)] -= offset * a[(v, c)];
+        }
+    }
 }
 
 const XI: [f64; 4] = [-1.0, 1.0, 1.0, -1.0];
@@ -399,8 +409,7 @@ pub fn stiffness(index: usize, shell: &Shell, p: &[Vector3<f64>; 4]) -> Result<M
         .map(|s| s.offset)
         .filter(|&z| z != 0.0)
     {
-        let t = offset_transform::<24>(4, offset);
-        k = t.transpose() * k * t;
+        apply_offset(&mut k, 4, offset);
     }
     Ok(to_global(&k, &geo.frame))
 }
@@ -483,8 +492,8 @@ pub fn lumped_mass(index: usize, shell: &Shell, p: &[Vector3<f64>; 4]) -> Result
         // The lumped mass sits on the reference plane; the corners carry it rigidly, which
         // couples translation and rotation and adds m z0² of rotary inertia.
         Some(offset) => {
-            let t = offset_transform::<24>(4, offset);
-            Ok(to_global(&(t.transpose() * m * t), &geo.frame))
+            apply_offset(&mut m, 4, offset);
+            Ok(to_global(&m, &geo.frame))
         }
         None => Ok(m),
     }
@@ -619,6 +628,20 @@ mod tests {
         let expected = mass * omega.cross(&(c + n * 0.013))[0];
         let got = (translate.transpose() * m * rotate)[0];
         assert!((got - expected).abs() < 1e-12 * mass, "{got} vs {expected}");
+    }
+
+    #[test]
+    fn offset_updates_equal_the_dense_transformation() {
+        let k = stiffness(0, &plate(), &corners()).unwrap();
+        let mut t = Mat24::identity();
+        for i in 0..4 {
+            t[(6 * i, 6 * i + 4)] = 0.01;
+            t[(6 * i + 1, 6 * i + 3)] = -0.01;
+        }
+        let mut fast = k;
+        apply_offset(&mut fast, 4, 0.01);
+        let dense = t.transpose() * k * t;
+        assert!((fast - dense).abs().max() < 1e-13 * dense.abs().max());
     }
 
     #[test]

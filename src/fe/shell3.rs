@@ -15,7 +15,7 @@ use nalgebra::{Matrix3, SMatrix, Vector3};
 
 use super::error::{require_non_negative, require_positive, FeError};
 use super::mesh::TriShell;
-use super::shell::{offset_transform, rotate_plane, DRILLING_FACTOR};
+use super::shell::{apply_offset, rotate_plane, DRILLING_FACTOR};
 
 /// 18 × 18 element matrix, DOF order (ux uy uz rx ry rz) per corner node.
 pub type Mat18 = SMatrix<f64, 18, 18>;
@@ -270,8 +270,7 @@ pub fn stiffness(index: usize, tri: &TriShell, p: &[Vector3<f64>; 3]) -> Result<
         k += (bb.transpose() * db * bb + bd.transpose() * bd * gamma) * weight;
     }
     if let Some(offset) = tri.section.as_ref().map(|s| s.offset).filter(|&z| z != 0.0) {
-        let t = offset_transform::<18>(3, offset);
-        k = t.transpose() * k * t;
+        apply_offset(&mut k, 3, offset);
     }
     Ok(to_global(&k, &frame))
 }
@@ -293,8 +292,8 @@ pub fn lumped_mass(index: usize, tri: &TriShell, p: &[Vector3<f64>; 3]) -> Resul
     match tri.section.as_ref().map(|s| s.offset).filter(|&z| z != 0.0) {
         // The mass sits on the offset reference plane, carried rigidly by the corners.
         Some(offset) => {
-            let t = offset_transform::<18>(3, offset);
-            Ok(to_global(&(t.transpose() * m * t), &frame))
+            apply_offset(&mut m, 3, offset);
+            Ok(to_global(&m, &frame))
         }
         None => Ok(m),
     }
