@@ -8,9 +8,11 @@ use std::fmt::Write;
 
 use engine_mount_chassis::fe::assembly::assemble;
 use engine_mount_chassis::fe::eigen::lowest_modes;
-use engine_mount_chassis::fe::nastran::{parse_str, NastranBody};
+use engine_mount_chassis::fe::mesh::{Material, Mesh, Shell};
+use engine_mount_chassis::fe::nastran::{parse_str, write_bulk_deck, NastranBody};
 use faer::prelude::Solve;
 use faer::Mat;
+use nalgebra::Vector3;
 
 const E: f64 = 2.1e11;
 const RHO: f64 = 7850.0;
@@ -379,6 +381,36 @@ fn mat2_with_the_isotropic_matrix_reproduces_mat1_in_any_orientation() {
         println!("{what}: MAT2 vs MAT1 largest difference / largest entry = {rel:.2e}");
         assert!(rel < 1e-12, "{what} differs by {rel:e}");
     }
+}
+
+#[test]
+fn a_beaded_sheet_written_as_a_deck_reads_back_as_the_same_sheet() {
+    // The mesh's sheet with bending thickness 1.7 t shears over 5/6 of it; the writer gives
+    // 12I/T³ = 1.7³ and TS/T = 5/6 · 1.7, which the reader recognises as that sheet again.
+    let mut mesh = Mesh::default();
+    for p in [
+        [0.0, 0.0, 0.0],
+        [0.3, 0.0, 0.0],
+        [0.3, 0.2, 0.01],
+        [0.0, 0.2, 0.0],
+    ] {
+        mesh.add_node(Vector3::from(p));
+    }
+    mesh.shells.push(Shell {
+        nodes: [0, 1, 2, 3],
+        material: Material::STEEL,
+        thickness: 0.001,
+        bending_thickness: 0.0017,
+        extra_mass_per_area: 0.3,
+        section: None,
+    });
+    let body = parse_str(&write_bulk_deck(&mesh).unwrap()).unwrap();
+    let read = &body.mesh.shells[0];
+    assert!(read.section.is_none(), "{read:?}");
+    assert!(
+        (read.bending_thickness / 0.0017 - 1.0).abs() < 1e-9,
+        "{read:?}"
+    );
 }
 
 // ---------------------------------------------------------------------------------------------

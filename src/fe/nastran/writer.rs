@@ -221,6 +221,8 @@ impl<'m> Deck<'m> {
     fn pshell(&mut self, m: &Material, [t, bending_t, nsm]: [f64; 3]) -> Result<u64, FeError> {
         let mid = self.mat1(m)?;
         let ratio = (bending_t / t).powi(3);
+        // The mesh's sheet shears over 5/6 of its bending thickness, Nastran over TS/T·T.
+        let ts_t = 5.0 / 6.0 * bending_t / t;
         let (pid, new) = self.properties.id(&[0.0, mid as f64, t, ratio, nsm]);
         if new {
             self.card(
@@ -232,7 +234,7 @@ impl<'m> Deck<'m> {
                     Out::Int(mid),
                     Out::Real(ratio),
                     Out::Int(mid),
-                    Out::Blank,
+                    Out::Real(ts_t),
                     Out::Real(nsm),
                 ],
             )?;

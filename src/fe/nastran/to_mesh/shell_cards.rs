@@ -353,12 +353,13 @@ pub(super) fn add_shells(
         }
         let bending_thickness = p.t * p.bending_ratio.cbrt();
         // The sheet the mesh has always had: one MAT1 for membrane, bending and shear, shear
-        // thickness 5/6 T, no offset; anything else carries a section.
+        // thickness 5/6 of the bending thickness (TS/T = 5/6 for 12I/T³ = 1, as the deck writer
+        // writes it otherwise), no offset; anything else carries a section.
+        let plain_ts_t = 5.0 / 6.0 * p.bending_ratio.cbrt();
         let plain = m1.isotropic.is_some()
             && m2.isotropic == m1.isotropic
             && m3.as_ref().is_some_and(|m| m.isotropic == m1.isotropic)
-            && p.bending_ratio == 1.0
-            && (p.ts_t - 5.0 / 6.0).abs() < 1e-5
+            && (p.ts_t / plain_ts_t - 1.0).abs() < 1e-5
             && plate.zoffs == 0.0;
         let section = (!plain).then(|| {
             Box::new(ShellSection {
