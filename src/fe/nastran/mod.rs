@@ -45,9 +45,11 @@
 //!   [`crate::fe::shell::KIRCHHOFF_SHEAR_FACTOR`] times the bending stiffness over the element
 //!   area, i.e. Kirchhoff). Refused: MID1 blank (no membrane), MID2 blank or −1 (membrane-only,
 //!   plane strain), MID4 (membrane–bending coupling), the same id on a MAT1 and a MAT2/MAT8.
-//!   A PSHELL whose MID1, MID2, MID3 are one MAT1 (or equal ones) with TS/T = 5/6, 12I/T³ = 1
-//!   and no offset is the plain isotropic sheet ([`crate::fe::mesh::Shell`] without a section,
-//!   the same numbers as before); anything else carries a [`crate::fe::shell::ShellSection`].
+//!   A PSHELL whose MID1, MID2, MID3 are one MAT1 (or equal ones) with TS/T = 5/6·(12I/T³)^⅓
+//!   (5/6 for a homogeneous sheet; [`write_bulk_deck`] writes it so) and no offset is the plain
+//!   isotropic sheet ([`crate::fe::mesh::Shell`] without a section, shear over 5/6 of the
+//!   bending thickness, the same numbers as before); anything else carries a
+//!   [`crate::fe::shell::ShellSection`].
 //! - CQUAD4 → the QM6 + MITC4 shell ([`crate::fe::shell`], Mindlin: transverse shear from
 //!   MID3); CTRIA3 → the CST + DKT shell ([`crate::fe::shell3`], Kirchhoff: MID3 does not
 //!   enter). THETA: material axis 1 at THETA° from the side G1 → G2 (projected onto the element
