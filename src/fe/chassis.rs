@@ -564,6 +564,7 @@ impl<'a> Builder<'a> {
                     thickness: sheet.thickness,
                     bending_thickness: sheet.bending_thickness,
                     extra_mass_per_area: 0.0,
+                    section: None,
                 });
             }
         }

@@ -367,6 +367,7 @@ mod tests {
             thickness: 0.001,
             bending_thickness: 0.001,
             extra_mass_per_area: 0.0,
+            section: None,
         });
     }
 

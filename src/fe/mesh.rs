@@ -5,6 +5,8 @@ use std::collections::BTreeMap;
 use nalgebra::{Matrix3, Vector3};
 use serde::{Deserialize, Serialize};
 
+use super::shell::ShellSection;
+
 /// Linear elastic isotropic material.
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
 pub struct Material {
@@ -99,6 +101,11 @@ pub struct Shell {
     pub bending_thickness: f64,
     /// Non-structural mass per area (kg/m²) (trim carried by the panel).
     pub extra_mass_per_area: f64,
+    /// General section (anisotropic materials, separate bending and shear materials, offset);
+    /// when given it replaces `material`'s E and ν and the thicknesses in the stiffness, while
+    /// the mass still follows density, thickness and bending thickness. `None`: the plain
+    /// isotropic sheet.
+    pub section: Option<Box<ShellSection>>,
 }
 
 /// Three-node flat shell (CST membrane with drilling rotation + DKT plate, lumped mass); the
@@ -115,6 +122,9 @@ pub struct TriShell {
     pub bending_thickness: f64,
     /// Non-structural mass per area (kg/m²).
     pub extra_mass_per_area: f64,
+    /// General section, as for [`Shell`] (the triangle has no transverse shear flexibility,
+    /// so the section's shear matrix is not used).
+    pub section: Option<Box<ShellSection>>,
 }
 
 /// Solid element (Nastran CTETRA, CPENTA, CHEXA) with translational stiffness and consistent

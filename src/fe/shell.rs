@@ -8,7 +8,7 @@
 use nalgebra::{Matrix2, Matrix3, SMatrix, Vector3};
 
 use super::error::{require_non_negative, require_positive, FeError};
-use super::mesh::Shell;
+use super::mesh::{Material, Shell};
 
 /// 24 × 24 element matrix, DOF order (ux uy uz rx ry rz) per corner node.
 pub type Mat24 = SMatrix<f64, 24, 24>;
@@ -19,6 +19,151 @@ pub const DRILLING_FACTOR: f64 = 0.01;
 
 /// Shear correction factor of the Mindlin plate.
 const SHEAR_CORRECTION: f64 = 5.0 / 6.0;
+
+/// Transverse shear stiffness of a section without transverse shear flexibility (Nastran
+/// PSHELL with MID3 blank), as a multiple of the largest bending stiffness over the element
+/// area: the shear compliance is then about 1e-5 of the bending compliance of a single
+/// element (less for a structure spanning many), which is Kirchhoff behaviour; MITC4 does not
+/// lock in that limit.
+pub const KIRCHHOFF_SHEAR_FACTOR: f64 = 1.0e5;
+
+/// Stiffness of a general shell section: separate membrane, bending and transverse shear
+/// constitutive matrices in material axes (orthotropic or anisotropic sheets, Nastran PSHELL with
+/// MAT1/MAT2/MAT8 and different MID1/MID2/MID3), a material orientation and an offset reference
+/// plane. A shell without a section is the homogeneous isotropic sheet of its `material`.
+///
+/// Strains in material axes (1, 2): membrane (ε₁, ε₂, γ₁₂), curvatures (κ₁, κ₂, κ₁₂),
+/// transverse shear (γ₁z, γ₂z). Mass still comes from the shell's density, thickness,
+/// bending thickness (rotary inertia) and non-structural mass.
+#[derive(Debug, Clone, PartialEq)]
+pub struct ShellSection {
+    /// A (N/m): (N₁, N₂, N₁₂) = A (ε₁, ε₂, γ₁₂) on the reference plane.
+    pub membrane: Matrix3<f64>,
+    /// D (N·m): (M₁, M₂, M₁₂) = D (κ₁, κ₂, κ₁₂).
+    pub bending: Matrix3<f64>,
+    /// S (N/m): (Q₁, Q₂) = S (γ₁z, γ₂z); `None`: no transverse shear flexibility (the
+    /// four-node shell uses [`KIRCHHOFF_SHEAR_FACTOR`], the triangle is Kirchhoff anyway).
+    pub transverse_shear: Option<Matrix2<f64>>,
+    /// Angle (rad) about the element normal from the side corner 1 → corner 2 (projected onto
+    /// the element plane) to material axis 1, as Nastran's THETA.
+    pub material_angle: f64,
+    /// Distance (m) of the reference plane from the plane of the corner nodes along the element
+    /// normal (Nastran ZOFFS): the corners carry the reference plane rigidly, u_ref = u + θ ×
+    /// (offset n), so stiffness and mass become Tᵀ K T and Tᵀ M T.
+    pub offset: f64,
+}
+
+impl ShellSection {
+    /// The section of a homogeneous isotropic sheet: what a shell without a section uses
+    /// (transverse shear k = 5/6 over the bending thickness), in any orientation.
+    pub fn isotropic(material: &Material, thickness: f64, bending_thickness: f64) -> Self {
+        let (e, nu) = (material.youngs_modulus, material.poisson_ratio);
+        let iso = Matrix3::new(1.0, nu, 0.0, nu, 1.0, 0.0, 0.0, 0.0, (1.0 - nu) / 2.0);
+        let shear = SHEAR_CORRECTION * material.shear_modulus() * bending_thickness;
+        Self {
+            membrane: iso * (e * thickness / (1.0 - nu * nu)),
+            bending: iso * (e * bending_thickness.powi(3) / (12.0 * (1.0 - nu * nu))),
+            transverse_shear: Some(Matrix2::identity() * shear),
+            material_angle: 0.0,
+            offset: 0.0,
+        }
+    }
+
+    /// Finite, symmetric positive definite A, D (and S when given), finite angle and offset.
+    pub(crate) fn validate(&self, what: &str) -> Result<(), FeError> {
+        let fail = |m: String| Err(FeError::InvalidInput(format!("{what}: {m}")));
+        let spd3 = |m: &Matrix3<f64>| {
+            m.iter().all(|v| v.is_finite())
+                && (m - m.transpose()).abs().max() <= 1e-9 * m.abs().max()
+                && m.cholesky().is_some()
+        };
+        if !spd3(&self.membrane) {
+            return fail(format!(
+                "membrane stiffness {} is not symmetric positive definite",
+                self.membrane
+            ));
+        }
+        if !spd3(&self.bending) {
+            return fail(format!(
+                "bending stiffness {} is not symmetric positive definite",
+                self.bending
+            ));
+        }
+        if let Some(s) = &self.transverse_shear {
+            let ok = s.iter().all(|v| v.is_finite())
+                && (s[(0, 1)] - s[(1, 0)]).abs() <= 1e-9 * s.abs().max()
+                && s.cholesky().is_some();
+            if !ok {
+                return fail(format!(
+                    "transverse shear stiffness {s} is not symmetric positive definite"
+                ));
+            }
+        }
+        if !(self.material_angle.is_finite() && self.offset.is_finite()) {
+            return fail("material angle and offset must be finite".into());
+        }
+        Ok(())
+    }
+
+    /// Mean in-plane shear stiffness over all directions, (A₁₁ + A₂₂ − 2A₁₂ + 4A₃₃)/8: G t
+    /// for an isotropic sheet; scales the drilling penalty independently of the orientation.
+    pub(crate) fn mean_membrane_shear(&self) -> f64 {
+        let a = &self.membrane;
+        (a[(0, 0)] + a[(1, 1)] - 2.0 * a[(0, 1)] + 4.0 * a[(2, 2)]) / 8.0
+    }
+}
+
+/// A plane constitutive matrix (engineering strains ε_x, ε_y, γ_xy) given in axes whose 1 axis
+/// lies at `angle` from x, expressed in (x, y): Tᵀ C T with ε₁₂ = T ε_xy.
+pub(crate) fn rotate_plane(c: &Matrix3<f64>, angle: f64) -> Matrix3<f64> {
+    if angle == 0.0 {
+        return *c;
+    }
+    let (s, co) = angle.sin_cos();
+    let t = Matrix3::new(
+        co * co,
+        s * s,
+        co * s,
+        s * s,
+        co * co,
+        -co * s,
+        -2.0 * co * s,
+        2.0 * co * s,
+        co * co - s * s,
+    );
+    t.transpose() * c * t
+}
+
+/// A transverse shear matrix given in axes rotated by `angle`, expressed in (x, y).
+pub(crate) fn rotate_shear(c: &Matrix2<f64>, angle: f64) -> Matrix2<f64> {
+    if angle == 0.0 {
+        return *c;
+    }
+    let (s, co) = angle.sin_cos();
+    let r = Matrix2::new(co, s, -s, co);
+    r.transpose() * c * r
+}
+
+/// Tᵀ A T for the rigid offset T of the reference plane by `offset` along the local normal,
+/// for `nodes` corners (local DOFs u v w θx θy θz): u_ref = u + offset θy, v_ref = v − offset
+/// θx. T is the identity plus two entries per corner, so the product is done by column and row
+/// updates instead of two dense products (this runs for every offset shell of a large deck).
+pub(crate) fn apply_offset<const D: usize>(a: &mut SMatrix<f64, D, D>, nodes: usize, offset: f64) {
+    for i in 0..nodes {
+        let (u, v, rx, ry) = (6 * i, 6 * i + 1, 6 * i + 3, 6 * i + 4);
+        for r in 0..D {
+            a[(r, ry)] += offset * a[(r, u)];
+            a[(r, rx)] -= offset * a[(r, v)];
+        }
+    }
+    for i in 0..nodes {
+        let (u, v, rx, ry) = (6 * i, 6 * i + 1, 6 * i + 3, 6 * i + 4);
+        for c in 0..D {
+            a[(ry, c)] += offset * a[(u, c)];
+            a[(rx, c)] -= offset * a[(v, c)];
+        }
+    }
+}
 
 const XI: [f64; 4] = [-1.0, 1.0, 1.0, -1.0];
 const ETA: [f64; 4] = [-1.0, -1.0, 1.0, 1.0];
@@ -116,9 +261,12 @@ fn validate(index: usize, shell: &Shell) -> Result<(), FeError> {
     let name = |f: &str| format!("shell {index}: {f}");
     require_positive(&name("thickness"), shell.thickness)?;
     require_positive(&name("bending_thickness"), shell.bending_thickness)?;
-    require_positive(&name("youngs_modulus"), m.youngs_modulus)?;
     require_non_negative(&name("density"), m.density)?;
     require_non_negative(&name("extra_mass_per_area"), shell.extra_mass_per_area)?;
+    if let Some(section) = &shell.section {
+        return section.validate(&name("section"));
+    }
+    require_positive(&name("youngs_modulus"), m.youngs_modulus)?;
     if !(m.poisson_ratio > -1.0 && m.poisson_ratio < 0.5) {
         return Err(FeError::InvalidInput(format!(
             "shell {index}: poisson_ratio must be in (-1, 0.5), got {}",
@@ -164,15 +312,7 @@ pub fn stiffness(index: usize, shell: &Shell, p: &[Vector3<f64>; 4]) -> Result<M
         )));
     }
     let xy = &geo.local_xy;
-    let mat = &shell.material;
-    let (e, nu, t) = (mat.youngs_modulus, mat.poisson_ratio, shell.thickness);
-    let tb = shell.bending_thickness;
-    let g = mat.shear_modulus();
-    let iso = Matrix3::new(1.0, nu, 0.0, nu, 1.0, 0.0, 0.0, 0.0, (1.0 - nu) / 2.0);
-    let dm = iso * (e * t / (1.0 - nu * nu));
-    let db = iso * (e * tb.powi(3) / (12.0 * (1.0 - nu * nu)));
-    let ds = SHEAR_CORRECTION * g * tb;
-    let gamma = DRILLING_FACTOR * g * t;
+    let (dm, db, ds, gamma) = constitutive(shell, &geo, p);
 
     let tie_xi = [
         covariant_shear_row(xy, 0.0, -1.0, true),
@@ -250,8 +390,11 @@ pub fn stiffness(index: usize, shell: &Shell, p: &[Vector3<f64>; 4]) -> Result<M
         k_membrane += bm.transpose() * dm * bm * det;
         k_coupling += bm.transpose() * dm * bi * det;
         k_internal += bi.transpose() * dm * bi * det;
-        k += (bb.transpose() * db * bb + bs.transpose() * bs * ds + bd.transpose() * bd * gamma)
-            * det;
+        let shear = match &ds {
+            TransverseShear::Isotropic(ds) => bs.transpose() * bs * *ds,
+            TransverseShear::General(s) => bs.transpose() * s * bs,
+        };
+        k += (bb.transpose() * db * bb + shear + bd.transpose() * bd * gamma) * det;
     }
     // Static condensation of the internal modes.
     let internal_inv = k_internal.try_inverse().ok_or_else(|| {
@@ -260,12 +403,65 @@ pub fn stiffness(index: usize, shell: &Shell, p: &[Vector3<f64>; 4]) -> Result<M
         ))
     })?;
     k += k_membrane - k_coupling * internal_inv * k_coupling.transpose();
+    if let Some(offset) = shell
+        .section
+        .as_ref()
+        .map(|s| s.offset)
+        .filter(|&z| z != 0.0)
+    {
+        apply_offset(&mut k, 4, offset);
+    }
     Ok(to_global(&k, &geo.frame))
+}
+
+enum TransverseShear {
+    Isotropic(f64),
+    General(Matrix2<f64>),
+}
+
+/// Membrane, bending, transverse shear matrices and drilling penalty in element axes.
+fn constitutive(
+    shell: &Shell,
+    geo: &ShellGeometry,
+    p: &[Vector3<f64>; 4],
+) -> (Matrix3<f64>, Matrix3<f64>, TransverseShear, f64) {
+    let Some(section) = &shell.section else {
+        let mat = &shell.material;
+        let (e, nu, t) = (mat.youngs_modulus, mat.poisson_ratio, shell.thickness);
+        let tb = shell.bending_thickness;
+        let g = mat.shear_modulus();
+        let iso = Matrix3::new(1.0, nu, 0.0, nu, 1.0, 0.0, 0.0, 0.0, (1.0 - nu) / 2.0);
+        let dm = iso * (e * t / (1.0 - nu * nu));
+        let db = iso * (e * tb.powi(3) / (12.0 * (1.0 - nu * nu)));
+        let ds = SHEAR_CORRECTION * g * tb;
+        return (
+            dm,
+            db,
+            TransverseShear::Isotropic(ds),
+            DRILLING_FACTOR * g * t,
+        );
+    };
+    // THETA is measured from the side G1 → G2, not from this element's e1 (the line joining
+    // the side midpoints), so the angle between the two is added.
+    let side = p[1] - p[0];
+    let along = geo.frame * side;
+    let angle = section.material_angle + along[1].atan2(along[0]);
+    let dm = rotate_plane(&section.membrane, angle);
+    let db = rotate_plane(&section.bending, angle);
+    let ds = match &section.transverse_shear {
+        Some(s) => rotate_shear(s, angle),
+        None => {
+            Matrix2::identity() * (KIRCHHOFF_SHEAR_FACTOR * db[(0, 0)].max(db[(1, 1)]) / geo.area)
+        }
+    };
+    let gamma = DRILLING_FACTOR * section.mean_membrane_shear();
+    (dm, db, TransverseShear::General(ds), gamma)
 }
 
 /// Global lumped mass matrix of shell `index`: each corner carries the row sum of the consistent
 /// translational mass (∫ N_i ρ t dA) and the same share of the rotary inertia (mass per area
-/// × t_b²/12) about all three axes (isotropic, so it stays diagonal in global axes).
+/// × t_b²/12) about all three axes (isotropic, so it stays diagonal in global axes), on the
+/// reference plane (offset by the section's offset, if any).
 pub fn lumped_mass(index: usize, shell: &Shell, p: &[Vector3<f64>; 4]) -> Result<Mat24, FeError> {
     validate(index, shell)?;
     let geo = geometry(index, p)?;
@@ -287,13 +483,25 @@ pub fn lumped_mass(index: usize, shell: &Shell, p: &[Vector3<f64>; 4]) -> Result
             m[(6 * i + 3 + d, 6 * i + 3 + d)] = rotary * share[i];
         }
     }
-    Ok(m)
+    match shell
+        .section
+        .as_ref()
+        .map(|s| s.offset)
+        .filter(|&z| z != 0.0)
+    {
+        // The lumped mass sits on the reference plane; the corners carry it rigidly, which
+        // couples translation and rotation and adds m z0² of rotary inertia.
+        Some(offset) => {
+            apply_offset(&mut m, 4, offset);
+            Ok(to_global(&m, &geo.frame))
+        }
+        None => Ok(m),
+    }
 }
 
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::fe::mesh::Material;
 
     fn plate() -> Shell {
         Shell {
@@ -302,6 +510,7 @@ mod tests {
             thickness: 0.002,
             bending_thickness: 0.002,
             extra_mass_per_area: 0.0,
+            section: None,
         }
     }
 
@@ -347,6 +556,92 @@ mod tests {
             zero, 6,
             "a single shell must have exactly six zero-energy modes"
         );
+    }
+
+    #[test]
+    fn isotropic_section_in_any_orientation_is_the_plain_sheet() {
+        let p = corners();
+        let plain = plate();
+        let mut general = plate();
+        let mut section = ShellSection::isotropic(&plain.material, 0.002, 0.002);
+        section.material_angle = 0.7;
+        general.section = Some(Box::new(section));
+        let (a, b) = (
+            stiffness(0, &plain, &p).unwrap(),
+            stiffness(0, &general, &p).unwrap(),
+        );
+        assert!((a - b).abs().max() < 1e-12 * a.abs().max());
+    }
+
+    #[test]
+    fn orthotropic_matrix_turned_by_ninety_degrees_swaps_its_axes() {
+        let c = Matrix3::new(9.0, 2.0, 0.0, 2.0, 4.0, 0.0, 0.0, 0.0, 3.0);
+        let r = rotate_plane(&c, std::f64::consts::FRAC_PI_2);
+        let swapped = Matrix3::new(4.0, 2.0, 0.0, 2.0, 9.0, 0.0, 0.0, 0.0, 3.0);
+        assert!((r - swapped).abs().max() < 1e-12, "{r}");
+        let s = rotate_shear(
+            &Matrix2::new(5.0, 0.0, 0.0, 1.0),
+            std::f64::consts::FRAC_PI_2,
+        );
+        assert!(
+            (s - Matrix2::new(1.0, 0.0, 0.0, 5.0)).abs().max() < 1e-12,
+            "{s}"
+        );
+    }
+
+    #[test]
+    fn offset_shell_keeps_six_rigid_modes_and_its_mass_moves_rigidly() {
+        let p = corners();
+        let mut s = plate();
+        let mut section = ShellSection::isotropic(&s.material, 0.002, 0.002);
+        section.offset = 0.013;
+        s.section = Some(Box::new(section));
+        let k = stiffness(0, &s, &p).unwrap();
+        let scale = k.abs().max();
+        let eig = k.symmetric_eigenvalues();
+        assert_eq!(eig.iter().filter(|v| v.abs() < 1e-9 * scale).count(), 6);
+        assert!(eig.iter().all(|v| *v > -1e-9 * scale));
+        // The mass sits on the plane offset by z0 n: its first moment, seen as the coupling of
+        // a unit x translation with a rigid rotation ω, is m (ω × (c + z0 n))ₓ.
+        let m = lumped_mass(0, &s, &p).unwrap();
+        let geo = geometry(0, &p).unwrap();
+        let n = geo.frame.row(2).transpose();
+        let mass = s.material.density * s.thickness * geo.area;
+        let mut translate = SMatrix::<f64, 24, 1>::zeros();
+        for i in 0..4 {
+            translate[6 * i] = 1.0;
+        }
+        let omega = Vector3::new(0.0, 1.0, 0.0);
+        let mut rotate = SMatrix::<f64, 24, 1>::zeros();
+        for (i, x) in p.iter().enumerate() {
+            let v = omega.cross(x);
+            for d in 0..3 {
+                rotate[6 * i + d] = v[d];
+                rotate[6 * i + 3 + d] = omega[d];
+            }
+        }
+        // c: centroid of the corner masses on the grid plane.
+        let c: Vector3<f64> = (0..4)
+            .map(|i| p[i] * m[(6 * i, 6 * i)])
+            .fold(Vector3::zeros(), |a, b| a + b)
+            / mass;
+        let expected = mass * omega.cross(&(c + n * 0.013))[0];
+        let got = (translate.transpose() * m * rotate)[0];
+        assert!((got - expected).abs() < 1e-12 * mass, "{got} vs {expected}");
+    }
+
+    #[test]
+    fn offset_updates_equal_the_dense_transformation() {
+        let k = stiffness(0, &plate(), &corners()).unwrap();
+        let mut t = Mat24::identity();
+        for i in 0..4 {
+            t[(6 * i, 6 * i + 4)] = 0.01;
+            t[(6 * i + 1, 6 * i + 3)] = -0.01;
+        }
+        let mut fast = k;
+        apply_offset(&mut fast, 4, 0.01);
+        let dense = t.transpose() * k * t;
+        assert!((fast - dense).abs().max() < 1e-13 * dense.abs().max());
     }
 
     #[test]

@@ -15,7 +15,7 @@ use nalgebra::{Matrix3, SMatrix, Vector3};
 
 use super::error::{require_non_negative, require_positive, FeError};
 use super::mesh::TriShell;
-use super::shell::DRILLING_FACTOR;
+use super::shell::{apply_offset, rotate_plane, DRILLING_FACTOR};
 
 /// 18 × 18 element matrix, DOF order (ux uy uz rx ry rz) per corner node.
 pub type Mat18 = SMatrix<f64, 18, 18>;
@@ -61,9 +61,12 @@ fn validate(index: usize, t: &TriShell) -> Result<(), FeError> {
     let name = |f: &str| format!("triangle {index}: {f}");
     require_positive(&name("thickness"), t.thickness)?;
     require_positive(&name("bending_thickness"), t.bending_thickness)?;
-    require_positive(&name("youngs_modulus"), m.youngs_modulus)?;
     require_non_negative(&name("density"), m.density)?;
     require_non_negative(&name("extra_mass_per_area"), t.extra_mass_per_area)?;
+    if let Some(section) = &t.section {
+        return section.validate(&name("section"));
+    }
+    require_positive(&name("youngs_modulus"), m.youngs_modulus)?;
     if !(m.poisson_ratio > -1.0 && m.poisson_ratio < 0.5) {
         return Err(FeError::InvalidInput(format!(
             "triangle {index}: poisson_ratio must be in (-1, 0.5), got {}",
@@ -208,12 +211,27 @@ pub fn stiffness(index: usize, tri: &TriShell, p: &[Vector3<f64>; 3]) -> Result<
         local_xy: xy,
         area,
     } = geometry(index, p)?;
-    let mat = &tri.material;
-    let (e, nu) = (mat.youngs_modulus, mat.poisson_ratio);
-    let iso = Matrix3::new(1.0, nu, 0.0, nu, 1.0, 0.0, 0.0, 0.0, (1.0 - nu) / 2.0);
-    let dm = iso * (e * tri.thickness / (1.0 - nu * nu));
-    let db = iso * (e * tri.bending_thickness.powi(3) / (12.0 * (1.0 - nu * nu)));
-    let gamma = DRILLING_FACTOR * mat.shear_modulus() * tri.thickness;
+    let (dm, db, gamma) = match &tri.section {
+        None => {
+            let mat = &tri.material;
+            let (e, nu) = (mat.youngs_modulus, mat.poisson_ratio);
+            let iso = Matrix3::new(1.0, nu, 0.0, nu, 1.0, 0.0, 0.0, 0.0, (1.0 - nu) / 2.0);
+            let dm = iso * (e * tri.thickness / (1.0 - nu * nu));
+            let db = iso * (e * tri.bending_thickness.powi(3) / (12.0 * (1.0 - nu * nu)));
+            (
+                dm,
+                db,
+                DRILLING_FACTOR * mat.shear_modulus() * tri.thickness,
+            )
+        }
+        // e1 runs along G1 → G2, from which Nastran measures THETA; the DKT has no transverse
+        // shear, so the section's shear matrix is not used.
+        Some(s) => (
+            rotate_plane(&s.membrane, s.material_angle),
+            rotate_plane(&s.bending, s.material_angle),
+            DRILLING_FACTOR * s.mean_membrane_shear(),
+        ),
+    };
 
     // Constant membrane strain: ∂Nᵢ/∂x = yⱼₖ / 2A, ∂Nᵢ/∂y = xₖⱼ / 2A.
     let twice = 2.0 * area;
@@ -251,6 +269,9 @@ pub fn stiffness(index: usize, tri: &TriShell, p: &[Vector3<f64>; 3]) -> Result<
         }
         k += (bb.transpose() * db * bb + bd.transpose() * bd * gamma) * weight;
     }
+    if let Some(offset) = tri.section.as_ref().map(|s| s.offset).filter(|&z| z != 0.0) {
+        apply_offset(&mut k, 3, offset);
+    }
     Ok(to_global(&k, &frame))
 }
 
@@ -258,7 +279,7 @@ pub fn stiffness(index: usize, tri: &TriShell, p: &[Vector3<f64>; 3]) -> Result<
 /// (mass per area × t_b²/12, isotropic) per corner, like the four-node shell.
 pub fn lumped_mass(index: usize, tri: &TriShell, p: &[Vector3<f64>; 3]) -> Result<Mat18, FeError> {
     validate(index, tri)?;
-    let area = geometry(index, p)?.area;
+    let TriGeometry { frame, area, .. } = geometry(index, p)?;
     let areal = tri.material.density * tri.thickness + tri.extra_mass_per_area;
     let rotary = areal * tri.bending_thickness.powi(2) / 12.0;
     let mut m = Mat18::zeros();
@@ -268,7 +289,14 @@ pub fn lumped_mass(index: usize, tri: &TriShell, p: &[Vector3<f64>; 3]) -> Resul
             m[(6 * i + 3 + d, 6 * i + 3 + d)] = rotary * area / 3.0;
         }
     }
-    Ok(m)
+    match tri.section.as_ref().map(|s| s.offset).filter(|&z| z != 0.0) {
+        // The mass sits on the offset reference plane, carried rigidly by the corners.
+        Some(offset) => {
+            apply_offset(&mut m, 3, offset);
+            Ok(to_global(&m, &frame))
+        }
+        None => Ok(m),
+    }
 }
 
 #[cfg(test)]
@@ -283,6 +311,7 @@ mod tests {
             thickness: 0.002,
             bending_thickness: 0.002,
             extra_mass_per_area: 0.0,
+            section: None,
         }
     }
 

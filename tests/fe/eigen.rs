@@ -33,6 +33,7 @@ fn model(grounded: bool) -> Mesh {
                 thickness: 0.0015,
                 bending_thickness: 0.0015,
                 extra_mass_per_area: 2.0,
+                section: None,
             });
         }
     }

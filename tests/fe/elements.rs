@@ -137,6 +137,7 @@ fn simply_supported_plate_frequency(thickness: f64, n: usize, distortion: f64) -
                 thickness,
                 bending_thickness: thickness,
                 extra_mass_per_area: 0.0,
+                section: None,
             });
         }
     }
@@ -211,6 +212,7 @@ fn in_plane_bending_of_a_one_element_deep_strip_matches_beam_theory() {
             thickness,
             bending_thickness: thickness,
             extra_mass_per_area: 0.0,
+            section: None,
         });
     }
     for node in 0..mesh.nodes.len() {
@@ -267,6 +269,7 @@ fn membrane_patch_test_reproduces_a_linear_displacement_field_exactly() {
             thickness: 0.001,
             bending_thickness: 0.001,
             extra_mass_per_area: 0.0,
+            section: None,
         });
     }
     let asm = assemble(&mesh).unwrap();
@@ -356,6 +359,7 @@ fn grid(
                 thickness: 0.002,
                 bending_thickness: 0.002,
                 extra_mass_per_area: 0.0,
+                section: None,
             });
         }
     }

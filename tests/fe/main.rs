@@ -8,3 +8,4 @@ mod eigen;
 mod elements;
 mod nastran;
 mod solids;
+mod shell_cards;

@@ -565,6 +565,11 @@ pub struct Plate {
     pub id: u32,
     pub pid: u32,
     pub grids: Vec<u32>,
+    /// THETA (degrees from the side G1 → G2), 0 when blank or when MCID is given.
+    pub theta: f64,
+    /// MCID when the THETA/MCID field holds an integer.
+    pub mcid: Option<i64>,
+    pub zoffs: f64,
     pub line: Loc,
 }
 
@@ -573,9 +578,19 @@ pub(crate) fn plate(r: &Reader, corners: usize) -> Result<Plate, FeError> {
     let grids = (0..corners)
         .map(|k| r.id(2 + k, &format!("G{}", k + 1)))
         .collect::<Result<Vec<_>, _>>()?;
-    // THETA/MCID: material orientation, irrelevant for isotropic MAT1.
-    r.value(2 + corners, "THETA/MCID")?;
-    r.require_blank(3 + corners, "ZOFFS", "shell offsets are not supported")?;
+    let (theta, mcid) = match r.value(2 + corners, "THETA/MCID")? {
+        Value::Blank => (0.0, None),
+        Value::Real(v) => (v, None),
+        Value::Int(v) if v >= 0 => (0.0, Some(v)),
+        other => {
+            return Err(r.error(
+                2 + corners,
+                "THETA/MCID",
+                format!("expected THETA (real) or MCID (integer >= 0), found {other:?}"),
+            ))
+        }
+    };
+    let zoffs = r.real_or(3 + corners, "ZOFFS", 0.0)?;
     let why = "corner thicknesses are not supported; give T on the PSHELL";
     let tflag = if corners == 4 { 9 } else { 10 };
     r.require_blank(tflag, "TFLAG", why)?;
@@ -587,6 +602,9 @@ pub(crate) fn plate(r: &Reader, corners: usize) -> Result<Plate, FeError> {
         id,
         pid: r.opt_id(1, "PID")?.unwrap_or(id),
         grids,
+        theta,
+        mcid,
+        zoffs,
         line: r.card().loc(),
     })
 }

@@ -31,12 +31,34 @@
 //!   (CONM2/CONM1 CID, CBUSH CID) take rectangular systems only.
 //! - MAT1: two of E, G, NU given, the third by E = 2(1+ν)G (Nastran's rule); all three given:
 //!   beams keep E and G, shells need G within 1 % of E/2(1+ν). RHO; GE/A/TREF ignored
-//!   (structural damping is added modally by the caller).
-//! - PSHELL (MID1 = MID2, MID3 blank or MID1, T, 12I/T³ → bending thickness T·(12I/T³)^⅓, NSM):
-//!   CQUAD4 is the QM6 + MITC4 shell with transverse shear (k = 5/6) always included (Nastran
-//!   omits transverse shear for MID3 blank: a difference of O((t/L)²) for thin sheets); CTRIA3
-//!   is the CST + DKT shell ([`crate::fe::shell3`], Kirchhoff: no transverse shear). No offsets,
-//!   no corner thicknesses.
+//!   (structural damping is added modally by the caller). MAT2 (G11..G33, RHO) and MAT8 (E1, E2,
+//!   NU12, G12, G1Z, G2Z, RHO) for shells (below); their thermal data, allowables and GE are
+//!   read and not used. Material ids are shared by MAT1, MAT2 and MAT8.
+//! - PSHELL (MID1, T, MID2, 12I/T³, MID3, TS/T, NSM; Z1/Z2 read and unused) with MAT1, MAT2
+//!   or MAT8 for each MID, as Nastran defines them: membrane A = G₁·T, bending
+//!   D = G₂·(12I/T³)·T³/12, transverse shear S = G₃·(TS/T)·T, where G is the MAT1 plane-stress
+//!   matrix E/(1−ν²)\[1 ν 0; ν 1 0; 0 0 (1−ν)/2\] (G₃₃ = MAT1 G) and G·I for shear, the MAT2
+//!   G11..G33 (as MID3: \[G11 G12; G12 G22\], G13/G23/G33 must be blank), or the MAT8 lamina
+//!   (E1, E2, NU12, G12; shear diag(G1Z, G2Z), both blank = rigid, one blank refused). Mass
+//!   per area = RHO(MID1)·T + NSM; rotary inertia (mass per area)·T_b²/12 with
+//!   T_b = T·(12I/T³)^⅓. MID3 blank: no transverse shear flexibility (CQUAD4: a shear penalty
+//!   [`crate::fe::shell::KIRCHHOFF_SHEAR_FACTOR`] times the bending stiffness over the element
+//!   area, i.e. Kirchhoff). Refused: MID1 blank (no membrane), MID2 blank or −1 (membrane-only,
+//!   plane strain), MID4 (membrane–bending coupling), the same id on a MAT1 and a MAT2/MAT8.
+//!   A PSHELL whose MID1, MID2, MID3 are one MAT1 (or equal ones) with TS/T = 5/6·(12I/T³)^⅓
+//!   (5/6 for a homogeneous sheet; [`write_bulk_deck`] writes it so) and no offset is the plain
+//!   isotropic sheet ([`crate::fe::mesh::Shell`] without a section, shear over 5/6 of the
+//!   bending thickness, the same numbers as before); anything else carries a
+//!   [`crate::fe::shell::ShellSection`].
+//! - CQUAD4 → the QM6 + MITC4 shell ([`crate::fe::shell`], Mindlin: transverse shear from
+//!   MID3); CTRIA3 → the CST + DKT shell ([`crate::fe::shell3`], Kirchhoff: MID3 does not
+//!   enter). THETA: material axis 1 at THETA° from the side G1 → G2 (projected onto the element
+//!   plane), about the element normal (G1 G2 G3 right-handed); MCID (integer in that field): the
+//!   x axis of basic (0) or of a CORD2R projected onto the element plane (a curvilinear MCID is
+//!   refused; for an all-MAT1 section the orientation is irrelevant and not looked up). ZOFFS:
+//!   the reference plane lies ZOFFS along the element normal from the grid plane, carried
+//!   rigidly (u_ref = u + θ × ZOFFS·n): K = Tᵀ K_ref T and the lumped mass likewise, which couples
+//!   membrane and bending. Corner thicknesses (TFLAG, T1..T4) are refused.
 //! - PBAR (A, I1, I2, J, NSM; I12 must be 0), PBEAM (constant section only), CBAR/CBEAM with
 //!   X1..X3 or G0, no pins or offsets. The element is Euler-Bernoulli: shear flexibility (PBAR/
 //!   PBEAM K1, K2) is not modelled. I1 bends in Nastran's plane 1 (element x-y) → `iz`,
@@ -75,7 +97,8 @@
 //!   (extraction requests) are accepted; any other card is an error naming card and line.
 //!
 //! Writing: [`write_bulk_deck`] emits large-field cards for a mesh of the supported elements
-//! (solids as CTETRA/CPENTA/CHEXA with one PSOLID per material).
+//! (solids as CTETRA/CPENTA/CHEXA with one PSOLID per material; isotropic sheets only: a shell
+//! with a [`crate::fe::shell::ShellSection`] is refused).
 
 mod cards;
 mod lexer;

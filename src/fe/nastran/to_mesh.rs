@@ -12,8 +12,10 @@ use super::NastranBody;
 use crate::fe::error::FeError;
 use crate::fe::mesh::{
     Beam, BeamSection, Bush, GroundSpring, InterpolationLink, InterpolationSource, Material, Mesh,
-    PointMass, RigidLink, Shell, Spring, TriShell,
+    PointMass, RigidLink, Spring,
 };
+
+mod shell_cards;
 
 /// Parameters that only steer output or solution bookkeeping: accepted and ignored.
 const IGNORED_PARAMS: [&str; 8] = [
@@ -29,6 +31,7 @@ struct Cards {
     grids: BTreeMap<u32, cards::Grid>,
     systems: BTreeMap<u32, cards::Cord2r>,
     materials: BTreeMap<u32, cards::Mat1>,
+    shell_materials: BTreeMap<u32, shell_cards::ShellMaterialCard>,
     shell_properties: BTreeMap<u32, cards::Pshell>,
     beam_properties: BTreeMap<u32, (cards::BeamProperty, &'static str)>,
     spring_properties: BTreeMap<u32, (f64, Loc)>,
@@ -107,6 +110,14 @@ impl Cards {
                 "MAT1" => {
                     let m = cards::mat1(&r)?;
                     insert_unique(&mut c.materials, "MAT1", m.id, &line, m)?;
+                }
+                "MAT2" | "MAT8" => {
+                    let m = if raw.name == "MAT2" {
+                        shell_cards::mat2(&r)?
+                    } else {
+                        shell_cards::mat8(&r)?
+                    };
+                    insert_unique(&mut c.shell_materials, &raw.name, m.id(), &line, m)?;
                 }
                 "PSHELL" => {
                     let p = cards::pshell(&r)?;
@@ -481,7 +492,7 @@ pub(crate) fn build(cards: Collector, spc_selection: Option<u32>) -> Result<Nast
             .constraints
             .extend(mask_nodes(g.ps).map(|d| (node, d)));
     }
-    add_shells(&c, &mut body)?;
+    shell_cards::add_shells(&c, &systems, &mut body)?;
     add_beams(&c, &mut body)?;
     add_solids(&c, &systems, &mut body)?;
     add_masses(&c, &systems, &mut body)?;
@@ -491,101 +502,6 @@ pub(crate) fn build(cards: Collector, spc_selection: Option<u32>) -> Result<Nast
     add_supports(&c, spc_selection, &mut body)?;
     check_dependents(&c, &body)?;
     Ok(body)
-}
-
-/// Long on purpose: one arm per shell card and property kind.
-fn add_shells(c: &Cards, body: &mut NastranBody) -> Result<(), FeError> {
-    for (&id, (plate, name)) in &c.plates {
-        let user = format!("{name} {id}");
-        let line = &plate.line;
-        let p = c.shell_properties.get(&plate.pid).ok_or_else(|| {
-            mesh_error(
-                line,
-                format!("{user}: property PSHELL {} not found", plate.pid),
-            )
-        })?;
-        let fail =
-            |why: String| mesh_error(&p.line, format!("PSHELL {} (used by {user}): {why}", p.id));
-        let mid1 = p.mid1.ok_or_else(|| {
-            fail("MID1 is blank: shells without membrane stiffness are not supported".into())
-        })?;
-        let m = material_named(c, mid1, &p.line, &format!("PSHELL {}", p.id))?;
-        let same_material = |mid2: i64| {
-            mid2 == mid1 as i64
-                || (mid2 > 0
-                    && c.materials
-                        .get(&(mid2 as u32))
-                        .is_some_and(|m2| (m2.e, m2.g, m2.nu) == (m.e, m.g, m.nu)))
-        };
-        if !p.mid2.is_some_and(same_material) {
-            return Err(fail(format!(
-                "MID2 = {:?}: bending must use the membrane material MID1 = {mid1} \
-                 (membrane-only, plane-strain and mixed-material shells are not supported)",
-                p.mid2
-            )));
-        }
-        if p.mid3.is_some_and(|m3| m3 != mid1) {
-            return Err(fail(format!(
-                "MID3 must be blank or equal MID1 = {mid1} (transverse shear uses the shell material)"
-            )));
-        }
-        if (p.ts_t - 5.0 / 6.0).abs() > 1e-3 {
-            return Err(fail(format!(
-                "TS/T = {} is not supported (the shell uses 5/6)",
-                p.ts_t
-            )));
-        }
-        if !(p.t > 0.0 && p.bending_ratio > 0.0) {
-            return Err(fail(format!(
-                "T = {} and 12I/T**3 = {} must be > 0",
-                p.t, p.bending_ratio
-            )));
-        }
-        let (e, g, nu) = moduli(&m, &user)?;
-        if (g / (e / (2.0 * (1.0 + nu))) - 1.0).abs() > 0.01 {
-            return Err(mesh_error(
-                &m.line,
-                format!(
-                    "MAT1 {} (used by {user}): G = {g} differs from E / 2(1 + NU) = {} by more \
-                     than 1 %; the isotropic shell needs consistent E, G, NU",
-                    m.id,
-                    e / (2.0 * (1.0 + nu))
-                ),
-            ));
-        }
-        let nodes = plate
-            .grids
-            .iter()
-            .map(|&g| node_of(body, g, line, &user))
-            .collect::<Result<Vec<_>, _>>()?;
-        let material = Material {
-            youngs_modulus: e,
-            poisson_ratio: nu,
-            density: m.rho * c.mass_scale,
-        };
-        let (thickness, bending_thickness) = (p.t, p.t * p.bending_ratio.cbrt());
-        let extra_mass_per_area = p.nsm * c.mass_scale;
-        if let [a, b, cc, d] = nodes[..] {
-            body.mesh.shells.push(Shell {
-                nodes: [a, b, cc, d],
-                material,
-                thickness,
-                bending_thickness,
-                extra_mass_per_area,
-            });
-            body.element_ids.shells.push(id);
-        } else if let [a, b, cc] = nodes[..] {
-            body.mesh.triangles.push(TriShell {
-                nodes: [a, b, cc],
-                material,
-                thickness,
-                bending_thickness,
-                extra_mass_per_area,
-            });
-            body.element_ids.triangles.push(id);
-        }
-    }
-    Ok(())
 }
 
 /// Solids take an isotropic MAT1 (E, G, NU consistent within 1 %, as shells need).

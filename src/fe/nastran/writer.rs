@@ -222,6 +222,8 @@ impl<'m> Deck<'m> {
     fn pshell(&mut self, m: &Material, [t, bending_t, nsm]: [f64; 3]) -> Result<u64, FeError> {
         let mid = self.mat1(m)?;
         let ratio = (bending_t / t).powi(3);
+        // The mesh's sheet shears over 5/6 of its bending thickness, Nastran over TS/T·T.
+        let ts_t = 5.0 / 6.0 * bending_t / t;
         let (pid, new) = self.properties.id(&[0.0, mid as f64, t, ratio, nsm]);
         if new {
             self.card(
@@ -233,7 +235,7 @@ impl<'m> Deck<'m> {
                     Out::Int(mid),
                     Out::Real(ratio),
                     Out::Int(mid),
-                    Out::Blank,
+                    Out::Real(ts_t),
                     Out::Real(nsm),
                 ],
             )?;
@@ -252,6 +254,7 @@ impl<'m> Deck<'m> {
 
     fn cquad4(&mut self) -> Result<(), FeError> {
         for (i, s) in self.mesh.shells.iter().enumerate() {
+            no_section(&format!("shell {i}"), s.section.is_some())?;
             let sheet = [s.thickness, s.bending_thickness, s.extra_mass_per_area];
             let pid = self.pshell(&s.material, sheet)?;
             self.plate("CQUAD4", &format!("shell {i}"), pid, &s.nodes)?;
@@ -261,6 +264,7 @@ impl<'m> Deck<'m> {
 
     fn ctria3(&mut self) -> Result<(), FeError> {
         for (i, t) in self.mesh.triangles.iter().enumerate() {
+            no_section(&format!("triangle {i}"), t.section.is_some())?;
             let sheet = [t.thickness, t.bending_thickness, t.extra_mass_per_area];
             let pid = self.pshell(&t.material, sheet)?;
             self.plate("CTRIA3", &format!("triangle {i}"), pid, &t.nodes)?;
@@ -480,6 +484,18 @@ pub fn write_bulk_deck(mesh: &Mesh) -> Result<String, FeError> {
     deck.spc1()?;
     deck.out.push_str("ENDDATA\n");
     Ok(deck.out)
+}
+
+/// The writer emits isotropic PSHELL/MAT1 sheets only; a general section (MAT2/MAT8, MID2/MID3
+/// materials, offsets) would be written wrong, so it is refused.
+fn no_section(what: &str, has_section: bool) -> Result<(), FeError> {
+    if has_section {
+        return Err(FeError::InvalidInput(format!(
+            "{what}: shells with a general section (anisotropic materials, separate bending or \
+             shear material, offset) are not written"
+        )));
+    }
+    Ok(())
 }
 
 #[cfg(test)]
