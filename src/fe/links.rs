@@ -19,6 +19,7 @@ use nalgebra::{Matrix3, Matrix6, SMatrix, Vector3};
 use super::dof::DOF_PER_NODE;
 use super::error::FeError;
 use super::mesh::{InterpolationLink, Mesh, RigidLink};
+use super::nodal_frames;
 
 /// One dependent DOF expressed through other DOFs.
 #[derive(Debug, Clone, PartialEq)]
@@ -54,7 +55,11 @@ fn rigid_equations(
                 "{origin}: node {dep} is both independent and dependent"
             )));
         }
-        let s = rigid_map(&(mesh.position(&origin, dep)? - xi));
+        // Components on nodes with a displacement frame (GRID CD) are the node's own: the
+        // dependent's listed components in its frame, the independent's six in its frame.
+        let s = nodal_frames::node_block(&mesh.displacement_frames, dep).transpose()
+            * rigid_map(&(mesh.position(&origin, dep)? - xi))
+            * nodal_frames::node_block(&mesh.displacement_frames, link.independent);
         for (row, _) in link.components.iter().enumerate().filter(|(_, on)| **on) {
             let terms = (0..DOF_PER_NODE)
                 .filter(|&col| s[(row, col)] != 0.0)
@@ -79,6 +84,15 @@ fn interpolation_equations(
     link: &InterpolationLink,
 ) -> Result<Vec<LinkEquation>, FeError> {
     let origin = format!("interpolation link {index}");
+    let framed = std::iter::once(link.reference)
+        .chain(link.sources.iter().flat_map(|g| g.nodes.iter().copied()))
+        .find(|n| mesh.displacement_frames.contains_key(n));
+    if let Some(node) = framed {
+        return Err(FeError::InvalidInput(format!(
+            "{origin}: node {node} has a displacement frame (GRID CD); interpolation links on \
+             such nodes are not supported"
+        )));
+    }
     let xr = mesh.position(&origin, link.reference)?;
     let mut sources = Vec::new();
     for group in &link.sources {
