@@ -115,7 +115,10 @@ pub fn assemble(mesh: &Mesh) -> Result<Assembled, FeError> {
         let p2 = mesh.position(&what, b.nodes[1])?;
         let ends = mesh.beam_ends.get(&i).copied().unwrap_or_default();
         k.scatter(&b.nodes, &beam::stiffness_with_ends(i, b, &ends, &p1, &p2)?);
-        m.scatter(&b.nodes, &beam::lumped_mass_with_ends(i, b, &ends, &p1, &p2)?);
+        m.scatter(
+            &b.nodes,
+            &beam::lumped_mass_with_ends(i, b, &ends, &p1, &p2)?,
+        );
     }
     for (i, s) in mesh.shells.iter().enumerate() {
         let what = format!("shell {i}");
@@ -145,16 +148,28 @@ pub fn assemble(mesh: &Mesh) -> Result<Assembled, FeError> {
     for (i, s) in mesh.ground_springs.iter().enumerate() {
         mesh.position(&format!("ground spring {i}"), s.node)?;
         let (ks, cs) = spring::ground_matrices(i, s)?;
-        k.scatter(&[s.node], &nodal_frames::to_global_axes(frames, &[s.node], &ks));
-        c.scatter(&[s.node], &nodal_frames::to_global_axes(frames, &[s.node], &cs));
+        k.scatter(
+            &[s.node],
+            &nodal_frames::to_global_axes(frames, &[s.node], &ks),
+        );
+        c.scatter(
+            &[s.node],
+            &nodal_frames::to_global_axes(frames, &[s.node], &cs),
+        );
     }
     for (i, s) in mesh.springs.iter().enumerate() {
         let what = format!("spring {i}");
         mesh.position(&what, s.nodes[0])?;
         mesh.position(&what, s.nodes[1])?;
         let (ks, cs) = spring::two_node_matrices(i, s)?;
-        k.scatter(&s.nodes, &nodal_frames::to_global_axes(frames, &s.nodes, &ks));
-        c.scatter(&s.nodes, &nodal_frames::to_global_axes(frames, &s.nodes, &cs));
+        k.scatter(
+            &s.nodes,
+            &nodal_frames::to_global_axes(frames, &s.nodes, &ks),
+        );
+        c.scatter(
+            &s.nodes,
+            &nodal_frames::to_global_axes(frames, &s.nodes, &cs),
+        );
     }
     for (i, bush) in mesh.bushes.iter().enumerate() {
         let what = format!("bush {i}");

@@ -129,7 +129,11 @@ fn frame_between_ends(
     p2: &Vector3<f64>,
 ) -> Result<(Matrix3<f64>, f64), FeError> {
     validate(index, beam)?;
-    if ends.offsets.iter().any(|w| w.iter().any(|c| !c.is_finite())) {
+    if ends
+        .offsets
+        .iter()
+        .any(|w| w.iter().any(|c| !c.is_finite()))
+    {
         return Err(FeError::InvalidInput(format!(
             "beam {index}: non-finite offset {:?}",
             ends.offsets

@@ -10,8 +10,8 @@ use super::lexer::{CardSink, Loc, RawCard, Value};
 use super::NastranBody;
 use crate::fe::error::FeError;
 use crate::fe::mesh::{
-    Beam, BeamEnds, BeamSection, Bush, GroundSpring, InterpolationLink, InterpolationSource, Material, Mesh,
-    PointMass, RigidLink, Shell, Spring, TriShell,
+    Beam, BeamEnds, BeamSection, Bush, GroundSpring, InterpolationLink, InterpolationSource,
+    Material, Mesh, PointMass, RigidLink, Shell, Spring, TriShell,
 };
 
 /// Parameters that only steer output or solution bookkeeping: accepted and ignored.
@@ -678,7 +678,9 @@ fn beam_geometry(
     };
     let [v_system, a_system, b_system] = bar.offt;
     let orientation = match bar.orientation {
-        Orientation::Vector(v) if v_system == cards::VectorSystem::Grid => frame(a) * Vector3::from(v),
+        Orientation::Vector(v) if v_system == cards::VectorSystem::Grid => {
+            frame(a) * Vector3::from(v)
+        }
         Orientation::Vector(v) => Vector3::from(v),
         Orientation::Node(g0) => {
             body.mesh.nodes[node_of(body, g0, line, &format!("{user} G0"))?] - body.mesh.nodes[a]
@@ -1017,7 +1019,10 @@ fn add_links(c: &Cards, body: &mut NastranBody) -> Result<(), FeError> {
         let user = format!("RBE3 {id}");
         let reference = node_of(body, e.reference, &e.line, &user)?;
         let grids = std::iter::once(&e.reference).chain(e.groups.iter().flat_map(|g| &g.2));
-        if let Some(g) = grids.into_iter().find(|g| c.grids.get(g).is_some_and(|g| g.cd.is_some())) {
+        if let Some(g) = grids
+            .into_iter()
+            .find(|g| c.grids.get(g).is_some_and(|g| g.cd.is_some()))
+        {
             return Err(mesh_error(
                 &e.line,
                 format!(
