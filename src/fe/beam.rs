@@ -286,6 +286,63 @@ mod tests {
     }
 
     #[test]
+    fn offsets_and_pins_keep_rigid_body_motions_free_and_released_ends_unloaded() {
+        let p1 = Vector3::new(0.1, -0.2, 0.3);
+        let p2 = Vector3::new(0.9, 0.4, -0.1);
+        let ends = BeamEnds {
+            offsets: [
+                Vector3::new(0.0, 0.05, -0.02),
+                Vector3::new(0.03, 0.0, 0.04),
+            ],
+            pins: [[false, false, false, false, true, true], [false; 6]],
+        };
+        let b = beam_along(Vector3::new(0.0, 0.0, 1.0));
+        let k = stiffness_with_ends(0, &b, &ends, &p1, &p2).unwrap();
+        let scale = k.abs().max();
+        assert!((k - k.transpose()).abs().max() < 1e-12 * scale);
+        for mode in 0..6 {
+            let mut u = SMatrix::<f64, 12, 1>::zeros();
+            for (n, p) in [p1, p2].iter().enumerate() {
+                let mut w = Vector3::zeros();
+                if mode < 3 {
+                    u[6 * n + mode] = 1.0;
+                    continue;
+                }
+                w[mode - 3] = 1.0;
+                let t = w.cross(p);
+                for d in 0..3 {
+                    u[6 * n + d] = t[d];
+                    u[6 * n + 3 + d] = w[d];
+                }
+            }
+            assert!(
+                (k * u).norm() < 1e-9 * scale,
+                "rigid mode {mode} strains the beam"
+            );
+        }
+        // Any node motion leaves no bending moment at the released end A: the element-axes
+        // forces at the end, T u with K in element axes, have zero ry and rz components.
+        let (r, _) = local_frame(
+            0,
+            &(p1 + ends.offsets[0]),
+            &(p2 + ends.offsets[1]),
+            &b.orientation,
+        )
+        .unwrap();
+        let t_inv = end_transform(&r, &ends.offsets).try_inverse().unwrap();
+        let k_local = t_inv.transpose() * k * t_inv;
+        for j in 0..12 {
+            assert!(k_local[(4, j)].abs() < 1e-9 * scale && k_local[(5, j)].abs() < 1e-9 * scale);
+        }
+        let mut all = ends;
+        all.pins[1] = [true; 6];
+        let err = stiffness_with_ends(3, &b, &all, &p1, &p2)
+            .unwrap_err()
+            .to_string();
+        assert!(err.contains("beam 3") && err.contains("six"), "{err}");
+    }
+
+    #[test]
     fn parallel_orientation_is_reported_with_the_beam_index() {
         let p1 = Vector3::zeros();
         let p2 = Vector3::new(1.0, 0.0, 0.0);

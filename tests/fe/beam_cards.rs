@@ -7,7 +7,7 @@ use std::fmt::Write;
 
 use engine_mount_chassis::fe::assembly::{assemble, Assembled};
 use engine_mount_chassis::fe::eigen::lowest_modes;
-use engine_mount_chassis::fe::nastran::{parse_str, NastranBody};
+use engine_mount_chassis::fe::nastran::{parse_str, write_bulk_deck, NastranBody};
 use nalgebra::{DMatrix, DVector, Matrix3, Vector3};
 
 const E: f64 = 2.1e11;
@@ -165,6 +165,12 @@ fn a_cantilever_on_offset_grids_equals_the_cantilever_on_its_axis() {
             assert!(rel(w, expected) < 1e-9, "{w} vs {expected}");
         }
     }
+    // Written back as bulk data, offsets (in basic) and pin flags survive.
+    let mut pinned = above.mesh.clone();
+    pinned.beam_ends.get_mut(&2).unwrap().pins =
+        [[false, true, false, false, false, true], [false; 6]];
+    let again = parse_str(&write_bulk_deck(&pinned).unwrap()).unwrap();
+    assert_eq!(again.mesh.beam_ends, pinned.beam_ends);
     let f_axis = frequencies(&axis, 8);
     for body in [&above, &beside] {
         for (a, b) in frequencies(body, 8).iter().zip(&f_axis) {
