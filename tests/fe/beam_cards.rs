@@ -197,7 +197,7 @@ fn an_axial_load_on_an_eccentric_arm_bends_the_beam_by_the_arm_moment() {
         );
     }
     for k in 1..=n {
-        let _ = write!(deck, "CBAR,{k},5,{},{},0.,1.,0.\n", k, k + 1);
+        let _ = writeln!(deck, "CBAR,{k},5,{},{},0.,1.,0.", k, k + 1);
         if k == n {
             let _ = writeln!(deck, ",,,0.,0.,0.,0.,0.,{}", r(-e));
         }
@@ -234,7 +234,7 @@ fn a_mass_on_a_rigid_arm_beyond_the_beam_end_has_the_arm_oscillator_frequency() 
         let _ = writeln!(deck, "GRID,{},,{},0.,0.", k + 1, r(x));
     }
     for k in 1..=n {
-        let _ = write!(deck, "CBAR,{k},5,{},{},0.,1.,0.\n", k, k + 1);
+        let _ = writeln!(deck, "CBAR,{k},5,{},{},0.,1.,0.", k, k + 1);
         if k == n {
             let _ = writeln!(deck, ",,,0.,0.,0.,{},0.,0.", r(-a));
         }
