@@ -603,3 +603,49 @@ fn bad_offset_codes_pin_flags_and_displacement_systems_are_refused_naming_card_a
     );
     assert!(err.contains("CBAR 7") && err.contains("line 6"), "{err}");
 }
+
+#[test]
+fn a_reduced_body_with_mount_grids_in_displacement_systems_reports_the_same_basic_motion() {
+    use engine_mount_chassis::cms::{reduce, BulkDeckBody, ModeSelection, ReductionSpec};
+    use engine_mount_chassis::fe::nastran::{deck_digest, DeckOptions};
+    let dir = std::env::temp_dir().join(format!("emc-beam-cards-cd-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let reduced = |cd: Cd| {
+        let path = dir.join(format!("frame-{}.bdf", cd as u8));
+        std::fs::write(&path, frame_deck(cd)).unwrap();
+        let points = [("mount_a", 3), ("mount_b", 4), ("out", 5)]
+            .map(|(n, g)| (n.to_string(), g))
+            .into();
+        let spec = ReductionSpec {
+            deck: Some(BulkDeckBody {
+                sha256: deck_digest(&path, &DeckOptions::default()).unwrap(),
+                path,
+                points,
+                include_root: None,
+            }),
+            interface: vec!["mount_a".into(), "mount_b".into()],
+            outputs: vec!["out".into()],
+            selection: ModeSelection::Count(3),
+            ..ReductionSpec::default()
+        };
+        reduce(&spec).unwrap()
+    };
+    let basic = reduced(Cd::Basic);
+    for cd in [Cd::Rectangular, Cd::Cylindrical] {
+        let other = reduced(cd);
+        assert_eq!(other.omega.len(), basic.omega.len());
+        for (k, (a, b)) in other.omega.iter().zip(&basic.omega).enumerate() {
+            assert!(rel(*a, *b) < 1e-9, "mode {k}: {a} vs {b} rad/s");
+            // The points' motion per modal coordinate is in basic (vehicle) axes: equal up to
+            // the sign of the mode.
+            let flat = |r: &engine_mount_chassis::cms::ReducedChassis| -> DVector<f64> {
+                DVector::from_iterator(18, r.points.iter().flat_map(|p| p.shape[k]))
+            };
+            let (u, u0) = (flat(&other), flat(&basic));
+            let diff = (u.clone() * u.dot(&u0).signum() - &u0).amax() / u0.amax();
+            println!("mode {k}: {a:.6} rad/s, point motion difference {diff:.2e}");
+            assert!(diff < 1e-7, "mode {k}: {diff}");
+        }
+    }
+    std::fs::remove_dir_all(&dir).ok();
+}
