@@ -444,6 +444,27 @@ mod tests {
     }
 
     #[test]
+    fn a_framed_node_numbers_its_own_components_and_moves_in_global_axes() {
+        // Node 1 in a frame whose axis 1 is (cos a, sin a, 0): fixing its component 1 leaves
+        // motion along axis 2 = (−sin a, cos a, 0) and the global z axis.
+        let a = 0.6f64;
+        let (s, c) = a.sin_cos();
+        let r = Matrix3::new(c, -s, 0.0, s, c, 0.0, 0.0, 0.0, 1.0);
+        let frames = BTreeMap::from([(1, r)]);
+        let map = DofMap::with_frames(2, &[(1, 0), (1, 3), (1, 4), (1, 5)], &[], &frames).unwrap();
+        assert_eq!(map.n_free(), 8);
+        let (gy, gz) = (map.global(1, 1).unwrap(), map.global(1, 2).unwrap());
+        assert_eq!(map.motion_row(1, 0).unwrap(), vec![(gy, -s)]);
+        assert_eq!(map.motion_row(1, 1).unwrap(), vec![(gy, c)]);
+        assert_eq!(map.motion_row(1, 2).unwrap(), vec![(gz, 1.0)]);
+        assert!(map.motion_row(1, 4).unwrap().is_empty());
+        let t = map.transformation().unwrap().to_dense();
+        assert_eq!((t[(6, gy)], t[(7, gy)], t[(8, gz)]), (-s, c, 1.0));
+        assert_eq!(map.frame(1), Some(&r));
+        assert_eq!(map.frame(0), None);
+    }
+
+    #[test]
     fn out_of_range_constraint_is_an_error() {
         let err = DofMap::new(2, &[(2, 0)]).unwrap_err();
         assert!(err.to_string().contains("node 2"));

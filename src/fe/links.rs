@@ -230,6 +230,48 @@ mod tests {
     }
 
     #[test]
+    fn rigid_link_components_are_those_of_the_nodes_displacement_frames() {
+        // Independent node 0 in a frame rotated 40° about z, dependent node 1 in one rotated
+        // −25° about x; only the dependent's component 2 (its own y axis) is tied.
+        let rot = |axis: Vector3<f64>, deg: f64| {
+            *nalgebra::Rotation3::from_axis_angle(
+                &nalgebra::Unit::new_normalize(axis),
+                deg.to_radians(),
+            )
+            .matrix()
+        };
+        let (r0, r1) = (rot(Vector3::z(), 40.0), rot(Vector3::x(), -25.0));
+        let mut mesh = Mesh::default();
+        mesh.add_node(Vector3::new(0.3, -0.2, 0.1));
+        mesh.add_node(Vector3::new(1.0, 0.5, -0.7));
+        mesh.displacement_frames.insert(0, r0);
+        mesh.displacement_frames.insert(1, r1);
+        let mut components = [false; 6];
+        components[1] = true;
+        mesh.rigid_links.push(RigidLink {
+            independent: 0,
+            dependent: vec![1],
+            components,
+        });
+        let eqs = equations(&mesh).unwrap();
+        assert_eq!(eqs.len(), 1);
+        assert_eq!(eqs[0].dependent, 6 + 1);
+        let (t, w) = (Vector3::new(0.2, -0.5, 0.9), Vector3::new(0.4, 0.1, -0.3));
+        // Node 0's own components of the rigid motion, and the tied one of node 1.
+        let (t0, w0) = (r0.transpose() * t, r0.transpose() * w);
+        let own = |slot: usize| {
+            if slot % 6 < 3 {
+                t0[slot % 6]
+            } else {
+                w0[slot % 6 - 3]
+            }
+        };
+        let d = mesh.nodes[1] - mesh.nodes[0];
+        let expected = r1.column(1).dot(&(t + w.cross(&d)));
+        assert!((evaluate(&eqs[0], &own) - expected).abs() < 1e-14);
+    }
+
+    #[test]
     fn rigid_link_reproduces_a_rigid_body_motion() {
         let mut mesh = Mesh::default();
         mesh.add_node(Vector3::new(0.3, -0.2, 0.1));
