@@ -6,7 +6,7 @@ use nalgebra::{Dim, Matrix, RawStorage};
 use super::dof::{DofMap, Expansion, DOF_PER_NODE};
 use super::error::FeError;
 use super::mesh::Mesh;
-use super::{beam, links, mass, shell, shell3, solid, spring};
+use super::{beam, links, mass, nodal_frames, shell, shell3, solid, spring};
 
 /// Sparse symmetric matrix type of the FE model (both triangles stored).
 pub type SparseMat = SparseColMat<usize, f64>;
@@ -83,7 +83,15 @@ fn terms(e: Expansion<'_>) -> Vec<(usize, f64)> {
 /// Assembles K, M, C of `mesh` on the DOFs left free by `mesh.constraints`.
 pub fn assemble(mesh: &Mesh) -> Result<Assembled, FeError> {
     let equations = links::equations(mesh)?;
-    let dofs = DofMap::with_links(mesh.nodes.len(), &mesh.constraints, &equations)?;
+    let dofs = DofMap::with_frames(
+        mesh.nodes.len(),
+        &mesh.constraints,
+        &equations,
+        &mesh.displacement_frames,
+    )?;
+    // Scalar springs and dampers act on node components (GRID CD): carried to global axes so
+    // that scattering through the DOF map gives them back on the components.
+    let frames = &mesh.displacement_frames;
     let mut k = TripletSink {
         dofs: &dofs,
         entries: Vec::new(),
@@ -100,8 +108,12 @@ pub fn assemble(mesh: &Mesh) -> Result<Assembled, FeError> {
         let what = format!("beam {i}");
         let p1 = mesh.position(&what, b.nodes[0])?;
         let p2 = mesh.position(&what, b.nodes[1])?;
-        k.scatter(&b.nodes, &beam::stiffness(i, b, &p1, &p2)?);
-        m.scatter(&b.nodes, &beam::lumped_mass(i, b, &p1, &p2)?);
+        let ends = mesh.beam_ends.get(&i).copied().unwrap_or_default();
+        k.scatter(&b.nodes, &beam::stiffness_with_ends(i, b, &ends, &p1, &p2)?);
+        m.scatter(
+            &b.nodes,
+            &beam::lumped_mass_with_ends(i, b, &ends, &p1, &p2)?,
+        );
     }
     for (i, s) in mesh.shells.iter().enumerate() {
         let what = format!("shell {i}");
@@ -131,16 +143,28 @@ pub fn assemble(mesh: &Mesh) -> Result<Assembled, FeError> {
     for (i, s) in mesh.ground_springs.iter().enumerate() {
         mesh.position(&format!("ground spring {i}"), s.node)?;
         let (ks, cs) = spring::ground_matrices(i, s)?;
-        k.scatter(&[s.node], &ks);
-        c.scatter(&[s.node], &cs);
+        k.scatter(
+            &[s.node],
+            &nodal_frames::to_global_axes(frames, &[s.node], &ks),
+        );
+        c.scatter(
+            &[s.node],
+            &nodal_frames::to_global_axes(frames, &[s.node], &cs),
+        );
     }
     for (i, s) in mesh.springs.iter().enumerate() {
         let what = format!("spring {i}");
         mesh.position(&what, s.nodes[0])?;
         mesh.position(&what, s.nodes[1])?;
         let (ks, cs) = spring::two_node_matrices(i, s)?;
-        k.scatter(&s.nodes, &ks);
-        c.scatter(&s.nodes, &cs);
+        k.scatter(
+            &s.nodes,
+            &nodal_frames::to_global_axes(frames, &s.nodes, &ks),
+        );
+        c.scatter(
+            &s.nodes,
+            &nodal_frames::to_global_axes(frames, &s.nodes, &cs),
+        );
     }
     for (i, bush) in mesh.bushes.iter().enumerate() {
         let what = format!("bush {i}");
@@ -184,10 +208,13 @@ pub fn mat_vec(a: &SparseMat, x: &[f64]) -> Vec<f64> {
 pub fn translational_mass(a: &Assembled, direction: usize) -> f64 {
     let owners = a.dofs.owners();
     let mut unit = vec![0.0; owners.len()];
-    for (g, &(_, d)) in owners.iter().enumerate() {
-        if d == direction {
-            unit[g] = 1.0;
-        }
+    for (g, &(node, d)) in owners.iter().enumerate() {
+        unit[g] = match a.dofs.frame(node) {
+            // A global translation e seen in a node's frame: Rᵀ e.
+            Some(r) if d < 3 => r[(direction, d)],
+            _ if d == direction => 1.0,
+            _ => 0.0,
+        };
     }
     let mu = mat_vec(&a.m, &unit);
     unit.iter().zip(&mu).map(|(u, v)| u * v).sum()

@@ -1,9 +1,22 @@
-//! Two-node 3D Euler-Bernoulli beam: stiffness and HRZ-lumped mass in global axes.
+//! Two-node 3D Euler-Bernoulli beam: stiffness and HRZ-lumped mass in global axes, with
+//! Nastran's end conditions ([`BeamEnds`]): pin flags released by static condensation in
+//! element axes, then rigid offsets from the nodes to the element ends.
+//!
+//! With offsets the element runs between the offset ends p₁ + w₁ and p₂ + w₂ (its axis, length
+//! and orientation come from them); each end moves rigidly with its node, u_end = u + θ × w,
+//! so K_node = Tᵀ K_end T with T = \[I −\[w\]×; 0 I\] per end, and likewise for the mass,
+//! which stays lumped at the element ends (the offset arm carries the lever-arm coupling).
+//!
+//! A pin flag releases element DOFs at an end: the released DOFs are condensed out one at a
+//! time (K ← K − K·ᵢ Kᵢ· / Kᵢᵢ); a released DOF left without stiffness by earlier releases
+//! (axial released at both ends, say) is dropped, as NASTRAN does, so a beam that becomes a
+//! mechanism on its own still assembles and carries what it still can. The lumped mass does not
+//! depend on the pin flags (Nastran's lumped mass does not either).
 
 use nalgebra::{Matrix3, SMatrix, Vector3};
 
 use super::error::{require_non_negative, require_positive, FeError};
-use super::mesh::Beam;
+use super::mesh::{Beam, BeamEnds};
 
 /// 12 × 12 element matrix, DOF order (ux uy uz rx ry rz) at node 1 then node 2.
 pub type Mat12 = SMatrix<f64, 12, 12>;
@@ -37,12 +50,34 @@ pub fn local_frame(
     Ok((r, length))
 }
 
-fn rotate(local: &Mat12, r: &Matrix3<f64>) -> Mat12 {
+/// T with u_element_axes = T u_nodes: the rigid offset arms (u_end = u − \[w\]× θ), then the
+/// rotation into element axes.
+fn end_transform(r: &Matrix3<f64>, offsets: &[Vector3<f64>; 2]) -> Mat12 {
     let mut t = Mat12::zeros();
-    for b in 0..4 {
-        t.fixed_view_mut::<3, 3>(3 * b, 3 * b).copy_from(r);
+    for (end, w) in offsets.iter().enumerate() {
+        let o = 6 * end;
+        t.fixed_view_mut::<3, 3>(o, o).copy_from(r);
+        t.fixed_view_mut::<3, 3>(o + 3, o + 3).copy_from(r);
+        t.fixed_view_mut::<3, 3>(o, o + 3)
+            .copy_from(&(-(r * w.cross_matrix())));
     }
-    t.transpose() * local * t
+    t
+}
+
+/// Static condensation of the released DOFs (indices 0..12 in element axes), one at a time.
+fn release(k: &mut Mat12, pins: &[[bool; 6]; 2]) {
+    let original: Vec<f64> = (0..12).map(|i| k[(i, i)]).collect();
+    for i in (0..12).filter(|&i| pins[i / 6][i % 6]) {
+        let kii = k[(i, i)];
+        // A DOF whose stiffness earlier releases took away is a mechanism of the element:
+        // nothing to condense, it just carries nothing (NASTRAN zeroes it the same way).
+        if kii > 1e-9 * original[i] {
+            let col = k.column(i).into_owned();
+            *k -= col * col.transpose() / kii;
+        }
+        k.row_mut(i).fill(0.0);
+        k.column_mut(i).fill(0.0);
+    }
 }
 
 fn validate(index: usize, beam: &Beam) -> Result<(), FeError> {
@@ -72,8 +107,62 @@ pub fn stiffness(
     p1: &Vector3<f64>,
     p2: &Vector3<f64>,
 ) -> Result<Mat12, FeError> {
+    stiffness_with_ends(index, beam, &BeamEnds::default(), p1, p2)
+}
+
+/// Global lumped mass matrix of `beam` with end points `p1`, `p2`.
+pub fn lumped_mass(
+    index: usize,
+    beam: &Beam,
+    p1: &Vector3<f64>,
+    p2: &Vector3<f64>,
+) -> Result<Mat12, FeError> {
+    lumped_mass_with_ends(index, beam, &BeamEnds::default(), p1, p2)
+}
+
+/// Element frame and length between the offset ends.
+fn frame_between_ends(
+    index: usize,
+    beam: &Beam,
+    ends: &BeamEnds,
+    p1: &Vector3<f64>,
+    p2: &Vector3<f64>,
+) -> Result<(Matrix3<f64>, f64), FeError> {
     validate(index, beam)?;
-    let (r, l) = local_frame(index, p1, p2, &beam.orientation)?;
+    if ends
+        .offsets
+        .iter()
+        .any(|w| w.iter().any(|c| !c.is_finite()))
+    {
+        return Err(FeError::InvalidInput(format!(
+            "beam {index}: non-finite offset {:?}",
+            ends.offsets
+        )));
+    }
+    if ends.pins.iter().any(|p| p.iter().all(|&r| r)) {
+        return Err(FeError::InvalidInput(format!(
+            "beam {index}: an end releases all six DOFs (Nastran allows at most five pin flags \
+             per end)"
+        )));
+    }
+    local_frame(
+        index,
+        &(p1 + ends.offsets[0]),
+        &(p2 + ends.offsets[1]),
+        &beam.orientation,
+    )
+}
+
+/// Global stiffness matrix of `beam` on its nodes at `p1`, `p2` with offsets and pin flags
+/// `ends` (see the module documentation).
+pub fn stiffness_with_ends(
+    index: usize,
+    beam: &Beam,
+    ends: &BeamEnds,
+    p1: &Vector3<f64>,
+    p2: &Vector3<f64>,
+) -> Result<Mat12, FeError> {
+    let (r, l) = frame_between_ends(index, beam, ends, p1, p2)?;
     let e = beam.material.youngs_modulus;
     let g = beam.material.shear_modulus();
     let s = &beam.section;
@@ -116,20 +205,24 @@ pub fn stiffness(
     put(8, 8, 12.0 * ei / l.powi(3));
     put(8, 10, 6.0 * ei / l.powi(2));
     put(10, 10, 4.0 * ei / l);
-    Ok(rotate(&k, &r))
+    release(&mut k, &ends.pins);
+    let t = end_transform(&r, &ends.offsets);
+    Ok(t.transpose() * k * t)
 }
 
-/// Global lumped mass matrix of `beam`. Translations carry half the mass per node; the torsional
-/// inertia is the section's polar moment; the bending rotations get the HRZ diagonal scaling of
-/// the consistent matrix (m L² / 78 per node), which keeps the lumped beam accurate for bending.
-pub fn lumped_mass(
+/// Global lumped mass matrix of `beam` on its nodes at `p1`, `p2` with offsets `ends`.
+/// Translations carry half the mass per element end; the torsional inertia is the section's
+/// polar moment; the bending rotations get the HRZ diagonal scaling of the consistent matrix
+/// (m L² / 78 per end), which keeps the lumped beam accurate for bending. The element length is
+/// the distance between the offset ends.
+pub fn lumped_mass_with_ends(
     index: usize,
     beam: &Beam,
+    ends: &BeamEnds,
     p1: &Vector3<f64>,
     p2: &Vector3<f64>,
 ) -> Result<Mat12, FeError> {
-    validate(index, beam)?;
-    let (r, l) = local_frame(index, p1, p2, &beam.orientation)?;
+    let (r, l) = frame_between_ends(index, beam, ends, p1, p2)?;
     let rho = beam.material.density;
     let s = &beam.section;
     let m = (rho * s.area + beam.extra_mass_per_length) * l;
@@ -145,7 +238,8 @@ pub fn lumped_mass(
         local[(o + 4, o + 4)] = bending;
         local[(o + 5, o + 5)] = bending;
     }
-    Ok(rotate(&local, &r))
+    let t = end_transform(&r, &ends.offsets);
+    Ok(t.transpose() * local * t)
 }
 
 #[cfg(test)]
@@ -189,6 +283,63 @@ mod tests {
                 "rigid mode {mode} strains the beam"
             );
         }
+    }
+
+    #[test]
+    fn offsets_and_pins_keep_rigid_body_motions_free_and_released_ends_unloaded() {
+        let p1 = Vector3::new(0.1, -0.2, 0.3);
+        let p2 = Vector3::new(0.9, 0.4, -0.1);
+        let ends = BeamEnds {
+            offsets: [
+                Vector3::new(0.0, 0.05, -0.02),
+                Vector3::new(0.03, 0.0, 0.04),
+            ],
+            pins: [[false, false, false, false, true, true], [false; 6]],
+        };
+        let b = beam_along(Vector3::new(0.0, 0.0, 1.0));
+        let k = stiffness_with_ends(0, &b, &ends, &p1, &p2).unwrap();
+        let scale = k.abs().max();
+        assert!((k - k.transpose()).abs().max() < 1e-12 * scale);
+        for mode in 0..6 {
+            let mut u = SMatrix::<f64, 12, 1>::zeros();
+            for (n, p) in [p1, p2].iter().enumerate() {
+                let mut w = Vector3::zeros();
+                if mode < 3 {
+                    u[6 * n + mode] = 1.0;
+                    continue;
+                }
+                w[mode - 3] = 1.0;
+                let t = w.cross(p);
+                for d in 0..3 {
+                    u[6 * n + d] = t[d];
+                    u[6 * n + 3 + d] = w[d];
+                }
+            }
+            assert!(
+                (k * u).norm() < 1e-9 * scale,
+                "rigid mode {mode} strains the beam"
+            );
+        }
+        // Any node motion leaves no bending moment at the released end A: the element-axes
+        // forces at the end, T u with K in element axes, have zero ry and rz components.
+        let (r, _) = local_frame(
+            0,
+            &(p1 + ends.offsets[0]),
+            &(p2 + ends.offsets[1]),
+            &b.orientation,
+        )
+        .unwrap();
+        let t_inv = end_transform(&r, &ends.offsets).try_inverse().unwrap();
+        let k_local = t_inv.transpose() * k * t_inv;
+        for j in 0..12 {
+            assert!(k_local[(4, j)].abs() < 1e-9 * scale && k_local[(5, j)].abs() < 1e-9 * scale);
+        }
+        let mut all = ends;
+        all.pins[1] = [true; 6];
+        let err = stiffness_with_ends(3, &b, &all, &p1, &p2)
+            .unwrap_err()
+            .to_string();
+        assert!(err.contains("beam 3") && err.contains("six"), "{err}");
     }
 
     #[test]

@@ -74,6 +74,12 @@ pub fn check_mesh(mesh: &Mesh, limits: &CheckLimits) -> Result<(), FeError> {
             problems.push(format!("beam {i}: node {:?} does not exist", b.nodes));
             continue;
         };
+        // With offsets the element runs between the offset ends, not the nodes.
+        let w = mesh
+            .beam_ends
+            .get(&i)
+            .map_or([Vector3::zeros(); 2], |e| e.offsets);
+        let (p1, p2) = (p1 + w[0], p2 + w[1]);
         if b.nodes[0] == b.nodes[1] || (p2 - p1).norm() < limits.min_beam_length {
             problems.push(format!(
                 "beam {i}: degenerate (length {:.3e} m)",

@@ -1,11 +1,13 @@
 //! Map from (node, local DOF 0..5) to the global equation index, with constrained DOFs removed
 //! and the dependent DOFs of rigid/interpolation links eliminated (u = T q, q the equations).
 //!
-//! Local DOF order at every node: ux, uy, uz, rx, ry, rz (vehicle/global axes).
+//! Local DOF order at every node: ux, uy, uz, rx, ry, rz (vehicle/global axes, or the node's
+//! displacement frame where the mesh gives one: [`crate::fe::nodal_frames`]).
 
 use std::collections::BTreeMap;
 
 use faer::sparse::{SparseColMat, Triplet};
+use nalgebra::Matrix3;
 
 use super::error::FeError;
 use super::links::LinkEquation;
@@ -21,6 +23,10 @@ pub struct DofMap {
     n_free: usize,
     /// Row of T for each dependent slot `node * 6 + dof`: `(equation, coefficient)`.
     dependent: BTreeMap<usize, Vec<(usize, f64)>>,
+    /// Displacement frames of nodes (columns: axes in global coordinates).
+    frames: BTreeMap<usize, Matrix3<f64>>,
+    /// Global-axes motion of the slots of framed nodes: `(equation, coefficient)`.
+    global_rows: BTreeMap<usize, Vec<(usize, f64)>>,
 }
 
 /// How one (node, dof) enters the equations: its own equation, nothing (fixed), or a
@@ -56,6 +62,19 @@ impl DofMap {
         constrained: &[(usize, usize)],
         links: &[LinkEquation],
     ) -> Result<Self, FeError> {
+        Self::with_frames(n_nodes, constrained, links, &BTreeMap::new())
+    }
+
+    /// Like [`DofMap::with_links`] for a mesh whose nodes in `frames` have displacement frames:
+    /// their slots (in `constrained` and in the link equations) are components in the frame,
+    /// and [`DofMap::motion_row`] (and assembly) see their motion in global axes.
+    pub fn with_frames(
+        n_nodes: usize,
+        constrained: &[(usize, usize)],
+        links: &[LinkEquation],
+        frames: &BTreeMap<usize, Matrix3<f64>>,
+    ) -> Result<Self, FeError> {
+        super::nodal_frames::validate(frames, n_nodes)?;
         let n_slots = n_nodes * DOF_PER_NODE;
         let mut fixed = vec![false; n_slots];
         for &(node, dof) in constrained {
@@ -110,14 +129,46 @@ impl DofMap {
             })
             .collect();
         let dependent = resolve_chains(links, &equation_of, &index, &slot_name)?;
+        let mut global_rows = BTreeMap::new();
+        for (&node, r) in frames {
+            let own = |slot: usize| -> Vec<(usize, f64)> {
+                match index[slot] {
+                    Some(g) => vec![(g, 1.0)],
+                    None => dependent.get(&slot).cloned().unwrap_or_default(),
+                }
+            };
+            for block in [0, 3] {
+                let base = node * DOF_PER_NODE + block;
+                for i in 0..3 {
+                    let mut row: BTreeMap<usize, f64> = BTreeMap::new();
+                    for j in 0..3 {
+                        for (g, c) in own(base + j) {
+                            *row.entry(g).or_insert(0.0) += r[(i, j)] * c;
+                        }
+                    }
+                    global_rows.insert(
+                        base + i,
+                        row.into_iter().filter(|(_, c)| *c != 0.0).collect(),
+                    );
+                }
+            }
+        }
         Ok(Self {
             index,
             n_free,
             dependent,
+            frames: frames.clone(),
+            global_rows,
         })
     }
 
-    /// Global equation index of `(node, dof)`, `None` if constrained or out of range.
+    /// Displacement frame of `node` (columns: axes in global coordinates), if it has one.
+    pub fn frame(&self, node: usize) -> Option<&Matrix3<f64>> {
+        self.frames.get(&node)
+    }
+
+    /// Global equation index of `(node, dof)` (a component in the node's displacement frame if
+    /// it has one), `None` if constrained or out of range.
     pub fn global(&self, node: usize, dof: usize) -> Option<usize> {
         if dof >= DOF_PER_NODE {
             return None;
@@ -136,9 +187,11 @@ impl DofMap {
         dof < DOF_PER_NODE && self.dependent.contains_key(&(node * DOF_PER_NODE + dof))
     }
 
-    /// The motion of `(node, dof)` as `(equation, coefficient)` pairs, `u = Σ c q[equation]`:
-    /// one pair with coefficient 1 for a free DOF, none for a constrained DOF, the row of T for a
-    /// dependent DOF. Use it to recover output points and mount points on RBE2/RBE3 nodes.
+    /// The motion of `(node, dof)` in global axes as `(equation, coefficient)` pairs,
+    /// `u = Σ c q[equation]`: one pair with coefficient 1 for a free DOF, none for a constrained
+    /// DOF, the row of T for a dependent DOF, the frame's mix of the node's own components for a
+    /// node with a displacement frame. Use it to recover output points and mount points on
+    /// RBE2/RBE3 nodes.
     pub fn motion_row(&self, node: usize, dof: usize) -> Result<Vec<(usize, f64)>, FeError> {
         match self.expansion(node, dof) {
             Some(Expansion::Equation(g)) => Ok(vec![(g, 1.0)]),
@@ -172,16 +225,20 @@ impl DofMap {
             .map_err(|e| FeError::Numerical(format!("building motion rows: {e:?}")))
     }
 
-    /// The transformation T (6·n_nodes × n_free) from the equations to all node DOFs, row
-    /// `node * 6 + dof`; rows of constrained DOFs are empty.
+    /// The transformation T (6·n_nodes × n_free) from the equations to all node DOFs in global
+    /// axes, row `node * 6 + dof`; rows of constrained DOFs are empty.
     pub fn transformation(&self) -> Result<SparseColMat<usize, f64>, FeError> {
         let mut entries = Vec::with_capacity(self.n_free + self.dependent.len());
+        let framed = |slot: &usize| self.frames.contains_key(&(slot / DOF_PER_NODE));
         for (slot, g) in self.index.iter().enumerate() {
-            if let Some(g) = g {
+            if let (Some(g), false) = (g, framed(&slot)) {
                 entries.push(Triplet::new(slot, *g, 1.0));
             }
         }
-        for (slot, row) in &self.dependent {
+        for (slot, row) in self.dependent.iter().filter(|(s, _)| !framed(s)) {
+            entries.extend(row.iter().map(|&(g, c)| Triplet::new(*slot, g, c)));
+        }
+        for (slot, row) in &self.global_rows {
             entries.extend(row.iter().map(|&(g, c)| Triplet::new(*slot, g, c)));
         }
         SparseColMat::try_new_from_triplets(self.index.len(), self.n_free, &entries)
@@ -193,6 +250,9 @@ impl DofMap {
             return None;
         }
         let slot = node * DOF_PER_NODE + dof;
+        if let Some(row) = self.global_rows.get(&slot) {
+            return Some(Expansion::Combination(row));
+        }
         match self.index.get(slot)? {
             Some(g) => Some(Expansion::Equation(*g)),
             None => Some(match self.dependent.get(&slot) {
@@ -381,6 +441,27 @@ mod tests {
             .unwrap_err()
             .to_string();
         assert!(err.contains("also constrained"), "{err}");
+    }
+
+    #[test]
+    fn a_framed_node_numbers_its_own_components_and_moves_in_global_axes() {
+        // Node 1 in a frame whose axis 1 is (cos a, sin a, 0): fixing its component 1 leaves
+        // motion along axis 2 = (−sin a, cos a, 0) and the global z axis.
+        let a = 0.6f64;
+        let (s, c) = a.sin_cos();
+        let r = Matrix3::new(c, -s, 0.0, s, c, 0.0, 0.0, 0.0, 1.0);
+        let frames = BTreeMap::from([(1, r)]);
+        let map = DofMap::with_frames(2, &[(1, 0), (1, 3), (1, 4), (1, 5)], &[], &frames).unwrap();
+        assert_eq!(map.n_free(), 8);
+        let (gy, gz) = (map.global(1, 1).unwrap(), map.global(1, 2).unwrap());
+        assert_eq!(map.motion_row(1, 0).unwrap(), vec![(gy, -s)]);
+        assert_eq!(map.motion_row(1, 1).unwrap(), vec![(gy, c)]);
+        assert_eq!(map.motion_row(1, 2).unwrap(), vec![(gz, 1.0)]);
+        assert!(map.motion_row(1, 4).unwrap().is_empty());
+        let t = map.transformation().unwrap().to_dense();
+        assert_eq!((t[(6, gy)], t[(7, gy)], t[(8, gz)]), (-s, c, 1.0));
+        assert_eq!(map.frame(1), Some(&r));
+        assert_eq!(map.frame(0), None);
     }
 
     #[test]

@@ -19,6 +19,7 @@ use nalgebra::{Matrix3, Matrix6, SMatrix, Vector3};
 use super::dof::DOF_PER_NODE;
 use super::error::FeError;
 use super::mesh::{InterpolationLink, Mesh, RigidLink};
+use super::nodal_frames;
 
 /// One dependent DOF expressed through other DOFs.
 #[derive(Debug, Clone, PartialEq)]
@@ -54,7 +55,11 @@ fn rigid_equations(
                 "{origin}: node {dep} is both independent and dependent"
             )));
         }
-        let s = rigid_map(&(mesh.position(&origin, dep)? - xi));
+        // Components on nodes with a displacement frame (GRID CD) are the node's own: the
+        // dependent's listed components in its frame, the independent's six in its frame.
+        let s = nodal_frames::node_block(&mesh.displacement_frames, dep).transpose()
+            * rigid_map(&(mesh.position(&origin, dep)? - xi))
+            * nodal_frames::node_block(&mesh.displacement_frames, link.independent);
         for (row, _) in link.components.iter().enumerate().filter(|(_, on)| **on) {
             let terms = (0..DOF_PER_NODE)
                 .filter(|&col| s[(row, col)] != 0.0)
@@ -79,6 +84,15 @@ fn interpolation_equations(
     link: &InterpolationLink,
 ) -> Result<Vec<LinkEquation>, FeError> {
     let origin = format!("interpolation link {index}");
+    let framed = std::iter::once(link.reference)
+        .chain(link.sources.iter().flat_map(|g| g.nodes.iter().copied()))
+        .find(|n| mesh.displacement_frames.contains_key(n));
+    if let Some(node) = framed {
+        return Err(FeError::InvalidInput(format!(
+            "{origin}: node {node} has a displacement frame (GRID CD); interpolation links on \
+             such nodes are not supported"
+        )));
+    }
     let xr = mesh.position(&origin, link.reference)?;
     let mut sources = Vec::new();
     for group in &link.sources {
@@ -213,6 +227,48 @@ mod tests {
                 w[dof - 3]
             }
         }
+    }
+
+    #[test]
+    fn rigid_link_components_are_those_of_the_nodes_displacement_frames() {
+        // Independent node 0 in a frame rotated 40° about z, dependent node 1 in one rotated
+        // −25° about x; only the dependent's component 2 (its own y axis) is tied.
+        let rot = |axis: Vector3<f64>, deg: f64| {
+            *nalgebra::Rotation3::from_axis_angle(
+                &nalgebra::Unit::new_normalize(axis),
+                deg.to_radians(),
+            )
+            .matrix()
+        };
+        let (r0, r1) = (rot(Vector3::z(), 40.0), rot(Vector3::x(), -25.0));
+        let mut mesh = Mesh::default();
+        mesh.add_node(Vector3::new(0.3, -0.2, 0.1));
+        mesh.add_node(Vector3::new(1.0, 0.5, -0.7));
+        mesh.displacement_frames.insert(0, r0);
+        mesh.displacement_frames.insert(1, r1);
+        let mut components = [false; 6];
+        components[1] = true;
+        mesh.rigid_links.push(RigidLink {
+            independent: 0,
+            dependent: vec![1],
+            components,
+        });
+        let eqs = equations(&mesh).unwrap();
+        assert_eq!(eqs.len(), 1);
+        assert_eq!(eqs[0].dependent, 6 + 1);
+        let (t, w) = (Vector3::new(0.2, -0.5, 0.9), Vector3::new(0.4, 0.1, -0.3));
+        // Node 0's own components of the rigid motion, and the tied one of node 1.
+        let (t0, w0) = (r0.transpose() * t, r0.transpose() * w);
+        let own = |slot: usize| {
+            if slot % 6 < 3 {
+                t0[slot % 6]
+            } else {
+                w0[slot % 6 - 3]
+            }
+        };
+        let d = mesh.nodes[1] - mesh.nodes[0];
+        let expected = r1.column(1).dot(&(t + w.cross(&d)));
+        assert!((evaluate(&eqs[0], &own) - expected).abs() < 1e-14);
     }
 
     #[test]

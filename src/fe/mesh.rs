@@ -87,6 +87,18 @@ pub struct Beam {
     pub extra_mass_per_length: f64,
 }
 
+/// End conditions of a [`Beam`] that Nastran's CBAR/CBEAM carry: rigid offsets from the nodes
+/// to the element ends and pin flags releasing element DOFs at an end.
+#[derive(Debug, Clone, Copy, Default, PartialEq)]
+pub struct BeamEnds {
+    /// Vector from each node to its element end in global axes (m): the end sits at
+    /// node + offset and is carried rigidly by the node (u_end = u + θ × offset, θ_end = θ).
+    pub offsets: [Vector3<f64>; 2],
+    /// Released DOFs per end in element axes (x along the beam, y and z of the section; order
+    /// ux uy uz rx ry rz): the element transmits no force or moment there.
+    pub pins: [[bool; 6]; 2],
+}
+
 /// Four-node flat shell (membrane with drilling rotation + MITC4 plate).
 #[derive(Debug, Clone, PartialEq)]
 pub struct Shell {
@@ -233,6 +245,14 @@ pub struct Mesh {
     pub nodes: Vec<Vector3<f64>>,
     /// Beam elements.
     pub beams: Vec<Beam>,
+    /// Offsets and pin flags of beams, by index into `beams` (a beam not listed has neither).
+    pub beam_ends: BTreeMap<usize, BeamEnds>,
+    /// Displacement frames of nodes (Nastran GRID CD), by node: the columns are the frame's
+    /// axes in global coordinates (orthonormal, right-handed). The six DOFs of such a node are
+    /// its components in this frame: constraints, scalar springs and dampers and rigid link
+    /// components name them; elements and masses are given in global axes and transformed, and
+    /// motions recovered from a [`super::dof::DofMap`] are global. Nodes not listed are global.
+    pub displacement_frames: BTreeMap<usize, Matrix3<f64>>,
     /// Shell elements.
     pub shells: Vec<Shell>,
     /// Three-node shell elements.

@@ -49,6 +49,7 @@ pub mod mass;
 pub mod mesh;
 pub mod modal;
 pub mod nastran;
+pub mod nodal_frames;
 pub mod shell;
 pub mod shell3;
 pub mod solid;

@@ -700,7 +700,12 @@ pub(crate) fn remove_free_rotations(
     }
     let mut constrained = mesh.constraints.clone();
     constrained.extend(&extra);
-    let reduced = DofMap::with_links(mesh.nodes.len(), &constrained, links)?;
+    let reduced = DofMap::with_frames(
+        mesh.nodes.len(),
+        &constrained,
+        links,
+        &mesh.displacement_frames,
+    )?;
     let new_index: Vec<Option<usize>> = owners
         .iter()
         .map(|&(node, d)| reduced.global(node, d))

@@ -121,9 +121,9 @@ fn a_beam_given_in_cylindrical_coordinates_has_the_frequencies_of_the_same_beam_
 }
 
 #[test]
-fn a_non_basic_displacement_system_is_refused_naming_the_grid_and_line() {
+fn a_missing_displacement_system_is_refused_naming_the_grid_and_line() {
     let err = error_of(
-        "BEGIN BULK\nCORD2C,5,,0.,0.,0.,0.,0.,1.\n,1.,0.,0.\nGRID,1,,0.,0.,0.\nGRID,17,,1.,0.,0.,5\n",
+        "BEGIN BULK\nCORD2C,5,,0.,0.,0.,0.,0.,1.\n,1.,0.,0.\nGRID,1,,0.,0.,0.\nGRID,17,,1.,0.,0.,6\n",
     );
     assert!(
         err.contains("GRID 17") && err.contains("line 5") && err.contains("CD"),

@@ -1,5 +1,6 @@
 //! Integration tests of the finite elements and the procedural chassis (`src/fe`) against analytic results.
 
+mod beam_cards;
 mod chassis;
 mod deck_cards;
 mod deck_properties;

@@ -538,8 +538,8 @@ fn malformed_field_names_line_and_field() {
     assert!(err.contains("line 3") && err.contains("field 3"), "{err}");
     let err = error_of("GRID,1,,0.,0.,0.,7\n");
     assert!(err.contains("CD"), "{err}");
-    // Bar offsets and tapered beams are rejected by name rather than ignored.
-    let err = error_of("CBAR,1,2,3,4,0.,0.,1.\n,,,0.01\n");
+    // Bad offset codes and tapered beams are rejected by name rather than ignored.
+    let err = error_of("CBAR,1,2,3,4,0.,0.,1.,GGO\n,,,0.01x\n");
     assert!(err.contains("line 2") && err.contains("W1A"), "{err}");
     let err = error_of("PBEAM,1,1,1.-4,1.-8,1.-8,,2.-8\n,,,,,,,,\n,YES,1.,2.-4\n");
     assert!(err.contains("tapered") && err.contains("line 3"), "{err}");

@@ -187,28 +187,14 @@ pub struct Grid {
     pub id: u32,
     pub cp: Option<u32>,
     pub x: [f64; 3],
+    /// Displacement coordinate system (blank/0: basic).
+    pub cd: Option<u32>,
     pub ps: [bool; 6],
     pub line: Loc,
 }
 
 pub(crate) fn grid(r: &Reader) -> Result<Grid, FeError> {
     r.at_most(8)?;
-    // The assembly numbers every node's DOFs in basic axes (springs, supports and links act on
-    // basic components), so a grid's own displacement system would need a per-node rotation
-    // through all of them: refused rather than half supported.
-    if !matches!(
-        r.value(5, "CD")?,
-        Value::Blank | Value::Int(0) | Value::Real(0.0)
-    ) {
-        let grid = r.opt_int(0, "ID")?.unwrap_or(0);
-        return Err(r.error(
-            5,
-            "CD",
-            format!(
-                "GRID {grid}: non-basic displacement coordinate systems are not supported (DOFs,                  SPC and spring components are basic); set CD blank or 0"
-            ),
-        ));
-    }
     r.require_blank(7, "SEID", "superelements are not supported")?;
     let ps = if r.opt_int(6, "PS")?.is_some() {
         r.components(6, "PS")?
@@ -223,6 +209,7 @@ pub(crate) fn grid(r: &Reader) -> Result<Grid, FeError> {
             r.real_or(3, "X2", 0.0)?,
             r.real_or(4, "X3", 0.0)?,
         ],
+        cd: r.opt_id_or_zero(5, "CD")?,
         ps,
         line: r.card().loc(),
     })
@@ -480,10 +467,21 @@ pub(crate) fn pbeam(r: &Reader) -> Result<BeamProperty, FeError> {
 /// How a bar's element y axis is given.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub enum Orientation {
-    /// Vector X1, X2, X3 (basic, since CD = 0 everywhere).
+    /// Vector X1, X2, X3 (in the system OFFT's first letter names for CBAR/CBEAM).
     Vector([f64; 3]),
     /// Direction from end A to grid G0.
     Node(u32),
+}
+
+/// Where a CBAR/CBEAM vector is measured (a letter of OFFT).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum VectorSystem {
+    /// G: the displacement coordinate system (GRID CD) of the grid the vector starts at.
+    Grid,
+    /// B: basic.
+    Basic,
+    /// O: the offset system (x from GA to GB, y in the plane of x and the orientation vector).
+    Element,
 }
 
 /// CBAR / CBEAM.
@@ -494,7 +492,69 @@ pub struct Bar {
     pub ga: u32,
     pub gb: u32,
     pub orientation: Orientation,
+    /// OFFT: system of the orientation vector, of offset A, of offset B.
+    pub offt: [VectorSystem; 3],
+    /// PA, PB: released DOFs (element axes) at end A, end B.
+    pub pins: [[bool; 6]; 2],
+    /// W1A..W3A, W1B..W3B.
+    pub offsets: [[f64; 3]; 2],
     pub line: Loc,
+}
+
+/// OFFT: three letters, orientation vector G or B, each offset G or O (Nastran's table: GGG,
+/// BGG, GGO, BGO, GOG, BOG, GOO, BOO); blank is GGG.
+fn offt(r: &Reader) -> Result<[VectorSystem; 3], FeError> {
+    let code = match r.value(7, "OFFT")? {
+        Value::Blank => return Ok([VectorSystem::Grid; 3]),
+        Value::Text(t) => t,
+        other => {
+            return Err(r.error(
+                7,
+                "OFFT",
+                format!("{other:?} is not an offset code (GGG, BGG, GGO, BGO, GOG, BOG, GOO, BOO)"),
+            ))
+        }
+    };
+    let letters: Vec<char> = code.chars().collect();
+    let parsed = match letters[..] {
+        [v, a, b] => [(v, true), (a, false), (b, false)].map(|(c, vector)| match (c, vector) {
+            ('G', _) => Some(VectorSystem::Grid),
+            ('B', true) => Some(VectorSystem::Basic),
+            ('O', false) => Some(VectorSystem::Element),
+            _ => None,
+        }),
+        _ => [None; 3],
+    };
+    match parsed {
+        [Some(v), Some(a), Some(b)] => Ok([v, a, b]),
+        _ => Err(r.error(
+            7,
+            "OFFT",
+            format!(
+                "'{code}' is not an offset code: the orientation vector is G or B, each offset G \
+                 or O (GGG, BGG, GGO, BGO, GOG, BOG, GOO, BOO)"
+            ),
+        )),
+    }
+}
+
+/// PA / PB: up to five distinct digits 1..6; blank or 0 releases nothing.
+fn pin_flags(r: &Reader, i: usize, name: &str) -> Result<[bool; 6], FeError> {
+    match r.opt_int(i, name)? {
+        None | Some(0) => Ok([false; 6]),
+        Some(_) => {
+            let mask = r.components(i, name)?;
+            if mask.iter().all(|&m| m) {
+                return Err(r.error(
+                    i,
+                    name,
+                    "releases all six DOFs of the end, which would leave the grid unconnected: \
+                     Nastran allows up to five pin flags per end",
+                ));
+            }
+            Ok(mask)
+        }
+    }
 }
 
 pub(crate) fn bar(r: &Reader, is_beam: bool) -> Result<Bar, FeError> {
@@ -516,34 +576,14 @@ pub(crate) fn bar(r: &Reader, is_beam: bool) -> Result<Bar, FeError> {
                 "an orientation vector or G0 is required (BAROR/BEAMOR defaults are not supported)",
             )),
         };
-    match r.value(7, "OFFT")? {
-        Value::Blank => {}
-        Value::Text(t)
-            if t.len() == 3
-                && t.chars().enumerate().all(|(k, c)| match k {
-                    0 => c == 'G' || c == 'B',
-                    _ => c == 'G' || c == 'O',
-                }) => {}
-        other => {
-            return Err(r.error(
-                7,
-                "OFFT",
-                format!("{other:?} is not a supported offset code"),
-            ))
+    let offt = offt(r)?;
+    let pins = [pin_flags(r, 8, "PA")?, pin_flags(r, 9, "PB")?];
+    let names = [["W1A", "W2A", "W3A"], ["W1B", "W2B", "W3B"]];
+    let mut offsets = [[0.0; 3]; 2];
+    for (end, w) in offsets.iter_mut().enumerate() {
+        for (d, v) in w.iter_mut().enumerate() {
+            *v = r.real_or(10 + 3 * end + d, names[end][d], 0.0)?;
         }
-    }
-    let why = "pin flags and offsets are not supported";
-    r.require_blank(8, "PA", why)?;
-    r.require_blank(9, "PB", why)?;
-    for (k, n) in [
-        (10, "W1A"),
-        (11, "W2A"),
-        (12, "W3A"),
-        (13, "W1B"),
-        (14, "W2B"),
-        (15, "W3B"),
-    ] {
-        r.require_blank(k, n, why)?;
     }
     if is_beam {
         r.require_blank(16, "SA", "warping scalar points are not supported")?;
@@ -555,6 +595,9 @@ pub(crate) fn bar(r: &Reader, is_beam: bool) -> Result<Bar, FeError> {
         ga: r.id(2, "GA")?,
         gb: r.id(3, "GB")?,
         orientation,
+        offt,
+        pins,
+        offsets,
         line: r.card().loc(),
     })
 }

@@ -24,11 +24,18 @@
 //! (`line 12 of sub/grids.bdf`).
 //!
 //! Cards and how they map:
-//! - GRID (CP → CORD2R/CORD2C/CORD2S, coordinates converted to basic; CD must be 0/blank:
-//!   the assembly's DOFs, supports, springs and links are in basic components, a non-basic CD
-//!   is refused naming the GRID and line; PS → supports), CORD2R, CORD2C (r, θ°, z), CORD2S
-//!   (r, θ°, φ°) by three points in RID (RID chains, any kind). Users with fixed directions
-//!   (CONM2/CONM1 CID, CBUSH CID) take rectangular systems only.
+//! - GRID (CP → CORD2R/CORD2C/CORD2S, coordinates converted to basic; PS → supports), CORD2R,
+//!   CORD2C (r, θ°, z), CORD2S (r, θ°, φ°) by three points in RID (RID chains, any kind).
+//!   Users with fixed directions (CONM2/CONM1 CID, CBUSH CID) take rectangular systems only.
+//! - GRID CD → [`crate::fe::mesh::Mesh::displacement_frames`]: the grid's six DOFs are its
+//!   components along the CD system's axes at the grid (CORD2R axes; CORD2C r, θ, z and CORD2S
+//!   r, θ, φ directions there, θ = φ = 0 on the axis). SPC/SPC1/PS components, CELAS/CDAMP
+//!   components, RBE2 CM (of the dependent grid) and the RBE2 independent grid's six DOFs,
+//!   CBAR/CBEAM G vectors (OFFT) and the CBUSH X1..X3 (in GA's CD) are in CD, as in Nastran;
+//!   elements and masses are formed in their own systems and transformed
+//!   ([`crate::fe::nodal_frames`]). Motions recovered through [`crate::fe::dof::DofMap`] (mount
+//!   and output points of a reduced body, mode shapes) are in basic. An unknown CD is refused
+//!   naming the GRID and line; RBE3 on a grid with a CD is refused naming the RBE3 and line.
 //! - MAT1: two of E, G, NU given, the third by E = 2(1+ν)G (Nastran's rule); all three given:
 //!   beams keep E and G, shells need G within 1 % of E/2(1+ν). RHO; GE/A/TREF ignored
 //!   (structural damping is added modally by the caller). MAT2 (G11..G33, RHO) and MAT8 (E1, E2,
@@ -60,9 +67,19 @@
 //!   rigidly (u_ref = u + θ × ZOFFS·n): K = Tᵀ K_ref T and the lumped mass likewise, which couples
 //!   membrane and bending. Corner thicknesses (TFLAG, T1..T4) are refused.
 //! - PBAR (A, I1, I2, J, NSM; I12 must be 0), PBEAM (constant section only), CBAR/CBEAM with
-//!   X1..X3 or G0, no pins or offsets. The element is Euler-Bernoulli: shear flexibility (PBAR/
-//!   PBEAM K1, K2) is not modelled. I1 bends in Nastran's plane 1 (element x-y) → `iz`,
-//!   I2 → `iy`.
+//!   X1..X3 or G0. The element is Euler-Bernoulli: shear flexibility (PBAR/PBEAM K1, K2) is not
+//!   modelled. I1 bends in Nastran's plane 1 (element x-y) → `iz`, I2 → `iy`.
+//! - CBAR/CBEAM offsets W1A..W3B and OFFT (blank = GGG) → [`crate::fe::mesh::BeamEnds`]
+//!   `offsets` in basic: OFFT letter 1 is the system of X1..X3 (G: GA's CD, B: basic), letters
+//!   2 and 3 those of the offsets at A and B (G: that grid's CD, O: the offset system, x from GA
+//!   to GB, y in the plane of x and the orientation vector); GGG, BGG, GGO, BGO, GOG, BOG, GOO,
+//!   BOO, anything else refused. The element runs between the offset ends, carried rigidly by
+//!   the grids (K and lumped M: Tᵀ · T with the offset arms, [`crate::fe::beam`]).
+//! - CBAR/CBEAM PA, PB (up to five distinct digits 1..6 per end, element axes) → `pins`:
+//!   released by static condensation in element axes before the offsets; a release that leaves
+//!   nothing to condense (a mechanism of the element, e.g. PA = PB = 1) carries nothing, as in
+//!   NASTRAN; six digits at one end are refused. The lumped mass ignores the pin flags. CBEAM
+//!   SA/SB (warping) and a real BIT in place of OFFT are refused.
 //! - CTETRA (4 or 10 grids: mid-edge grids all given or all blank), CPENTA (6 grids), CHEXA
 //!   (8 grids) with PSOLID (MID: an isotropic MAT1, E, G, NU consistent within 1 %; CORDM
 //!   blank, 0, −1 or an existing system, irrelevant for an isotropic material; IN blank, 0 or

@@ -11,8 +11,8 @@ use super::solid_cards;
 use super::NastranBody;
 use crate::fe::error::FeError;
 use crate::fe::mesh::{
-    Beam, BeamSection, Bush, GroundSpring, InterpolationLink, InterpolationSource, Material, Mesh,
-    PointMass, RigidLink, Spring,
+    Beam, BeamEnds, BeamSection, Bush, GroundSpring, InterpolationLink, InterpolationSource,
+    Material, Mesh, PointMass, RigidLink, Spring,
 };
 
 mod shell_cards;
@@ -299,6 +299,30 @@ impl System {
         };
         self.origin + self.axes * local
     }
+
+    /// Axes (columns, in basic) of this system's components at the basic point `p`: for
+    /// CORD2C the r, θ, z directions there, for CORD2S r, θ, φ. On the axis (r = 0 in the x-y
+    /// plane of the system) θ and φ are taken as 0.
+    fn axes_at(self, p: &Vector3<f64>) -> Matrix3<f64> {
+        let l = self.axes.transpose() * (p - self.origin);
+        let local = match self.kind {
+            SystemKind::Rectangular => Matrix3::identity(),
+            SystemKind::Cylindrical => {
+                let (s, c) = l.y.atan2(l.x).sin_cos();
+                Matrix3::new(c, -s, 0.0, s, c, 0.0, 0.0, 0.0, 1.0)
+            }
+            SystemKind::Spherical => {
+                let (sp, cp) = l.y.atan2(l.x).sin_cos();
+                let (st, ct) = l.x.hypot(l.y).atan2(l.z).sin_cos();
+                Matrix3::from_columns(&[
+                    Vector3::new(st * cp, st * sp, ct),
+                    Vector3::new(ct * cp, ct * sp, -st),
+                    Vector3::new(-sp, cp, 0.0),
+                ])
+            }
+        };
+        self.axes * local
+    }
 }
 
 /// Resolved systems by id.
@@ -488,6 +512,12 @@ pub(crate) fn build(cards: Collector, spc_selection: Option<u32>) -> Result<Nast
         };
         let node = body.mesh.add_node(p);
         body.grid_index.insert(id, node);
+        if let Some(cd) = g.cd {
+            let frame = systems
+                .get(cd, &g.line, &format!("GRID {id} CD"))?
+                .axes_at(&p);
+            body.mesh.displacement_frames.insert(node, frame);
+        }
         body.mesh
             .constraints
             .extend(mask_nodes(g.ps).map(|d| (node, d)));
@@ -556,13 +586,10 @@ fn add_beams(c: &Cards, body: &mut NastranBody) -> Result<(), FeError> {
         }
         let a = node_of(body, bar.ga, line, &user)?;
         let b = node_of(body, bar.gb, line, &user)?;
-        let orientation = match bar.orientation {
-            Orientation::Vector(v) => Vector3::from(v),
-            Orientation::Node(g0) => {
-                body.mesh.nodes[node_of(body, g0, line, &format!("{user} G0"))?]
-                    - body.mesh.nodes[a]
-            }
-        };
+        let (orientation, ends) = beam_geometry(body, bar, a, b, &user)?;
+        if ends != BeamEnds::default() {
+            body.mesh.beam_ends.insert(body.mesh.beams.len(), ends);
+        }
         body.mesh.beams.push(Beam {
             nodes: [a, b],
             material: Material {
@@ -583,6 +610,69 @@ fn add_beams(c: &Cards, body: &mut NastranBody) -> Result<(), FeError> {
         body.element_ids.beams.push(id);
     }
     Ok(())
+}
+
+/// Orientation vector and end conditions of a CBAR/CBEAM in basic, by OFFT: a G vector is in
+/// the displacement system (GRID CD) of its grid, B in basic, an O offset in the offset system
+/// (x from GA to GB, y in the plane of x and the orientation vector: Nastran's rule).
+fn beam_geometry(
+    body: &NastranBody,
+    bar: &cards::Bar,
+    a: usize,
+    b: usize,
+    user: &str,
+) -> Result<(Vector3<f64>, BeamEnds), FeError> {
+    let line = &bar.line;
+    let frame = |node: usize| {
+        body.mesh
+            .displacement_frames
+            .get(&node)
+            .copied()
+            .unwrap_or_else(Matrix3::identity)
+    };
+    let [v_system, a_system, b_system] = bar.offt;
+    let orientation = match bar.orientation {
+        Orientation::Vector(v) if v_system == cards::VectorSystem::Grid => {
+            frame(a) * Vector3::from(v)
+        }
+        Orientation::Vector(v) => Vector3::from(v),
+        Orientation::Node(g0) => {
+            body.mesh.nodes[node_of(body, g0, line, &format!("{user} G0"))?] - body.mesh.nodes[a]
+        }
+    };
+    let mut offsets = [Vector3::zeros(); 2];
+    for (end, (node, system)) in [(a, a_system), (b, b_system)].into_iter().enumerate() {
+        let w = Vector3::from(bar.offsets[end]);
+        offsets[end] = match system {
+            cards::VectorSystem::Element => {
+                let (rows, _) = crate::fe::beam::local_frame(
+                    0,
+                    &body.mesh.nodes[a],
+                    &body.mesh.nodes[b],
+                    &orientation,
+                )
+                .map_err(|e| {
+                    mesh_error(
+                        line,
+                        format!(
+                            "{user}: offsets in the element system (OFFT {:?}) need GA and GB \
+                             apart and an orientation vector off the line GA-GB: {e}",
+                            bar.offt
+                        ),
+                    )
+                })?;
+                rows.transpose() * w
+            }
+            _ => frame(node) * w,
+        };
+    }
+    Ok((
+        orientation,
+        BeamEnds {
+            offsets,
+            pins: bar.pins,
+        },
+    ))
 }
 
 fn add_masses(c: &Cards, systems: &Systems, body: &mut NastranBody) -> Result<(), FeError> {
@@ -741,7 +831,12 @@ fn add_bushes(c: &Cards, systems: &Systems, body: &mut NastranBody) -> Result<()
             }
             cards::BushAxes::Line(Some(o)) => {
                 let v = match o {
-                    Orientation::Vector(v) => Vector3::from(v),
+                    // X1..X3 are components in GA's displacement system (GRID CD).
+                    Orientation::Vector(v) => body
+                        .mesh
+                        .displacement_frames
+                        .get(&a)
+                        .map_or(Vector3::from(v), |r| r * Vector3::from(v)),
                     Orientation::Node(g0) => {
                         body.mesh.nodes[node_of(body, g0, line, &format!("{user} GO"))?] - xa
                     }
@@ -877,6 +972,19 @@ fn add_links(c: &Cards, body: &mut NastranBody) -> Result<(), FeError> {
     for (&id, e) in &c.interpolation {
         let user = format!("RBE3 {id}");
         let reference = node_of(body, e.reference, &e.line, &user)?;
+        let grids = std::iter::once(&e.reference).chain(e.groups.iter().flat_map(|g| &g.2));
+        if let Some(g) = grids
+            .into_iter()
+            .find(|g| c.grids.get(g).is_some_and(|g| g.cd.is_some()))
+        {
+            return Err(mesh_error(
+                &e.line,
+                format!(
+                    "{user}: GRID {g} has a displacement coordinate system (CD); RBE3 on grids \
+                     with CD is not supported (give the RBE3's grids CD 0)"
+                ),
+            ));
+        }
         let mut sources = Vec::new();
         for (weight, components, grids) in &e.groups {
             if weight.is_nan() || *weight <= 0.0 {

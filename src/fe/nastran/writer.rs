@@ -1,8 +1,10 @@
 //! [`Mesh`] → Nastran bulk data in large-field format (16-column fields, so a real keeps 10 or
 //! more significant digits; most values of a generated mesh are written exactly).
 //!
-//! GRID ids are node index + 1; elements are numbered from 1 in the order CQUAD4, CTRIA3, CBAR, CONM2,
-//! CELAS2, CDAMP2, RBE2, RBE3, CTETRA/CPENTA/CHEXA. Supports are SPC1 set 1 (a Nastran run needs `SPC = 1` in its
+//! GRID ids are node index + 1 (all in basic: a mesh with displacement frames is refused);
+//! beam offsets and pin flags are written on the CBAR (OFFT GGG = basic here); elements are
+//! numbered from 1 in the order CQUAD4, CTRIA3, CBAR, CONM2, CELAS2, CDAMP2, RBE2, RBE3,
+//! CTETRA/CPENTA/CHEXA. Supports are SPC1 set 1 (a Nastran run needs `SPC = 1` in its
 //! case control; [`super::parse_str`] applies the only set present). Named nodes are listed in
 //! comments.
 
@@ -300,7 +302,7 @@ impl<'m> Deck<'m> {
         for (i, b) in self.mesh.beams.iter().enumerate() {
             let pid = self.pbar(b)?;
             let what = format!("beam {i}");
-            let fields = [
+            let mut fields = vec![
                 self.next_element(),
                 Out::Int(pid),
                 self.grid_id(&what, b.nodes[0])?,
@@ -309,6 +311,24 @@ impl<'m> Deck<'m> {
                 Out::Real(b.orientation.y),
                 Out::Real(b.orientation.z),
             ];
+            if let Some(ends) = self.mesh.beam_ends.get(&i) {
+                // OFFT blank (GGG): the grids are written in basic, so their displacement
+                // systems are basic too.
+                fields.push(Out::Blank);
+                for pins in ends.pins {
+                    let digits = (0..6)
+                        .filter(|&d| pins[d])
+                        .fold(0u64, |acc, d| acc * 10 + d as u64 + 1);
+                    fields.push(if digits == 0 {
+                        Out::Blank
+                    } else {
+                        Out::Int(digits)
+                    });
+                }
+                for w in ends.offsets {
+                    fields.extend(w.iter().map(|&c| Out::Real(c)));
+                }
+            }
             self.card("CBAR", &fields)?;
         }
         Ok(())
@@ -468,6 +488,12 @@ pub fn write_bulk_deck(mesh: &Mesh) -> Result<String, FeError> {
         return Err(FeError::Mesh(format!(
             "the mesh has {} bushes (CBUSH); writing them is not supported",
             mesh.bushes.len()
+        )));
+    }
+    if let Some(node) = mesh.displacement_frames.keys().next() {
+        return Err(FeError::Mesh(format!(
+            "node {node} has a displacement frame (GRID CD); writing displacement frames is not \
+             supported"
         )));
     }
     let mut deck = Deck::new(mesh);
