@@ -288,20 +288,33 @@ fn hexa_rule(n: usize) -> Rule {
     out
 }
 
-fn stiffness_rule(kind: SolidKind) -> Rule {
+/// Stiffness and mass rules of the tetrahedra, the wedge and the hexahedron, built once.
+fn rules() -> &'static [(Rule, Rule); 3] {
+    static RULES: std::sync::OnceLock<[(Rule, Rule); 3]> = std::sync::OnceLock::new();
+    RULES.get_or_init(|| {
+        [
+            (tetra_rule_4(), tetra_rule_14()),
+            (penta_rule(2, 2), penta_rule(4, 3)),
+            (hexa_rule(2), hexa_rule(3)),
+        ]
+    })
+}
+
+fn rule_set(kind: SolidKind) -> &'static (Rule, Rule) {
+    let r = rules();
     match kind {
-        SolidKind::Tetra4 | SolidKind::Tetra10 => tetra_rule_4(),
-        SolidKind::Penta6 => penta_rule(2, 2),
-        SolidKind::Hexa8 => hexa_rule(2),
+        SolidKind::Tetra4 | SolidKind::Tetra10 => &r[0],
+        SolidKind::Penta6 => &r[1],
+        SolidKind::Hexa8 => &r[2],
     }
 }
 
-fn mass_rule(kind: SolidKind) -> Rule {
-    match kind {
-        SolidKind::Tetra4 | SolidKind::Tetra10 => tetra_rule_14(),
-        SolidKind::Penta6 => penta_rule(4, 3),
-        SolidKind::Hexa8 => hexa_rule(3),
-    }
+fn stiffness_rule(kind: SolidKind) -> &'static Rule {
+    &rule_set(kind).0
+}
+
+fn mass_rule(kind: SolidKind) -> &'static Rule {
+    &rule_set(kind).1
 }
 
 /// Natural coordinates of the nodes.
@@ -384,7 +397,7 @@ fn classify(x: &[Vector3<f64>]) -> Result<Checked, String> {
     let size = x.iter().map(|p| (p - x[0]).norm()).fold(0.0f64, f64::max);
     let tol = 1e-9 * size.powi(3);
     let mut points = node_points(kind);
-    points.extend(stiffness_rule(kind).into_iter().map(|(p, _)| p));
+    points.extend(stiffness_rule(kind).iter().map(|(p, _)| *p));
     let dets: Vec<f64> = points
         .iter()
         .map(|&p| jacobian(&shape(kind, p), x).determinant())
@@ -500,14 +513,14 @@ fn stiffness_parts(c: Checked, m: &Material, x: &[Vector3<f64>]) -> Result<Stiff
     let mut kuu = DMatrix::zeros(nd, nd);
     let mut kua = DMatrix::zeros(nd, na);
     let mut kaa = DMatrix::zeros(na, na);
-    for (p, w) in stiffness_rule(c.kind) {
+    for &(p, w) in stiffness_rule(c.kind) {
         let (b, ba, dv) = b_matrices(c, x, p, w, &j0)?;
         let db = &d * &b;
-        kuu += b.transpose() * &db * dv;
+        kuu.gemm_tr(dv, &b, &db, 1.0);
         if na > 0 {
             let dba = &d * &ba;
-            kua += b.transpose() * &dba * dv;
-            kaa += ba.transpose() * dba * dv;
+            kua.gemm_tr(dv, &b, &dba, 1.0);
+            kaa.gemm_tr(dv, &ba, &dba, 1.0);
         }
     }
     Ok((kuu, kua, kaa))
@@ -545,7 +558,15 @@ fn checked(index: usize, solid: &Solid, x: &[Vector3<f64>]) -> Result<Checked, F
 /// Stiffness matrix (3n × 3n, DOFs ux uy uz per node in the element's node order) of a solid
 /// with nodes at `x`; the hexahedron's incompatible modes are condensed out.
 pub fn stiffness(index: usize, solid: &Solid, x: &[Vector3<f64>]) -> Result<DMatrix<f64>, FeError> {
-    let c = checked(index, solid, x)?;
+    stiffness_checked(index, checked(index, solid, x)?, solid, x)
+}
+
+fn stiffness_checked(
+    index: usize,
+    c: Checked,
+    solid: &Solid,
+    x: &[Vector3<f64>],
+) -> Result<DMatrix<f64>, FeError> {
     let fail = |why: String| FeError::Mesh(format!("solid {index}: {why}"));
     let (kuu, kua, kaa) = stiffness_parts(c, &solid.material, x).map_err(fail)?;
     if kaa.nrows() == 0 {
@@ -561,14 +582,17 @@ pub fn stiffness(index: usize, solid: &Solid, x: &[Vector3<f64>]) -> Result<DMat
 
 /// Consistent mass matrix ρ ∫ Nᵀ N dV (3n × 3n, as [`stiffness`]).
 pub fn mass(index: usize, solid: &Solid, x: &[Vector3<f64>]) -> Result<DMatrix<f64>, FeError> {
-    let c = checked(index, solid, x)?;
+    Ok(mass_checked(checked(index, solid, x)?, solid, x))
+}
+
+fn mass_checked(c: Checked, solid: &Solid, x: &[Vector3<f64>]) -> DMatrix<f64> {
     let n = x.len();
     let mut scalar = DMatrix::zeros(n, n);
-    for (p, w) in mass_rule(c.kind) {
+    for &(p, w) in mass_rule(c.kind) {
         let s = shape(c.kind, p);
         let dv = w * c.sign * jacobian(&s, x).determinant();
         let nv = DVector::from_column_slice(&s.n);
-        scalar += &nv * nv.transpose() * dv;
+        scalar.ger(dv, &nv, &nv, 1.0);
     }
     let rho = solid.material.density;
     let mut m = DMatrix::zeros(3 * n, 3 * n);
@@ -579,7 +603,7 @@ pub fn mass(index: usize, solid: &Solid, x: &[Vector3<f64>]) -> Result<DMatrix<f
             }
         }
     }
-    Ok(m)
+    m
 }
 
 /// Volume of a solid (m³).
@@ -618,7 +642,7 @@ pub fn strains(
     };
     let j0 = centre_jacobian(c, x).map_err(fail)?;
     let mut out = Vec::new();
-    for (p, w) in stiffness_rule(c.kind) {
+    for &(p, w) in stiffness_rule(c.kind) {
         let (b, ba, _) = b_matrices(c, x, p, w, &j0).map_err(fail)?;
         let e = b * &ue + ba * &alpha;
         out.push([e[0], e[1], e[2], e[3], e[4], e[5]]);
@@ -654,9 +678,10 @@ pub(crate) fn assembly_matrices(
         .iter()
         .map(|&k| mesh.position(&what, k))
         .collect::<Result<Vec<_>, _>>()?;
+    let c = checked(index, solid, &x)?;
     Ok((
-        six_dof(&stiffness(index, solid, &x)?),
-        six_dof(&mass(index, solid, &x)?),
+        six_dof(&stiffness_checked(index, c, solid, &x)?),
+        six_dof(&mass_checked(c, solid, &x)),
     ))
 }
 

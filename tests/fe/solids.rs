@@ -533,10 +533,12 @@ fn deck_of(b: &Block, kind: SolidKind, clamped: bool) -> String {
     deck
 }
 
-/// Index of the mode whose shape is most axial (largest share of ux in Σ u²).
+/// Index of the elastic mode whose shape is most axial (largest share of ux in Σ u²); rigid
+/// translation along x, the most axial of all, is left out.
 fn most_axial(asm: &Assembled, modes: &Modes) -> usize {
     let owners = asm.dofs.owners();
     (0..modes.len())
+        .filter(|&m| modes.eigenvalues[m] > 1.0)
         .max_by(|&a, &b| {
             let share = |m: usize| {
                 let (mut ax, mut all) = (0.0, 0.0);
