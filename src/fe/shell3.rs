@@ -353,6 +353,30 @@ mod tests {
     }
 
     #[test]
+    fn offset_orthotropic_triangle_keeps_six_rigid_body_modes() {
+        let r = nalgebra::Rotation3::from_euler_angles(-0.3, 0.6, 0.2);
+        let p = [
+            r * Vector3::new(0.0, 0.0, 0.0),
+            r * Vector3::new(0.9, 0.2, 0.0),
+            r * Vector3::new(0.3, 0.8, 0.0),
+        ];
+        let mut t = tri();
+        let ortho = Matrix3::new(9.0e8, 1.0e8, 0.0, 1.0e8, 2.0e8, 0.0, 0.0, 0.0, 1.5e8);
+        t.section = Some(Box::new(crate::fe::shell::ShellSection {
+            membrane: ortho,
+            bending: ortho * 1e-6,
+            transverse_shear: None,
+            material_angle: 0.4,
+            offset: -0.004,
+        }));
+        let k = stiffness(0, &t, &p).unwrap();
+        let scale = k.abs().max();
+        let eig = k.symmetric_eigenvalues();
+        assert_eq!(eig.iter().filter(|v| v.abs() < 1e-9 * scale).count(), 6);
+        assert!(eig.iter().all(|v| *v > -1e-9 * scale));
+    }
+
+    #[test]
     fn collinear_corners_are_rejected_with_the_index() {
         let p = [Vector3::zeros(), Vector3::x(), 2.0 * Vector3::x()];
         let err = stiffness(5, &tri(), &p).unwrap_err().to_string();

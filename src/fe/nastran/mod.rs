@@ -52,6 +52,8 @@
 //!   [`crate::fe::shell::KIRCHHOFF_SHEAR_FACTOR`] times the bending stiffness over the element
 //!   area, i.e. Kirchhoff). Refused: MID1 blank (no membrane), MID2 blank or −1 (membrane-only,
 //!   plane strain), MID4 (membrane–bending coupling), the same id on a MAT1 and a MAT2/MAT8.
+//!   MSC's PSHELL has no offset of its own (fields after MID4, e.g. OptiStruct's T0/ZOFFS, are
+//!   refused); offsets come from the elements' ZOFFS.
 //!   A PSHELL whose MID1, MID2, MID3 are one MAT1 (or equal ones) with TS/T = 5/6·(12I/T³)^⅓
 //!   (5/6 for a homogeneous sheet; [`write_bulk_deck`] writes it so) and no offset is the plain
 //!   isotropic sheet ([`crate::fe::mesh::Shell`] without a section, shear over 5/6 of the
