@@ -1,7 +1,7 @@
 //! Sparse assembly of K, M and C from the element matrices (triplets → faer `SparseColMat`).
 
 use faer::sparse::{SparseColMat, Triplet};
-use nalgebra::{Dim, Matrix, RawStorage};
+use nalgebra::{DMatrix, Dim, Matrix, RawStorage};
 
 use super::dof::{DofMap, Expansion, DOF_PER_NODE};
 use super::error::FeError;
@@ -37,9 +37,34 @@ impl TripletSink<'_> {
         local: &Matrix<f64, R, C, S>,
     ) {
         let dofs = self.dofs;
+        if !nodes.iter().any(|&n| dofs.frame(n).is_some()) {
+            return self.scatter_on(nodes, local, |n, d| dofs.expansion(n, d));
+        }
+        // Nodes with a displacement frame: the global-axes matrix turned to their own
+        // components first (Bᵀ K B, B = diag(R, R) per such node), then scattered on those like
+        // the components of any other node (cheaper than spreading every entry over the frame).
+        let mut own = DMatrix::from_fn(local.nrows(), local.ncols(), |i, j| local[(i, j)]);
+        for (k, &node) in nodes.iter().enumerate() {
+            if let Some(r) = dofs.frame(node) {
+                for o in [DOF_PER_NODE * k, DOF_PER_NODE * k + 3] {
+                    let rows = r.transpose() * own.fixed_rows::<3>(o);
+                    own.fixed_rows_mut::<3>(o).copy_from(&rows);
+                    let cols = own.fixed_columns::<3>(o) * r;
+                    own.fixed_columns_mut::<3>(o).copy_from(&cols);
+                }
+            }
+        }
+        self.scatter_on(nodes, &own, |n, d| dofs.own_expansion(n, d));
+    }
+
+    fn scatter_on<'d, R: Dim, C: Dim, S: RawStorage<f64, R, C>>(
+        &mut self,
+        nodes: &[usize],
+        local: &Matrix<f64, R, C, S>,
+        expansion: impl Fn(usize, usize) -> Option<Expansion<'d>>,
+    ) {
         let index = |k: usize| {
-            dofs.expansion(nodes[k / DOF_PER_NODE], k % DOF_PER_NODE)
-                .unwrap_or(Expansion::Fixed)
+            expansion(nodes[k / DOF_PER_NODE], k % DOF_PER_NODE).unwrap_or(Expansion::Fixed)
         };
         for j in 0..local.ncols() {
             let ej = index(j);

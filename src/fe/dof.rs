@@ -249,10 +249,19 @@ impl DofMap {
         if dof >= DOF_PER_NODE {
             return None;
         }
-        let slot = node * DOF_PER_NODE + dof;
-        if let Some(row) = self.global_rows.get(&slot) {
+        if let Some(row) = self.global_rows.get(&(node * DOF_PER_NODE + dof)) {
             return Some(Expansion::Combination(row));
         }
+        self.own_expansion(node, dof)
+    }
+
+    /// Like [`DofMap::expansion`] for component `dof` of the node in its own displacement
+    /// frame (the same for a node without one).
+    pub(crate) fn own_expansion(&self, node: usize, dof: usize) -> Option<Expansion<'_>> {
+        if dof >= DOF_PER_NODE {
+            return None;
+        }
+        let slot = node * DOF_PER_NODE + dof;
         match self.index.get(slot)? {
             Some(g) => Some(Expansion::Equation(*g)),
             None => Some(match self.dependent.get(&slot) {
