@@ -5,7 +5,9 @@
 //! - `vehicle.json`: the default vehicle with `"body": {"kind": "dmig", ...}` naming that file,
 //! - `matrices.json`: the same matrices as triplets `[GJ, CJ, Gi, Ci, value]` (column, row), for
 //!   a second reader to compare against (`python/tests/test_dmig.py` reads `body.pch` with
-//!   pyNastran).
+//!   pyNastran),
+//! - `modes.json`: the frequencies (Hz) of the same body reduced in process, for a check of the
+//!   matrices by an eigen solve of the second reader's.
 //!
 //! The fixed-interface modes are those the FMU's scene 2 keeps by default (automatic cut-off,
 //! 225 Hz), so the same vehicle with the procedural body and with this file run alike.
@@ -13,7 +15,8 @@
 //! `cargo run --release --example write_dmig -- <folder> [cut-off Hz]`
 
 use engine_mount_chassis::cms::dmig_of_reduction;
-use engine_mount_chassis::model::scene::{reduction_spec, BodyOptions};
+use engine_mount_chassis::cms::CacheSetting;
+use engine_mount_chassis::model::scene::{body as reduced_body, reduction_spec, BodyOptions};
 use engine_mount_chassis::model::VehicleConfig;
 
 fn main() -> Result<(), Box<dyn std::error::Error>> {
@@ -60,6 +63,20 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         })
         .collect();
     std::fs::write(dir.join("matrices.json"), serde_json::to_string(&matrices)?)?;
+    let ours = BodyOptions {
+        cache: CacheSetting::Disabled,
+        ..options.clone()
+    };
+    let (reduced, _) = reduced_body(&vehicle, &ours)?;
+    let hz: Vec<f64> = reduced
+        .omega
+        .iter()
+        .map(|w| w / (2.0 * std::f64::consts::PI))
+        .collect();
+    std::fs::write(
+        dir.join("modes.json"),
+        serde_json::to_string(&serde_json::json!({ "hz": hz }))?,
+    )?;
     let k = &body.file.matrices["KAAX"];
     println!(
         "{}: {} Craig-Bampton coordinates ({origin}), points {:?}",
