@@ -131,7 +131,7 @@ fn card_error(card: &RawCard, line: usize, message: impl std::fmt::Display) -> F
 }
 
 impl Collector {
-    fn field<'c>(card: &'c RawCard, i: usize) -> (&'c str, usize) {
+    fn field(card: &RawCard, i: usize) -> (&str, usize) {
         match card.fields.get(i) {
             Some(f) => (f.text.as_str(), f.line),
             None => ("", card.fields.last().map_or(card.line, |f| f.line)),
@@ -466,7 +466,8 @@ DMIG*   KAAX                         101
         assert_eq!(k.get((11, 1), (101, 0)), -1.0e3);
         assert_eq!(k.get((101, 0), (11, 1)), -1.0e3);
         assert_eq!(k.get((101, 0), (101, 0)), 4.0e4);
-        let b = parse_dmig_str(&write_dmig_file(&BTreeMap::new(), &[k.clone()])).unwrap();
+        let b =
+            parse_dmig_str(&write_dmig_file(&BTreeMap::new(), std::slice::from_ref(k))).unwrap();
         assert_eq!(&b.matrices["KAAX"], k);
     }
 
