@@ -249,6 +249,31 @@ fn malformed_dmig_is_refused_naming_card_and_line_or_matrix() {
             && e.contains("body.pch"),
         "{e}"
     );
+    // The vehicle JSON's body is strict: a misspelt field, a missing matrix name, a point no
+    // mount or output uses are refused by their path.
+    let points = r#"{"mount_front_left": 1, "mount_front_right": 2, "mount_rear_left": 3,
+                     "mount_rear_right": 4, "steering_wheel": 5, "seat_rail": 6}"#;
+    for (body, field) in [
+        (
+            format!(r#"{{"kind": "dmig", "path": "b.pch", "stifness": "KAAX", "mass": "MAAX", "points": {points}}}"#),
+            "stifness",
+        ),
+        (
+            format!(r#"{{"kind": "dmig", "path": "b.pch", "stiffness": "KAAX", "points": {points}}}"#),
+            "mass",
+        ),
+        (
+            r#"{"kind": "dmig", "path": "b.pch", "stiffness": "KAAX", "mass": "MAAX", "points": {"wheel": 5}}"#
+                .to_string(),
+            "body.points.wheel",
+        ),
+    ] {
+        let e = VehicleConfig::from_json(&format!(r#"{{"extends": "default", "body": {body}}}"#))
+            .unwrap_err()
+            .to_string();
+        assert!(e.contains(field), "{field}: {e}");
+    }
+
     let bad = dir.join("bad.pch");
     std::fs::write(&bad, "$ header\nDMIG,KAAX,0,6,2,0\nDMIG,KAAX,1,1,,1,1,1,\n").unwrap();
     let e = read_dmig_file(&bad, &DeckOptions::default())
