@@ -65,6 +65,31 @@ fn our_reduction_written_as_dmig_and_read_back_gives_the_same_body_modes() {
     for (k, (a, b)) in ours.omega.iter().zip(&read.omega).enumerate() {
         assert!((a - b).abs() <= 1e-9 * a, "mode {k}: {a} vs {b} rad/s");
     }
+    let worst_frequency = ours
+        .omega
+        .iter()
+        .zip(&read.omega)
+        .map(|(a, b)| (a - b).abs() / a)
+        .fold(0.0, f64::max);
+    let worst_shape = ours
+        .points
+        .iter()
+        .zip(&read.points)
+        .map(|(p, q)| {
+            let s = scale(&p.shape);
+            p.shape
+                .iter()
+                .flatten()
+                .zip(q.shape.iter().flatten())
+                .map(|(x, y)| (x - y).abs() / s)
+                .fold(0.0, f64::max)
+        })
+        .fold(0.0, f64::max);
+    eprintln!(
+        "{} modes: frequencies within {worst_frequency:.1e}, point shapes within {worst_shape:.1e} \
+         of each point's largest entry",
+        ours.n_modes()
+    );
     assert_eq!(ours.zeta, read.zeta);
     assert_eq!(ours.points.len(), read.points.len());
     for (p, q) in ours.points.iter().zip(&read.points) {
