@@ -14,7 +14,7 @@
 //! motion in component `c` is the recovery matrix's row (grid, c) if the file has one
 //! (rectangular `DMIG`, rows = physical DOFs, columns = the a-set DOFs as in `KAAX`: the
 //! Craig-Bampton basis restricted to the output DOFs), else the boundary DOF itself, else zero.
-//! Positions come from the file's `GRID` cards (basic system).
+//! Positions come from the file's `GRID` cards (basic system); a point's `node` is its GRID id.
 //!
 //! [`dmig_of_reduction`] writes our own reduction of a body in this form.
 

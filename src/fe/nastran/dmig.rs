@@ -117,7 +117,7 @@ const SYMMETRY_TOLERANCE: f64 = 1e-9;
 struct Collector {
     file: DmigFile,
     /// Where each entry was given, for the message about an inconsistent mirror entry.
-    seen: BTreeMap<(String, DmigDof, DmigDof), Loc>,
+    seen: BTreeMap<String, BTreeMap<(DmigDof, DmigDof), Loc>>,
     grid_loc: BTreeMap<u32, Loc>,
 }
 
@@ -233,6 +233,7 @@ impl Collector {
         if n == 0 {
             return Err(card_error(card, card.line, "column card without entries"));
         }
+        let seen = self.seen.entry(name.clone()).or_default();
         for e in 0..n.div_ceil(4) {
             let at = 4 + 4 * e;
             let row = Self::dof(card, at, &format!("G{}", e + 1), &format!("C{}", e + 1))?;
@@ -250,7 +251,7 @@ impl Collector {
             }
             let line = card.fields[at].line;
             let here = card.loc_of_line(line);
-            if let Some(first) = self.seen.get(&(name.clone(), col, row)) {
+            if let Some(first) = seen.get(&(col, row)) {
                 return Err(card_error(
                     card,
                     line,
@@ -261,7 +262,7 @@ impl Collector {
                 ));
             }
             if symmetric && row != col {
-                if let Some(first) = self.seen.get(&(name.clone(), row, col)) {
+                if let Some(first) = seen.get(&(row, col)) {
                     let other = self.file.matrices[&name].entries[&(row, col)];
                     let scale = value.abs().max(other.abs());
                     if (value - other).abs() > SYMMETRY_TOLERANCE * scale {
@@ -276,11 +277,11 @@ impl Collector {
                             ),
                         ));
                     }
-                    self.seen.insert((name.clone(), col, row), here);
+                    seen.insert((col, row), here);
                     continue;
                 }
             }
-            self.seen.insert((name.clone(), col, row), here);
+            seen.insert((col, row), here);
             if let Some(m) = self.file.matrices.get_mut(&name) {
                 m.entries.insert((col, row), value);
             }
