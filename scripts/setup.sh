@@ -49,3 +49,18 @@ if [ ! -f "$stamp" ] || [ "$(cat "$stamp")" != "$want" ]; then
   "$venv/bin/pip" install -q --disable-pip-version-check --no-deps -e "$root/python"
   echo "$want" >"$stamp"
 fi
+
+# pyNastran, the independent reader of DMIG body files in the Python tests, pins numpy < 2, which
+# fmpy above cannot share: it gets a venv of its own inside the main one.
+nastran_venv="$venv/pynastran"
+nastran_req="$root/python/requirements-pynastran.txt"
+nastran_stamp="$nastran_venv/.requirements.sha256"
+if [ ! -x "$nastran_venv/bin/python" ]; then
+  python3 -m venv "$nastran_venv"
+fi
+want=$(sha256sum <"$nastran_req" | cut -d' ' -f1)
+if [ ! -f "$nastran_stamp" ] || [ "$(cat "$nastran_stamp")" != "$want" ]; then
+  echo "setup: installing pyNastran (a venv of its own: it needs numpy < 2)"
+  "$nastran_venv/bin/pip" install -q --disable-pip-version-check -r "$nastran_req"
+  echo "$want" >"$nastran_stamp"
+fi

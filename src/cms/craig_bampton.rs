@@ -147,19 +147,33 @@ fn reduced_eigen(k_r: &Mat<f64>, m_r: &Mat<f64>) -> Result<(Vec<f64>, Mat<f64>),
     Ok((lambda, x))
 }
 
-/// Craig-Bampton reduction of the pencil (K, M) onto the interface equations `interface`,
-/// keeping the fixed-interface modes chosen by `selection`, then orthogonalised.
+/// A Craig-Bampton basis and the pencil projected on it, before the orthogonalisation.
+#[derive(Debug, Clone)]
+pub struct CraigBamptonBasis {
+    /// Basis vectors over all equations: the kept fixed-interface modes (unit modal mass), then
+    /// the constraint modes in the order of the interface equations (unit interface motion).
+    pub t: Mat<f64>,
+    /// `Tᵀ K T`, symmetrised.
+    pub k_r: Mat<f64>,
+    /// `Tᵀ M T`, symmetrised.
+    pub m_r: Mat<f64>,
+    /// Frequencies (Hz) of the fixed-interface normal modes that were kept.
+    pub fixed_interface_hz: Vec<f64>,
+    /// Number of constraint modes (= interface DOFs).
+    pub n_constraint_modes: usize,
+}
+
+/// The Craig-Bampton basis of the pencil (K, M) on the interface equations `interface`, with
+/// the fixed-interface modes chosen by `selection`, and the reduced matrices.
 ///
 /// K must be positive definite on the interior DOFs (the interface fixed), M positive
-/// semi-definite with the reduced mass positive definite.
-///
-/// Long on purpose: one reduction (partition, constraint modes, fixed-interface eigenproblem, projection, orthogonalisation), each step using the previous step's factors.
-pub fn craig_bampton(
+/// semi-definite.
+pub fn craig_bampton_basis(
     k: &SparseMat,
     m: &SparseMat,
     interface: &[usize],
     selection: ModeSelection,
-) -> Result<CraigBampton, CmsError> {
+) -> Result<CraigBamptonBasis, CmsError> {
     let n = k.nrows();
     if k.ncols() != n || m.nrows() != n || m.ncols() != n {
         return Err(CmsError::InvalidInput(format!(
@@ -212,8 +226,33 @@ pub fn craig_bampton(
     }
     drop(psi);
 
-    let mut m_r = symmetrised(&(t.transpose() * sparse_times_dense(m, t.as_ref())));
-    let mut k_r = symmetrised(&(t.transpose() * sparse_times_dense(k, t.as_ref())));
+    let m_r = symmetrised(&(t.transpose() * sparse_times_dense(m, t.as_ref())));
+    let k_r = symmetrised(&(t.transpose() * sparse_times_dense(k, t.as_ref())));
+    Ok(CraigBamptonBasis {
+        t,
+        k_r,
+        m_r,
+        fixed_interface_hz: normal.frequencies_hz(),
+        n_constraint_modes: nb,
+    })
+}
+
+/// The orthogonalisation (eq. 14–15) of a reduced pencil (K_r, M_r), M_r positive definite:
+/// the frequencies ω (rad/s, ascending) and the coefficients `C` with `Cᵀ M_r C = I` and
+/// `Cᵀ K_r C = diag(ω²)`. The modes over the structure are `T C`. Shared by the in-process
+/// reduction and the bodies reduced elsewhere ([`crate::cms::reduce_external`]), so both go the same
+/// way from the Craig-Bampton matrices to the modes the coupled model gets.
+pub fn orthogonalise(k_r: &Mat<f64>, m_r: &Mat<f64>) -> Result<(Vec<f64>, Mat<f64>), CmsError> {
+    let r = k_r.nrows();
+    if k_r.ncols() != r || m_r.nrows() != r || m_r.ncols() != r {
+        return Err(CmsError::InvalidInput(format!(
+            "reduced K is {}x{}, reduced M is {}x{}: both must be square and of equal size",
+            k_r.nrows(),
+            k_r.ncols(),
+            m_r.nrows(),
+            m_r.ncols()
+        )));
+    }
     // Unit generalised mass on every basis vector keeps M_r well conditioned (constraint modes
     // in metres carry up to the whole body mass, normal modes one).
     let scale: Vec<f64> = (0..r)
@@ -229,28 +268,38 @@ pub fn craig_bampton(
             }
         })
         .collect::<Result<_, _>>()?;
-    for j in 0..r {
-        for i in 0..r {
-            m_r[(i, j)] *= scale[i] * scale[j];
-            k_r[(i, j)] *= scale[i] * scale[j];
-        }
-        for g in 0..n {
-            t[(g, j)] *= scale[j];
-        }
-    }
-
-    let (lambda, x) = reduced_eigen(&k_r, &m_r)?;
+    let m_s = Mat::from_fn(r, r, |i, j| m_r[(i, j)] * scale[i] * scale[j]);
+    let k_s = Mat::from_fn(r, r, |i, j| k_r[(i, j)] * scale[i] * scale[j]);
+    let (lambda, x) = reduced_eigen(&k_s, &m_s)?;
     if let Some(bad) = lambda.iter().position(|l| !(l.is_finite() && *l > 0.0)) {
         return Err(CmsError::Numerical(format!(
             "reduced mode {bad} has eigenvalue {}: K is not positive definite",
             lambda[bad]
         )));
     }
+    let coefficients = Mat::from_fn(r, r, |i, j| scale[i] * x[(i, j)]);
+    Ok((lambda.iter().map(|l| l.sqrt()).collect(), coefficients))
+}
+
+/// Craig-Bampton reduction of the pencil (K, M) onto the interface equations `interface`,
+/// keeping the fixed-interface modes chosen by `selection`, then orthogonalised
+/// ([`craig_bampton_basis`], then [`orthogonalise`]).
+///
+/// K must be positive definite on the interior DOFs (the interface fixed), M positive
+/// semi-definite with the reduced mass positive definite.
+pub fn craig_bampton(
+    k: &SparseMat,
+    m: &SparseMat,
+    interface: &[usize],
+    selection: ModeSelection,
+) -> Result<CraigBampton, CmsError> {
+    let basis = craig_bampton_basis(k, m, interface, selection)?;
+    let (omega, coefficients) = orthogonalise(&basis.k_r, &basis.m_r)?;
     Ok(CraigBampton {
-        omega: lambda.iter().map(|l| l.sqrt()).collect(),
-        shapes: &t * &x,
-        fixed_interface_hz: normal.frequencies_hz(),
-        n_constraint_modes: nb,
+        omega,
+        shapes: &basis.t * &coefficients,
+        fixed_interface_hz: basis.fixed_interface_hz,
+        n_constraint_modes: basis.n_constraint_modes,
     })
 }
 

@@ -12,6 +12,10 @@
 //! orthogonalisation) → [`ReducedChassis`] with the rows of the recovery points only.
 //! [`reduce_cached`] keeps the result in the user's cache directory.
 //!
+//! A body reduced in another solver comes as Craig-Bampton matrices (Nastran `DMIG`):
+//! [`reduce_external`] takes it from there the same way ([`orthogonalise`], the damping table),
+//! and [`dmig_of_reduction`] writes our own reduction in that form.
+//!
 //! Recovery points, in order: the layout's mount nodes (`mount_front_left`, `mount_front_right`,
 //! `mount_rear_left`, `mount_rear_right`, minus the one the three-mount layout removes), then the
 //! spec's `outputs` (default `steering_wheel`, `seat_rail`; any named FE node is allowed).
@@ -54,6 +58,7 @@ mod cache;
 mod craig_bampton;
 mod damping;
 mod error;
+mod external;
 mod hash;
 mod reduce;
 mod reduced;
@@ -62,9 +67,12 @@ mod spec;
 mod transfer;
 
 pub use cache::{reduce_cached, CacheOutcome, CacheSetting, FORMAT_VERSION};
-pub use craig_bampton::{craig_bampton, CraigBampton};
+pub use craig_bampton::{
+    craig_bampton, craig_bampton_basis, orthogonalise, CraigBampton, CraigBamptonBasis,
+};
 pub use damping::{DampingBand, DampingTable};
 pub use error::CmsError;
+pub use external::{dmig_of_reduction, reduce_external, DmigBody, ExternalBody};
 pub use hash::sha256_hex;
 pub use reduce::{reduce, reduce_detailed, Reduction};
 pub use reduced::{RecoveryPoint, ReducedChassis};

@@ -3,6 +3,7 @@
 //! the output points).
 
 use super::craig_bampton::{craig_bampton, CraigBampton};
+use super::damping::DampingTable;
 use super::error::CmsError;
 use super::reduced::{RecoveryPoint, ReducedChassis};
 use super::spec::BulkDeckBody;
@@ -47,8 +48,17 @@ pub fn reduce(spec: &ReductionSpec) -> Result<ReducedChassis, CmsError> {
     Ok(reduce_detailed(spec)?.reduced)
 }
 
-/// The reduction of `spec` with the full model and full mode shapes kept.
-pub fn reduce_detailed(spec: &ReductionSpec) -> Result<Reduction, CmsError> {
+/// The body of `spec` built and assembled, its interface: the named mount nodes and their
+/// global interface equations (mount by mount, DOF order of the spec).
+pub(crate) struct Model {
+    pub chassis: Chassis,
+    pub assembled: Assembled,
+    pub mounts: Vec<(String, usize)>,
+    pub interface: Vec<usize>,
+}
+
+/// Builds and assembles the body `spec` describes.
+pub(crate) fn model(spec: &ReductionSpec) -> Result<Model, CmsError> {
     spec.validate()?;
     let chassis = match &spec.deck {
         None => Chassis::build(&spec.chassis)?,
@@ -64,26 +74,55 @@ pub fn reduce_detailed(spec: &ReductionSpec) -> Result<Reduction, CmsError> {
     let interface = assembled
         .dofs
         .indices_of(&mount_ids, spec.interface_dofs.local())?;
-    let modes = craig_bampton(&assembled.k, &assembled.m, &interface, spec.selection)?;
+    Ok(Model {
+        chassis,
+        assembled,
+        mounts,
+        interface,
+    })
+}
 
-    let mut named: Vec<(String, usize)> = mounts;
-    for name in &spec.outputs {
+/// The recovered points in order: the mounts, then the outputs not among them.
+pub(crate) fn named_points(
+    model: &Model,
+    outputs: &[String],
+) -> Result<Vec<(String, usize)>, CmsError> {
+    let mut named = model.mounts.clone();
+    for name in outputs {
         if !named.iter().any(|(n, _)| n == name) {
-            named.push((name.clone(), chassis.node(name)?));
+            named.push((name.clone(), model.chassis.node(name)?));
         }
     }
-    let points = named
-        .into_iter()
-        .map(|(name, node)| recovery_point(&chassis, &assembled.dofs, &modes, name, node))
-        .collect::<Result<Vec<_>, _>>()?;
-    let mut zeta: Vec<f64> = modes
-        .omega
+    Ok(named)
+}
+
+/// The damping ratio of each mode by the table: shared by every body, reduced here or elsewhere.
+pub(crate) fn table_damping(omega: &[f64], damping: &DampingTable) -> Vec<f64> {
+    omega
         .iter()
-        .map(|w| spec.damping.zeta(w / (2.0 * std::f64::consts::PI)))
-        .collect();
+        .map(|w| damping.zeta(w / (2.0 * std::f64::consts::PI)))
+        .collect()
+}
+
+/// The reduction of `spec` with the full model and full mode shapes kept.
+pub fn reduce_detailed(spec: &ReductionSpec) -> Result<Reduction, CmsError> {
+    let model = model(spec)?;
+    let modes = craig_bampton(
+        &model.assembled.k,
+        &model.assembled.m,
+        &model.interface,
+        spec.selection,
+    )?;
+    let points = named_points(&model, &spec.outputs)?
+        .into_iter()
+        .map(|(name, node)| {
+            recovery_point(&model.chassis, &model.assembled.dofs, &modes, name, node)
+        })
+        .collect::<Result<Vec<_>, _>>()?;
+    let mut zeta = table_damping(&modes.omega, &spec.damping);
     if spec.discrete_dampers {
         for (k, z) in zeta.iter_mut().enumerate() {
-            *z += projected_damping(&assembled.c, &modes, k) / (2.0 * modes.omega[k]);
+            *z += projected_damping(&model.assembled.c, &modes, k) / (2.0 * modes.omega[k]);
         }
     }
     let reduced = ReducedChassis {
@@ -92,9 +131,9 @@ pub fn reduce_detailed(spec: &ReductionSpec) -> Result<Reduction, CmsError> {
         points,
     };
     Ok(Reduction {
-        chassis,
-        assembled,
-        interface,
+        chassis: model.chassis,
+        assembled: model.assembled,
+        interface: model.interface,
         modes,
         reduced,
     })

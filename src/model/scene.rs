@@ -3,8 +3,8 @@
 //! scene needs (scene 2, Table 1 middle column).
 
 use crate::cms::{
-    reduce_cached, BulkDeckBody, CacheOutcome, CacheSetting, InterfaceDofs, ModeSelection,
-    ReducedChassis, ReductionSpec,
+    reduce_cached, reduce_external, BulkDeckBody, CacheOutcome, CacheSetting, ExternalBody,
+    InterfaceDofs, ModeSelection, ReducedChassis, ReductionSpec,
 };
 use crate::fe::chassis_config::ChassisConfig;
 
@@ -246,6 +246,34 @@ pub fn build(
     Ok(Built { model, notes })
 }
 
+/// The fixed-interface modes the scene keeps, and how they were chosen (for the log).
+fn mode_selection(vehicle: &VehicleConfig, options: &BodyOptions) -> (ModeSelection, String) {
+    // A rigid body needs no fixed-interface modes: the constraint modes alone contain its
+    // rigid-body motion on the suspension, the only part kept later.
+    if !vehicle.effects.chassis_flexibility {
+        (
+            ModeSelection::Count(0),
+            "rigid chassis: rigid-body modes on the suspension only".to_owned(),
+        )
+    } else if options.max_modes > 0 {
+        (
+            ModeSelection::Count(options.max_modes),
+            format!("{} fixed-interface modes", options.max_modes),
+        )
+    } else {
+        let cutoff = options.cutoff_hz();
+        let origin = if options.mode_cutoff_hz > 0.0 {
+            format!("cut-off {cutoff:.0} Hz (given)")
+        } else {
+            format!(
+                "automatic cut-off {cutoff:.0} Hz = {} rpm / 60 x order {} x margin {AUTO_CUTOFF_MARGIN}",
+                options.max_rpm, options.max_engine_order
+            )
+        };
+        (ModeSelection::CutoffHz(cutoff), origin)
+    }
+}
+
 /// What the procedural body's reduction depends on for this vehicle and these options, and a
 /// description of the mode selection for the log.
 pub fn reduction_spec(
@@ -277,37 +305,14 @@ pub fn reduction_spec(
             };
             (ChassisConfig::default(), Some(deck))
         }
-        BodyConfig::Reduced { .. } => {
+        BodyConfig::Reduced { .. } | BodyConfig::Dmig { .. } => {
             return Err(SceneError::Model(
                 "the vehicle's body is already reduced".into(),
             ));
         }
     };
     let interface = vehicle.interface_nodes().map_err(|e| e.to_string())?;
-    // A rigid body needs no fixed-interface modes: the constraint modes alone contain its
-    // rigid-body motion on the suspension, the only part kept later.
-    let (selection, origin) = if !vehicle.effects.chassis_flexibility {
-        (
-            ModeSelection::Count(0),
-            "rigid chassis: rigid-body modes on the suspension only".to_owned(),
-        )
-    } else if options.max_modes > 0 {
-        (
-            ModeSelection::Count(options.max_modes),
-            format!("{} fixed-interface modes", options.max_modes),
-        )
-    } else {
-        let cutoff = options.cutoff_hz();
-        let origin = if options.mode_cutoff_hz > 0.0 {
-            format!("cut-off {cutoff:.0} Hz (given)")
-        } else {
-            format!(
-                "automatic cut-off {cutoff:.0} Hz = {} rpm / 60 x order {} x margin {AUTO_CUTOFF_MARGIN}",
-                options.max_rpm, options.max_engine_order
-            )
-        };
-        (ModeSelection::CutoffHz(cutoff), origin)
-    };
+    let (selection, origin) = mode_selection(vehicle, options);
     let mut chassis = chassis;
     chassis.options.stiffening_bar |= options.stiffening_bar;
     chassis.options.stiff_front_plate |= options.stiff_front_plate;
@@ -366,6 +371,52 @@ pub fn body(
                 }
             };
             (body, format!("{what}, {source}"))
+        }
+        BodyConfig::Dmig {
+            path,
+            stiffness,
+            mass,
+            recovery,
+            points,
+            include_root,
+        } => {
+            options.procedural_only("given as Craig-Bampton matrices (DMIG)")?;
+            if options.interface_rotations {
+                return Err(option_error(
+                    BodyOption::InterfaceRotations,
+                    true,
+                    "does not apply to a body given as DMIG matrices: its interface is the \
+                     file's boundary set",
+                ));
+            }
+            let (selection, origin) = mode_selection(vehicle, options);
+            let read_options = crate::fe::nastran::DeckOptions {
+                include_root: include_root.clone(),
+                ..Default::default()
+            };
+            let (file, _) = crate::fe::nastran::read_dmig_file(path, &read_options)
+                .map_err(|e| format!("DMIG body: {e}"))?;
+            let interface = vehicle.interface_nodes().map_err(|e| e.to_string())?;
+            let damping = ReductionSpec::default().damping;
+            let body = reduce_external(&ExternalBody {
+                file: &file,
+                stiffness,
+                mass,
+                recovery: recovery.as_deref(),
+                points,
+                interface: &interface,
+                outputs: &vehicle.outputs,
+                selection,
+                damping: &damping,
+            })
+            .map_err(|e| format!("DMIG body {}: {e}", path.display()))?;
+            (
+                body,
+                format!(
+                    "DMIG body {} (Craig-Bampton matrices {stiffness}, {mass}; {origin})",
+                    path.display()
+                ),
+            )
         }
         BodyConfig::Reduced { path } => {
             options.procedural_only("a reduced model from a file")?;

@@ -48,6 +48,30 @@ pub enum BodyConfig {
         #[serde(default, skip_serializing_if = "Option::is_none")]
         include_root: Option<PathBuf>,
     },
+    /// A body reduced elsewhere: Craig-Bampton matrices in Nastran `DMIG` form
+    /// ([`crate::fe::nastran::read_dmig_file`], [`crate::cms::reduce_external`]), reduced to its
+    /// modes with the damping table like the other bodies. `points` names the GRID ids of the
+    /// mount body nodes (boundary grids of `stiffness`) and of the outputs (boundary grids or
+    /// rows of `recovery`). A relative path is taken from the configuration file's folder, and
+    /// the file is confined to that folder, or to `include_root` if given.
+    Dmig {
+        /// The DMIG (punch) file.
+        path: PathBuf,
+        /// Name of the stiffness matrix (Nastran writes `KAAX`).
+        stiffness: String,
+        /// Name of the mass matrix (Nastran writes `MAAX`).
+        mass: String,
+        /// Name of the recovery matrix of the output points (rows: their DOFs, columns: the
+        /// DOFs of `stiffness`), if the outputs are not all boundary grids.
+        #[serde(default, skip_serializing_if = "Option::is_none")]
+        recovery: Option<String>,
+        /// GRID id of every named point (mount body nodes, outputs).
+        points: std::collections::BTreeMap<String, u32>,
+        /// The folder the file (and its INCLUDE files) may lie in (relative: to the
+        /// configuration file's folder).
+        #[serde(default, skip_serializing_if = "Option::is_none")]
+        include_root: Option<PathBuf>,
+    },
     /// Modal data of an already reduced body: the JSON of a [`crate::cms::ReducedChassis`]
     /// (frequencies, damping ratios, named points with their mode-shape rows). A relative path is
     /// taken from the configuration file's folder.
@@ -227,14 +251,20 @@ impl VehicleConfig {
             .map_err(|e| err("file", e))?;
         let mut config = Self::from_json(&text)?;
         let dir = path.parent().unwrap_or(std::path::Path::new(""));
-        if let BodyConfig::Reduced { path: body } | BodyConfig::Nastran { path: body, .. } =
-            &mut config.body
+        if let BodyConfig::Reduced { path: body }
+        | BodyConfig::Nastran { path: body, .. }
+        | BodyConfig::Dmig { path: body, .. } = &mut config.body
         {
             if body.is_relative() {
                 *body = dir.join(&*body);
             }
         }
         if let BodyConfig::Nastran {
+            path: deck,
+            include_root,
+            ..
+        }
+        | BodyConfig::Dmig {
             path: deck,
             include_root,
             ..
@@ -295,7 +325,8 @@ impl VehicleConfig {
     /// Every named point of a bulk-deck body must be a node the vehicle uses (a mount's body
     /// node or an output): a misspelt name would otherwise be ignored.
     fn validate_body_points(&self) -> Result<(), ConfigError> {
-        let BodyConfig::Nastran { points, .. } = &self.body else {
+        let (BodyConfig::Nastran { points, .. } | BodyConfig::Dmig { points, .. }) = &self.body
+        else {
             return Ok(());
         };
         let used = |name: &str| {

@@ -3,5 +3,6 @@
 mod bulk_deck;
 mod cache;
 mod damping;
+mod dmig;
 mod reduction;
 mod transfer;

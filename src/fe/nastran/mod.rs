@@ -118,8 +118,12 @@
 //! Writing: [`write_bulk_deck`] emits large-field cards for a mesh of the supported elements
 //! (solids as CTETRA/CPENTA/CHEXA with one PSOLID per material; isotropic sheets only: a shell
 //! with a [`crate::fe::shell::ShellSection`] is refused).
+//!
+//! Reduced bodies: [`read_dmig_file`] / [`write_dmig_file`] read and write Craig-Bampton
+//! matrices as Nastran punches them (`DMIG`, see the `dmig` module).
 
 mod cards;
+mod dmig;
 mod lexer;
 mod reader;
 mod solid_cards;
@@ -129,6 +133,7 @@ mod writer;
 use std::collections::BTreeMap;
 use std::path::Path;
 
+pub use dmig::{parse_dmig_str, read_dmig_file, write_dmig_file, DmigDof, DmigFile, DmigMatrix};
 pub use lexer::{classify, lex, parse_real, Deck, Field, Loc, RawCard, Value};
 pub use reader::{DeckLimits, DeckOptions};
 pub use writer::write_bulk_deck;

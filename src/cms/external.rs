@@ -1,0 +1,363 @@
+//! A body reduced elsewhere: Craig-Bampton matrices in Nastran `DMIG` form
+//! ([`crate::fe::nastran::read_dmig_file`]) → the [`ReducedChassis`] the coupled model gets, by
+//! the same orthogonalisation ([`orthogonalise`]) and damping table as the in-process reduction.
+//!
+//! The matrices: stiffness and mass (Nastran's `KAAX`, `MAAX`; symmetric, IFO 6) over the a-set
+//! of the component: boundary DOFs (grid points, components 1–6 or 1–3) and modal coordinates
+//! (scalar points, component 0: the q-set). The fixed-interface frequency of each modal
+//! coordinate is its Rayleigh quotient `√(K_qq / M_qq)`, exact for the mass-normalised
+//! fixed-interface modes a Craig-Bampton run writes; the spec's mode selection (count or
+//! cut-off) picks among them as it picks among the fixed-interface modes of our own reduction,
+//! and every boundary DOF is kept.
+//!
+//! Points: every mount's body node must be a boundary grid with components 1–3. A point's
+//! motion in component `c` is the recovery matrix's row (grid, c) if the file has one
+//! (rectangular `DMIG`, rows = physical DOFs, columns = the a-set DOFs as in `KAAX`: the
+//! Craig-Bampton basis restricted to the output DOFs), else the boundary DOF itself, else zero.
+//! Positions come from the file's `GRID` cards (basic system); a point's `node` is its GRID id.
+//!
+//! [`dmig_of_reduction`] writes our own reduction of a body in this form.
+
+use std::collections::{BTreeMap, BTreeSet};
+
+use faer::Mat;
+
+use super::craig_bampton::{craig_bampton_basis, orthogonalise};
+use super::damping::DampingTable;
+use super::error::CmsError;
+use super::reduce::{model, named_points, table_damping};
+use super::reduced::{RecoveryPoint, ReducedChassis};
+use super::spec::{ModeSelection, ReductionSpec};
+use crate::fe::nastran::{write_dmig_file, DmigDof, DmigFile, DmigMatrix};
+
+/// What a body given as Craig-Bampton matrices needs to become a [`ReducedChassis`].
+#[derive(Debug, Clone, Copy)]
+pub struct ExternalBody<'a> {
+    /// The matrices and grid positions.
+    pub file: &'a DmigFile,
+    /// Name of the stiffness matrix (e.g. `KAAX`).
+    pub stiffness: &'a str,
+    /// Name of the mass matrix (e.g. `MAAX`).
+    pub mass: &'a str,
+    /// Name of the recovery matrix of the output points, if any.
+    pub recovery: Option<&'a str>,
+    /// GRID id of every named point.
+    pub points: &'a BTreeMap<String, u32>,
+    /// The mounts' body nodes, in mount order (the interface).
+    pub interface: &'a [String],
+    /// Points recovered after the mounts.
+    pub outputs: &'a [String],
+    /// Which modal coordinates (fixed-interface modes) are kept.
+    pub selection: ModeSelection,
+    /// Modal damping of the final modes.
+    pub damping: &'a DampingTable,
+}
+
+fn invalid(message: String) -> CmsError {
+    CmsError::InvalidInput(message)
+}
+
+fn dof_name(d: DmigDof) -> String {
+    if d.1 == 0 {
+        format!("scalar point {}", d.0)
+    } else {
+        format!("GRID {} component {}", d.0, d.1)
+    }
+}
+
+/// The symmetric matrix `name` of the file.
+fn symmetric<'f>(file: &'f DmigFile, name: &str) -> Result<&'f DmigMatrix, CmsError> {
+    let m = file.matrix(name).map_err(CmsError::from)?;
+    if m.form != 6 {
+        return Err(invalid(format!(
+            "DMIG matrix {} has IFO {}; a Craig-Bampton stiffness or mass matrix is symmetric \
+             (IFO 6)",
+            m.name, m.form
+        )));
+    }
+    Ok(m)
+}
+
+/// The kept modal coordinates, ascending id: the Rayleigh frequency of each selects it.
+fn select_modal(
+    k: &DmigMatrix,
+    m: &DmigMatrix,
+    modal: &[DmigDof],
+    selection: ModeSelection,
+) -> Result<Vec<DmigDof>, CmsError> {
+    let mut hz = Vec::with_capacity(modal.len());
+    for &q in modal {
+        let (kq, mq) = (k.get(q, q), m.get(q, q));
+        if !(mq > 0.0 && kq > 0.0) {
+            return Err(invalid(format!(
+                "modal coordinate {} has K = {kq:e}, M = {mq:e} on the diagonal of {} / {}: a \
+                 fixed-interface mode has positive stiffness and mass",
+                dof_name(q),
+                k.name,
+                m.name
+            )));
+        }
+        hz.push(((kq / mq).sqrt() / (2.0 * std::f64::consts::PI), q));
+    }
+    let mut kept: Vec<DmigDof> = match selection {
+        ModeSelection::Count(n) => {
+            if n > modal.len() {
+                return Err(invalid(format!(
+                    "selection.count = {n} exceeds the {} modal coordinates of {}",
+                    modal.len(),
+                    k.name
+                )));
+            }
+            hz.sort_by(|a, b| a.0.total_cmp(&b.0));
+            hz.iter().take(n).map(|&(_, q)| q).collect()
+        }
+        ModeSelection::CutoffHz(f) => hz.iter().filter(|(h, _)| *h < f).map(|&(_, q)| q).collect(),
+    };
+    kept.sort_unstable();
+    Ok(kept)
+}
+
+/// The body given by Craig-Bampton matrices, reduced to its modes like our own reduction.
+///
+/// Long on purpose: the coordinates, their selection, the modes and the points are one reading
+/// of the same matrices, each step indexing by the coordinates the previous one chose.
+pub fn reduce_external(body: &ExternalBody<'_>) -> Result<ReducedChassis, CmsError> {
+    body.damping.validate()?;
+    let k = symmetric(body.file, body.stiffness)?;
+    let m = symmetric(body.file, body.mass)?;
+    let a_set: BTreeSet<DmigDof> = k.dofs().union(&m.dofs()).copied().collect();
+    let modal: Vec<DmigDof> = a_set.iter().copied().filter(|d| d.1 == 0).collect();
+    let boundary: BTreeSet<DmigDof> = a_set.iter().copied().filter(|d| d.1 > 0).collect();
+    let grid_of = |name: &str, what: &str| {
+        body.points.get(name).copied().ok_or_else(|| {
+            invalid(format!(
+                "{what} '{name}' has no GRID id in the body's points ({})",
+                body.points.keys().cloned().collect::<Vec<_>>().join(", ")
+            ))
+        })
+    };
+    let boundary_grids = || {
+        boundary
+            .iter()
+            .map(|d| d.0)
+            .collect::<BTreeSet<_>>()
+            .iter()
+            .map(u32::to_string)
+            .collect::<Vec<_>>()
+            .join(", ")
+    };
+
+    // Coordinates: the kept modal ones, then the mounts' boundary DOFs in mount order (the
+    // order of our own reduction's constraint modes), then any other boundary DOF.
+    let mut coords = select_modal(k, m, &modal, body.selection)?;
+    let mut interface_dofs = Vec::new();
+    for name in body.interface {
+        let g = grid_of(name, "mount body node")?;
+        for c in 1..=3u8 {
+            if !boundary.contains(&(g, c)) {
+                return Err(invalid(format!(
+                    "mount body node '{name}' is GRID {g}, whose component {c} is not a \
+                     boundary DOF of {} (boundary grids: {}); the mounts attach at boundary grids",
+                    k.name,
+                    boundary_grids()
+                )));
+            }
+        }
+        interface_dofs.extend(boundary.range((g, 1)..=(g, 6)).copied());
+    }
+    coords.extend(interface_dofs.iter().copied());
+    coords.extend(
+        boundary
+            .iter()
+            .filter(|d| !interface_dofs.contains(d))
+            .copied(),
+    );
+    let index: BTreeMap<DmigDof, usize> = coords.iter().enumerate().map(|(i, d)| (*d, i)).collect();
+    let r = coords.len();
+    let k_r = Mat::from_fn(r, r, |i, j| k.get(coords[i], coords[j]));
+    let m_r = Mat::from_fn(r, r, |i, j| m.get(coords[i], coords[j]));
+    if let Some(d) = coords.iter().find(|d| m.get(**d, **d) <= 0.0) {
+        return Err(invalid(format!(
+            "{} has no positive mass on the diagonal of {}: every coordinate needs mass",
+            dof_name(*d),
+            m.name
+        )));
+    }
+    let (omega, coefficients) = orthogonalise(&k_r, &m_r)?;
+
+    let recovery = match body.recovery {
+        Some(name) => {
+            let rec = body.file.matrix(name).map_err(CmsError::from)?;
+            if let Some(&(col, _)) = rec.entries.keys().find(|(c, _)| !a_set.contains(c)) {
+                return Err(invalid(format!(
+                    "recovery matrix {} has a column for {}, which is not a DOF of {}",
+                    rec.name,
+                    dof_name(col),
+                    k.name
+                )));
+            }
+            Some(rec)
+        }
+        None => None,
+    };
+    let rows: BTreeMap<DmigDof, Vec<(DmigDof, f64)>> = recovery.map_or_else(BTreeMap::new, |rec| {
+        let mut rows: BTreeMap<DmigDof, Vec<(DmigDof, f64)>> = BTreeMap::new();
+        for (&(col, row), &v) in &rec.entries {
+            rows.entry(row).or_default().push((col, v));
+        }
+        rows
+    });
+
+    let mut names: Vec<&String> = body.interface.iter().collect();
+    names.extend(body.outputs.iter().filter(|o| !body.interface.contains(o)));
+    let mut points = Vec::with_capacity(names.len());
+    for name in names {
+        let g = grid_of(name, "point")?;
+        let position = *body.file.grids.get(&g).ok_or_else(|| {
+            invalid(format!(
+                "point '{name}' is GRID {g}, which has no GRID card in the DMIG file (its \
+                 position is needed)"
+            ))
+        })?;
+        let mut basis_rows: Vec<Vec<(usize, f64)>> = vec![Vec::new(); 6];
+        let mut moves = false;
+        for c in 1..=6u8 {
+            let row = &mut basis_rows[usize::from(c - 1)];
+            if let Some(entries) = rows.get(&(g, c)) {
+                // Columns of modal coordinates left out by the selection drop out here.
+                row.extend(
+                    entries
+                        .iter()
+                        .filter_map(|(col, v)| index.get(col).map(|&j| (j, *v))),
+                );
+                moves = true;
+            } else if let Some(&j) = index.get(&(g, c)) {
+                row.push((j, 1.0));
+                moves = true;
+            }
+        }
+        if !moves {
+            return Err(invalid(format!(
+                "point '{name}' is GRID {g}, which is neither a boundary grid of {} (boundary \
+                 grids: {}) nor has rows in {}",
+                k.name,
+                boundary_grids(),
+                body.recovery.unwrap_or("a recovery matrix (none is named)")
+            )));
+        }
+        let shape = (0..r)
+            .map(|mode| {
+                let mut s = [0.0; 6];
+                for (c, row) in basis_rows.iter().enumerate() {
+                    s[c] = row.iter().map(|&(j, v)| v * coefficients[(j, mode)]).sum();
+                }
+                s
+            })
+            .collect();
+        points.push(RecoveryPoint {
+            name: name.clone(),
+            node: g as usize,
+            position,
+            shape,
+        });
+    }
+    Ok(ReducedChassis {
+        zeta: table_damping(&omega, body.damping),
+        omega,
+        points,
+    })
+}
+
+/// Our own reduction of a body as Craig-Bampton matrices in `DMIG` form.
+#[derive(Debug, Clone, PartialEq)]
+pub struct DmigBody {
+    /// The matrices `KAAX`, `MAAX` (symmetric, upper triangle) and `PHIOUT` (the basis at the
+    /// named points' DOFs that are not boundary DOFs), and the named points' GRID cards.
+    pub file: DmigFile,
+    /// GRID id of every named point (mounts, outputs): FE node index + 1.
+    pub points: BTreeMap<String, u32>,
+}
+
+impl DmigBody {
+    /// The file's text (free field, 17 significant digits).
+    pub fn text(&self) -> String {
+        let order = ["KAAX", "MAAX", "PHIOUT"];
+        let matrices: Vec<DmigMatrix> = order
+            .iter()
+            .filter_map(|n| self.file.matrices.get(*n).cloned())
+            .collect();
+        write_dmig_file(&self.file.grids, &matrices)
+    }
+}
+
+/// The Craig-Bampton matrices of the body `spec` describes (the same basis our reduction
+/// orthogonalises), as a Nastran `EXTSEOUT(DMIGPCH)` run would hand them over: boundary DOFs
+/// at the mount grids (`spec.interface_dofs`), the kept fixed-interface modes as scalar points
+/// numbered from the first power of ten above the GRID ids, plus the recovery matrix `PHIOUT`
+/// for the named points.
+pub fn dmig_of_reduction(spec: &ReductionSpec) -> Result<DmigBody, CmsError> {
+    let model = model(spec)?;
+    let basis = craig_bampton_basis(
+        &model.assembled.k,
+        &model.assembled.m,
+        &model.interface,
+        spec.selection,
+    )?;
+    let n_nodes = model.chassis.mesh.nodes.len() as u64;
+    let first_spoint = 10u64.pow((n_nodes + 1).to_string().len() as u32) + 1;
+    let nf = basis.fixed_interface_hz.len();
+    let local = spec.interface_dofs.local();
+    let mut coords: Vec<DmigDof> = (0..nf)
+        .map(|q| {
+            u32::try_from(first_spoint + q as u64)
+                .map(|id| (id, 0))
+                .map_err(|_| invalid("too many nodes and modes for Nastran ids".into()))
+        })
+        .collect::<Result<_, _>>()?;
+    for (_, node) in &model.mounts {
+        coords.extend(local.iter().map(|&d| (*node as u32 + 1, d as u8 + 1)));
+    }
+    let r = coords.len();
+    let triangle = |name: &str, a: &Mat<f64>| {
+        let mut mat = DmigMatrix::new(name, 6);
+        mat.ncol = Some(r);
+        for j in 0..r {
+            for i in 0..=j {
+                if a[(i, j)] != 0.0 {
+                    mat.entries.insert((coords[j], coords[i]), a[(i, j)]);
+                }
+            }
+        }
+        mat
+    };
+    let mut file = DmigFile::default();
+    file.matrices
+        .insert("KAAX".into(), triangle("KAAX", &basis.k_r));
+    file.matrices
+        .insert("MAAX".into(), triangle("MAAX", &basis.m_r));
+    let mut phi = DmigMatrix::new("PHIOUT", 9);
+    phi.ncol = Some(r);
+    let boundary: BTreeSet<DmigDof> = coords.iter().copied().filter(|d| d.1 > 0).collect();
+    let mut points = BTreeMap::new();
+    for (name, node) in named_points(&model, &spec.outputs)? {
+        let g = node as u32 + 1;
+        points.insert(name, g);
+        let p = &model.chassis.mesh.nodes[node];
+        file.grids.insert(g, [p.x, p.y, p.z]);
+        for d in 0..6 {
+            if boundary.contains(&(g, d as u8 + 1)) {
+                continue;
+            }
+            // A node of a rigid or interpolation link moves with its independent nodes.
+            let combination = model.assembled.dofs.motion_row(node, d)?;
+            for (j, &col) in coords.iter().enumerate() {
+                let v: f64 = combination.iter().map(|(e, c)| c * basis.t[(*e, j)]).sum();
+                if v != 0.0 {
+                    phi.entries.insert((col, (g, d as u8 + 1)), v);
+                }
+            }
+        }
+    }
+    file.matrices.insert("PHIOUT".into(), phi);
+    Ok(DmigBody { file, points })
+}
