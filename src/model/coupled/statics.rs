@@ -6,7 +6,7 @@ use faer::Mat;
 use nalgebra::Vector3;
 
 use super::evaluate::Mode;
-use super::{CoupledModel, MountTarget};
+use super::CoupledModel;
 
 /// The static equilibrium could not be found.
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]
@@ -179,7 +179,7 @@ impl CoupledModel {
         }
         y[l.positions()].copy_from_slice(&z[..nq]);
         y[l.eta()].copy_from_slice(&z[nq..]);
-        let points = self.mount_deflections(&y)?;
+        let points = self.mount_deflections(t0, &y)?;
         for (m, p) in self.mounts.iter_mut().zip(points) {
             if let Some(m) = m {
                 m.mount.operating_point = p;
@@ -188,23 +188,25 @@ impl CoupledModel {
         Ok(y)
     }
 
-    /// Deflection of every configured mount at state `y` (zero for a removed one), checked
+    /// Checks that every mount at `(t, y)` deflects within the range of its curves: an external
+    /// body's attachment input may push a mount beyond what its characteristic describes.
+    pub fn check_mount_ranges(&self, t: f64, y: &[f64]) -> Result<(), StaticsError> {
+        self.mount_deflections(t, y).map(|_| ())
+    }
+
+    /// Deflection of every configured mount at `(t, y)` (zero for a removed one), checked
     /// against the range of its curves.
-    fn mount_deflections(&self, y: &[f64]) -> Result<Vec<Vector3<f64>>, StaticsError> {
+    fn mount_deflections(&self, t: f64, y: &[f64]) -> Result<Vec<Vector3<f64>>, StaticsError> {
         let hb = self.powertrain.housing_index();
         let h = self.kinematics(y, hb);
         let reference = self.powertrain.bodies()[hb].reference;
-        let eta = &y[self.layout.eta()];
         let mut out = Vec::with_capacity(self.mounts.len());
         for (i, m) in self.mounts.iter().enumerate() {
             let Some(m) = m else {
                 out.push(Vector3::zeros());
                 continue;
             };
-            let a = match m.target {
-                MountTarget::Ground => Vector3::zeros(),
-                MountTarget::BodyPoint(p) => self.point_translation(p, eta),
-            };
+            let (a, _) = self.attachment_motion(i, m.target, t, y);
             let mount = &m.mount;
             let d = mount.deflection(&h.point(&(mount.bracket - reference)), &a);
             for k in 0..3 {
