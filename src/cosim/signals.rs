@@ -46,6 +46,13 @@ pub struct Inputs {
     pub stiffness_scale: [Signal; 4],
     /// Scale on each mount's damping (>= 0).
     pub damping_scale: [Signal; 4],
+    /// Scene 3: displacement of each mount's attachment point on the external body, m, per
+    /// vehicle axis.
+    pub body_displacement: [[Signal; 3]; 4],
+    /// Scene 3: velocity of each mount's attachment point on the external body, m/s.
+    pub body_velocity: [[Signal; 3]; 4],
+    /// The body alone: the force on the body at each mount point, N, per vehicle axis.
+    pub body_force: [[Signal; 3]; 4],
 }
 
 impl Inputs {
@@ -57,7 +64,23 @@ impl Inputs {
             load_torque: Signal::constant(0.0),
             stiffness_scale: [Signal::constant(1.0); 4],
             damping_scale: [Signal::constant(1.0); 4],
+            body_displacement: [[Signal::constant(0.0); 3]; 4],
+            body_velocity: [[Signal::constant(0.0); 3]; 4],
+            body_force: [[Signal::constant(0.0); 3]; 4],
         }
+    }
+
+    /// The signals of the external body's interface: attachment displacements and velocities
+    /// and the forces on the body, mount by mount.
+    pub fn interface(&self) -> impl Iterator<Item = &Signal> + '_ {
+        [
+            &self.body_displacement,
+            &self.body_velocity,
+            &self.body_force,
+        ]
+        .into_iter()
+        .flatten()
+        .flatten()
     }
 
     /// Physical admissibility of the input values (finite values are checked by the caller).
@@ -98,6 +121,10 @@ impl Inputs {
                 .iter()
                 .zip(&next.damping_scale)
                 .all(|(a, b)| a.continues_into(b, t))
+            && self
+                .interface()
+                .zip(next.interface())
+                .all(|(a, b)| a.continues_into(b, t))
     }
 }
 
@@ -115,6 +142,7 @@ mod tests {
             load_torque: Signal::constant(0.0),
             stiffness_scale: [Signal::constant(1.0); 4],
             damping_scale: [Signal::constant(1.0); 4],
+            ..Inputs::steady(0.0)
         }
     }
 

@@ -24,6 +24,7 @@
 //! (paper §4.2) and keeps free vibration with the crank at rest conservative.
 
 mod energy;
+pub mod interface;
 mod evaluate;
 pub mod jacobian;
 mod layout;

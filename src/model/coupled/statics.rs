@@ -179,7 +179,14 @@ impl CoupledModel {
         }
         y[l.positions()].copy_from_slice(&z[..nq]);
         y[l.eta()].copy_from_slice(&z[nq..]);
-        let points = self.mount_deflections(t0, &y)?;
+        let points = self.mount_deflections(t0, &y).map_err(|e| {
+            let why = if self.has_external_body() {
+                "the external body's displacement at the start moves it beyond its characteristic"
+            } else {
+                "the mounts are too soft to carry the powertrain"
+            };
+            StaticsError(format!("{}: {why}", e.0))
+        })?;
         for (m, p) in self.mounts.iter_mut().zip(points) {
             if let Some(m) = m {
                 m.mount.operating_point = p;
@@ -213,7 +220,7 @@ impl CoupledModel {
                 let (lo, hi) = mount.curves[k].range();
                 if d[k] < lo || d[k] > hi {
                     return Err(StaticsError(format!(
-                        "mount {i} ({}) deflects {:.1} mm along its axis {k}, beyond its curve [{:.1}, {:.1}] mm: the mounts are too soft to carry the powertrain",
+                        "mount {i} ({}) deflects {:.1} mm along its axis {k}, beyond its curve [{:.1}, {:.1}] mm",
                         mount.name,
                         d[k] * 1e3,
                         lo * 1e3,
