@@ -281,7 +281,12 @@ fn expand(table: &Value) -> (Vec<Scalar>, Vec<Family>) {
             feedthrough: feedthrough
                 .and_then(|f| f.get("inputs"))
                 .and_then(Value::as_array)
-                .map(|l| l.iter().filter_map(Value::as_str).map(str::to_owned).collect())
+                .map(|l| {
+                    l.iter()
+                        .filter_map(Value::as_str)
+                        .map(str::to_owned)
+                        .collect()
+                })
                 .unwrap_or_default(),
             per_mount: feedthrough
                 .and_then(|f| f.get("perMount"))
@@ -346,7 +351,10 @@ fn validate(table: &Value, scalars: &[Scalar], families: &[Family], mask: u8) {
     for f in families {
         for input in &f.feedthrough {
             if !families.iter().any(|g| &g.rust == input) {
-                fail(&format!("{} lists unknown feedthrough input {input}", f.name));
+                fail(&format!(
+                    "{} lists unknown feedthrough input {input}",
+                    f.name
+                ));
             }
         }
     }
@@ -593,7 +601,10 @@ fn write_model_description(
                 // the table declares as `feedthrough` (a body's motion at the mounts, the mount
                 // forces on a body), through which the outputs respond at once, as a coupling
                 // algorithm needs.
-                for (list, unknowns) in [("Outputs", &outputs), ("InitialUnknowns", &initial_unknowns)] {
+                for (list, unknowns) in [
+                    ("Outputs", &outputs),
+                    ("InitialUnknowns", &initial_unknowns),
+                ] {
                     w.create_element(list).write_inner_content(|w| {
                         for (i, direct) in unknowns {
                             let dependencies = if list == "Outputs" {
@@ -660,7 +671,11 @@ fn rust_table(table: &Value, scalars: &[Scalar], families: &[Family], fmus: &[Fm
         "/// `modelIdentifier` of the body FMU.\npub const BODY_MODEL_IDENTIFIER: &str = {:?};",
         fmus[1].identifier
     );
-    let _ = writeln!(r, "/// The GUID of the body FMU's `modelDescription.xml`.\npub const BODY_GUID: &str = {:?};", fmus[1].guid);
+    let _ = writeln!(
+        r,
+        "/// The GUID of the body FMU's `modelDescription.xml`.\npub const BODY_GUID: &str = {:?};",
+        fmus[1].guid
+    );
     let _ = writeln!(
         r,
         "/// What the XML adds to a variable's index among its type ([`real`], [`integer`], …) to\n/// make its value reference, per type Real, Integer, Boolean, String: value references are\n/// unique across types.\npub const VR_BASE: [u32; 4] = {VR_BASE:?};"
@@ -894,14 +909,10 @@ fn documentation(scalars: &[Scalar], fmu: &Fmu) -> String {
         h,
         "<!DOCTYPE html>\n<html lang=\"en\"><head><meta charset=\"utf-8\"><title>{name}</title>\n<style>body{{font-family:sans-serif;max-width:70em;margin:2em auto}}table{{border-collapse:collapse}}td,th{{border:1px solid #bbb;padding:3px 6px;text-align:left}}</style></head><body>"
     );
-    let _ = writeln!(
-        h,
-        "<h1>{name}</h1>\n<p>{}</p>",
-        xml_escape(fmu.description)
-    );
+    let _ = writeln!(h, "<h1>{name}</h1>\n<p>{}</p>", xml_escape(fmu.description));
     let _ = writeln!(h, "<p>FMI 2.0 co-simulation, GUID <code>{guid}</code>.</p>");
     if fmu.mask == ENGINE {
-    h.push_str(
+        h.push_str(
         "<h2>Scenes</h2>\n<ul><li><b>1</b>: engine on rigid ground: monoblock and housing (with gearbox) as rigid bodies \
          connected by ring carriers, on nonlinear engine mounts fixed to ground (paper Table 1, left column).</li>\
          <li><b>2</b>: engine in the elastic car body: the mounts connect the housing brackets to the mount nodes of the \

@@ -361,7 +361,11 @@ impl Simulation {
             let force = s.force_per_displacement * u + s.force_per_velocity * v;
             let acceleration = s.housing_acceleration_per_force * force;
             out.mount_force[i] = force.into();
-            for (a, d) in out.powertrain_acceleration.iter_mut().zip(acceleration.iter()) {
+            for (a, d) in out
+                .powertrain_acceleration
+                .iter_mut()
+                .zip(acceleration.iter())
+            {
                 *a += d;
             }
         }

@@ -3,8 +3,8 @@
 //! know which, except where the two FMUs' variables differ.
 
 use super::body::{BodySimulation, BodyState};
-use super::{Counters, Error, Inputs, Outputs, Settings, Simulation, SimulationState, StepFailure};
 use super::settings::Replaced;
+use super::{Counters, Error, Inputs, Outputs, Settings, Simulation, SimulationState, StepFailure};
 use crate::model::Mode;
 
 /// Which FMU an instance is.
@@ -36,7 +36,12 @@ pub enum RuntimeState {
 
 impl Runtime {
     /// Builds the model of `kind` at its start under the inputs at `t0`.
-    pub fn new(kind: FmuKind, settings: &Settings, t0: f64, inputs: &Inputs) -> Result<Self, Error> {
+    pub fn new(
+        kind: FmuKind,
+        settings: &Settings,
+        t0: f64,
+        inputs: &Inputs,
+    ) -> Result<Self, Error> {
         Ok(match kind {
             FmuKind::Engine => Runtime::Engine(Simulation::new(settings, t0, inputs)?),
             FmuKind::Body => Runtime::Body(BodySimulation::new(settings, t0, inputs)?),

@@ -3,8 +3,8 @@
 
 use super::settings::Replaced;
 use super::{Error, Inputs, Outputs, Settings};
-use crate::model::scene::build;
 use crate::model::inputs::AttachmentMotion;
+use crate::model::scene::build;
 use crate::model::{CoupledModel, RampInput, VehicleConfig};
 
 /// Number of mounts the FMU's variables expose (`mount[1..4]`).

@@ -480,13 +480,19 @@ impl Instance {
     ) -> Result<Vec<f64>, String> {
         self.check_members::<f64>(unknowns)?;
         self.check_members::<f64>(knowns)?;
-        if let Some(&i) = knowns.iter().find(|&&i| REALS[i].causality != Causality::Input) {
+        if let Some(&i) = knowns
+            .iter()
+            .find(|&&i| REALS[i].causality != Causality::Input)
+        {
             return Err(format!(
                 "{} is not an input: the derivatives provided are of outputs with respect to inputs",
                 REALS[i].name
             ));
         }
-        if let Some(&i) = unknowns.iter().find(|&&i| REALS[i].causality != Causality::Output) {
+        if let Some(&i) = unknowns
+            .iter()
+            .find(|&&i| REALS[i].causality != Causality::Output)
+        {
             return Err(format!(
                 "{} is not an output: the derivatives provided are of outputs with respect to inputs",
                 REALS[i].name
@@ -515,10 +521,7 @@ impl Instance {
             .map_err(|e| parameters::message(&e))?;
         let mut scratch = self.core.values.reals.clone();
         parameters::put_outputs(&mut scratch, &response);
-        Ok(unknowns
-            .iter()
-            .map(|&u| *scratch.get(u as u32))
-            .collect())
+        Ok(unknowns.iter().map(|&u| *scratch.get(u as u32)).collect())
     }
 
     /// The input signals after the Reals at `indices` were set: each input set continues from
@@ -667,9 +670,10 @@ mod tests {
             tt += 1e-3;
             assert_eq!(&inst.core.values.reals, r, "in-memory");
         }
-        let core =
-            super::super::snapshot::deserialize(&bytes, inst.guid(), |c, d| inst.restore_simulation(c, d))
-                .unwrap();
+        let core = super::super::snapshot::deserialize(&bytes, inst.guid(), |c, d| {
+            inst.restore_simulation(c, d)
+        })
+        .unwrap();
         let a = saved.simulation.as_ref().unwrap().dynamic_state();
         let b = core.simulation.as_ref().unwrap().dynamic_state();
         assert_eq!(a, b);

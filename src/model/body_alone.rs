@@ -156,8 +156,7 @@ impl BodyAlone {
             )));
         }
         for (i, f) in forces.iter().enumerate() {
-            if f
-                .iter()
+            if f.iter()
                 .any(|r| !(r.value.is_finite() && r.rate.is_finite() && r.since.is_finite()))
             {
                 return Err(InputError(format!(
@@ -282,7 +281,10 @@ impl BodyAlone {
 
     /// The body point of output `name`, if reported.
     pub fn output_point(&self, name: &str) -> Option<usize> {
-        self.outputs.iter().find(|o| o.name == name).map(|o| o.point)
+        self.outputs
+            .iter()
+            .find(|o| o.name == name)
+            .map(|o| o.point)
     }
 }
 
@@ -326,7 +328,8 @@ mod tests {
             b.advance(t, t + 3.3e-3, &mut y);
             t += 3.3e-3;
             let exact = (1.0
-                - (-z * w * t).exp() * ((wd * t).cos() + z / (1.0 - z * z).sqrt() * (wd * t).sin()))
+                - (-z * w * t).exp()
+                    * ((wd * t).cos() + z / (1.0 - z * z).sqrt() * (wd * t).sin()))
                 / (w * w);
             assert!((y[0] - exact).abs() < 1e-12 * (1.0 / (w * w)), "t = {t}");
         }
@@ -342,7 +345,8 @@ mod tests {
             rate: r,
             since: 0.0,
         };
-        b.set_forces(&[[RampInput::ZERO, RampInput::ZERO, ramp]]).unwrap();
+        b.set_forces(&[[RampInput::ZERO, RampInput::ZERO, ramp]])
+            .unwrap();
         let mut y = vec![0.0, 0.0];
         b.advance(0.0, 0.4, &mut y);
         let t: f64 = 0.4;

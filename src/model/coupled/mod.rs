@@ -24,8 +24,8 @@
 //! (paper §4.2) and keeps free vibration with the crank at rest conservative.
 
 mod energy;
-pub mod interface;
 mod evaluate;
+pub mod interface;
 pub mod jacobian;
 mod layout;
 pub mod modes;
