@@ -248,16 +248,11 @@ impl Simulation {
         let jumped = sharp_kink || !self.inputs.continue_into(&compared, t);
         let previous = self.inputs;
         scene::apply_inputs(&mut self.scene, inputs)?;
-        if self.scene.has_external_body() {
-            // An external body may move a mount beyond its characteristic: refuse the inputs
-            // (naming the mount) rather than extrapolate a curve the mount does not have.
-            if let Err(e) = self.scene.check_mount_ranges(t, &self.state) {
-                scene::apply_inputs(&mut self.scene, &previous)?;
-                return Err(Error::Model(format!(
-                    "the external body's motion at t = {t} s: {}",
-                    e.0
-                )));
-            }
+        // An external body may move a mount beyond its characteristic: refuse the inputs
+        // (naming the mount) rather than extrapolate a curve the mount does not have.
+        if let Err(e) = self.interface_in_range() {
+            scene::apply_inputs(&mut self.scene, &previous)?;
+            return Err(e);
         }
         self.inputs = *inputs;
         if jumped {
@@ -337,9 +332,27 @@ impl Simulation {
     pub fn outputs_with(&mut self, interface: &Inputs) -> Result<Outputs, Error> {
         let trial = self.with_interface(interface);
         scene::apply_inputs(&mut self.scene, &trial)?;
-        let outputs = scene::outputs(&self.scene, self.time, &self.state);
+        let outputs = self
+            .interface_in_range()
+            .and_then(|()| scene::outputs(&self.scene, self.time, &self.state));
         scene::apply_inputs(&mut self.scene, &self.inputs)?;
         outputs
+    }
+
+    /// With an external body, whether its motion at the communication time keeps every mount
+    /// within its characteristic (an error naming the mount otherwise).
+    fn interface_in_range(&self) -> Result<(), Error> {
+        if !self.scene.has_external_body() {
+            return Ok(());
+        }
+        self.scene
+            .check_mount_ranges(self.time, &self.state)
+            .map_err(|e| {
+                Error::Model(format!(
+                    "the external body's motion at t = {} s: {}",
+                    self.time, e.0
+                ))
+            })
     }
 
     /// The response of the mount forces and the powertrain acceleration to the attachment
