@@ -130,7 +130,7 @@ impl BodySimulation {
 
     /// Propagates to `t`.
     pub fn advance_to(&mut self, t: f64) -> Result<(), StepFailure> {
-        if !(t >= self.time) {
+        if t.partial_cmp(&self.time).is_none_or(|o| o.is_lt()) {
             return Err(StepFailure {
                 error: Error::Model(format!("{t} is behind the current time {}", self.time)),
                 reached: self.time,

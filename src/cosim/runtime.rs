@@ -19,19 +19,19 @@ pub enum FmuKind {
 /// A built model ready to step.
 #[derive(Clone)]
 pub enum Runtime {
-    /// The engine FMU's simulation.
-    Engine(Simulation),
+    /// The engine FMU's simulation (both boxed: large and of different sizes).
+    Engine(Box<Simulation>),
     /// The body FMU's.
-    Body(BodySimulation),
+    Body(Box<BodySimulation>),
 }
 
 /// What a [`Runtime`]'s settings do not determine.
 #[derive(Debug, Clone, PartialEq, serde::Serialize, serde::Deserialize)]
 pub enum RuntimeState {
-    /// Of an engine simulation.
-    Engine(SimulationState),
+    /// Of an engine simulation (both boxed: large and of different sizes).
+    Engine(Box<SimulationState>),
     /// Of the body alone.
-    Body(BodyState),
+    Body(Box<BodyState>),
 }
 
 impl Runtime {
@@ -43,16 +43,16 @@ impl Runtime {
         inputs: &Inputs,
     ) -> Result<Self, Error> {
         Ok(match kind {
-            FmuKind::Engine => Runtime::Engine(Simulation::new(settings, t0, inputs)?),
-            FmuKind::Body => Runtime::Body(BodySimulation::new(settings, t0, inputs)?),
+            FmuKind::Engine => Runtime::Engine(Box::new(Simulation::new(settings, t0, inputs)?)),
+            FmuKind::Body => Runtime::Body(Box::new(BodySimulation::new(settings, t0, inputs)?)),
         })
     }
 
     /// Rebuilds from the settings and a saved [`RuntimeState`].
     pub fn restore(settings: &Settings, saved: &RuntimeState) -> Result<Self, Error> {
         Ok(match saved {
-            RuntimeState::Engine(s) => Runtime::Engine(Simulation::restore(settings, s)?),
-            RuntimeState::Body(s) => Runtime::Body(BodySimulation::restore(settings, s)?),
+            RuntimeState::Engine(s) => Runtime::Engine(Box::new(Simulation::restore(settings, s)?)),
+            RuntimeState::Body(s) => Runtime::Body(Box::new(BodySimulation::restore(settings, s)?)),
         })
     }
 
@@ -158,8 +158,8 @@ impl Runtime {
     /// Everything the settings do not determine.
     pub fn dynamic_state(&self) -> RuntimeState {
         match self {
-            Runtime::Engine(s) => RuntimeState::Engine(s.dynamic_state()),
-            Runtime::Body(s) => RuntimeState::Body(s.dynamic_state()),
+            Runtime::Engine(s) => RuntimeState::Engine(Box::new(s.dynamic_state())),
+            Runtime::Body(s) => RuntimeState::Body(Box::new(s.dynamic_state())),
         }
     }
 }

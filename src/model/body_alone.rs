@@ -234,10 +234,10 @@ impl BodyAlone {
         let m = self.modes();
         let mut out = PointKinematics::default();
         for (k, s) in self.body.points[p].shape.iter().enumerate() {
-            for j in 0..3 {
-                out.displacement[j] += s[j] * y[k];
-                out.velocity[j] += s[j] * y[m + k];
-                out.acceleration[j] += s[j] * acc[k];
+            for (j, sj) in s.iter().take(3).enumerate() {
+                out.displacement[j] += sj * y[k];
+                out.velocity[j] += sj * y[m + k];
+                out.acceleration[j] += sj * acc[k];
             }
         }
         out

@@ -101,9 +101,7 @@ impl Split {
         let mut body = BodySimulation::new(&body_settings, 0.0, &body_inputs).unwrap();
         for _ in 0..6 {
             let f = engine.outputs().unwrap().mount_force;
-            for i in 0..4 {
-                body_inputs.body_force[i] = f[i].map(Signal::constant);
-            }
+            body_inputs.body_force = f.map(|m| m.map(Signal::constant));
             body = BodySimulation::new(&body_settings, 0.0, &body_inputs).unwrap();
             engine_interface(&mut engine_inputs, &body.outputs(), 0.0);
             engine = Simulation::new(&engine_settings, 0.0, &engine_inputs).unwrap();
@@ -121,14 +119,18 @@ impl Split {
         self.engine.advance_to(t + self.h).unwrap();
         let after = self.engine.outputs().unwrap();
         let mut body_inputs = *self.body.inputs();
-        for i in 0..4 {
-            for j in 0..3 {
-                body_inputs.body_force[i][j] = Signal {
-                    value: before[i][j],
-                    derivative: (after.mount_force[i][j] - before[i][j]) / self.h,
-                    reference_time: t,
-                };
-            }
+        for ((slot, b), a) in body_inputs
+            .body_force
+            .iter_mut()
+            .flatten()
+            .zip(before.iter().flatten())
+            .zip(after.mount_force.iter().flatten())
+        {
+            *slot = Signal {
+                value: *b,
+                derivative: (a - b) / self.h,
+                reference_time: t,
+            };
         }
         self.body.set_inputs(&body_inputs).unwrap();
         self.body.advance_to(t + self.h).unwrap();
