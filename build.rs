@@ -1,10 +1,12 @@
-//! Generates, from the one variable table `modelDescription/variables.json`:
-//! - `modelDescription.xml` (packaged into the FMU),
+//! Generates, from the one variable table `modelDescription/variables.json`, for each of the two
+//! FMUs the crate's library serves (the engine FMU and, from the variables tagged `"fmus":
+//! [.., "body"]`, the body FMU; one library, told apart by the GUID at instantiation):
+//! - `modelDescription.xml` and `body.modelDescription.xml` (packaged into the FMUs),
 //! - `variables.rs` (the value-reference table the FMI layer includes),
-//! - `index.html` (the FMU's documentation page),
+//! - `index.html` and `body.index.html` (the FMUs' documentation pages),
 //! - `exports.map`, a linker version script that exports exactly the fmi2 functions.
 //!
-//! The GUID is a hash of the table's content, so the XML and the binary can never disagree.
+//! The GUIDs are hashes of the table's content, so the XML and the binary can never disagree.
 
 use quick_xml::events::{BytesDecl, BytesText, Event};
 use quick_xml::Writer;
@@ -62,8 +64,28 @@ fn vr_base(ty: &str) -> usize {
     VR_BASE[TYPES.iter().position(|t| *t == ty).unwrap_or(0)]
 }
 
+/// The engine FMU's bit in a variable's `fmus` mask.
+const ENGINE: u8 = 1;
+/// The body FMU's bit.
+const BODY: u8 = 2;
+
+/// One of the FMUs the table describes.
+struct Fmu<'a> {
+    mask: u8,
+    model_name: &'a str,
+    identifier: &'a str,
+    description: &'a str,
+    guid: String,
+}
+
 /// One scalar variable after expanding `{i}`/`{j}` families.
 struct Scalar {
+    /// Which FMUs have the variable (bits [`ENGINE`], [`BODY`]).
+    fmus: u8,
+    /// Its family in the table.
+    family: usize,
+    /// The family index `{i}` (1-based), if any.
+    first_index: Option<usize>,
     name: String,
     description: String,
     ty: &'static str,
@@ -87,6 +109,10 @@ struct Family {
     ty: &'static str,
     dims: Vec<usize>,
     first_vr: usize,
+    /// Inputs (family `rust` names) this output depends on directly.
+    feedthrough: Vec<String>,
+    /// Whether the dependency is on the same mount (`{i}`) only.
+    per_mount: bool,
 }
 
 fn main() {
@@ -101,21 +127,40 @@ fn main() {
     let table: Value = serde_json::from_str(&text)
         .unwrap_or_else(|e| fail(&format!("{} is not valid JSON: {e}", table_path.display())));
 
-    let guid = guid_of(&text);
+    let body = table
+        .get("bodyModel")
+        .unwrap_or_else(|| fail("missing `bodyModel`"));
+    let fmus = [
+        Fmu {
+            mask: ENGINE,
+            model_name: str_field(&table, "modelName"),
+            identifier: str_field(&table, "modelIdentifier"),
+            description: str_field(&table, "description"),
+            guid: guid_of(&text),
+        },
+        Fmu {
+            mask: BODY,
+            model_name: str_field(body, "modelName"),
+            identifier: str_field(body, "modelIdentifier"),
+            description: str_field(body, "description"),
+            guid: guid_of(&format!("{text}\nbody")),
+        },
+    ];
     let (scalars, families) = expand(&table);
-    validate(&table, &scalars);
-
-    write(
-        &out.join("modelDescription.xml"),
-        &model_description(&table, &scalars, &guid),
-    );
+    for (fmu, prefix) in fmus.iter().zip(["", "body."]) {
+        validate(&table, &scalars, &families, fmu.mask);
+        write(
+            &out.join(format!("{prefix}modelDescription.xml")),
+            &model_description(&table, &scalars, &families, fmu),
+        );
+        write(
+            &out.join(format!("{prefix}index.html")),
+            &documentation(&scalars, fmu),
+        );
+    }
     write(
         &out.join("variables.rs"),
-        &rust_table(&table, &scalars, &families, &guid),
-    );
-    write(
-        &out.join("index.html"),
-        &documentation(&table, &scalars, &guid),
+        &rust_table(&table, &scalars, &families, &fmus),
     );
 
     let mut map = String::from("{\n  global:\n");
@@ -213,6 +258,18 @@ fn expand(table: &Value) -> (Vec<Scalar>, Vec<Family>) {
             fail(&format!("bad dims in {}", str_field(e, "name")));
         }
         let first_vr = next_vr[ty];
+        let fmus = match e.get("fmus").and_then(Value::as_array) {
+            None => ENGINE,
+            Some(list) => list.iter().fold(0, |m, f| {
+                m | match f.as_str() {
+                    Some("engine") => ENGINE,
+                    Some("body") => BODY,
+                    _ => fail(&format!("unknown FMU {f} in {}", str_field(e, "name"))),
+                }
+            }),
+        };
+        let feedthrough = e.get("feedthrough");
+        let family = families.len();
         families.push(Family {
             rust: str_field(e, "rust").to_owned(),
             name: str_field(e, "name").to_owned(),
@@ -221,6 +278,20 @@ fn expand(table: &Value) -> (Vec<Scalar>, Vec<Family>) {
             ty,
             dims: dims.clone(),
             first_vr,
+            feedthrough: feedthrough
+                .and_then(|f| f.get("inputs"))
+                .and_then(Value::as_array)
+                .map(|l| {
+                    l.iter()
+                        .filter_map(Value::as_str)
+                        .map(str::to_owned)
+                        .collect()
+                })
+                .unwrap_or_default(),
+            per_mount: feedthrough
+                .and_then(|f| f.get("perMount"))
+                .and_then(Value::as_bool)
+                .unwrap_or(false),
         });
         let indices: Vec<Vec<usize>> = match dims.as_slice() {
             [] => vec![vec![]],
@@ -244,6 +315,9 @@ fn expand(table: &Value) -> (Vec<Scalar>, Vec<Family>) {
             let vr = next_vr[ty];
             *next_vr.get_mut(ty).unwrap_or_else(|| fail("type")) += 1;
             scalars.push(Scalar {
+                fmus,
+                family,
+                first_index: idx.first().copied(),
                 name: subst(str_field(e, "name")),
                 description: subst(str_field(e, "description")),
                 ty,
@@ -266,15 +340,25 @@ fn expand(table: &Value) -> (Vec<Scalar>, Vec<Family>) {
     (scalars, families)
 }
 
-/// The combinations fmpy's validator and the standard require.
-fn validate(table: &Value, scalars: &[Scalar]) {
+/// The combinations fmpy's validator and the standard require, in the FMU `mask`.
+fn validate(table: &Value, scalars: &[Scalar], families: &[Family], mask: u8) {
     let units: Vec<&str> = table
         .get("units")
         .and_then(Value::as_array)
         .map(|u| u.iter().map(|x| str_field(x, "name")).collect())
         .unwrap_or_default();
     let mut names = std::collections::BTreeSet::new();
-    for s in scalars {
+    for f in families {
+        for input in &f.feedthrough {
+            if !families.iter().any(|g| &g.rust == input) {
+                fail(&format!(
+                    "{} lists unknown feedthrough input {input}",
+                    f.name
+                ));
+            }
+        }
+    }
+    for s in scalars.iter().filter(|s| s.fmus & mask != 0) {
         if !names.insert(s.name.clone()) {
             fail(&format!("duplicate variable name {}", s.name));
         }
@@ -325,21 +409,38 @@ fn element<'w>(
         .with_attributes(attributes.iter().map(|(k, v)| (k.as_str(), v.as_str())))
 }
 
-fn model_description(table: &Value, scalars: &[Scalar], guid: &str) -> String {
+fn model_description(table: &Value, scalars: &[Scalar], families: &[Family], fmu: &Fmu) -> String {
     let mut w = Writer::new_with_indent(Vec::new(), b' ', 2);
-    write_model_description(&mut w, table, scalars, guid)
+    write_model_description(&mut w, table, scalars, families, fmu)
         .unwrap_or_else(|e| fail(&format!("writing modelDescription.xml: {e}")));
     let mut xml = String::from_utf8(w.into_inner()).expect("quick-xml writes UTF-8");
     xml.push('\n');
     xml
 }
 
+/// The direct dependencies of output `s` among the FMU's variables `visible` (1-based indices of
+/// the XML's variable list), as its family's `feedthrough` declares them.
+fn feedthrough_of(s: &Scalar, visible: &[&Scalar], families: &[Family]) -> Vec<usize> {
+    let family = &families[s.family];
+    visible
+        .iter()
+        .enumerate()
+        .filter(|(_, v)| {
+            family.feedthrough.contains(&families[v.family].rust)
+                && (!family.per_mount || v.first_index == s.first_index)
+        })
+        .map(|(i, _)| i + 1)
+        .collect()
+}
+
 fn write_model_description(
     w: &mut Writer<Vec<u8>>,
     table: &Value,
     scalars: &[Scalar],
-    guid: &str,
+    families: &[Family],
+    fmu: &Fmu,
 ) -> std::io::Result<()> {
+    let scalars: Vec<&Scalar> = scalars.iter().filter(|s| s.fmus & fmu.mask != 0).collect();
     let array = |key: &str| -> Vec<Value> {
         table
             .get(key)
@@ -350,9 +451,9 @@ fn write_model_description(
     w.write_event(Event::Decl(BytesDecl::new("1.0", Some("UTF-8"), None)))?;
     let root = vec![
         attr("fmiVersion", "2.0"),
-        attr("modelName", str_field(table, "modelName")),
-        attr("guid", guid),
-        attr("description", str_field(table, "description")),
+        attr("modelName", fmu.model_name),
+        attr("guid", &fmu.guid),
+        attr("description", fmu.description),
         attr("author", str_field(table, "author")),
         attr("version", str_field(table, "version")),
         attr("generationTool", "engine_mount_chassis build.rs"),
@@ -361,7 +462,7 @@ fn write_model_description(
     ];
     element(w, "fmiModelDescription", &root).write_inner_content(|w| {
         let co_simulation = vec![
-            attr("modelIdentifier", str_field(table, "modelIdentifier")),
+            attr("modelIdentifier", fmu.identifier),
             attr("needsExecutionTool", false),
             attr("canHandleVariableCommunicationStepSize", true),
             attr("canInterpolateInputs", true),
@@ -371,7 +472,7 @@ fn write_model_description(
             attr("canNotUseMemoryManagementFunctions", true),
             attr("canGetAndSetFMUstate", true),
             attr("canSerializeFMUstate", true),
-            attr("providesDirectionalDerivative", false),
+            attr("providesDirectionalDerivative", true),
         ];
         element(w, "CoSimulation", &co_simulation).write_empty()?;
         w.create_element("UnitDefinitions")
@@ -459,11 +560,15 @@ fn write_model_description(
                 }
                 Ok(())
             })?;
-        let outputs: Vec<usize> = scalars
+        let outputs: Vec<(usize, String)> = scalars
             .iter()
             .enumerate()
             .filter(|(_, s)| s.causality == "output")
-            .map(|(i, _)| i + 1)
+            .map(|(i, s)| {
+                let direct = feedthrough_of(s, &scalars, families);
+                let list = direct.iter().map(usize::to_string).collect::<Vec<_>>();
+                (i + 1, list.join(" "))
+            })
             .collect();
         // FMI 2.0 §2.2.8: the initial unknowns are the outputs and the calculated parameters,
         // in index order.
@@ -472,6 +577,10 @@ fn write_model_description(
             .enumerate()
             .filter(|(_, s)| matches!(s.causality.as_str(), "output" | "calculatedParameter"))
             .map(|(i, _)| i + 1)
+            .collect();
+        let initial_unknowns: Vec<(usize, String)> = initial_unknowns
+            .into_iter()
+            .map(|i| (i, String::new()))
             .collect();
         // At the end of initialisation the outputs describe the static equilibrium, which
         // depends on every parameter and on the load torque and mount stiffness scales; with initialization.periodic they describe the periodic orbit, and
@@ -486,16 +595,23 @@ fn write_model_description(
             .join(" ");
         w.create_element("ModelStructure")
             .write_inner_content(|w| {
-                // Outputs are computed from the integrator's state at the communication point, in
-                // fmi2DoStep (and at initialisation): an input set at a communication point acts
-                // from there on and changes no output before the next step, so no output depends on
-                // an input directly.
-                for (list, indices, dependencies) in [
-                    ("Outputs", &outputs, ""),
-                    ("InitialUnknowns", &initial_unknowns, knowns.as_str()),
+                // Outputs are computed from the state at the communication point, in fmi2DoStep
+                // (and at initialisation): an input set at a communication point acts from there
+                // on and changes no output before the next step — except the interface inputs
+                // the table declares as `feedthrough` (a body's motion at the mounts, the mount
+                // forces on a body), through which the outputs respond at once, as a coupling
+                // algorithm needs.
+                for (list, unknowns) in [
+                    ("Outputs", &outputs),
+                    ("InitialUnknowns", &initial_unknowns),
                 ] {
                     w.create_element(list).write_inner_content(|w| {
-                        for i in indices {
+                        for (i, direct) in unknowns {
+                            let dependencies = if list == "Outputs" {
+                                direct.as_str()
+                            } else {
+                                knowns.as_str()
+                            };
                             let unknown =
                                 vec![attr("index", i), attr("dependencies", dependencies)];
                             element(w, "Unknown", &unknown).write_empty()?;
@@ -540,16 +656,26 @@ fn rust_variability(v: &str) -> &'static str {
     }
 }
 
-fn rust_table(table: &Value, scalars: &[Scalar], families: &[Family], guid: &str) -> String {
+fn rust_table(table: &Value, scalars: &[Scalar], families: &[Family], fmus: &[Fmu; 2]) -> String {
     let mut r = String::from(
         "// Generated by build.rs from modelDescription/variables.json. Do not edit.\n\n",
     );
     let _ = writeln!(
         r,
-        "/// `modelIdentifier`: the FMU's binary name.\npub const MODEL_IDENTIFIER: &str = {:?};",
-        str_field(table, "modelIdentifier")
+        "/// `modelIdentifier` of the engine FMU: its binary name.\npub const MODEL_IDENTIFIER: &str = {:?};",
+        fmus[0].identifier
     );
-    let _ = writeln!(r, "/// The GUID of `modelDescription.xml` (a hash of the variable table).\npub const GUID: &str = {guid:?};");
+    let _ = writeln!(r, "/// The GUID of the engine FMU's `modelDescription.xml` (a hash of the variable table).\npub const GUID: &str = {:?};", fmus[0].guid);
+    let _ = writeln!(
+        r,
+        "/// `modelIdentifier` of the body FMU.\npub const BODY_MODEL_IDENTIFIER: &str = {:?};",
+        fmus[1].identifier
+    );
+    let _ = writeln!(
+        r,
+        "/// The GUID of the body FMU's `modelDescription.xml`.\npub const BODY_GUID: &str = {:?};",
+        fmus[1].guid
+    );
     let _ = writeln!(
         r,
         "/// What the XML adds to a variable's index among its type ([`real`], [`integer`], …) to\n/// make its value reference, per type Real, Integer, Boolean, String: value references are\n/// unique across types.\npub const VR_BASE: [u32; 4] = {VR_BASE:?};"
@@ -614,10 +740,11 @@ fn rust_table(table: &Value, scalars: &[Scalar], families: &[Family], guid: &str
             };
             let _ = writeln!(
                 r,
-                "    Variable {{ name: {:?}, vr: {}, index: {}, causality: {}, variability: {}, start: {start}, min: {}, max: {} }},",
+                "    Variable {{ name: {:?}, vr: {}, index: {}, fmus: {}, causality: {}, variability: {}, start: {start}, min: {}, max: {} }},",
                 s.name,
                 s.vr + vr_base(s.ty),
                 s.vr,
+                s.fmus,
                 rust_causality(&s.causality),
                 rust_variability(&s.variability),
                 if matches!(ty, "Real" | "Integer") { bound(s.min) } else { "None".to_owned() },
@@ -774,20 +901,18 @@ fn xml_escape(s: &str) -> String {
     quick_xml::escape::escape(s).into_owned()
 }
 
-fn documentation(table: &Value, scalars: &[Scalar], guid: &str) -> String {
+fn documentation(scalars: &[Scalar], fmu: &Fmu) -> String {
     let mut h = String::new();
-    let name = xml_escape(str_field(table, "modelName"));
+    let name = xml_escape(fmu.model_name);
+    let guid = &fmu.guid;
     let _ = writeln!(
         h,
         "<!DOCTYPE html>\n<html lang=\"en\"><head><meta charset=\"utf-8\"><title>{name}</title>\n<style>body{{font-family:sans-serif;max-width:70em;margin:2em auto}}table{{border-collapse:collapse}}td,th{{border:1px solid #bbb;padding:3px 6px;text-align:left}}</style></head><body>"
     );
-    let _ = writeln!(
-        h,
-        "<h1>{name}</h1>\n<p>{}</p>",
-        xml_escape(str_field(table, "description"))
-    );
+    let _ = writeln!(h, "<h1>{name}</h1>\n<p>{}</p>", xml_escape(fmu.description));
     let _ = writeln!(h, "<p>FMI 2.0 co-simulation, GUID <code>{guid}</code>.</p>");
-    h.push_str(
+    if fmu.mask == ENGINE {
+        h.push_str(
         "<h2>Scenes</h2>\n<ul><li><b>1</b>: engine on rigid ground: monoblock and housing (with gearbox) as rigid bodies \
          connected by ring carriers, on nonlinear engine mounts fixed to ground (paper Table 1, left column).</li>\
          <li><b>2</b>: engine in the elastic car body: the mounts connect the housing brackets to the mount nodes of the \
@@ -806,8 +931,17 @@ fn documentation(table: &Value, scalars: &[Scalar], guid: &str) -> String {
          set-point that the crank follows critically damped with time constant <code>crank.speedTimeConstant</code>, so \
          a jump becomes a smooth speed change.</p>\n",
     );
+    } else {
+        h.push_str(
+            "<h2>The body alone</h2>\n<p>The Craig-Bampton reduced body on its suspension, linear about a reference \
+             state carrying its own weight: the forces <code>mount[i].F</code> on it at the mount points move it. It starts \
+             in static equilibrium under the forces given at initialisation and integrates its modal equations exactly for \
+             inputs that are linear over a step (set <code>fmi2SetRealInputDerivatives</code> for the force ramps). Units SI, \
+             vehicle frame ISO 8855.</p>\n",
+        );
+    }
     h.push_str("<h2>Variables</h2>\n<table><tr><th>name</th><th>type</th><th>causality</th><th>variability</th><th>start</th><th>unit</th><th>description</th></tr>\n");
-    for s in scalars {
+    for s in scalars.iter().filter(|s| s.fmus & fmu.mask != 0) {
         let _ = writeln!(
             h,
             "<tr><td><code>{}</code></td><td>{}</td><td>{}</td><td>{}</td><td>{}</td><td>{}</td><td>{}</td></tr>",

@@ -54,6 +54,7 @@ fn inputs_at(case: &Case, t: f64, interpolate: bool) -> Inputs {
         load_torque: Signal::constant(0.0),
         stiffness_scale: [Signal::constant(1.0); 4],
         damping_scale: [Signal::constant(1.0); 4],
+        ..Inputs::steady(0.0)
     }
 }
 

@@ -52,6 +52,7 @@ mod cvode {
             load_torque: Signal::constant(0.0),
             stiffness_scale: [Signal::constant(1.0); 4],
             damping_scale: [Signal::constant(1.0); 4],
+            ..Inputs::steady(0.0)
         };
         let (mut s, _) = build_model(&settings).expect("scene");
         apply_inputs(&mut s, &inputs).expect("inputs");

@@ -9,6 +9,7 @@
 use std::path::PathBuf;
 use std::time::Instant;
 
+use engine_mount_chassis::cosim::FmuKind;
 use engine_mount_chassis::fmi2::instance::{Instance, Outcome, Status};
 use engine_mount_chassis::fmi2::logger::Logger;
 use engine_mount_chassis::fmi2::variables::{integer, real};
@@ -24,7 +25,7 @@ struct Run {
 fn run(scene: i32, seconds: f64, h: f64, derivatives: bool) -> Result<Run, String> {
     let resources = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("resources");
     let logger = Logger::new(None, std::ptr::null_mut(), "rpm", false);
-    let mut fmu = Instance::new("rpm", logger, Some(resources));
+    let mut fmu = Instance::new("rpm", FmuKind::Engine, logger, Some(resources));
     let ok = |s: Outcome, what: &str| match s {
         Ok(Status::Ok | Status::Warning) => Ok(()),
         Ok(other) => Err(format!("{what}: {other:?}")),

@@ -4,6 +4,15 @@
 //! its `index` in the per-type arrays [`REALS`], [`INTEGERS`], [`BOOLEANS`] and [`STRINGS`]; the
 //! constants in [`real`], [`integer`], [`boolean`] and [`string`] are these indices. Its value
 //! reference `vr` is the index plus its type's [`VR_BASE`] (unique across types).
+//!
+//! One table serves both FMUs of the library, the engine FMU and the body FMU: a variable's
+//! [`Variable::fmus`] says which model descriptions list it; value references are the same in
+//! both.
+
+/// Bit of [`Variable::fmus`]: the engine FMU (`EngineMountChassis`) has the variable.
+pub const ENGINE_FMU: u8 = 1;
+/// Bit of [`Variable::fmus`]: the body FMU (`EngineMountBody`) has the variable.
+pub const BODY_FMU: u8 = 2;
 
 /// FMI causality of a variable.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -44,6 +53,8 @@ pub struct Variable<T: 'static> {
     pub vr: u32,
     /// Position among the variables of its type.
     pub index: u32,
+    /// The FMUs whose model description has the variable ([`ENGINE_FMU`], [`BODY_FMU`] bits).
+    pub fmus: u8,
     /// Who sets the variable and when.
     pub causality: Causality,
     /// When the variable can change.

@@ -163,7 +163,7 @@ def test_comfort_outputs_are_declared_in_g_display_units(fmu_path):
         v = by_name[name]
         assert v.causality == "output" and v.unit == "m/s2" and v.displayUnit == "g"
     scene = by_name["scene"]
-    assert scene.max == "2" or scene.max == 2
+    assert scene.max == "3" or scene.max == 3
     for name in ["chassis.modeCutoff", "chassis.maxModes", "chassis.stiffeningBar",
                  "chassis.cacheEnabled", "chassis.cacheDir"]:
         assert by_name[name].causality == "parameter", name

@@ -6,8 +6,10 @@
 //! The integrator keeps its history across communication points and lands exactly on each one
 //! (a stop time, not a restart); it restarts at order 1 only where an input really jumps.
 
+pub mod body;
 pub mod error;
 pub mod periodic;
+pub mod runtime;
 pub mod scene;
 pub mod settings;
 mod signals;
@@ -15,11 +17,14 @@ mod signals;
 pub use crate::cms::CacheSetting;
 pub use crate::model::scene::{BodyOption, BodyOptions, SceneKind, AUTO_CUTOFF_MARGIN};
 pub use crate::model::{EffectSwitch, Effects};
+pub use body::{BodySimulation, BodyState};
 pub use error::{Error, Input};
+pub use runtime::{FmuKind, Runtime, RuntimeState};
 pub use scene::FMU_MOUNTS;
 pub use settings::{EffectOverrides, Replaced, Settings, VehicleOverrides, VehicleSetting};
 pub use signals::{Inputs, Signal};
 
+pub use crate::model::body_alone::PointKinematics;
 use crate::model::CoupledModel;
 use crate::ode::{Bdf, BdfOptions, BdfSnapshot, OdeProblem};
 
@@ -46,6 +51,8 @@ pub struct Outputs {
     pub steering_wheel_acceleration: [f64; 3],
     /// Seat-rail acceleration from the equations of motion, m/s² (scene 2; zero in scene 1).
     pub seat_acceleration: [f64; 3],
+    /// The body alone: motion of the body at each mount point (zero in the engine's scenes).
+    pub mount_point: [PointKinematics; 4],
 }
 
 /// Work counters of the integrator since initialisation.
@@ -241,6 +248,12 @@ impl Simulation {
         let jumped = sharp_kink || !self.inputs.continue_into(&compared, t);
         let previous = self.inputs;
         scene::apply_inputs(&mut self.scene, inputs)?;
+        // An external body may move a mount beyond its characteristic: refuse the inputs
+        // (naming the mount) rather than extrapolate a curve the mount does not have.
+        if let Err(e) = self.interface_in_range() {
+            scene::apply_inputs(&mut self.scene, &previous)?;
+            return Err(e);
+        }
         self.inputs = *inputs;
         if jumped {
             if let Err(e) = self.integrator.restart_at(&mut self.scene, t, &self.state) {
@@ -295,6 +308,81 @@ impl Simulation {
     /// equations of motion.
     pub fn outputs(&mut self) -> Result<Outputs, Error> {
         scene::outputs(&self.scene, self.time, &self.state)
+    }
+
+    /// The inputs in force.
+    pub fn inputs(&self) -> &Inputs {
+        &self.inputs
+    }
+
+    /// The inputs in force with the interface signals (attachment motion, forces on a body)
+    /// of `interface`.
+    fn with_interface(&self, interface: &Inputs) -> Inputs {
+        Inputs {
+            body_displacement: interface.body_displacement,
+            body_velocity: interface.body_velocity,
+            body_force: interface.body_force,
+            ..self.inputs
+        }
+    }
+
+    /// Outputs at the communication time, the state held, with the interface signals of
+    /// `interface`: the mount forces and the powertrain acceleration respond at once to the
+    /// external body's motion (scene 3).
+    pub fn outputs_with(&mut self, interface: &Inputs) -> Result<Outputs, Error> {
+        let trial = self.with_interface(interface);
+        scene::apply_inputs(&mut self.scene, &trial)?;
+        let outputs = self
+            .interface_in_range()
+            .and_then(|()| scene::outputs(&self.scene, self.time, &self.state));
+        scene::apply_inputs(&mut self.scene, &self.inputs)?;
+        outputs
+    }
+
+    /// With an external body, whether its motion at the communication time keeps every mount
+    /// within its characteristic (an error naming the mount otherwise).
+    fn interface_in_range(&self) -> Result<(), Error> {
+        if !self.scene.has_external_body() {
+            return Ok(());
+        }
+        self.scene
+            .check_mount_ranges(self.time, &self.state)
+            .map_err(|e| {
+                Error::Model(format!(
+                    "the external body's motion at t = {} s: {}",
+                    self.time, e.0
+                ))
+            })
+    }
+
+    /// The response of the mount forces and the powertrain acceleration to the attachment
+    /// increments in `seed` (values only), the state held, at the interface signals of `at`:
+    /// the exact derivatives of [`Self::outputs_with`] (zero outside scene 3).
+    pub fn output_derivatives(&mut self, at: &Inputs, seed: &Inputs) -> Result<Outputs, Error> {
+        let trial = self.with_interface(at);
+        scene::apply_inputs(&mut self.scene, &trial)?;
+        let sensitivities = self
+            .scene
+            .interface_sensitivities(self.time, &self.state)
+            .map_err(|e| Error::Model(format!("{e:?}")));
+        scene::apply_inputs(&mut self.scene, &self.inputs)?;
+        let mut out = Outputs::default();
+        for (i, s) in sensitivities?.iter().enumerate().take(FMU_MOUNTS) {
+            let Some(s) = s else { continue };
+            let u = nalgebra::Vector3::from(seed.body_displacement[i].map(|x| x.value));
+            let v = nalgebra::Vector3::from(seed.body_velocity[i].map(|x| x.value));
+            let force = s.force_per_displacement * u + s.force_per_velocity * v;
+            let acceleration = s.housing_acceleration_per_force * force;
+            out.mount_force[i] = force.into();
+            for (a, d) in out
+                .powertrain_acceleration
+                .iter_mut()
+                .zip(acceleration.iter())
+            {
+                *a += d;
+            }
+        }
+        Ok(out)
     }
 
     /// The integrator's work since this simulation was built (or restored).

@@ -3,7 +3,8 @@
 
 use super::settings::Replaced;
 use super::{Error, Inputs, Outputs, Settings};
-use crate::model::scene::{build, SceneKind};
+use crate::model::inputs::AttachmentMotion;
+use crate::model::scene::build;
 use crate::model::{CoupledModel, RampInput, VehicleConfig};
 
 /// Number of mounts the FMU's variables expose (`mount[1..4]`).
@@ -61,10 +62,7 @@ pub fn build_model(settings: &Settings) -> Result<BuiltModel, Error> {
     notes.push(format!(
         "scene {} ({}): {}",
         settings.scene.number(),
-        match settings.scene {
-            SceneKind::Ground => "engine on rigid ground",
-            SceneKind::Body => "engine in the elastic chassis",
-        },
+        settings.scene.describe(),
         built.model.describe()
     ));
     Ok(BuiltModel {
@@ -90,6 +88,10 @@ pub fn apply_inputs(model: &mut CoupledModel, inputs: &Inputs) -> Result<(), Err
     for i in 0..m.stiffness_scale.len().min(FMU_MOUNTS) {
         m.stiffness_scale[i] = ramp(&inputs.stiffness_scale[i]);
         m.damping_scale[i] = ramp(&inputs.damping_scale[i]);
+        m.body_motion[i] = AttachmentMotion {
+            displacement: inputs.body_displacement[i].each_ref().map(ramp),
+            velocity: inputs.body_velocity[i].each_ref().map(ramp),
+        };
     }
     model.set_inputs(&m).map_err(|e| Error::Model(e.0))
 }

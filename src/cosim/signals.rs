@@ -46,6 +46,13 @@ pub struct Inputs {
     pub stiffness_scale: [Signal; 4],
     /// Scale on each mount's damping (>= 0).
     pub damping_scale: [Signal; 4],
+    /// Scene 3: displacement of each mount's attachment point on the external body, m, per
+    /// vehicle axis.
+    pub body_displacement: [[Signal; 3]; 4],
+    /// Scene 3: velocity of each mount's attachment point on the external body, m/s.
+    pub body_velocity: [[Signal; 3]; 4],
+    /// The body alone: the force on the body at each mount point, N, per vehicle axis.
+    pub body_force: [[Signal; 3]; 4],
 }
 
 impl Inputs {
@@ -57,7 +64,23 @@ impl Inputs {
             load_torque: Signal::constant(0.0),
             stiffness_scale: [Signal::constant(1.0); 4],
             damping_scale: [Signal::constant(1.0); 4],
+            body_displacement: [[Signal::constant(0.0); 3]; 4],
+            body_velocity: [[Signal::constant(0.0); 3]; 4],
+            body_force: [[Signal::constant(0.0); 3]; 4],
         }
+    }
+
+    /// The signals of the external body's interface: attachment displacements and velocities
+    /// and the forces on the body, mount by mount.
+    pub fn interface(&self) -> impl Iterator<Item = &Signal> + '_ {
+        [
+            &self.body_displacement,
+            &self.body_velocity,
+            &self.body_force,
+        ]
+        .into_iter()
+        .flatten()
+        .flatten()
     }
 
     /// Physical admissibility of the input values (finite values are checked by the caller).
@@ -81,7 +104,11 @@ impl Inputs {
         Ok(())
     }
 
-    /// Whether `next` continues every signal without a jump at time `t`.
+    /// Whether `next` continues every signal without a jump at time `t`. The interface signals
+    /// of an external body are not compared: a coupling master sets them every communication
+    /// step from the other model's outputs, where they never exactly continue the ramp before;
+    /// their small jumps bend the trajectory less than an integrator restart at each step would
+    /// cost, and the error control sees them.
     pub fn continue_into(&self, next: &Inputs, t: f64) -> bool {
         let pairs = [
             (&self.crank_speed, &next.crank_speed),
@@ -115,6 +142,7 @@ mod tests {
             load_torque: Signal::constant(0.0),
             stiffness_scale: [Signal::constant(1.0); 4],
             damping_scale: [Signal::constant(1.0); 4],
+            ..Inputs::steady(0.0)
         }
     }
 

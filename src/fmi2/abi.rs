@@ -20,7 +20,10 @@ use super::snapshot;
 use super::state::{self, Mask, Phase};
 use super::uri::resource_path;
 use super::values::{indices, Typed};
-use super::variables::{string, LogCategory, GUID, STRINGS};
+use super::variables::{
+    string, LogCategory, BODY_GUID, BODY_MODEL_IDENTIFIER, GUID, MODEL_IDENTIFIER, STRINGS,
+};
+use crate::cosim::FmuKind;
 
 /// Marks a live instance allocated by `fmi2Instantiate`; cleared when freed, so a stale or
 /// foreign pointer is recognised with high probability instead of being used.
@@ -278,12 +281,18 @@ pub extern "C" fn fmi2Instantiate(
                 "this FMU supports co-simulation only (fmuType must be fmi2CoSimulation)",
             );
         }
-        if guid != GUID {
+        let kind = if guid == GUID {
+            FmuKind::Engine
+        } else if guid == BODY_GUID {
+            FmuKind::Body
+        } else {
             return refuse(
                 &logger,
-                &format!("GUID \"{guid}\" does not match this FMU's {GUID}"),
+                &format!(
+                    "GUID \"{guid}\" matches neither {MODEL_IDENTIFIER} ({GUID}) nor {BODY_MODEL_IDENTIFIER} ({BODY_GUID}), the FMUs of this library"
+                ),
             );
-        }
+        };
         let resource_dir = match resource_dir(resources.as_deref()) {
             Ok(dir) => dir,
             Err(m) => return refuse(&logger, &m),
@@ -298,7 +307,7 @@ pub extern "C" fn fmi2Instantiate(
         }
         let handle = Box::new(Handle {
             live: LIVE,
-            instance: Instance::new(&name, logger, resource_dir),
+            instance: Instance::new(&name, kind, logger, resource_dir),
             returned_strings: Vec::new(),
             states: Vec::new(),
         });
@@ -670,7 +679,7 @@ pub extern "C" fn fmi2SerializedFMUstateSize(
         let i = h.state(FMUstate)?;
         // SAFETY: size points to a writable usize.
         let size = unsafe { place(size, "size") }?;
-        *size = snapshot::serialize(&h.states[i].core).len();
+        *size = snapshot::serialize(&h.states[i].core, h.instance.guid()).len();
         Ok(Status::Ok)
     })
 }
@@ -687,7 +696,7 @@ pub extern "C" fn fmi2SerializeFMUstate(
 ) -> fmi2Status {
     entry(c, "fmi2SerializeFMUstate", state::FMU_STATE, |h| {
         let i = h.state(FMUstate)?;
-        let bytes = snapshot::serialize(&h.states[i].core);
+        let bytes = snapshot::serialize(&h.states[i].core, h.instance.guid());
         if bytes.len() != size {
             return Err(format!(
                 "buffer has {size} bytes, the state needs {}",
@@ -721,7 +730,7 @@ pub extern "C" fn fmi2DeSerializeFMUstate(
             )
         };
         let inst = &h.instance;
-        let core = snapshot::deserialize(bytes, |core, dynamic| {
+        let core = snapshot::deserialize(bytes, inst.guid(), |core, dynamic| {
             inst.restore_simulation(core, dynamic)
         })?;
         h.store_state(slot, core)
@@ -729,23 +738,43 @@ pub extern "C" fn fmi2DeSerializeFMUstate(
 }
 const _: fmi2DeSerializeFMUstateTYPE = Some(fmi2DeSerializeFMUstate);
 
-/// Always refused with fmi2Error: the model description declares
-/// `providesDirectionalDerivative="false"`.
+/// Directional derivatives of Real outputs with respect to Real inputs between steps
+/// (`providesDirectionalDerivative="true"`): `dvUnknown[i] = Σ_k ∂unknown_i/∂known_k · dvKnown[k]`
+/// at the current communication point, the state held. Non-zero only through the interface
+/// inputs the model structure declares as direct dependencies.
 #[no_mangle]
 pub extern "C" fn fmi2GetDirectionalDerivative(
     c: fmi2Component,
-    _vUnknown_ref: *const fmi2ValueReference,
-    _nUnknown: usize,
-    _vKnown_ref: *const fmi2ValueReference,
-    _nKnown: usize,
-    _dvKnown: *const fmi2Real,
-    _dvUnknown: *mut fmi2Real,
+    vUnknown_ref: *const fmi2ValueReference,
+    nUnknown: usize,
+    vKnown_ref: *const fmi2ValueReference,
+    nKnown: usize,
+    dvKnown: *const fmi2Real,
+    dvUnknown: *mut fmi2Real,
 ) -> fmi2Status {
     entry(
         c,
         "fmi2GetDirectionalDerivative",
         state::DIRECTIONAL_DERIVATIVE,
-        |_| Err("not provided (providesDirectionalDerivative=false)".into()),
+        |h| {
+            // SAFETY: FMI passes nUnknown unknown references, nKnown known references and seeds,
+            // and a writable array of nUnknown results.
+            let (unknowns, knowns, seeds, out) = unsafe {
+                (
+                    array(vUnknown_ref, nUnknown, "vUnknown_ref")?,
+                    array(vKnown_ref, nKnown, "vKnown_ref")?,
+                    array(dvKnown, nKnown, "dvKnown")?,
+                    array_mut(dvUnknown, nUnknown, "dvUnknown")?,
+                )
+            };
+            let unknowns = indices::<f64>(unknowns)?;
+            let knowns = indices::<f64>(knowns)?;
+            let values = h
+                .instance
+                .directional_derivative(&unknowns, &knowns, seeds)?;
+            out.copy_from_slice(&values);
+            Ok(Status::Ok)
+        },
     )
 }
 const _: fmi2GetDirectionalDerivativeTYPE = Some(fmi2GetDirectionalDerivative);

@@ -15,7 +15,7 @@ use super::parameters;
 use super::state::Phase;
 use super::values::{Num, Store, Typed, Values, VarType};
 use super::variables::{integer, real, Causality, LogCategory, Variability, Variable, REALS};
-use crate::cosim::{self, Simulation};
+use crate::cosim::{self, FmuKind, Runtime};
 
 /// Result of an FMI call, mapped to `fmi2Status` by the ABI layer.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, PartialOrd, Ord)]
@@ -58,7 +58,7 @@ pub struct Core {
     pub terminated: bool,
     /// The built model with its integrator; `None` before initialisation ends and after a
     /// parameter change in initialisation mode (rebuilt when next needed).
-    pub simulation: Option<Simulation>,
+    pub simulation: Option<Runtime>,
     /// Why building the model failed with the current parameters and inputs: asked again
     /// without a change, the answer is the same, without building again.
     pub setup_failure: Option<String>,
@@ -124,6 +124,8 @@ impl Core {
 pub struct Instance {
     /// The `instanceName` of fmi2Instantiate.
     pub name: String,
+    /// Which of the library's FMUs this instance is (from the GUID it was instantiated with).
+    pub kind: FmuKind,
     /// The master's logger callback with the enabled categories.
     pub logger: Logger,
     /// The FMU's `resources` directory, from `fmuResourceLocation`; relative `configFile`
@@ -135,12 +137,55 @@ pub struct Instance {
 
 impl Instance {
     /// A freshly instantiated instance with start values and no model.
-    pub fn new(name: &str, logger: Logger, resource_dir: Option<PathBuf>) -> Instance {
+    pub fn new(
+        name: &str,
+        kind: FmuKind,
+        logger: Logger,
+        resource_dir: Option<PathBuf>,
+    ) -> Instance {
         Instance {
             name: name.to_owned(),
+            kind,
             logger,
             resource_dir,
             core: Core::fresh(),
+        }
+    }
+
+    /// The GUID of this instance's FMU.
+    pub fn guid(&self) -> &'static str {
+        match self.kind {
+            FmuKind::Engine => super::variables::GUID,
+            FmuKind::Body => super::variables::BODY_GUID,
+        }
+    }
+
+    /// The bit of this instance's FMU in [`Variable::fmus`].
+    fn fmu_bit(&self) -> u8 {
+        match self.kind {
+            FmuKind::Engine => super::variables::ENGINE_FMU,
+            FmuKind::Body => super::variables::BODY_FMU,
+        }
+    }
+
+    /// Refuses variables the model description of this instance's FMU does not list (the two
+    /// FMUs share one value-reference space).
+    fn check_members<T: Typed>(&self, indices: &[usize]) -> Result<(), String> {
+        let bit = self.fmu_bit();
+        match indices.iter().find(|&&i| T::table()[i].fmus & bit == 0) {
+            Some(&i) => {
+                let v = &T::table()[i];
+                Err(format!(
+                    "value reference {} ({}) is not a variable of {}",
+                    v.vr,
+                    v.name,
+                    match self.kind {
+                        FmuKind::Engine => super::variables::MODEL_IDENTIFIER,
+                        FmuKind::Body => super::variables::BODY_MODEL_IDENTIFIER,
+                    }
+                ))
+            }
+            None => Ok(()),
         }
     }
 
@@ -267,7 +312,7 @@ impl Instance {
     }
 
     /// A simulation built from the current parameters and inputs, at its static equilibrium.
-    fn build_simulation(&self) -> Result<Simulation, String> {
+    fn build_simulation(&self) -> Result<Runtime, String> {
         let settings = self.settings_for(&self.core)?;
         let inputs = parameters::inputs_from(&self.core.inputs, self.core.time);
         self.event(&parameters::tolerance_note(
@@ -275,9 +320,12 @@ impl Instance {
             &settings,
             self.core.experiment_tolerance,
         ));
+        let what = match self.kind {
+            FmuKind::Engine => format!("scene {}", settings.scene.number()),
+            FmuKind::Body => "the body alone".to_owned(),
+        };
         self.event(&format!(
-            "building scene {} at t = {} s (config: {})",
-            settings.scene.number(),
+            "building {what} at t = {} s (config: {})",
             self.core.time,
             settings
                 .config_file
@@ -285,7 +333,7 @@ impl Instance {
                 .map(|p| p.display().to_string())
                 .unwrap_or_else(|| "built-in defaults".to_owned())
         ));
-        Simulation::new(&settings, self.core.time, &inputs)
+        Runtime::new(self.kind, &settings, self.core.time, &inputs)
             .map_err(|e| format!("model set-up failed: {}", parameters::message(&e)))
     }
 
@@ -293,9 +341,9 @@ impl Instance {
     pub fn restore_simulation(
         &self,
         core: &Core,
-        dynamic: &cosim::SimulationState,
-    ) -> Result<Simulation, String> {
-        Simulation::restore(&self.settings_for(core)?, dynamic).map_err(|e| parameters::message(&e))
+        dynamic: &cosim::RuntimeState,
+    ) -> Result<Runtime, String> {
+        Runtime::restore(&self.settings_for(core)?, dynamic).map_err(|e| parameters::message(&e))
     }
 
     /// The model settings the parameters of `core` describe.
@@ -351,6 +399,7 @@ impl Instance {
     /// the static equilibrium's; calculated parameters (the natural modes) are computed when
     /// first asked for.
     pub fn get<T: Typed>(&mut self, indices: &[usize]) -> Result<Vec<T>, String> {
+        self.check_members::<T>(indices)?;
         let causality = |i: &usize| T::table()[*i].causality;
         if self.core.phase == Phase::InitializationMode
             && indices.iter().any(|i| causality(i) == Causality::Output)
@@ -369,6 +418,7 @@ impl Instance {
 
     /// `fmi2SetXXX` for the variables at `indices`: all checked before any is applied.
     pub fn set<T: Typed>(&mut self, indices: &[usize], values: &[T]) -> Outcome {
+        self.check_members::<T>(indices)?;
         let phase = self.core.phase;
         let next = self
             .core
@@ -377,8 +427,20 @@ impl Instance {
             .with_set(indices, values, |v| settable(v, phase))?;
         let before = std::mem::replace(self.core.values.of_mut::<T>(), next);
         if T::TYPE_INDEX == <f64 as VarType>::TYPE_INDEX {
-            if let Err(m) = self.follow_real_inputs(indices) {
+            let tracks = self.core.inputs.clone();
+            let refreshed = self.follow_real_inputs(indices).and_then(|()| {
+                if phase == Phase::StepComplete
+                    && indices.iter().any(|&i| parameters::is_interface_input(i))
+                {
+                    self.refresh_feedthrough()
+                } else {
+                    Ok(())
+                }
+            });
+            if let Err(m) = refreshed {
+                // `before` is the whole Real store: inputs and any output a refresh wrote.
                 *self.core.values.of_mut::<T>() = before;
+                self.core.inputs = tracks;
                 return Err(m);
             }
         }
@@ -388,6 +450,78 @@ impl Instance {
             self.core.setup_failure = None;
         }
         Ok(Status::Ok)
+    }
+
+    /// Recomputes the outputs with direct feedthrough from the interface inputs just set (the
+    /// state held): a coupling master reads the mount forces for the body motion it has just
+    /// given, within the same communication point.
+    fn refresh_feedthrough(&mut self) -> Result<(), String> {
+        let interface = parameters::inputs_from(&self.core.inputs, self.core.time);
+        let Some(runtime) = self.core.simulation.as_mut() else {
+            return Ok(());
+        };
+        let outputs = runtime
+            .outputs_with(&interface)
+            .map_err(|e| parameters::message(&e))?;
+        parameters::put_outputs(&mut self.core.values.reals, &outputs);
+        Ok(())
+    }
+
+    /// `fmi2GetDirectionalDerivative`: `Σ_k ∂unknown/∂known_k · seed_k` for Real outputs with
+    /// respect to Real inputs at the current communication point, the state held — the same
+    /// instantaneous dependence the model structure declares (non-zero only through the
+    /// interface inputs). Exact: from the mounts' tangent stiffness and damping and the
+    /// housing's mass matrix, or the body's modal shapes.
+    pub fn directional_derivative(
+        &mut self,
+        unknowns: &[usize],
+        knowns: &[usize],
+        seeds: &[f64],
+    ) -> Result<Vec<f64>, String> {
+        self.check_members::<f64>(unknowns)?;
+        self.check_members::<f64>(knowns)?;
+        if let Some(&i) = knowns
+            .iter()
+            .find(|&&i| REALS[i].causality != Causality::Input)
+        {
+            return Err(format!(
+                "{} is not an input: the derivatives provided are of outputs with respect to inputs",
+                REALS[i].name
+            ));
+        }
+        if let Some(&i) = unknowns
+            .iter()
+            .find(|&&i| REALS[i].causality != Causality::Output)
+        {
+            return Err(format!(
+                "{} is not an output: the derivatives provided are of outputs with respect to inputs",
+                REALS[i].name
+            ));
+        }
+        if let Some(s) = seeds.iter().find(|s| !s.is_finite()) {
+            return Err(format!("seed {} is not finite", Num(*s)));
+        }
+        if self.core.phase != Phase::StepComplete {
+            return Err(
+                "directional derivatives are provided between steps, after fmi2ExitInitializationMode"
+                    .into(),
+            );
+        }
+        let mut increments = vec![0.0; REALS.len()];
+        for (&k, &s) in knowns.iter().zip(seeds) {
+            increments[k] += s;
+        }
+        let seed = parameters::input_increments(&increments);
+        let at = parameters::inputs_from(&self.core.inputs, self.core.time);
+        let Some(runtime) = self.core.simulation.as_mut() else {
+            return Err("the model is not built".into());
+        };
+        let response = runtime
+            .output_derivatives(&at, &seed)
+            .map_err(|e| parameters::message(&e))?;
+        let mut scratch = self.core.values.reals.clone();
+        parameters::put_outputs(&mut scratch, &response);
+        Ok(unknowns.iter().map(|&u| *scratch.get(u as u32)).collect())
     }
 
     /// The input signals after the Reals at `indices` were set: each input set continues from
@@ -413,6 +547,7 @@ impl Instance {
         orders: &[i32],
         values: &[f64],
     ) -> Outcome {
+        self.check_members::<f64>(indices)?;
         let mut candidate = self.core.inputs.clone();
         for ((&i, order), value) in indices.iter().zip(orders).zip(values) {
             let v = &REALS[i];
@@ -510,7 +645,7 @@ mod tests {
     fn deserialized_state_continues_bit_for_bit() {
         let logger = Logger::new(None, std::ptr::null_mut(), "t", false);
         let resources = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("resources");
-        let mut inst = Instance::new("t", logger, Some(resources));
+        let mut inst = Instance::new("t", FmuKind::Engine, logger, Some(resources));
         assert_eq!(inst.setup_experiment(0.0, None, None), Ok(Status::Ok));
         inst.enter_initialization().unwrap();
         assert_eq!(inst.exit_initialization(), Ok(Status::Ok));
@@ -519,7 +654,7 @@ mod tests {
             assert_eq!(inst.do_step(t, 1e-3), Ok(Status::Ok));
             t += 1e-3;
         }
-        let bytes = super::super::snapshot::serialize(&inst.core);
+        let bytes = super::super::snapshot::serialize(&inst.core, inst.guid());
         let saved = inst.core.clone();
         let mut reference = Vec::new();
         let mut tt = t;
@@ -535,9 +670,10 @@ mod tests {
             tt += 1e-3;
             assert_eq!(&inst.core.values.reals, r, "in-memory");
         }
-        let core =
-            super::super::snapshot::deserialize(&bytes, |c, d| inst.restore_simulation(c, d))
-                .unwrap();
+        let core = super::super::snapshot::deserialize(&bytes, inst.guid(), |c, d| {
+            inst.restore_simulation(c, d)
+        })
+        .unwrap();
         let a = saved.simulation.as_ref().unwrap().dynamic_state();
         let b = core.simulation.as_ref().unwrap().dynamic_state();
         assert_eq!(a, b);

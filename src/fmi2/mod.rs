@@ -33,5 +33,9 @@ pub use crate::variables;
 pub const MODEL_DESCRIPTION_XML: &str =
     include_str!(concat!(env!("OUT_DIR"), "/modelDescription.xml"));
 
+/// The body FMU's `modelDescription.xml` (the variables of the same table tagged for it).
+pub const BODY_MODEL_DESCRIPTION_XML: &str =
+    include_str!(concat!(env!("OUT_DIR"), "/body.modelDescription.xml"));
+
 /// The FMU's `documentation/index.html`.
 pub const DOCUMENTATION_HTML: &str = include_str!(concat!(env!("OUT_DIR"), "/index.html"));

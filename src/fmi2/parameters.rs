@@ -149,7 +149,11 @@ pub fn tolerance_note(values: &Values, settings: &Settings, experiment: Option<f
 
 /// The parameters the vehicle values come from, set to the values the model uses (a
 /// configuration file's where the master did not set them), so that reading one tells the truth.
-pub fn write_effective_parameters(values: &mut Values, simulation: &cosim::Simulation) {
+pub fn write_effective_parameters(values: &mut Values, runtime: &cosim::Runtime) {
+    let Some(simulation) = runtime.engine() else {
+        // The body FMU's parameters are all the model's own (nothing comes from the engine).
+        return;
+    };
     let model = simulation.model();
     let engine = model.powertrain().config();
     let r = &mut values.reals;
@@ -173,20 +177,68 @@ pub fn write_effective_parameters(values: &mut Values, simulation: &cosim::Simul
 
 /// The runtime's inputs from the Real input signals, from `time` on (SI units).
 pub fn inputs_from(tracks: &[InputTrack], time: f64) -> cosim::Inputs {
-    let signal = |index: u32, scale: f64| {
+    inputs_by(|index, scale| {
         let (value, derivative) = tracks[index as usize].preview(time);
         cosim::Signal {
             value: value * scale,
             derivative: derivative * scale,
             reference_time: time,
         }
-    };
+    })
+}
+
+/// Input increments as runtime inputs (SI units, values only), from increments `seeds` of the
+/// Reals indexed like [`REALS`]: the seed of a directional derivative.
+pub fn input_increments(seeds: &[f64]) -> cosim::Inputs {
+    inputs_by(|index, scale| cosim::Signal::constant(seeds[index as usize] * scale))
+}
+
+/// The runtime's inputs with each signal from `signal(real index, factor to SI)`: the one place
+/// that knows which Real input feeds which runtime input.
+fn inputs_by(signal: impl Fn(u32, f64) -> cosim::Signal) -> cosim::Inputs {
     cosim::Inputs {
         crank_speed: signal(real::RPM, RPM),
         load_torque: signal(real::LOAD_TORQUE, 1.0),
         stiffness_scale: real::MOUNT_STIFFNESS_SCALE.map(|i| signal(i, 1.0)),
         damping_scale: real::MOUNT_DAMPING_SCALE.map(|i| signal(i, 1.0)),
+        body_displacement: real::MOUNT_BODY_R.map(|m| m.map(|i| signal(i, 1.0))),
+        body_velocity: real::MOUNT_BODY_V.map(|m| m.map(|i| signal(i, 1.0))),
+        body_force: real::BODY_MOUNT_F.map(|m| m.map(|i| signal(i, 1.0))),
     }
+}
+
+/// Writes the runtime's outputs into the Reals (both FMUs' outputs: each FMU lists its own).
+pub fn put_outputs(r: &mut super::values::Store<f64>, o: &cosim::Outputs) {
+    for (i, mount) in o.mount_force.iter().enumerate() {
+        for (j, f) in mount.iter().enumerate() {
+            r.put(real::MOUNT_F[i][j], *f);
+        }
+    }
+    r.put(real::CRANK_ANGLE, o.crank_angle);
+    for k in 0..3 {
+        r.put(real::POWERTRAIN_R[k], o.powertrain_displacement[k]);
+        r.put(real::POWERTRAIN_PHI[k], o.powertrain_rotation[k]);
+        r.put(real::POWERTRAIN_A[k], o.powertrain_acceleration[k]);
+        r.put(real::STEERING_WHEEL_A[k], o.steering_wheel_acceleration[k]);
+        r.put(real::SEAT_A[k], o.seat_acceleration[k]);
+    }
+    for (i, p) in o.mount_point.iter().enumerate() {
+        for j in 0..3 {
+            r.put(real::BODY_MOUNT_R[i][j], p.displacement[j]);
+            r.put(real::BODY_MOUNT_V[i][j], p.velocity[j]);
+            r.put(real::BODY_MOUNT_A[i][j], p.acceleration[j]);
+        }
+    }
+}
+
+/// Whether Real `index` is an input through which outputs respond at once (the interface to an
+/// external body: attachment motion, forces on the body).
+pub fn is_interface_input(index: usize) -> bool {
+    [real::MOUNT_BODY_R, real::MOUNT_BODY_V, real::BODY_MOUNT_F]
+        .iter()
+        .flatten()
+        .flatten()
+        .any(|&i| i as usize == index)
 }
 
 /// The Real input behind a runtime input, and the factor from SI units to the input's unit.

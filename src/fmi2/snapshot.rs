@@ -10,14 +10,13 @@ use super::input_track::InputTrack;
 use super::instance::Core;
 use super::state::Phase;
 use super::values::Values;
-use super::variables::GUID;
-use crate::cosim::{Simulation, SimulationState};
+use crate::cosim::{Runtime, RuntimeState};
 use crate::saved_state;
 
 const MAGIC: &[u8; 8] = b"EMCSTATE";
 /// 4: values with the variables the master set; 3: postcard; 1 and 2 were hand-written byte
 /// layouts.
-const FORMAT_VERSION: u32 = 4;
+const FORMAT_VERSION: u32 = 5;
 
 /// What a serialized state holds: the co-simulation state machine, every variable value, the
 /// input signals and the simulation's dynamic state.
@@ -32,13 +31,13 @@ struct SavedCore {
     experiment_tolerance: Option<f64>,
     values: Values,
     inputs: Vec<InputTrack>,
-    simulation: Option<SimulationState>,
+    simulation: Option<RuntimeState>,
 }
 
 /// Serializes a state captured by `fmi2GetFMUstate`.
-pub fn serialize(core: &Core) -> Vec<u8> {
+pub fn serialize(core: &Core, guid: &str) -> Vec<u8> {
     let saved = SavedCore {
-        guid: GUID.to_string(),
+        guid: guid.to_string(),
         phase: core.phase,
         start_time: core.start_time,
         stop_time: core.stop_time,
@@ -47,7 +46,7 @@ pub fn serialize(core: &Core) -> Vec<u8> {
         experiment_tolerance: core.experiment_tolerance,
         values: core.values.clone(),
         inputs: core.inputs.clone(),
-        simulation: core.simulation.as_ref().map(Simulation::dynamic_state),
+        simulation: core.simulation.as_ref().map(Runtime::dynamic_state),
     };
     saved_state::encode(MAGIC, FORMAT_VERSION, &saved)
 }
@@ -56,13 +55,14 @@ pub fn serialize(core: &Core) -> Vec<u8> {
 /// the simulation's dynamic state.
 pub fn deserialize(
     bytes: &[u8],
-    rebuild: impl FnOnce(&Core, &SimulationState) -> Result<Simulation, String>,
+    guid: &str,
+    rebuild: impl FnOnce(&Core, &RuntimeState) -> Result<Runtime, String>,
 ) -> Result<Core, String> {
     let saved: SavedCore =
         saved_state::decode(bytes, MAGIC, FORMAT_VERSION, "an FMU state of this model")?;
-    if saved.guid != GUID {
+    if saved.guid != guid {
         return Err(format!(
-            "FMU state belongs to GUID {}, this FMU is {GUID}",
+            "FMU state belongs to GUID {}, this FMU is {guid}",
             saved.guid
         ));
     }

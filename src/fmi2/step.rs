@@ -5,7 +5,7 @@ use super::logger::Level;
 use super::parameters;
 use super::state::Phase;
 use super::values::Num;
-use super::variables::{integer, real, Causality, LogCategory, REALS};
+use super::variables::{integer, Causality, LogCategory, REALS};
 use crate::cosim;
 
 /// Relative tolerance on communication points: masters compute them as `t0 + n h`.
@@ -203,20 +203,7 @@ impl Instance {
 
     /// Writes the outputs and the solver counters.
     pub(super) fn write_outputs(&mut self, o: &cosim::Outputs, c: &cosim::Counters) {
-        let r = &mut self.core.values.reals;
-        for (i, mount) in o.mount_force.iter().enumerate() {
-            for (j, f) in mount.iter().enumerate() {
-                r.put(real::MOUNT_F[i][j], *f);
-            }
-        }
-        r.put(real::CRANK_ANGLE, o.crank_angle);
-        for k in 0..3 {
-            r.put(real::POWERTRAIN_R[k], o.powertrain_displacement[k]);
-            r.put(real::POWERTRAIN_PHI[k], o.powertrain_rotation[k]);
-            r.put(real::POWERTRAIN_A[k], o.powertrain_acceleration[k]);
-            r.put(real::STEERING_WHEEL_A[k], o.steering_wheel_acceleration[k]);
-            r.put(real::SEAT_A[k], o.seat_acceleration[k]);
-        }
+        parameters::put_outputs(&mut self.core.values.reals, o);
         let n = &mut self.core.values.integers;
         let clamp = |x: u64| x.min(i32::MAX as u64) as i32;
         n.put(integer::SOLVER_STEPS, clamp(c.steps));

@@ -15,6 +15,13 @@ pub struct RampInput {
 }
 
 impl RampInput {
+    /// The constant zero.
+    pub const ZERO: RampInput = RampInput {
+        value: 0.0,
+        rate: 0.0,
+        since: 0.0,
+    };
+
     /// A constant input.
     pub fn constant(value: f64) -> Self {
         Self {
@@ -47,6 +54,42 @@ pub struct ModelInputs {
     pub stiffness_scale: Vec<RampInput>,
     /// Per configured mount: damping scale factor, held at zero like the stiffness scale.
     pub damping_scale: Vec<RampInput>,
+    /// Per configured mount: motion of its attachment point on an external body (scene 3),
+    /// vehicle frame; unused for mounts on ground or on the model's own body.
+    pub body_motion: Vec<AttachmentMotion>,
+}
+
+/// Displacement from its reference position and velocity of a mount's attachment point on a
+/// body outside the model, per vehicle axis, each a ramp like every continuous input.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+pub struct AttachmentMotion {
+    /// Displacement (m) along x, y, z.
+    pub displacement: [RampInput; 3],
+    /// Velocity (m/s) along x, y, z.
+    pub velocity: [RampInput; 3],
+}
+
+impl AttachmentMotion {
+    /// The attachment at rest in its reference position.
+    pub const AT_REST: AttachmentMotion = AttachmentMotion {
+        displacement: [RampInput::ZERO; 3],
+        velocity: [RampInput::ZERO; 3],
+    };
+
+    /// Displacement and velocity at `t`.
+    pub fn at(&self, t: f64) -> ([f64; 3], [f64; 3]) {
+        (
+            self.displacement.map(|r| r.at(t)),
+            self.velocity.map(|r| r.at(t)),
+        )
+    }
+
+    fn is_finite(&self) -> bool {
+        self.displacement
+            .iter()
+            .chain(&self.velocity)
+            .all(RampInput::is_finite)
+    }
 }
 
 impl ModelInputs {
@@ -57,6 +100,7 @@ impl ModelInputs {
             load_torque: RampInput::constant(0.0),
             stiffness_scale: vec![RampInput::constant(1.0); mounts],
             damping_scale: vec![RampInput::constant(1.0); mounts],
+            body_motion: vec![AttachmentMotion::AT_REST; mounts],
         }
     }
 
@@ -86,6 +130,17 @@ impl ModelInputs {
                 "{} stiffness and {} damping scales for {mounts} mounts",
                 self.stiffness_scale.len(),
                 self.damping_scale.len()
+            )));
+        }
+        if self.body_motion.len() != mounts {
+            return Err(InputError(format!(
+                "{} attachment motions for {mounts} mounts",
+                self.body_motion.len()
+            )));
+        }
+        if let Some(i) = self.body_motion.iter().position(|m| !m.is_finite()) {
+            return Err(InputError(format!(
+                "mounts[{i}] attachment displacement and velocity must be finite"
             )));
         }
         for (i, (k, c)) in self

@@ -33,6 +33,7 @@
 //! ```
 
 pub mod blend;
+pub mod body_alone;
 pub mod coupled;
 pub mod effects;
 pub mod follower;

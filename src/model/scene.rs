@@ -8,6 +8,7 @@ use crate::cms::{
 };
 use crate::fe::chassis_config::ChassisConfig;
 
+use super::body_alone::BodyAlone;
 use super::coupled::CoupledModel;
 use super::vehicle::{BodyConfig, VehicleConfig};
 
@@ -26,25 +27,40 @@ pub enum SceneKind {
     Ground,
     /// Powertrain on its mounts in the vehicle's elastic body.
     Body,
+    /// Powertrain on its mounts on a body outside the model, whose motion at each mount is an
+    /// input (a vehicle co-simulation carries the body).
+    ExternalBody,
 }
 
 impl SceneKind {
-    /// The scene by its number in the paper's Table 1 (1: rigid ground, 2: elastic body).
+    /// The scene by its number (1: rigid ground, 2: elastic body, as in the paper's Table 1;
+    /// 3: external body).
     pub fn from_number(number: i32) -> Result<SceneKind, String> {
         match number {
             1 => Ok(SceneKind::Ground),
             2 => Ok(SceneKind::Body),
+            3 => Ok(SceneKind::ExternalBody),
             other => Err(format!(
-                "scene {other} does not exist (1: engine on rigid ground, 2: engine in the elastic chassis)"
+                "scene {other} does not exist (1: engine on rigid ground, 2: engine in the elastic chassis, 3: engine on an external body)"
             )),
         }
     }
 
-    /// The scene's number in the paper's Table 1.
+    /// The scene's number.
     pub fn number(self) -> i32 {
         match self {
             SceneKind::Ground => 1,
             SceneKind::Body => 2,
+            SceneKind::ExternalBody => 3,
+        }
+    }
+
+    /// What the scene is, for logs.
+    pub fn describe(self) -> &'static str {
+        match self {
+            SceneKind::Ground => "engine on rigid ground",
+            SceneKind::Body => "engine in the elastic chassis",
+            SceneKind::ExternalBody => "engine on an external body",
         }
     }
 }
@@ -237,6 +253,13 @@ pub fn build(
     vehicle.validate().map_err(|e| e.to_string())?;
     let (body, notes) = match scene {
         SceneKind::Ground => (ReducedChassis::rigid_ground(), Vec::new()),
+        SceneKind::ExternalBody => {
+            let model = CoupledModel::on_external_body(vehicle).map_err(|e| e.to_string())?;
+            return Ok(Built {
+                model,
+                notes: Vec::new(),
+            });
+        }
         SceneKind::Body => {
             let (body, note) = body(vehicle, options)?;
             (body, vec![note])
@@ -272,6 +295,19 @@ fn mode_selection(vehicle: &VehicleConfig, options: &BodyOptions) -> (ModeSelect
         };
         (ModeSelection::CutoffHz(cutoff), origin)
     }
+}
+
+/// The vehicle's reduced body alone, driven by forces at its mount points (the body FMU), with
+/// a log line on how the body was obtained.
+pub fn build_body_alone(
+    vehicle: &VehicleConfig,
+    options: &BodyOptions,
+) -> Result<(BodyAlone, String), SceneError> {
+    vehicle.validate().map_err(|e| e.to_string())?;
+    let (reduced, note) = body(vehicle, options)?;
+    let model =
+        BodyAlone::new(reduced, &vehicle.mounts, &vehicle.outputs).map_err(|e| e.to_string())?;
+    Ok((model, note))
 }
 
 /// What the procedural body's reduction depends on for this vehicle and these options, and a

@@ -3,6 +3,7 @@
 mod abi;
 mod bad_inputs;
 mod common;
+mod coupling;
 mod inputs;
 mod model_structure;
 mod natural_modes;

@@ -17,6 +17,7 @@ fn inputs(rpm: f64, torque: f64, stiffness: f64) -> Inputs {
         load_torque: Signal::constant(torque),
         stiffness_scale: [Signal::constant(stiffness); 4],
         damping_scale: [Signal::constant(1.0); 4],
+        ..Inputs::steady(0.0)
     }
 }
 

@@ -188,8 +188,6 @@ impl CoupledModel {
     fn add_mounts(&self, t: f64, y: &[f64], hb: usize, mode: Mode, ev: &mut Evaluation) {
         let reference = self.powertrain.bodies()[hb].reference;
         let nonlinear = mode.nonlinear_mounts || self.effects().mount_nonlinearity;
-        let eta = &y[self.layout.eta()];
-        let eta_rate = &y[self.layout.eta_rate()];
         ev.modal_force.clear();
         ev.modal_force.resize(self.layout.modes(), 0.0);
         ev.mounts.clear();
@@ -202,13 +200,7 @@ impl CoupledModel {
             let local = m.mount.bracket - reference;
             let x = h.point(&local);
             let xv = h.point_velocity(&local);
-            let (a, av) = match m.target {
-                MountTarget::Ground => (Vector3::zeros(), Vector3::zeros()),
-                MountTarget::BodyPoint(p) => (
-                    self.point_translation(p, eta),
-                    self.point_translation(p, eta_rate),
-                ),
-            };
+            let (a, av) = self.attachment_motion(i, m.target, t, y);
             let (k_scale, c_scale) = self.inputs.mount_scales(i, t);
             let r = m.mount.response(
                 &(x - m.mount.attachment - a),

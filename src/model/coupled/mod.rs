@@ -25,6 +25,7 @@
 
 mod energy;
 mod evaluate;
+pub mod interface;
 pub mod jacobian;
 mod layout;
 pub mod modes;
@@ -62,6 +63,9 @@ pub enum MountTarget {
     Ground,
     /// Point `p` of the body (its motion is `Σ_k φ_{p,k} η_k`).
     BodyPoint(usize),
+    /// A point of a body outside the model, moving as the mount's
+    /// [`AttachmentMotion`](super::inputs::AttachmentMotion) input says (scene 3).
+    External,
 }
 
 /// A mount with what it connects.
@@ -181,9 +185,28 @@ impl CoupledModel {
         outputs: &[String],
         follower: SpeedFollower,
     ) -> Result<Self, ModelError> {
+        Self::assemble(powertrain, mounts, body, outputs, follower, false)
+    }
+
+    /// [`Self::new`], or with `external` every mount attached at its ground point to a body
+    /// outside the model whose motion is an input (the body must then have no modes).
+    fn assemble(
+        powertrain: Powertrain,
+        mounts: &[MountConfig],
+        body: ReducedChassis,
+        outputs: &[String],
+        follower: SpeedFollower,
+        external: bool,
+    ) -> Result<Self, ModelError> {
         check_body(&body)?;
         follower.validate("speed_follower")?;
         let ground = body.n_modes() == 0;
+        if external && !ground {
+            return Err(ModelError::Body(
+                "a model whose mounts sit on an external body cannot have body modes of its own"
+                    .into(),
+            ));
+        }
         let mut connected = Vec::with_capacity(mounts.len());
         for (i, m) in mounts.iter().enumerate() {
             m.validate(&format!("mounts[{i}]"))?;
@@ -193,7 +216,12 @@ impl CoupledModel {
             }
             let (attachment, target) = if ground {
                 let at = m.ground_point.as_ref().unwrap_or(&m.bracket);
-                (v3(at), MountTarget::Ground)
+                let target = if external {
+                    MountTarget::External
+                } else {
+                    MountTarget::Ground
+                };
+                (v3(at), target)
             } else {
                 let node = m.body_node.as_deref().ok_or_else(|| {
                     ModelError::Config(ConfigError {
@@ -270,6 +298,23 @@ impl CoupledModel {
         Self::with_body(config, ReducedChassis::rigid_ground())
     }
 
+    /// The powertrain of `config` on its mounts on a body outside the model (scene 3): each
+    /// mount's far end sits at its ground point displaced by its
+    /// [`AttachmentMotion`](super::inputs::AttachmentMotion) input. With every attachment at
+    /// rest this is [`Self::on_ground`].
+    pub fn on_external_body(config: &super::VehicleConfig) -> Result<Self, ModelError> {
+        config.validate()?;
+        let powertrain = Powertrain::new(config.engine.clone(), config.effects, config.gravity)?;
+        Self::assemble(
+            powertrain,
+            &config.mounts,
+            ReducedChassis::rigid_ground(),
+            &[],
+            config.speed_follower,
+            true,
+        )
+    }
+
     /// The vehicle of `config` with the given (reduced) body; a body without modes is rigid
     /// ground.
     pub fn with_body(
@@ -335,7 +380,7 @@ impl CoupledModel {
             let m = m.as_ref()?;
             match m.target {
                 MountTarget::BodyPoint(p) => Some((i, &m.mount, p)),
-                MountTarget::Ground => None,
+                MountTarget::Ground | MountTarget::External => None,
             }
         })
     }
@@ -454,6 +499,35 @@ impl CoupledModel {
         } else {
             crate::model::blend::smooth_step((t - self.fade_start) / tf)
         }
+    }
+
+    /// Displacement and velocity of the far end of mount `i` (target `target`) at `(t, y)`.
+    pub(crate) fn attachment_motion(
+        &self,
+        i: usize,
+        target: MountTarget,
+        t: f64,
+        y: &[f64],
+    ) -> (Vector3<f64>, Vector3<f64>) {
+        match target {
+            MountTarget::Ground => (Vector3::zeros(), Vector3::zeros()),
+            MountTarget::BodyPoint(p) => (
+                self.point_translation(p, &y[self.layout.eta()]),
+                self.point_translation(p, &y[self.layout.eta_rate()]),
+            ),
+            MountTarget::External => {
+                let (u, v) = self.inputs.body_motion[i].at(t);
+                (Vector3::from(u), Vector3::from(v))
+            }
+        }
+    }
+
+    /// Whether the mounts sit on a body outside the model (scene 3).
+    pub fn has_external_body(&self) -> bool {
+        self.mounts
+            .iter()
+            .flatten()
+            .any(|m| m.target == MountTarget::External)
     }
 
     /// Translation (or, for modal rates, velocity) of body point `p` for modal vector `x`.

@@ -6,7 +6,7 @@ use faer::Mat;
 use nalgebra::Vector3;
 
 use super::evaluate::Mode;
-use super::{CoupledModel, MountTarget};
+use super::CoupledModel;
 
 /// The static equilibrium could not be found.
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]
@@ -179,7 +179,14 @@ impl CoupledModel {
         }
         y[l.positions()].copy_from_slice(&z[..nq]);
         y[l.eta()].copy_from_slice(&z[nq..]);
-        let points = self.mount_deflections(&y)?;
+        let points = self.mount_deflections(t0, &y).map_err(|e| {
+            let why = if self.has_external_body() {
+                "the external body's displacement at the start moves it beyond its characteristic"
+            } else {
+                "the mounts are too soft to carry the powertrain"
+            };
+            StaticsError(format!("{}: {why}", e.0))
+        })?;
         for (m, p) in self.mounts.iter_mut().zip(points) {
             if let Some(m) = m {
                 m.mount.operating_point = p;
@@ -188,30 +195,32 @@ impl CoupledModel {
         Ok(y)
     }
 
-    /// Deflection of every configured mount at state `y` (zero for a removed one), checked
+    /// Checks that every mount at `(t, y)` deflects within the range of its curves: an external
+    /// body's attachment input may push a mount beyond what its characteristic describes.
+    pub fn check_mount_ranges(&self, t: f64, y: &[f64]) -> Result<(), StaticsError> {
+        self.mount_deflections(t, y).map(|_| ())
+    }
+
+    /// Deflection of every configured mount at `(t, y)` (zero for a removed one), checked
     /// against the range of its curves.
-    fn mount_deflections(&self, y: &[f64]) -> Result<Vec<Vector3<f64>>, StaticsError> {
+    fn mount_deflections(&self, t: f64, y: &[f64]) -> Result<Vec<Vector3<f64>>, StaticsError> {
         let hb = self.powertrain.housing_index();
         let h = self.kinematics(y, hb);
         let reference = self.powertrain.bodies()[hb].reference;
-        let eta = &y[self.layout.eta()];
         let mut out = Vec::with_capacity(self.mounts.len());
         for (i, m) in self.mounts.iter().enumerate() {
             let Some(m) = m else {
                 out.push(Vector3::zeros());
                 continue;
             };
-            let a = match m.target {
-                MountTarget::Ground => Vector3::zeros(),
-                MountTarget::BodyPoint(p) => self.point_translation(p, eta),
-            };
+            let (a, _) = self.attachment_motion(i, m.target, t, y);
             let mount = &m.mount;
             let d = mount.deflection(&h.point(&(mount.bracket - reference)), &a);
             for k in 0..3 {
                 let (lo, hi) = mount.curves[k].range();
                 if d[k] < lo || d[k] > hi {
                     return Err(StaticsError(format!(
-                        "mount {i} ({}) deflects {:.1} mm along its axis {k}, beyond its curve [{:.1}, {:.1}] mm: the mounts are too soft to carry the powertrain",
+                        "mount {i} ({}) deflects {:.1} mm along its axis {k}, beyond its curve [{:.1}, {:.1}] mm",
                         mount.name,
                         d[k] * 1e3,
                         lo * 1e3,

@@ -385,6 +385,29 @@ impl Slave<'_> {
             .collect();
         (s, strings)
     }
+    /// `fmi2GetDirectionalDerivative` of `unknowns` for seeds `seeds` on `knowns`.
+    pub fn directional_derivative(
+        &self,
+        unknowns: &[u32],
+        knowns: &[u32],
+        seeds: &[f64],
+    ) -> (fmi2Status, Vec<f64>) {
+        let mut out = vec![0.0; unknowns.len()];
+        // SAFETY: arrays of the lengths passed.
+        let s = unsafe {
+            (self.f().fmi2GetDirectionalDerivative)(
+                self.c,
+                unknowns.as_ptr(),
+                unknowns.len(),
+                knowns.as_ptr(),
+                knowns.len(),
+                seeds.as_ptr(),
+                out.as_mut_ptr(),
+            )
+        };
+        (s, out)
+    }
+
     pub fn set_input_derivatives(&self, vrs: &[u32], values: &[f64]) -> fmi2Status {
         let orders = vec![1; vrs.len()];
         // SAFETY: arrays of equal length nvr.

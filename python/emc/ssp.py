@@ -1,0 +1,138 @@
+"""The engine on the body as a system a co-simulation tool loads: an SSP 1.0 archive (``.ssp``)
+holding both FMUs, their mount-by-mount connections and the parameter values.
+
+The engine FMU (EngineMountChassis, scene 3) passes each mount's force on the body to the body
+FMU (EngineMountBody); the body passes the displacement and velocity of each mount point back.
+Together they are scene 2 split at the mounts.
+
+    python -m emc.ssp dist/EngineMountChassis.fmu dist/EngineMountBody.fmu -o dist/EngineInBody.ssp
+"""
+
+from __future__ import annotations
+
+import argparse
+import pathlib
+import zipfile
+from xml.sax.saxutils import quoteattr
+
+SSD = "http://ssp-standard.org/SSP1/SystemStructureDescription"
+SSC = "http://ssp-standard.org/SSP1/SystemStructureCommon"
+SSV = "http://ssp-standard.org/SSP1/SystemStructureParameterValues"
+
+MOUNTS = 4
+AXES = 3
+
+
+def connections() -> list[tuple[str, str, str, str]]:
+    """(from element, from connector, to element, to connector), mount by mount and axis by axis."""
+    out = []
+    for i in range(1, MOUNTS + 1):
+        for j in range(1, AXES + 1):
+            out.append(("engine", f"mount[{i}].F[{j}]", "body", f"mount[{i}].F[{j}]"))
+            out.append(("body", f"mount[{i}].r[{j}]", "engine", f"mount[{i}].body.r[{j}]"))
+            out.append(("body", f"mount[{i}].v[{j}]", "engine", f"mount[{i}].body.v[{j}]"))
+    return out
+
+
+def _value(v) -> str:
+    if isinstance(v, bool):
+        return f'<ssv:Boolean value="{str(v).lower()}"/>'
+    if isinstance(v, int):
+        return f'<ssv:Integer value="{v}"/>'
+    if isinstance(v, float):
+        return f'<ssv:Real value="{v!r}"/>'
+    return f"<ssv:String value={quoteattr(str(v))}/>"
+
+
+def _component(name: str, fmu: str, connectors: list[tuple[str, str]], parameters: dict) -> str:
+    lines = [f'      <ssd:Component name="{name}" source="resources/{fmu}" '
+             'type="application/x-fmu-sharedlibrary">', "        <ssd:Connectors>"]
+    for connector, kind in connectors:
+        lines.append(f"          <ssd:Connector name={quoteattr(connector)} kind=\"{kind}\"><ssc:Real/></ssd:Connector>")
+    lines.append("        </ssd:Connectors>")
+    if parameters:
+        lines += ["        <ssd:ParameterBindings>", "          <ssd:ParameterBinding>",
+                  "            <ssd:ParameterValues>",
+                  f'              <ssv:ParameterSet version="1.0" name="{name}">',
+                  "                <ssv:Parameters>"]
+        for key, value in parameters.items():
+            lines.append(f"                  <ssv:Parameter name={quoteattr(key)}>{_value(value)}</ssv:Parameter>")
+        lines += ["                </ssv:Parameters>", "              </ssv:ParameterSet>",
+                  "            </ssd:ParameterValues>", "          </ssd:ParameterBinding>",
+                  "        </ssd:ParameterBindings>"]
+    lines.append("      </ssd:Component>")
+    return "\n".join(lines)
+
+
+def system_structure(engine_fmu: str, body_fmu: str, engine_parameters: dict | None = None,
+                     body_parameters: dict | None = None, step_size: float = 1e-4,
+                     stop_time: float = 1.0) -> str:
+    """The SystemStructure.ssd text. ``engine_parameters`` and ``body_parameters`` are start values
+    by FMI variable name; the engine's ``scene`` is 3 whatever is given."""
+    engine_parameters = {**(engine_parameters or {}), "scene": 3}
+    body_parameters = body_parameters or {}
+    links = connections()
+    def connectors(element: str) -> list[tuple[str, str]]:
+        return ([(c, "output") for e, c, _, _ in links if e == element]
+                + [(c, "input") for _, _, e, c in links if e == element])
+
+    elements = "\n".join([
+        _component("engine", engine_fmu, connectors("engine"), engine_parameters),
+        _component("body", body_fmu, connectors("body"), body_parameters),
+    ])
+    wires = "\n".join(
+        f'      <ssd:Connection startElement="{a}" startConnector={quoteattr(b)} '
+        f'endElement="{c}" endConnector={quoteattr(d)}/>' for a, b, c, d in links)
+    return f"""<?xml version="1.0" encoding="UTF-8"?>
+<ssd:SystemStructureDescription xmlns:ssd="{SSD}" xmlns:ssc="{SSC}" xmlns:ssv="{SSV}"
+    version="1.0" name="EngineInBody">
+  <ssd:System name="EngineInBody" description="The engine (EngineMountChassis, scene 3) on the elastic body (EngineMountBody), coupled at the four engine mounts: scene 2 split at the mounts.">
+    <ssd:Elements>
+{elements}
+    </ssd:Elements>
+    <ssd:Connections>
+{wires}
+    </ssd:Connections>
+  </ssd:System>
+  <ssd:DefaultExperiment startTime="0.0" stopTime="{stop_time!r}">
+    <ssc:Annotations>
+      <ssc:Annotation type="com.opensimulationplatform">
+        <osp:Algorithm xmlns:osp="http://opensimulationplatform.com/SSP/OSPAnnotations">
+          <osp:FixedStepAlgorithm baseStepSize="{step_size!r}"/>
+        </osp:Algorithm>
+      </ssc:Annotation>
+    </ssc:Annotations>
+  </ssd:DefaultExperiment>
+</ssd:SystemStructureDescription>
+"""
+
+
+def write_ssp(engine_fmu: pathlib.Path, body_fmu: pathlib.Path, out: pathlib.Path,
+              engine_parameters: dict | None = None, body_parameters: dict | None = None,
+              step_size: float = 1e-4, stop_time: float = 1.0) -> pathlib.Path:
+    """Writes the ``.ssp`` archive: SystemStructure.ssd and both FMUs under resources/."""
+    engine_fmu, body_fmu, out = pathlib.Path(engine_fmu), pathlib.Path(body_fmu), pathlib.Path(out)
+    ssd = system_structure(engine_fmu.name, body_fmu.name, engine_parameters, body_parameters,
+                           step_size, stop_time)
+    out.parent.mkdir(parents=True, exist_ok=True)
+    tmp = out.with_suffix(".ssp.tmp")
+    with zipfile.ZipFile(tmp, "w", compression=zipfile.ZIP_DEFLATED) as z:
+        z.writestr("SystemStructure.ssd", ssd)
+        z.write(engine_fmu, f"resources/{engine_fmu.name}")
+        z.write(body_fmu, f"resources/{body_fmu.name}")
+    tmp.replace(out)
+    return out
+
+
+def main(argv: list[str] | None = None) -> None:
+    parser = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
+    parser.add_argument("engine_fmu")
+    parser.add_argument("body_fmu")
+    parser.add_argument("-o", "--out", default="dist/EngineInBody.ssp")
+    parser.add_argument("--step", type=float, default=1e-4, help="coupling step in s")
+    args = parser.parse_args(argv)
+    print(write_ssp(args.engine_fmu, args.body_fmu, pathlib.Path(args.out), step_size=args.step))
+
+
+if __name__ == "__main__":
+    main()
