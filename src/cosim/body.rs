@@ -172,7 +172,7 @@ impl BodySimulation {
 
     /// The outputs' response to the force increments in `seed.body_force` (values only), the
     /// state held: exact, the accelerations being linear in the forces.
-    pub fn output_derivatives(&self, seed: &Inputs) -> Outputs {
+    pub fn input_sensitivities(&self, seed: &Inputs) -> Outputs {
         let mut out = Outputs::default();
         let points = self.model.mount_points();
         let response = |p: usize| {

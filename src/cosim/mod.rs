@@ -358,7 +358,7 @@ impl Simulation {
     /// The response of the mount forces and the powertrain acceleration to the attachment
     /// increments in `seed` (values only), the state held, at the interface signals of `at`:
     /// the exact derivatives of [`Self::outputs_with`] (zero outside scene 3).
-    pub fn output_derivatives(&mut self, at: &Inputs, seed: &Inputs) -> Result<Outputs, Error> {
+    pub fn input_sensitivities(&mut self, at: &Inputs, seed: &Inputs) -> Result<Outputs, Error> {
         let trial = self.with_interface(at);
         scene::apply_inputs(&mut self.scene, &trial)?;
         let sensitivities = self

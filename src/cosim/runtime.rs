@@ -100,10 +100,10 @@ impl Runtime {
 
     /// The response of the outputs to the interface increments in `seed` (values only), the
     /// state held, evaluated with the interface signals of `at`.
-    pub fn output_derivatives(&mut self, at: &Inputs, seed: &Inputs) -> Result<Outputs, Error> {
+    pub fn input_sensitivities(&mut self, at: &Inputs, seed: &Inputs) -> Result<Outputs, Error> {
         match self {
-            Runtime::Engine(s) => s.output_derivatives(at, seed),
-            Runtime::Body(s) => Ok(s.output_derivatives(seed)),
+            Runtime::Engine(s) => s.input_sensitivities(at, seed),
+            Runtime::Body(s) => Ok(s.input_sensitivities(seed)),
         }
     }
 

@@ -517,7 +517,7 @@ impl Instance {
             return Err("the model is not built".into());
         };
         let response = runtime
-            .output_derivatives(&at, &seed)
+            .input_sensitivities(&at, &seed)
             .map_err(|e| parameters::message(&e))?;
         let mut scratch = self.core.values.reals.clone();
         parameters::put_outputs(&mut scratch, &response);
