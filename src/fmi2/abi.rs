@@ -149,7 +149,7 @@ fn entry(
 ///
 /// # Safety
 /// `ptr` must be null or point to `n` initialised elements that stay valid and unaliased for `'a`.
-unsafe fn array<'a, T>(ptr: *const T, n: usize, name: &str) -> Result<&'a [T], String> {
+pub(crate) unsafe fn array<'a, T>(ptr: *const T, n: usize, name: &str) -> Result<&'a [T], String> {
     if n == 0 {
         Ok(&[])
     } else if ptr.is_null() {
@@ -164,7 +164,11 @@ unsafe fn array<'a, T>(ptr: *const T, n: usize, name: &str) -> Result<&'a [T], S
 ///
 /// # Safety
 /// As [`array`], and the elements must be writable.
-unsafe fn array_mut<'a, T>(ptr: *mut T, n: usize, name: &str) -> Result<&'a mut [T], String> {
+pub(crate) unsafe fn array_mut<'a, T>(
+    ptr: *mut T,
+    n: usize,
+    name: &str,
+) -> Result<&'a mut [T], String> {
     if n == 0 {
         Ok(&mut [])
     } else if ptr.is_null() {
@@ -179,7 +183,7 @@ unsafe fn array_mut<'a, T>(ptr: *mut T, n: usize, name: &str) -> Result<&'a mut 
 ///
 /// # Safety
 /// `ptr` must be null or point to a writable `T` valid for `'a`.
-unsafe fn place<'a, T>(ptr: *mut T, name: &str) -> Result<&'a mut T, String> {
+pub(crate) unsafe fn place<'a, T>(ptr: *mut T, name: &str) -> Result<&'a mut T, String> {
     // SAFETY: guaranteed by the caller's contract above.
     unsafe { ptr.as_mut() }.ok_or_else(|| format!("argument {name} is NULL"))
 }
@@ -188,7 +192,7 @@ unsafe fn place<'a, T>(ptr: *mut T, name: &str) -> Result<&'a mut T, String> {
 ///
 /// # Safety
 /// `ptr` is null or a NUL-terminated string valid for the call.
-unsafe fn text(ptr: fmi2String) -> Option<String> {
+pub(crate) unsafe fn text(ptr: fmi2String) -> Option<String> {
     if ptr.is_null() {
         return None;
     }
@@ -203,7 +207,11 @@ unsafe fn text(ptr: fmi2String) -> Option<String> {
 ///
 /// # Safety
 /// As [`array`], each entry null or a NUL-terminated string valid for the call.
-unsafe fn texts(ptr: *const fmi2String, n: usize, name: &str) -> Result<Vec<String>, String> {
+pub(crate) unsafe fn texts(
+    ptr: *const fmi2String,
+    n: usize,
+    name: &str,
+) -> Result<Vec<String>, String> {
     // SAFETY: the caller's contract.
     let raw = unsafe { array(ptr, n, name) }?;
     raw.iter()
