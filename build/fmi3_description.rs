@@ -19,9 +19,9 @@ use quick_xml::Writer;
 use serde_json::Value;
 use std::fmt::Write as _;
 
-/// The functions of the FMI 3.0 common and co-simulation API (with the model-exchange and
-/// scheduled-execution instantiation functions, which refuse).
-pub const FMI3_FUNCTIONS: [&str; 64] = [
+/// Every function of `fmi3Functions.h`: the common and co-simulation API, and the model-exchange
+/// and scheduled-execution functions, which refuse (masters such as fmpy resolve them all).
+pub const FMI3_FUNCTIONS: [&str; 75] = [
     "fmi3GetVersion",
     "fmi3SetDebugLogging",
     "fmi3InstantiateModelExchange",
@@ -86,6 +86,17 @@ pub const FMI3_FUNCTIONS: [&str; 64] = [
     "fmi3EnterStepMode",
     "fmi3GetOutputDerivatives",
     "fmi3DoStep",
+    "fmi3EnterContinuousTimeMode",
+    "fmi3CompletedIntegratorStep",
+    "fmi3SetTime",
+    "fmi3SetContinuousStates",
+    "fmi3GetContinuousStateDerivatives",
+    "fmi3GetEventIndicators",
+    "fmi3GetContinuousStates",
+    "fmi3GetNominalsOfContinuousStates",
+    "fmi3GetNumberOfEventIndicators",
+    "fmi3GetNumberOfContinuousStates",
+    "fmi3ActivateModelPartition",
 ];
 
 /// Value reference of the independent variable `time`.
@@ -377,10 +388,16 @@ fn write_variable(w: &mut Writer<Vec<u8>>, v: &Var3) -> std::io::Result<()> {
         attr("variability", str_field(e, "variability")),
         attr("description", description3(v)),
     ];
+    // A String's start values are <Start> elements (FMI 3.0 §2.4.7.4), the others' a list.
+    let count = v.family.dims.iter().product::<usize>().max(1);
+    let mut string_starts = Vec::new();
     if let Some(start) = e.get("start") {
         let one = value_text(start);
-        let count: usize = v.family.dims.iter().product();
-        a.push(attr("start", vec![one; count.max(1)].join(" ")));
+        if ty == "String" {
+            string_starts = vec![one; count];
+        } else {
+            a.push(attr("start", vec![one; count].join(" ")));
+        }
     }
     if let Some(u) = opt_str(e, "unit") {
         a.push(attr("unit", u));
@@ -396,7 +413,7 @@ fn write_variable(w: &mut Writer<Vec<u8>>, v: &Var3) -> std::io::Result<()> {
         }
     }
     let tag = type3(ty);
-    if v.family.dims.is_empty() {
+    if v.family.dims.is_empty() && string_starts.is_empty() {
         return element(w, tag, &a).write_empty().map(|_| ());
     }
     element(w, tag, &a).write_inner_content(|w| {
@@ -406,6 +423,9 @@ fn write_variable(w: &mut Writer<Vec<u8>>, v: &Var3) -> std::io::Result<()> {
             for d in &v.family.dims {
                 element(w, "Dimension", &vec![attr("start", d)]).write_empty()?;
             }
+        }
+        for value in &string_starts {
+            element(w, "Start", &vec![attr("value", value)]).write_empty()?;
         }
         Ok(())
     })?;

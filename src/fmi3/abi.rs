@@ -1058,6 +1058,46 @@ refused!(fmi3GetOutputDerivatives, fmi3GetOutputDerivativesTYPE,
     (valueReferences: *const fmi3ValueReference, nValueReferences: usize,
      orders: *const fmi3Int32, values: *mut fmi3Float64, nValues: usize));
 
+// ----- model exchange and scheduled execution: never instantiated ------------------------------
+
+// Masters such as fmpy resolve every function of fmi3Functions.h, so the model-exchange and
+// scheduled-execution ones exist too; a co-simulation instance refuses them.
+
+refused!(
+    fmi3EnterContinuousTimeMode,
+    fmi3EnterContinuousTimeModeTYPE,
+    "model exchange only; this is a co-simulation instance",
+    ()
+);
+refused!(fmi3CompletedIntegratorStep, fmi3CompletedIntegratorStepTYPE,
+    "model exchange only; this is a co-simulation instance",
+    (noSetFMUStatePriorToCurrentPoint: fmi3Boolean, enterEventMode: *mut fmi3Boolean,
+     terminateSimulation: *mut fmi3Boolean));
+refused!(fmi3SetTime, fmi3SetTimeTYPE,
+    "model exchange only; this is a co-simulation instance", (time: fmi3Float64));
+refused!(fmi3SetContinuousStates, fmi3SetContinuousStatesTYPE,
+    "model exchange only; this is a co-simulation instance",
+    (continuousStates: *const fmi3Float64, nContinuousStates: usize));
+refused!(fmi3GetContinuousStateDerivatives, fmi3GetContinuousStateDerivativesTYPE,
+    "model exchange only; this is a co-simulation instance",
+    (derivatives: *mut fmi3Float64, nContinuousStates: usize));
+refused!(fmi3GetEventIndicators, fmi3GetEventIndicatorsTYPE,
+    "model exchange only; this is a co-simulation instance",
+    (eventIndicators: *mut fmi3Float64, nEventIndicators: usize));
+refused!(fmi3GetContinuousStates, fmi3GetContinuousStatesTYPE,
+    "model exchange only; this is a co-simulation instance",
+    (continuousStates: *mut fmi3Float64, nContinuousStates: usize));
+refused!(fmi3GetNominalsOfContinuousStates, fmi3GetNominalsOfContinuousStatesTYPE,
+    "model exchange only; this is a co-simulation instance",
+    (nominals: *mut fmi3Float64, nContinuousStates: usize));
+refused!(fmi3GetNumberOfEventIndicators, fmi3GetNumberOfEventIndicatorsTYPE,
+    "model exchange only; this is a co-simulation instance", (nEventIndicators: *mut usize));
+refused!(fmi3GetNumberOfContinuousStates, fmi3GetNumberOfContinuousStatesTYPE,
+    "model exchange only; this is a co-simulation instance", (nContinuousStates: *mut usize));
+refused!(fmi3ActivateModelPartition, fmi3ActivateModelPartitionTYPE,
+    "scheduled execution only; this is a co-simulation instance",
+    (clockReference: fmi3ValueReference, activationTime: fmi3Float64));
+
 // ----- FMU state -------------------------------------------------------------------------------
 
 /// Copies the instance's complete state (values, input signals, time, integrator history) into a
