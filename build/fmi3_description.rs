@@ -243,7 +243,7 @@ fn write_model_description(
             attr("providesAdjointDerivatives", false),
             attr("providesPerElementDependencies", false),
             attr("canHandleVariableCommunicationStepSize", true),
-            attr("maxOutputDerivativeOrder", 0),
+            attr("maxOutputDerivativeOrder", 1),
             attr("providesIntermediateUpdate", false),
             attr("mightReturnEarlyFromDoStep", false),
             attr("canReturnEarlyAfterIntermediateUpdate", false),

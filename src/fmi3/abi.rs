@@ -1053,10 +1053,54 @@ refused!(fmi3GetAdjointDerivative, fmi3GetAdjointDerivativeTYPE,
     (unknowns: *const fmi3ValueReference, nUnknowns: usize, knowns: *const fmi3ValueReference,
      nKnowns: usize, seed: *const fmi3Float64, nSeed: usize, sensitivity: *mut fmi3Float64,
      nSensitivity: usize));
-refused!(fmi3GetOutputDerivatives, fmi3GetOutputDerivativesTYPE,
-    "not provided (maxOutputDerivativeOrder=0)",
-    (valueReferences: *const fmi3ValueReference, nValueReferences: usize,
-     orders: *const fmi3Int32, values: *mut fmi3Float64, nValues: usize));
+
+/// The first time derivatives (order 1, `maxOutputDerivativeOrder="1"`) of continuous Float64
+/// outputs at the current communication point, along the trajectory the integrator follows
+/// there: from the state derivative of the equations of motion, by a central difference of the
+/// outputs along it ([`crate::cosim::Simulation::output_derivatives`]). Arrays give all their
+/// elements; another order, a non-output or a count that does not match is refused.
+#[no_mangle]
+pub extern "C" fn fmi3GetOutputDerivatives(
+    instance: fmi3Instance,
+    valueReferences: *const fmi3ValueReference,
+    nValueReferences: usize,
+    orders: *const fmi3Int32,
+    values: *mut fmi3Float64,
+    nValues: usize,
+) -> fmi3Status {
+    entry(
+        instance,
+        "fmi3GetOutputDerivatives",
+        state::GET_OUTPUT_DERIVATIVES,
+        |h| {
+            // SAFETY: FMI passes nValueReferences value references and orders, and room for
+            // nValues values.
+            let (vrs, orders, out) = unsafe {
+                (
+                    array(valueReferences, nValueReferences, "valueReferences")?,
+                    array(orders, nValueReferences, "orders")?,
+                    array_mut(values, nValues, "values")?,
+                )
+            };
+            if let Some(order) = orders.iter().find(|o| **o != 1) {
+                return Err(format!(
+                    "derivative order {order} is not provided (maxOutputDerivativeOrder=1)"
+                ));
+            }
+            let mut elements = Vec::with_capacity(nValues);
+            for s in resolve::<f64>(vrs, h.modes_size, nValues)? {
+                match s {
+                    Slot::Element(i) => elements.push(i),
+                    Slot::Time => return Err("time is not an output".into()),
+                }
+            }
+            let derivatives = h.instance.output_derivatives(&elements)?;
+            out.copy_from_slice(&derivatives);
+            Ok(Status::Ok)
+        },
+    )
+}
+const _: fmi3GetOutputDerivativesTYPE = Some(fmi3GetOutputDerivatives);
 
 // ----- model exchange and scheduled execution: never instantiated ------------------------------
 

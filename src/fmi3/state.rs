@@ -98,6 +98,8 @@ pub const EXIT_CONFIGURATION: Mask = Mask::of(&[ConfigurationMode]);
 pub const EXIT_INITIALIZATION: Mask = Mask::of(&[InitializationMode]);
 /// fmi3Terminate.
 pub const TERMINATE: Mask = Mask::of(&[StepMode]);
+/// fmi3GetOutputDerivatives: at a communication point after initialisation.
+pub const GET_OUTPUT_DERIVATIVES: Mask = Mask::of(&[StepMode, Terminated]);
 /// fmi3DoStep.
 pub const DO_STEP: Mask = Mask::of(&[StepMode]);
 /// fmi3GetFloat64, Int32, Boolean, String: the 2.0 phases where values can be read, and the

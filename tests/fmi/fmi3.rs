@@ -246,12 +246,13 @@ fn what_the_fmu_does_not_have_is_refused() {
     let b = f.instantiate();
     assert_eq!(b.init(), OK);
     let vr = [real::CRANK_ANGLE];
-    let (order, mut value) = ([1], [0.0]);
+    let (order, mut value) = ([2], [0.0]);
     // SAFETY: arrays of one element each.
     let s = unsafe {
         (f.fmi3GetOutputDerivatives)(b.i, vr.as_ptr(), 1, order.as_ptr(), value.as_mut_ptr(), 1)
     };
     assert_eq!(s, ERROR);
+    assert!(logged("derivative order 2 is not provided"));
     let c = f.instantiate();
     assert_eq!(c.init(), OK);
     let mut x = [0f32];
@@ -366,4 +367,85 @@ fn a_3_0_run_repeats_the_2_0_run_of_the_same_library_bit_for_bit() {
         (common::OK, steps3.to_vec())
     );
     assert!(steps3[0] > 0);
+}
+
+impl Instance<'_> {
+    fn derivatives(&self, vrs: &[u32], n: usize) -> (fmi3Status, Vec<f64>) {
+        let orders = vec![1; vrs.len()];
+        let mut v = vec![0.0; n];
+        // SAFETY: vrs and orders of equal length, room for n values.
+        let s = unsafe {
+            (self.f.fmi3GetOutputDerivatives)(
+                self.i,
+                vrs.as_ptr(),
+                vrs.len(),
+                orders.as_ptr(),
+                v.as_mut_ptr(),
+                n,
+            )
+        };
+        (s, v)
+    }
+}
+
+/// The output derivatives are the slopes of the outputs' trajectories: compared with central
+/// differences of the outputs over 20 µs communication steps (their error ~ (20 µs)² ω² / 6 of
+/// the derivative, and the integrator's tolerance), and asking for them changes nothing in the run.
+#[test]
+fn output_derivatives_are_the_slopes_of_the_trajectories_and_change_nothing() {
+    let f = F3::load();
+    let (a, b) = (f.instantiate(), f.instantiate());
+    let tight = [real::SOLVER_REL_TOL];
+    for x in [&a, &b] {
+        assert_eq!(x.set(&tight, &[1e-9]), OK);
+        assert_eq!(x.init(), OK);
+    }
+    let vrs = [
+        real::CRANK_ANGLE,
+        real::POWERTRAIN_R[0],
+        real::MOUNT_F[0][0],
+    ];
+    let h = 2e-5;
+    let mut outputs = Vec::new();
+    let mut slopes = Vec::new();
+    for k in 0..3000 {
+        let t = k as f64 * h;
+        assert_eq!(a.step(t, h).0, OK);
+        assert_eq!(b.step(t, h).0, OK);
+        let (s, y) = a.get(&vrs, 1 + 3 + 12);
+        assert_eq!(s, OK);
+        let (s, dy) = a.derivatives(&vrs, 1 + 3 + 12);
+        assert_eq!(s, OK);
+        assert_eq!(
+            b.get(&vrs, 16).1,
+            y,
+            "a run that asks for derivatives is the same run"
+        );
+        outputs.push(y);
+        slopes.push(dy);
+    }
+    // The crank angle's rate: the set-point, 800 rpm, plus the block's rocking about the crank
+    // axis (the angle is measured against the block).
+    let speed = 800.0 * std::f64::consts::PI / 30.0;
+    assert!(
+        (slopes[2999][0] - speed).abs() < 1e-2 * speed,
+        "{}",
+        slopes[2999][0]
+    );
+    let mut worst = 0.0f64;
+    for k in [1000, 2000, 2998] {
+        for e in 0..16 {
+            let difference = (outputs[k + 1][e] - outputs[k - 1][e]) / (2.0 * h);
+            let scale = slopes.iter().map(|s| s[e].abs()).fold(0.0, f64::max);
+            worst = worst.max((slopes[k][e] - difference).abs() / scale);
+            assert!(
+                (slopes[k][e] - difference).abs() <= 5e-4 * scale,
+                "element {e} at step {k}: derivative {} vs central difference {difference}",
+                slopes[k][e]
+            );
+        }
+    }
+    println!("output derivatives vs central differences: {worst:.1e} of the largest derivative");
+    // An input is not an output.
+    assert_eq!(a.derivatives(&[real::RPM], 1).0, ERROR);
 }
