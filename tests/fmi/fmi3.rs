@@ -39,8 +39,7 @@ unsafe extern "C" fn log_message(
 }
 
 fn logged(part: &str) -> bool {
-    LOG.lock()
-        .map_or(false, |l| l.iter().any(|m| m.contains(part)))
+    LOG.lock().is_ok_and(|l| l.iter().any(|m| m.contains(part)))
 }
 
 macro_rules! symbols {
