@@ -491,6 +491,7 @@ fn get_values<T: Typed, C>(
     time: impl Fn(f64) -> Option<C>,
 ) -> fmi3Status {
     entry(instance, function, state::GET_VALUES, |h| {
+        before_initialization(h)?;
         // SAFETY: FMI passes nvr value references and room for nValues values.
         let (vrs, out) = unsafe { (array(vr, nvr, "vr")?, array_mut(value, n_values, "values")?) };
         let slots = resolve::<T>(vrs, h.modes_size, n_values)?;
@@ -543,6 +544,15 @@ fn set_values<T: Typed, C: Copy>(
             .collect::<Result<Vec<T>, String>>()?;
         h.instance.set::<T>(&elements, &values)
     })
+}
+
+/// Refuses reading in the error state entered before initialisation: a calculated parameter
+/// read there would build the model as a side effect of a diagnostic read.
+fn before_initialization(h: &Handle) -> Result<(), String> {
+    if h.instance.phase() == Phase2::Instantiated {
+        return Err("nothing to read before initialisation".into());
+    }
+    Ok(())
 }
 
 /// A C `bool` read as its byte: a value other than 0 or 1 is refused instead of being undefined
@@ -635,6 +645,7 @@ pub extern "C" fn fmi3GetString(
     nValues: usize,
 ) -> fmi3Status {
     entry(instance, "fmi3GetString", state::GET_VALUES, |h| {
+        before_initialization(h)?;
         // SAFETY: FMI passes nValueReferences value references and nValues string slots.
         let (vrs, out) = unsafe {
             (

@@ -212,6 +212,11 @@ fn an_error_leads_to_the_error_state_left_by_reset_or_a_restored_state() {
     // Stepping before initialisation is refused, and from then on only recovery is allowed.
     assert_eq!(a.step(0.0, 1e-3).0, ERROR);
     assert!(logged("fmi3DoStep is not allowed in phase Instantiated"));
+    // Reading for diagnosis is allowed in the error state, but before initialisation there is
+    // nothing to read (a natural mode would build the model).
+    let modes = [real::MODE_FREQUENCY[0]];
+    assert_eq!(a.get(&modes, MODES_SIZE_MAX as usize).0, ERROR);
+    assert!(logged("nothing to read before initialisation"));
     assert_eq!(
         unsafe { (f.fmi3EnterInitializationMode)(a.i, false, 0.0, 0.0, false, 0.0) },
         ERROR
