@@ -218,3 +218,29 @@ def test_natural_mode_arrays_follow_the_structural_parameter(fmu3_path, tmp_path
     finally:
         fmu.terminate()
         fmu.freeInstance()
+
+
+def test_output_derivatives_through_fmpy_follow_the_crank_angle(fmu3_path):
+    """fmi3GetOutputDerivatives as fmpy calls it: the crank angle's rate is its slope over a step."""
+    md = read_model_description(str(fmu3_path))
+    assert md.coSimulation.maxOutputDerivativeOrder == 1
+    vr = {v.name: v.valueReference for v in md.modelVariables}
+    fmu = FMU3Slave(guid=md.guid, unzipDirectory=extract(str(fmu3_path)),
+                    modelIdentifier="EngineMountChassis", instanceName="derivatives")
+    fmu.instantiate()
+    try:
+        fmu.setFloat64([vr["rpm"]], [1200.0])
+        fmu.enterInitializationMode()
+        fmu.exitInitializationMode()
+        t, h, angles, rates = 0.0, 1e-5, [], []
+        for _ in range(2000):
+            fmu.doStep(t, h)
+            t += h
+            angles.append(fmu.getFloat64([vr["crankAngle"]])[0])
+            rates.append(fmu.getOutputDerivatives([vr["crankAngle"]], [1])[0])
+        slope = (angles[-1] - angles[-3]) / (2 * h)
+        assert abs(rates[-2] - slope) < 1e-4 * abs(slope), (rates[-2], slope)
+        assert abs(rates[-2] - 1200.0 * np.pi / 30.0) < 0.01 * 1200.0 * np.pi / 30.0
+    finally:
+        fmu.terminate()
+        fmu.freeInstance()
