@@ -3,8 +3,9 @@
 //! the C caller), the call is checked against the state machine ([`super::state`]), and a
 //! refusal is logged once, naming the function. Inside, C arguments become slices (`array`,
 //! `array_mut`, null pointers refused), value references become typed positions through the
-//! one table ([`super::values::indices`]), and the instance does the rest. This file is the only
-//! place with `unsafe` in the crate: every block says why it is sound.
+//! one table ([`super::values::indices`]), and the instance does the rest. This file, the
+//! logger's callback and [`crate::fmi3::abi`] (which reuses the slice helpers here) are the only
+//! places with `unsafe` in the crate: every block says why it is sound.
 
 #![allow(non_snake_case)]
 #![allow(clippy::not_unsafe_ptr_arg_deref)] // the C ABI hands us raw pointers by design
