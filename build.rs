@@ -4,7 +4,8 @@
 //! - `modelDescription.xml` and `body.modelDescription.xml` (packaged into the FMUs),
 //! - `variables.rs` (the value-reference table the FMI layer includes),
 //! - `index.html` and `body.index.html` (the FMUs' documentation pages),
-//! - `exports.map`, a linker version script that exports exactly the fmi2 functions.
+//! - `exports.map`, a linker version script that exports exactly the fmi2 and fmi3 functions;
+//! - the FMI 3.0 files of the engine FMU (`build/fmi3_description.rs`).
 //!
 //! The GUIDs are hashes of the table's content, so the XML and the binary can never disagree.
 
@@ -14,6 +15,9 @@ use serde_json::Value;
 use std::collections::BTreeMap;
 use std::fmt::Write as _;
 use std::path::{Path, PathBuf};
+
+#[path = "build/fmi3_description.rs"]
+mod fmi3_description;
 
 /// The 34 functions of the FMI 2.0 common and co-simulation API.
 const FMI2_FUNCTIONS: [&str; 34] = [
@@ -121,6 +125,7 @@ fn main() {
     let table_path = manifest.join("modelDescription/variables.json");
     println!("cargo:rerun-if-changed={}", table_path.display());
     println!("cargo:rerun-if-changed=build.rs");
+    println!("cargo:rerun-if-changed=build/fmi3_description.rs");
 
     let text = std::fs::read_to_string(&table_path)
         .unwrap_or_else(|e| fail(&format!("cannot read {}: {e}", table_path.display())));
@@ -160,11 +165,16 @@ fn main() {
     }
     write(
         &out.join("variables.rs"),
-        &rust_table(&table, &scalars, &families, &fmus),
+        &(rust_table(&table, &scalars, &families, &fmus)
+            + &fmi3_description::rust_map(&table, &families)),
     );
+    fmi3_description::write_files(&out, &table, &families, &fmus[0].guid);
 
     let mut map = String::from("{\n  global:\n");
-    for f in FMI2_FUNCTIONS {
+    for f in FMI2_FUNCTIONS
+        .iter()
+        .chain(&fmi3_description::FMI3_FUNCTIONS)
+    {
         let _ = writeln!(map, "    {f};");
     }
     // fmi-sys (fmi2 feature) defines a #[no_mangle] `callback_log` that rustc would export too.
@@ -173,9 +183,12 @@ fn main() {
     write(&map_path, &map);
     if std::env::var("CARGO_CFG_TARGET_OS").as_deref() == Ok("windows") {
         // The PE linker would export what rustc lists in its own .def file (every #[no_mangle]
-        // function, fmi-sys' callback_log included); this .def file names the 34 alone.
+        // function, fmi-sys' callback_log included); this .def file names the fmi2 and fmi3 functions alone.
         let mut def = String::from("EXPORTS\n");
-        for f in FMI2_FUNCTIONS {
+        for f in FMI2_FUNCTIONS
+            .iter()
+            .chain(&fmi3_description::FMI3_FUNCTIONS)
+        {
             let _ = writeln!(def, "    {f}");
         }
         let def_path = out.join("exports.def");

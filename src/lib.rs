@@ -7,8 +7,9 @@
 //! - [`fe`]: finite elements, assembly and the procedural chassis.
 //! - [`model`]: engine multibody model, mounts, coupled system, outputs.
 //! - [`cosim`]: a scene with its integrator and inputs, stepped between communication points.
-//! - [`fmi2`]: the FMI 2.0 co-simulation C ABI (the only `unsafe` code); its
+//! - [`fmi2`]: the FMI 2.0 co-simulation C ABI (with [`fmi3`], the only `unsafe` code); its
 //!   [`fmi2::parameters`] is the one mapping between FMU variables and the typed settings.
+//! - [`fmi3`]: the FMI 3.0 co-simulation C ABI over the same instance.
 //! - [`variables`]: the variable table generated from `modelDescription/variables.json` (a leaf:
 //!   it imports nothing from the model), with [`variables::Parameters`], every parameter as one
 //!   typed structure.
@@ -20,6 +21,7 @@ pub mod cms;
 pub mod cosim;
 pub mod fe;
 pub mod fmi2;
+pub mod fmi3;
 pub mod model;
 pub mod ode;
 pub mod paper;

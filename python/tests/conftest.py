@@ -14,3 +14,12 @@ def fmu_path() -> pathlib.Path:
     if not path.exists():
         subprocess.run([sys.executable, str(ROOT / "packaging" / "package.py")], check=True)
     return path
+
+
+@pytest.fixture(scope="session")
+def fmu3_path(fmu_path) -> pathlib.Path:
+    """The packaged FMI 3.0 FMU, which package.py writes beside the 2.0 one."""
+    path = ROOT / "dist" / "EngineMountChassis-fmi3.fmu"
+    if not path.exists():
+        subprocess.run([sys.executable, str(ROOT / "packaging" / "package.py")], check=True)
+    return path

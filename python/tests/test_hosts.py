@@ -119,3 +119,72 @@ def test_win64_binary_under_wine_agrees_with_linux64(unpacked):
         assert d < 2e-3, f"scene {scene}: win64 and linux64 differ by {d:.1e} at rtol 1e-5"
     print(f"max relative difference win64 vs linux64: without gas at rtol 1e-10 {tight}, "
           f"full model at rtol 1e-5 {default}")
+
+
+# ----- the FMI 3.0 FMU: the same library through tools/fmi3_master.c --------------------------
+
+MASTER3 = ROOT / "tools" / "fmi3_master.c"
+OUTPUTS3 = ["mount.F", "steeringWheel.a", "seat.a"]  # the 18 values of OUTPUTS, as 3.0 arrays
+
+
+@pytest.fixture(scope="module")
+def unpacked3(fmu3_path, tmp_path_factory):
+    work = tmp_path_factory.mktemp("hosts3")
+    with zipfile.ZipFile(fmu3_path) as z:
+        z.extractall(work / "fmu")
+    root = ET.parse(work / "fmu" / "modelDescription.xml").getroot()
+    vr = {v.get("name"): v.get("valueReference") for v in root.find("ModelVariables")}
+    names = ["scene", "rpm", "chassis.cacheDir", "solver.relTol", "effects.gasForces", *OUTPUTS3]
+    return work, root.get("instantiationToken"), ",".join(vr[n] for n in names)
+
+
+def _linux3(work, token, vrs, rel_tol, gas):
+    exe = work / "master3"
+    if not exe.exists():
+        subprocess.run(["gcc", "-O2", "-o", str(exe), str(MASTER3), "-ldl", "-lm"], check=True)
+    lib = work / "fmu" / "binaries" / "x86_64-linux" / "EngineMountChassis.so"
+    resources = str(work / "fmu" / "resources") + "/"
+    return _run([str(exe), str(lib), resources, str(work / "cache-linux"), vrs, str(rel_tol), str(int(gas))],
+                token)
+
+
+def _windows3(work, token, vrs, rel_tol, gas):
+    wine = _wine()
+    mingw = shutil.which("x86_64-w64-mingw32-gcc")
+    if wine is None or mingw is None:
+        pytest.skip("wine or mingw-w64 is not installed (scripts/setup.sh installs both); "
+                    "the win64 binary was not run")
+    exe = work / "master3.exe"
+    if not exe.exists():
+        subprocess.run([mingw, "-O2", "-o", str(exe), str(MASTER3)], check=True)
+        subprocess.run([mingw, "-shared", "-O2", "-o", str(work / "bcryptprimitives.dll"), str(SHIM),
+                        "-lbcrypt"], check=True)
+    to_windows = lambda p: "Z:" + str(p).replace("/", "\\")  # noqa: E731  wine maps / to Z:
+    lib = to_windows(work / "fmu" / "binaries" / "x86_64-windows" / "EngineMountChassis.dll")
+    resources = to_windows(work / "fmu" / "resources") + "\\"
+    cache = to_windows(work / "cache-win")
+    try:
+        return _run([wine, str(exe), lib, resources, cache, vrs, str(rel_tol), str(int(gas))], token,
+                    {"WINEDEBUG": "-all", "WINEPREFIX": str(work / "wineprefix")})
+    except subprocess.TimeoutExpired:
+        pytest.skip("wine did not finish within 10 minutes on this machine; the win64 binary was not checked")
+
+
+def test_fmi3_master_repeats_the_fmi2_master_run_exactly(unpacked, unpacked3):
+    """The same library and scenario through the other standard's ABI: the same numbers."""
+    work, guid, vrs = unpacked
+    work3, token, vrs3 = unpacked3
+    assert token == guid
+    np.testing.assert_array_equal(_linux3(work3, token, vrs3, 1e-5, True), _linux(work, guid, vrs, 1e-5, True))
+
+
+def test_fmi3_win64_binary_under_wine_agrees_with_linux64(unpacked3):
+    work, token, vrs = unpacked3
+    tight = _difference(_linux3(work, token, vrs, 1e-10, False), _windows3(work, token, vrs, 1e-10, False))
+    for scene, d in tight.items():
+        assert d < 1e-6, f"scene {scene}: FMI 3.0 win64 and linux64 differ by {d:.1e} at rtol 1e-10 without gas"
+    default = _difference(_linux3(work, token, vrs, 1e-5, True), _windows3(work, token, vrs, 1e-5, True))
+    for scene, d in default.items():
+        assert d < 2e-3, f"scene {scene}: FMI 3.0 win64 and linux64 differ by {d:.1e} at rtol 1e-5"
+    print(f"FMI 3.0, max relative difference win64 vs linux64: without gas at rtol 1e-10 {tight}, "
+          f"full model at rtol 1e-5 {default}")

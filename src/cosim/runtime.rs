@@ -107,6 +107,17 @@ impl Runtime {
         }
     }
 
+    /// The outputs' first time derivatives at the communication time (the engine's; the body
+    /// FMU has no FMI 3.0 twin that would ask).
+    pub fn output_derivatives(&mut self) -> Result<Outputs, Error> {
+        match self {
+            Runtime::Engine(s) => s.output_derivatives(),
+            Runtime::Body(_) => Err(Error::Model(
+                "output derivatives are provided by the engine FMU only".into(),
+            )),
+        }
+    }
+
     /// Work counters.
     pub fn counters(&self) -> Counters {
         match self {

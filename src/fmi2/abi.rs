@@ -3,8 +3,9 @@
 //! the C caller), the call is checked against the state machine ([`super::state`]), and a
 //! refusal is logged once, naming the function. Inside, C arguments become slices (`array`,
 //! `array_mut`, null pointers refused), value references become typed positions through the
-//! one table ([`super::values::indices`]), and the instance does the rest. This file is the only
-//! place with `unsafe` in the crate: every block says why it is sound.
+//! one table ([`super::values::indices`]), and the instance does the rest. This file, the
+//! logger's callback and [`crate::fmi3::abi`] (which reuses the slice helpers here) are the only
+//! places with `unsafe` in the crate: every block says why it is sound.
 
 #![allow(non_snake_case)]
 #![allow(clippy::not_unsafe_ptr_arg_deref)] // the C ABI hands us raw pointers by design
@@ -152,7 +153,7 @@ fn entry(
 ///
 /// # Safety
 /// `ptr` must be null or point to `n` initialised elements that stay valid and unaliased for `'a`.
-unsafe fn array<'a, T>(ptr: *const T, n: usize, name: &str) -> Result<&'a [T], String> {
+pub(crate) unsafe fn array<'a, T>(ptr: *const T, n: usize, name: &str) -> Result<&'a [T], String> {
     if n == 0 {
         Ok(&[])
     } else if ptr.is_null() {
@@ -167,7 +168,11 @@ unsafe fn array<'a, T>(ptr: *const T, n: usize, name: &str) -> Result<&'a [T], S
 ///
 /// # Safety
 /// As [`array`], and the elements must be writable.
-unsafe fn array_mut<'a, T>(ptr: *mut T, n: usize, name: &str) -> Result<&'a mut [T], String> {
+pub(crate) unsafe fn array_mut<'a, T>(
+    ptr: *mut T,
+    n: usize,
+    name: &str,
+) -> Result<&'a mut [T], String> {
     if n == 0 {
         Ok(&mut [])
     } else if ptr.is_null() {
@@ -182,7 +187,7 @@ unsafe fn array_mut<'a, T>(ptr: *mut T, n: usize, name: &str) -> Result<&'a mut 
 ///
 /// # Safety
 /// `ptr` must be null or point to a writable `T` valid for `'a`.
-unsafe fn place<'a, T>(ptr: *mut T, name: &str) -> Result<&'a mut T, String> {
+pub(crate) unsafe fn place<'a, T>(ptr: *mut T, name: &str) -> Result<&'a mut T, String> {
     // SAFETY: guaranteed by the caller's contract above.
     unsafe { ptr.as_mut() }.ok_or_else(|| format!("argument {name} is NULL"))
 }
@@ -191,7 +196,7 @@ unsafe fn place<'a, T>(ptr: *mut T, name: &str) -> Result<&'a mut T, String> {
 ///
 /// # Safety
 /// `ptr` is null or a NUL-terminated string valid for the call.
-unsafe fn text(ptr: fmi2String) -> Option<String> {
+pub(crate) unsafe fn text(ptr: fmi2String) -> Option<String> {
     if ptr.is_null() {
         return None;
     }
@@ -206,7 +211,11 @@ unsafe fn text(ptr: fmi2String) -> Option<String> {
 ///
 /// # Safety
 /// As [`array`], each entry null or a NUL-terminated string valid for the call.
-unsafe fn texts(ptr: *const fmi2String, n: usize, name: &str) -> Result<Vec<String>, String> {
+pub(crate) unsafe fn texts(
+    ptr: *const fmi2String,
+    n: usize,
+    name: &str,
+) -> Result<Vec<String>, String> {
     // SAFETY: the caller's contract.
     let raw = unsafe { array(ptr, n, name) }?;
     raw.iter()

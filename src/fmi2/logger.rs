@@ -1,9 +1,11 @@
-//! Logging through the simulation environment's printf-style callback.
+//! Logging through the simulation environment's callback: FMI 2.0's printf-style one, or FMI
+//! 3.0's, which takes the message as it is.
 
 use fmi_sys::fmi2::{
     fmi2CallbackLogger, fmi2ComponentEnvironment, fmi2Status, fmi2Status_fmi2Error,
     fmi2Status_fmi2Fatal, fmi2Status_fmi2Warning,
 };
+use fmi_sys::fmi3::fmi3LogMessageCallback;
 use std::ffi::CString;
 
 use super::variables::{LogCategory, LOG_CATEGORIES};
@@ -22,9 +24,25 @@ pub enum Level {
     Fatal,
 }
 
+/// The environment's callback, of the standard the instance was created through.
+#[derive(Clone, Copy)]
+enum Callback {
+    Fmi2(fmi2CallbackLogger),
+    Fmi3(fmi3LogMessageCallback),
+}
+
+impl Callback {
+    fn is_some(self) -> bool {
+        match self {
+            Callback::Fmi2(c) => c.is_some(),
+            Callback::Fmi3(c) => c.is_some(),
+        }
+    }
+}
+
 /// The environment's logger and which categories it asked for.
 pub struct Logger {
-    callback: fmi2CallbackLogger,
+    callback: Callback,
     environment: fmi2ComponentEnvironment,
     instance_name: CString,
     enabled: Vec<bool>,
@@ -42,11 +60,25 @@ impl Logger {
         debug_logging: bool,
     ) -> Logger {
         Logger {
-            callback,
+            callback: Callback::Fmi2(callback),
             environment,
             instance_name: sanitized(instance_name),
             enabled: vec![true; LOG_CATEGORIES.len()],
             debug_logging,
+        }
+    }
+
+    /// A logger for an FMI 3.0 instance: as [`Logger::new`], with the 3.0 callback, which gets
+    /// the instance environment and no instance name.
+    pub fn new_fmi3(
+        callback: fmi3LogMessageCallback,
+        environment: *mut std::ffi::c_void,
+        instance_name: &str,
+        debug_logging: bool,
+    ) -> Logger {
+        Logger {
+            callback: Callback::Fmi3(callback),
+            ..Logger::new(None, environment, instance_name, debug_logging)
         }
     }
 
@@ -96,9 +128,6 @@ impl Logger {
         if !self.wants(level, category) {
             return;
         }
-        let Some(callback) = self.callback else {
-            return;
-        };
         let status: fmi2Status = match level {
             Level::Info => 0,
             Level::Warning => fmi2Status_fmi2Warning,
@@ -107,19 +136,33 @@ impl Logger {
         };
         let category = sanitized(category.name());
         let message = sanitized(message);
-        // SAFETY: the callback was supplied by the environment in fmi2Instantiate and stays valid
-        // for the instance's lifetime (FMI 2.0 §2.1.5). The format is the literal "%s" and the
-        // single vararg is a NUL-terminated string that outlives the call, so the printf-style
-        // callee reads exactly one valid C string.
-        unsafe {
-            callback(
-                self.environment,
-                self.instance_name.as_ptr(),
-                status,
-                category.as_ptr(),
-                c"%s".as_ptr(),
-                message.as_ptr(),
-            );
+        match self.callback {
+            // SAFETY: the callback was supplied by the environment in fmi2Instantiate and stays
+            // valid for the instance's lifetime (FMI 2.0 §2.1.5). The format is the literal "%s"
+            // and the single vararg is a NUL-terminated string that outlives the call, so the
+            // printf-style callee reads exactly one valid C string.
+            Callback::Fmi2(Some(callback)) => unsafe {
+                callback(
+                    self.environment,
+                    self.instance_name.as_ptr(),
+                    status,
+                    category.as_ptr(),
+                    c"%s".as_ptr(),
+                    message.as_ptr(),
+                );
+            },
+            // SAFETY: supplied by the environment in fmi3InstantiateCoSimulation, valid for the
+            // instance's lifetime (FMI 3.0 §2.3.1); both strings are NUL-terminated and outlive
+            // the call. fmi3Status and fmi2Status number OK..Fatal alike.
+            Callback::Fmi3(Some(callback)) => unsafe {
+                callback(
+                    self.environment,
+                    status,
+                    category.as_ptr(),
+                    message.as_ptr(),
+                );
+            },
+            Callback::Fmi2(None) | Callback::Fmi3(None) => {}
         }
     }
 }

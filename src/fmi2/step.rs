@@ -5,7 +5,7 @@ use super::logger::Level;
 use super::parameters;
 use super::state::Phase;
 use super::values::Num;
-use super::variables::{integer, Causality, LogCategory, REALS};
+use super::variables::{integer, Causality, LogCategory, Variability, REALS};
 use crate::cosim;
 
 /// Relative tolerance on communication points: masters compute them as `t0 + n h`.
@@ -199,6 +199,31 @@ impl Instance {
             }
         }
         clipped
+    }
+
+    /// The first time derivatives of the Real outputs at `indices` at the current communication
+    /// point ([`cosim::Simulation::output_derivatives`]), for FMI 3.0's
+    /// fmi3GetOutputDerivatives; refused for anything but a continuous output.
+    pub fn output_derivatives(&mut self, indices: &[usize]) -> Result<Vec<f64>, String> {
+        if let Some(v) = indices
+            .iter()
+            .map(|&i| &REALS[i])
+            .find(|v| v.causality != Causality::Output || v.variability != Variability::Continuous)
+        {
+            return Err(format!("{} is not a continuous output", v.name));
+        }
+        let Some(simulation) = self.core.simulation.as_mut() else {
+            return Err("the model was not initialised".into());
+        };
+        let derivatives = simulation
+            .output_derivatives()
+            .map_err(|e| parameters::message(&e))?;
+        let counters = simulation.counters();
+        // The one mapping from outputs to variables, applied to the derivatives on a copy.
+        let values = self.core.values.clone();
+        self.write_outputs(&derivatives, &counters);
+        let reals = std::mem::replace(&mut self.core.values, values).reals;
+        Ok(indices.iter().map(|&i| reals.as_slice()[i]).collect())
     }
 
     /// Writes the outputs and the solver counters.

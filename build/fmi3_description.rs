@@ -1,0 +1,571 @@
+//! The FMI 3.0 side of `build.rs`, from the same variable table as the 2.0 files:
+//! - `fmi3/modelDescription.xml`: a family with `dims` becomes one array variable (`mount[{i}].F[{j}]`
+//!   becomes `mount.F` with dimensions 4 × 3), the natural modes become arrays whose length is the
+//!   structural parameter `modes.size`; units, display units and descriptions as in 2.0;
+//! - `fmi3/terminalsAndIcons.xml`: terminals grouping the engine inputs and the outputs;
+//! - the Rust map from each 3.0 value reference to the scalar indices of the 2.0 table (appended
+//!   to `variables.rs`);
+//! - [`FMI3_FUNCTIONS`], the exported fmi3 symbols.
+//!
+//! Value references: a 3.0 variable takes the 2.0 value reference of its first element, so a
+//! scalar keeps its 2.0 value reference and arrays never overlap; `time` and `modes.size`, which
+//! have no 2.0 counterpart, sit above the 2.0 ranges.
+
+use super::{
+    attr, element, fail, opt_str, str_field, value_text, vr_base, Attributes, Family, VR_BASE,
+};
+use quick_xml::events::{BytesDecl, Event};
+use quick_xml::Writer;
+use serde_json::Value;
+use std::fmt::Write as _;
+
+/// Every function of `fmi3Functions.h`: the common and co-simulation API, and the model-exchange
+/// and scheduled-execution functions, which refuse (masters such as fmpy resolve them all).
+pub const FMI3_FUNCTIONS: [&str; 75] = [
+    "fmi3GetVersion",
+    "fmi3SetDebugLogging",
+    "fmi3InstantiateModelExchange",
+    "fmi3InstantiateCoSimulation",
+    "fmi3InstantiateScheduledExecution",
+    "fmi3FreeInstance",
+    "fmi3EnterInitializationMode",
+    "fmi3ExitInitializationMode",
+    "fmi3EnterEventMode",
+    "fmi3Terminate",
+    "fmi3Reset",
+    "fmi3GetFloat32",
+    "fmi3GetFloat64",
+    "fmi3GetInt8",
+    "fmi3GetUInt8",
+    "fmi3GetInt16",
+    "fmi3GetUInt16",
+    "fmi3GetInt32",
+    "fmi3GetUInt32",
+    "fmi3GetInt64",
+    "fmi3GetUInt64",
+    "fmi3GetBoolean",
+    "fmi3GetString",
+    "fmi3GetBinary",
+    "fmi3GetClock",
+    "fmi3SetFloat32",
+    "fmi3SetFloat64",
+    "fmi3SetInt8",
+    "fmi3SetUInt8",
+    "fmi3SetInt16",
+    "fmi3SetUInt16",
+    "fmi3SetInt32",
+    "fmi3SetUInt32",
+    "fmi3SetInt64",
+    "fmi3SetUInt64",
+    "fmi3SetBoolean",
+    "fmi3SetString",
+    "fmi3SetBinary",
+    "fmi3SetClock",
+    "fmi3GetNumberOfVariableDependencies",
+    "fmi3GetVariableDependencies",
+    "fmi3GetFMUState",
+    "fmi3SetFMUState",
+    "fmi3FreeFMUState",
+    "fmi3SerializedFMUStateSize",
+    "fmi3SerializeFMUState",
+    "fmi3DeserializeFMUState",
+    "fmi3GetDirectionalDerivative",
+    "fmi3GetAdjointDerivative",
+    "fmi3EnterConfigurationMode",
+    "fmi3ExitConfigurationMode",
+    "fmi3GetIntervalDecimal",
+    "fmi3GetIntervalFraction",
+    "fmi3GetShiftDecimal",
+    "fmi3GetShiftFraction",
+    "fmi3SetIntervalDecimal",
+    "fmi3SetIntervalFraction",
+    "fmi3SetShiftDecimal",
+    "fmi3SetShiftFraction",
+    "fmi3EvaluateDiscreteStates",
+    "fmi3UpdateDiscreteStates",
+    "fmi3EnterStepMode",
+    "fmi3GetOutputDerivatives",
+    "fmi3DoStep",
+    "fmi3EnterContinuousTimeMode",
+    "fmi3CompletedIntegratorStep",
+    "fmi3SetTime",
+    "fmi3SetContinuousStates",
+    "fmi3GetContinuousStateDerivatives",
+    "fmi3GetEventIndicators",
+    "fmi3GetContinuousStates",
+    "fmi3GetNominalsOfContinuousStates",
+    "fmi3GetNumberOfEventIndicators",
+    "fmi3GetNumberOfContinuousStates",
+    "fmi3ActivateModelPartition",
+];
+
+/// Value reference of the independent variable `time`.
+const TIME_VR: usize = 4000;
+/// Value reference of the structural parameter `modes.size`.
+const MODES_SIZE_VR: usize = 4001;
+
+/// One 3.0 variable: a table entry with its 2.0 family.
+struct Var3<'a> {
+    entry: &'a Value,
+    family: &'a Family,
+    name: String,
+    vr: usize,
+    /// The length of the first dimension is `modes.size` (the natural modes).
+    sized_by_modes: bool,
+}
+
+fn type3(ty: &str) -> &'static str {
+    match ty {
+        "Real" => "Float64",
+        "Integer" => "Int32",
+        "Boolean" => "Boolean",
+        _ => "String",
+    }
+}
+
+/// The 3.0 variables of the table's entries, in table order.
+fn variables<'a>(table: &'a Value, families: &'a [Family]) -> Vec<Var3<'a>> {
+    let entries = table
+        .get("variables")
+        .and_then(Value::as_array)
+        .unwrap_or_else(|| fail("`variables` must be an array"));
+    let mut names = std::collections::BTreeSet::new();
+    // The FMI 3.0 FMU is the engine FMU's twin: the body FMU's variables are not its own.
+    let in_engine = |entry: &Value| {
+        entry
+            .get("fmus")
+            .and_then(Value::as_array)
+            .is_none_or(|l| l.iter().any(|f| f.as_str() == Some("engine")))
+    };
+    let vars: Vec<Var3> = entries
+        .iter()
+        .zip(families)
+        .filter(|(entry, _)| in_engine(entry))
+        .map(|(entry, family)| {
+            let name = family.name.replace("[{i}]", "").replace("[{j}]", "");
+            if name.contains('{') {
+                fail(&format!(
+                    "{}: array indices must be `[{{i}}]`/`[{{j}}]`",
+                    family.name
+                ));
+            }
+            if !names.insert(name.clone()) {
+                fail(&format!("FMI 3.0 name {name} occurs twice"));
+            }
+            let sized_by_modes =
+                family.dims.len() == 1 && str_field(entry, "causality") == "calculatedParameter";
+            Var3 {
+                entry,
+                family,
+                name,
+                vr: family.first_vr + vr_base(family.ty),
+                sized_by_modes,
+            }
+        })
+        .collect();
+    let sizes: Vec<usize> = vars
+        .iter()
+        .filter(|v| v.sized_by_modes)
+        .map(|v| v.family.dims[0])
+        .collect();
+    if sizes.windows(2).any(|w| w[0] != w[1]) {
+        fail("the natural-mode arrays must have one length");
+    }
+    vars
+}
+
+/// The longest natural-mode array (the 2.0 table's slots), the maximum of `modes.size`.
+fn modes_max(vars: &[Var3]) -> usize {
+    vars.iter()
+        .find(|v| v.sized_by_modes)
+        .map(|v| v.family.dims[0])
+        .unwrap_or_else(|| fail("no natural-mode array (calculatedParameter with dims)"))
+}
+
+/// The description of an array: the family's, with its placeholders named.
+fn description3(v: &Var3) -> String {
+    let text = v.family.description.replace("{i}", "i").replace("{j}", "j");
+    match v.family.dims.len() {
+        0 => text,
+        1 => format!("{text}. Array element [i]"),
+        _ => format!("{text}. Array element [i, j]"),
+    }
+}
+
+/// Writes `fmi3/modelDescription.xml` and `fmi3/terminalsAndIcons.xml` below `out`.
+pub fn write_files(out: &std::path::Path, table: &Value, families: &[Family], guid: &str) {
+    let dir = out.join("fmi3");
+    std::fs::create_dir_all(&dir)
+        .unwrap_or_else(|e| fail(&format!("cannot create {}: {e}", dir.display())));
+    let vars = variables(table, families);
+    let mut w = Writer::new_with_indent(Vec::new(), b' ', 2);
+    write_model_description(&mut w, table, &vars, guid)
+        .unwrap_or_else(|e| fail(&format!("writing the FMI 3.0 modelDescription.xml: {e}")));
+    super::write(&dir.join("modelDescription.xml"), &finish(w));
+    let mut w = Writer::new_with_indent(Vec::new(), b' ', 2);
+    write_terminals(&mut w, &vars)
+        .unwrap_or_else(|e| fail(&format!("writing terminalsAndIcons.xml: {e}")));
+    super::write(&dir.join("terminalsAndIcons.xml"), &finish(w));
+}
+
+fn finish(w: Writer<Vec<u8>>) -> String {
+    let mut xml = String::from_utf8(w.into_inner()).expect("quick-xml writes UTF-8");
+    xml.push('\n');
+    xml
+}
+
+fn write_model_description(
+    w: &mut Writer<Vec<u8>>,
+    table: &Value,
+    vars: &[Var3],
+    guid: &str,
+) -> std::io::Result<()> {
+    let array = |key: &str| -> Vec<Value> {
+        table
+            .get(key)
+            .and_then(Value::as_array)
+            .cloned()
+            .unwrap_or_default()
+    };
+    w.write_event(Event::Decl(BytesDecl::new("1.0", Some("UTF-8"), None)))?;
+    let root = vec![
+        attr("fmiVersion", "3.0"),
+        attr("modelName", str_field(table, "modelName")),
+        attr("instantiationToken", guid),
+        attr("description", str_field(table, "description")),
+        attr("author", str_field(table, "author")),
+        attr("version", str_field(table, "version")),
+        attr("generationTool", "engine_mount_chassis build.rs"),
+        attr("variableNamingConvention", "structured"),
+    ];
+    element(w, "fmiModelDescription", &root).write_inner_content(|w| {
+        // No event mode, no intermediate update, no early return: fmi3DoStep always completes
+        // the step (or stops at a failure, reported by fmi3Discard).
+        let co_simulation = vec![
+            attr("modelIdentifier", str_field(table, "modelIdentifier")),
+            attr("needsExecutionTool", false),
+            attr("canBeInstantiatedOnlyOncePerProcess", false),
+            attr("canGetAndSetFMUState", true),
+            attr("canSerializeFMUState", true),
+            attr("providesDirectionalDerivative", false),
+            attr("providesAdjointDerivatives", false),
+            attr("providesPerElementDependencies", false),
+            attr("canHandleVariableCommunicationStepSize", true),
+            attr("maxOutputDerivativeOrder", 1),
+            attr("providesIntermediateUpdate", false),
+            attr("mightReturnEarlyFromDoStep", false),
+            attr("canReturnEarlyAfterIntermediateUpdate", false),
+            attr("hasEventMode", false),
+            attr("providesEvaluateDiscreteStates", false),
+        ];
+        element(w, "CoSimulation", &co_simulation).write_empty()?;
+        w.create_element("UnitDefinitions")
+            .write_inner_content(|w| {
+                for u in array("units") {
+                    let name = vec![attr("name", str_field(&u, "name"))];
+                    element(w, "Unit", &name).write_inner_content(|w| {
+                        let mut base: Attributes = u
+                            .get("base")
+                            .and_then(Value::as_object)
+                            .into_iter()
+                            .flatten()
+                            .map(|(k, v)| attr(k, v))
+                            .collect();
+                        if let Some(f) = u.get("factor").and_then(Value::as_f64) {
+                            base.push(attr("factor", format!("{f:?}")));
+                        }
+                        element(w, "BaseUnit", &base).write_empty()?;
+                        for d in u
+                            .get("display")
+                            .and_then(Value::as_array)
+                            .into_iter()
+                            .flatten()
+                        {
+                            let factor = d.get("factor").and_then(Value::as_f64).unwrap_or(1.0);
+                            let display = vec![
+                                attr("name", str_field(d, "name")),
+                                attr("factor", format!("{factor:?}")),
+                            ];
+                            element(w, "DisplayUnit", &display).write_empty()?;
+                        }
+                        Ok(())
+                    })?;
+                }
+                Ok(())
+            })?;
+        w.create_element("LogCategories").write_inner_content(|w| {
+            for c in array("logCategories") {
+                let category = vec![
+                    attr("name", str_field(&c, "name")),
+                    attr("description", str_field(&c, "description")),
+                ];
+                element(w, "Category", &category).write_empty()?;
+            }
+            Ok(())
+        })?;
+        if let Some(de) = table.get("defaultExperiment").and_then(Value::as_object) {
+            let experiment: Attributes = de.iter().map(|(k, v)| attr(k, v)).collect();
+            element(w, "DefaultExperiment", &experiment).write_empty()?;
+        }
+        let max = modes_max(vars);
+        w.create_element("ModelVariables")
+            .write_inner_content(|w| {
+                let time = vec![
+                    attr("name", "time"),
+                    attr("valueReference", TIME_VR),
+                    attr("causality", "independent"),
+                    attr("variability", "continuous"),
+                    attr("description", "Simulation time"),
+                    attr("unit", "s"),
+                ];
+                element(w, "Float64", &time).write_empty()?;
+                let mut sized_written = false;
+                for v in vars {
+                    if v.sized_by_modes && !sized_written {
+                        sized_written = true;
+                        let size = vec![
+                            attr("name", "modes.size"),
+                            attr("valueReference", MODES_SIZE_VR),
+                            attr("causality", "structuralParameter"),
+                            attr("variability", "fixed"),
+                            attr(
+                                "description",
+                                format!(
+                                    "Length of the natural-mode arrays mode.*: the lowest modes.size \
+                                     natural modes are reported (1..{max}; entries beyond modes.count \
+                                     are 0). Set in configuration mode"
+                                ),
+                            ),
+                            attr("start", max),
+                            attr("min", 1),
+                            attr("max", max),
+                        ];
+                        element(w, "UInt64", &size).write_empty()?;
+                    }
+                    write_variable(w, v)?;
+                }
+                Ok(())
+            })?;
+        let knowns: Vec<String> = vars
+            .iter()
+            .filter(|v| matches!(str_field(v.entry, "causality"), "parameter" | "input"))
+            .map(|v| v.vr)
+            .chain(std::iter::once(MODES_SIZE_VR))
+            .map(|vr| vr.to_string())
+            .collect();
+        let knowns = knowns.join(" ");
+        w.create_element("ModelStructure")
+            .write_inner_content(|w| {
+                // As in the 2.0 file: outputs come from the state at the communication point, so
+                // none depends directly on an input except through the external body's interface
+                // (the table's `feedthrough`; arrays depend on whole arrays); at the end of
+                // initialisation every output and calculated parameter depends on every input and
+                // parameter.
+                for v in vars
+                    .iter()
+                    .filter(|v| str_field(v.entry, "causality") == "output")
+                {
+                    let direct: Vec<String> = vars
+                        .iter()
+                        .filter(|k| v.family.feedthrough.contains(&k.family.rust))
+                        .map(|k| k.vr.to_string())
+                        .collect();
+                    let unknown = vec![
+                        attr("valueReference", v.vr),
+                        attr("dependencies", direct.join(" ")),
+                    ];
+                    element(w, "Output", &unknown).write_empty()?;
+                }
+                for v in vars.iter().filter(|v| {
+                    matches!(
+                        str_field(v.entry, "causality"),
+                        "output" | "calculatedParameter"
+                    )
+                }) {
+                    let unknown = vec![
+                        attr("valueReference", v.vr),
+                        attr("dependencies", &knowns),
+                    ];
+                    element(w, "InitialUnknown", &unknown).write_empty()?;
+                }
+                Ok(())
+            })?;
+        Ok(())
+    })?;
+    Ok(())
+}
+
+fn write_variable(w: &mut Writer<Vec<u8>>, v: &Var3) -> std::io::Result<()> {
+    let e = v.entry;
+    let ty = v.family.ty;
+    let mut a = vec![
+        attr("name", &v.name),
+        attr("valueReference", v.vr),
+        attr("causality", str_field(e, "causality")),
+        attr("variability", str_field(e, "variability")),
+        attr("description", description3(v)),
+    ];
+    // A String's start values are <Start> elements (FMI 3.0 §2.4.7.4), the others' a list.
+    let count = v.family.dims.iter().product::<usize>().max(1);
+    let mut string_starts = Vec::new();
+    if let Some(start) = e.get("start") {
+        let one = value_text(start);
+        if ty == "String" {
+            string_starts = vec![one; count];
+        } else {
+            a.push(attr("start", vec![one; count].join(" ")));
+        }
+    }
+    if let Some(u) = opt_str(e, "unit") {
+        a.push(attr("unit", u));
+    }
+    if let Some(u) = opt_str(e, "displayUnit") {
+        a.push(attr("displayUnit", u));
+    }
+    if matches!(ty, "Real" | "Integer") {
+        for key in ["min", "max"] {
+            if let Some(m) = e.get(key).and_then(Value::as_f64) {
+                a.push(attr(key, super::number_text(ty, m)));
+            }
+        }
+    }
+    let tag = type3(ty);
+    if v.family.dims.is_empty() && string_starts.is_empty() {
+        return element(w, tag, &a).write_empty().map(|_| ());
+    }
+    element(w, tag, &a).write_inner_content(|w| {
+        if v.sized_by_modes {
+            element(w, "Dimension", &vec![attr("valueReference", MODES_SIZE_VR)]).write_empty()?;
+        } else {
+            for d in &v.family.dims {
+                element(w, "Dimension", &vec![attr("start", d)]).write_empty()?;
+            }
+        }
+        for value in &string_starts {
+            element(w, "Start", &vec![attr("value", value)]).write_empty()?;
+        }
+        Ok(())
+    })?;
+    Ok(())
+}
+
+/// Terminals: the engine's inputs, the mount ports (forces and the scales of their
+/// characteristics), the powertrain's motion and the comfort points.
+fn write_terminals(w: &mut Writer<Vec<u8>>, vars: &[Var3]) -> std::io::Result<()> {
+    let terminals: [(&str, &str, &[&str]); 4] = [
+        (
+            "engine",
+            "Engine operating point: speed set-point and drivetrain load torque",
+            &["rpm", "loadTorque"],
+        ),
+        (
+            "mounts",
+            "The engine mounts: forces on the ground/chassis side and the scales of their stiffness and damping",
+            &["mount.F", "mount.stiffnessScale", "mount.dampingScale"],
+        ),
+        (
+            "powertrain",
+            "Motion of the powertrain (housing) centre of gravity",
+            &["powertrain.r", "powertrain.phi", "powertrain.a", "crankAngle"],
+        ),
+        (
+            "comfort",
+            "Comfort points of the car body: steering wheel and driver's seat rail accelerations",
+            &["steeringWheel.a", "seat.a"],
+        ),
+    ];
+    w.write_event(Event::Decl(BytesDecl::new("1.0", Some("UTF-8"), None)))?;
+    element(w, "fmiTerminalsAndIcons", &vec![attr("fmiVersion", "3.0")]).write_inner_content(
+        |w| {
+            w.create_element("Terminals").write_inner_content(|w| {
+                for (name, description, members) in terminals {
+                    let terminal = vec![
+                        attr("name", name),
+                        attr("matchingRule", "bus"),
+                        attr("description", description),
+                    ];
+                    element(w, "Terminal", &terminal).write_inner_content(|w| {
+                        for member in members {
+                            let v = vars
+                                .iter()
+                                .find(|v| v.name == *member)
+                                .unwrap_or_else(|| fail(&format!("terminal member {member}")));
+                            let short = member.rsplit('.').next().unwrap_or(member);
+                            let m = vec![
+                                attr("variableName", &v.name),
+                                attr("memberName", short),
+                                attr("variableKind", "signal"),
+                            ];
+                            element(w, "TerminalMemberVariable", &m).write_empty()?;
+                        }
+                        Ok(())
+                    })?;
+                }
+                Ok(())
+            })?;
+            Ok(())
+        },
+    )?;
+    Ok(())
+}
+
+/// The Rust map of the 3.0 variables, appended to `variables.rs`.
+pub fn rust_map(table: &Value, families: &[Family]) -> String {
+    let vars = variables(table, families);
+    let max = modes_max(&vars);
+    let mut r = String::new();
+    let _ = writeln!(
+        r,
+        r#"
+/// One variable of the FMI 3.0 model description: a scalar or an array over variables of the
+/// 2.0 table (which the instance stores).
+#[derive(Debug, Clone, Copy)]
+pub struct ArrayVariable {{
+    /// FMI 3.0 name, e.g. `mount.F`.
+    pub name: &'static str,
+    /// FMI 3.0 value reference: the 2.0 value reference of the first element.
+    pub vr: u32,
+    /// The type as an index into Real, Integer, Boolean, String (the 3.0 types Float64, Int32,
+    /// Boolean, String).
+    pub type_index: usize,
+    /// The elements' indices among the variables of their type ([`REALS`], …), row-major.
+    pub indices: &'static [u32],
+    /// The array's dimensions as declared (empty for a scalar).
+    pub dims: &'static [usize],
+    /// The first dimension is the structural parameter `modes.size`: only the first
+    /// `modes.size` elements exist.
+    pub sized_by_modes: bool,
+}}
+
+/// The FMI 3.0 variables beyond the 2.0 table and the map from 3.0 value references to the 2.0
+/// table.
+pub mod fmi3 {{
+    /// Value reference of the independent variable `time` \[s\].
+    pub const TIME: u32 = {TIME_VR};
+    /// Value reference of the structural parameter `modes.size` (UInt64): the length of the
+    /// natural-mode arrays.
+    pub const MODES_SIZE: u32 = {MODES_SIZE_VR};
+    /// The largest `modes.size` (and its start value): the 2.0 table's natural-mode slots.
+    pub const MODES_SIZE_MAX: u64 = {max};
+    /// Every 3.0 variable with a 2.0 counterpart, in the order of the model description.
+    pub static VARIABLES: &[super::ArrayVariable] = &["#
+    );
+    for v in &vars {
+        let count: usize = v.family.dims.iter().product::<usize>().max(1);
+        let indices: Vec<usize> = (0..count).map(|k| v.family.first_vr + k).collect();
+        let type_index = ["Real", "Integer", "Boolean", "String"]
+            .iter()
+            .position(|t| *t == v.family.ty)
+            .unwrap_or(0);
+        let _ = writeln!(
+            r,
+            "        super::ArrayVariable {{ name: {:?}, vr: {}, type_index: {type_index}, indices: &{indices:?}, dims: &{:?}, sized_by_modes: {} }},",
+            v.name, v.vr, v.family.dims, v.sized_by_modes
+        );
+    }
+    r.push_str("    ];\n}\n");
+    if VR_BASE[3] + 1000 > TIME_VR {
+        fail("the FMI 3.0 value references of time and modes.size overlap the 2.0 ranges");
+    }
+    r
+}

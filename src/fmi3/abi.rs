@@ -1,0 +1,1326 @@
+//! The exported FMI 3.0 functions. As in [`crate::fmi2::abi`], every entry point with an
+//! instance passes one guard, `entry`: the instance pointer is checked, panics are caught (none
+//! may unwind into the C caller), the call is checked against the 3.0 state machine
+//! ([`super::state`]), a refusal is logged once naming the function, and every fmi3Error puts
+//! the instance into the error state. Inside, value references are resolved to the 2.0 table
+//! ([`super::values`]) and the shared [`Instance`] does the work: the model, the stepping and the
+//! FMU states are the 2.0 layer's.
+
+#![allow(non_snake_case)]
+#![allow(clippy::not_unsafe_ptr_arg_deref)] // the C ABI hands us raw pointers by design
+#![allow(clippy::too_many_arguments)] // the signatures are the standard's
+
+use std::ffi::{c_char, CString};
+use std::panic::{catch_unwind, AssertUnwindSafe};
+use std::path::PathBuf;
+
+use fmi_sys::fmi3::*;
+
+use super::state::{self, Mask, Phase};
+use super::values::{resolve, unknown, Slot};
+use crate::fmi2::abi::{array, array_mut, place, text, texts};
+use crate::fmi2::instance::{Core, Instance, Outcome, Status};
+use crate::fmi2::logger::{Level, Logger};
+use crate::fmi2::snapshot;
+use crate::fmi2::state::Phase as Phase2;
+use crate::fmi2::values::Typed;
+use crate::variables::fmi3::{MODES_SIZE, MODES_SIZE_MAX};
+use crate::variables::{string, LogCategory, GUID, STRINGS};
+
+/// Marks a live instance allocated by `fmi3InstantiateCoSimulation` (another value than the 2.0
+/// layer's, so an instance of one standard is never used through the other).
+const LIVE: u64 = 0x454d_4346_4d55_0003;
+
+struct Handle {
+    live: u64,
+    instance: Instance,
+    /// In configuration mode (the 2.0 phase underneath stays `Instantiated`).
+    configuration: bool,
+    /// A call returned fmi3Error: the error state until an FMU state is restored or the instance
+    /// is reset.
+    error: bool,
+    /// The structural parameter `modes.size`: the length of the natural-mode arrays.
+    modes_size: u64,
+    /// Strings returned by fmi3GetString stay valid until the next call on this instance.
+    returned_strings: Vec<CString>,
+    /// The FMU states this instance handed out and has not freed, recognised by address.
+    #[allow(clippy::vec_box)]
+    states: Vec<Box<StateHandle>>,
+}
+
+/// An FMU state handed out by `fmi3GetFMUState`: the 2.0 instance's state, which the 2.0
+/// snapshot functions serialize.
+struct StateHandle {
+    core: Core,
+}
+
+impl Handle {
+    fn phase(&self) -> Phase {
+        Phase::of(self.instance.phase(), self.configuration, self.error)
+    }
+
+    /// The state behind `state`, if this instance handed it out.
+    fn state(&self, state: fmi3FMUState) -> Result<usize, String> {
+        self.states
+            .iter()
+            .position(|s| std::ptr::eq(&**s, state as *const StateHandle))
+            .ok_or_else(|| "not an FMU state of this instance".to_owned())
+    }
+
+    /// Puts `core` into the slot the master passed: a new state for a null slot, the same state
+    /// overwritten for one of ours.
+    fn store_state(&mut self, slot: &mut fmi3FMUState, core: Core) -> Outcome {
+        if slot.is_null() {
+            let mut boxed = Box::new(StateHandle { core });
+            let ptr: *mut StateHandle = &mut *boxed;
+            self.states.push(boxed);
+            *slot = ptr as fmi3FMUState;
+        } else {
+            let i = self.state(*slot)?;
+            self.states[i].core = core;
+        }
+        Ok(Status::Ok)
+    }
+}
+
+fn status(s: Status) -> fmi3Status {
+    match s {
+        Status::Ok => fmi3Status_fmi3OK,
+        Status::Warning => fmi3Status_fmi3Warning,
+        Status::Discard => fmi3Status_fmi3Discard,
+        Status::Error => fmi3Status_fmi3Error,
+        Status::Fatal => fmi3Status_fmi3Fatal,
+    }
+}
+
+/// The guard of every entry point with an instance: runs `body` on the instance behind
+/// `instance` if `function` may be called in its phase (`mask`). A null or stale pointer gives
+/// fmi3Error; a refusal is logged as "`function`: reason" and gives fmi3Error and the error
+/// state; a panic gives fmi3Fatal (the instance is then unusable); in the fatal state only
+/// fmi3FreeInstance is allowed.
+fn entry(
+    instance: fmi3Instance,
+    function: &'static str,
+    mask: Mask,
+    body: impl FnOnce(&mut Handle) -> Outcome,
+) -> fmi3Status {
+    if instance.is_null() {
+        return fmi3Status_fmi3Error;
+    }
+    let ptr = instance as *mut Handle;
+    // SAFETY: a non-null fmi3Instance is, per FMI 3.0, the pointer fmi3InstantiateCoSimulation
+    // returned and fmi3FreeInstance has not been called on it; one instance must not be used from
+    // two threads at once (FMI 3.0 §2.2.2), so this is the only live reference.
+    let handle = unsafe { &mut *ptr };
+    if handle.live != LIVE {
+        return fmi3Status_fmi3Error;
+    }
+    let result = catch_unwind(AssertUnwindSafe(|| {
+        let inst = &handle.instance;
+        inst.logger.log(Level::Info, LogCategory::Calls, function);
+        let phase = handle.phase();
+        if phase == Phase::Fatal {
+            inst.logger.log(
+                Level::Fatal,
+                LogCategory::StatusError,
+                &format!("{function}: the instance is in a fatal state; only fmi3FreeInstance is allowed"),
+            );
+            return Status::Fatal;
+        }
+        if !mask.allows(phase) {
+            let hint = if phase == Phase::Error {
+                " (after fmi3Error: fmi3SetFMUState, fmi3Reset or fmi3FreeInstance)"
+            } else {
+                ""
+            };
+            inst.log_error(&format!(
+                "{function} is not allowed in phase {phase:?}{hint}"
+            ));
+            return Status::Error;
+        }
+        match body(handle) {
+            Ok(s) => s,
+            Err(message) => {
+                handle.instance.log_error(&format!("{function}: {message}"));
+                Status::Error
+            }
+        }
+    }));
+    match result {
+        Ok(s) => {
+            if s == Status::Error {
+                handle.error = true;
+            }
+            status(s)
+        }
+        Err(panic) => {
+            let what = panic
+                .downcast_ref::<&str>()
+                .map(|s| s.to_string())
+                .or_else(|| panic.downcast_ref::<String>().cloned())
+                .unwrap_or_else(|| "unknown panic".to_owned());
+            let _ = catch_unwind(AssertUnwindSafe(|| {
+                handle.instance.core.phase = Phase2::Fatal;
+                handle.instance.logger.log(
+                    Level::Fatal,
+                    LogCategory::StatusError,
+                    &format!("{function}: internal error (bug), the instance is unusable: {what}"),
+                );
+            }));
+            fmi3Status_fmi3Fatal
+        }
+    }
+}
+
+// ----- inquiry, creation and destruction -------------------------------------------------------
+
+/// Returns `"3.0"`. Needs no instance.
+#[no_mangle]
+pub extern "C" fn fmi3GetVersion() -> *const c_char {
+    c"3.0".as_ptr()
+}
+const _: fmi3GetVersionTYPE = Some(fmi3GetVersion);
+
+/// Creates a co-simulation instance and returns it, or null after logging why through
+/// `logMessage`: a missing `instanceName`, an instantiation token that is not this FMU's, a
+/// resource path that is not a directory, `eventModeUsed` (the FMU has no event mode) or
+/// required intermediate variables (it provides no intermediate update). `earlyReturnAllowed`
+/// is accepted; fmi3DoStep never returns early.
+#[no_mangle]
+pub extern "C" fn fmi3InstantiateCoSimulation(
+    instanceName: fmi3String,
+    instantiationToken: fmi3String,
+    resourcePath: fmi3String,
+    _visible: fmi3Boolean,
+    loggingOn: fmi3Boolean,
+    eventModeUsed: fmi3Boolean,
+    _earlyReturnAllowed: fmi3Boolean,
+    _requiredIntermediateVariables: *const fmi3ValueReference,
+    nRequiredIntermediateVariables: usize,
+    instanceEnvironment: fmi3InstanceEnvironment,
+    logMessage: fmi3LogMessageCallback,
+    _intermediateUpdate: fmi3IntermediateUpdateCallback,
+) -> fmi3Instance {
+    let result = catch_unwind(AssertUnwindSafe(|| {
+        // SAFETY: FMI strings are NUL-terminated or null.
+        let (name, token, resources) = unsafe {
+            (
+                text(instanceName).unwrap_or_default(),
+                text(instantiationToken).unwrap_or_default(),
+                text(resourcePath),
+            )
+        };
+        let logger = Logger::new_fmi3(logMessage, instanceEnvironment, &name, loggingOn);
+        let refuse = |logger: &Logger, message: &str| {
+            let message = format!("fmi3InstantiateCoSimulation: {message}");
+            logger.log(Level::Error, LogCategory::StatusError, &message);
+            std::ptr::null_mut()
+        };
+        if name.is_empty() {
+            return refuse(&logger, "instanceName is missing");
+        }
+        if token != GUID {
+            return refuse(
+                &logger,
+                &format!("instantiation token \"{token}\" does not match this FMU's {GUID}"),
+            );
+        }
+        if eventModeUsed {
+            return refuse(
+                &logger,
+                "eventModeUsed: this FMU has no event mode (hasEventMode=false)",
+            );
+        }
+        if nRequiredIntermediateVariables > 0 {
+            return refuse(
+                &logger,
+                "required intermediate variables: this FMU provides no intermediate update",
+            );
+        }
+        let resource_dir = match resources.filter(|r| !r.is_empty()) {
+            None => {
+                let config = STRINGS[string::CONFIG_FILE as usize].name;
+                logger.log(
+                    Level::Warning,
+                    LogCategory::StatusWarning,
+                    &format!("fmi3InstantiateCoSimulation: no resource path given; the built-in vehicle is used unless {config} names an absolute path"),
+                );
+                None
+            }
+            Some(r) if PathBuf::from(&r).is_dir() => Some(PathBuf::from(r)),
+            Some(r) => return refuse(&logger, &format!("resource path {r} is not a directory")),
+        };
+        let handle = Box::new(Handle {
+            live: LIVE,
+            instance: Instance::new(&name, crate::cosim::FmuKind::Engine, logger, resource_dir),
+            configuration: false,
+            error: false,
+            modes_size: MODES_SIZE_MAX,
+            returned_strings: Vec::new(),
+            states: Vec::new(),
+        });
+        Box::into_raw(handle) as fmi3Instance
+    }));
+    result.unwrap_or(std::ptr::null_mut())
+}
+const _: fmi3InstantiateCoSimulationTYPE = Some(fmi3InstantiateCoSimulation);
+
+/// Logs through `logMessage` that `interface` is not supported and returns null.
+fn refuse_interface(
+    interface: &str,
+    instanceName: fmi3String,
+    environment: fmi3InstanceEnvironment,
+    logMessage: fmi3LogMessageCallback,
+) -> fmi3Instance {
+    let _ = catch_unwind(AssertUnwindSafe(|| {
+        // SAFETY: FMI strings are NUL-terminated or null.
+        let name = unsafe { text(instanceName) }.unwrap_or_default();
+        Logger::new_fmi3(logMessage, environment, &name, false).log(
+            Level::Error,
+            LogCategory::StatusError,
+            &format!("fmi3Instantiate{interface}: this FMU supports co-simulation only"),
+        );
+    }));
+    std::ptr::null_mut()
+}
+
+/// Always null: the FMU supports co-simulation only (the refusal is logged).
+#[no_mangle]
+pub extern "C" fn fmi3InstantiateModelExchange(
+    instanceName: fmi3String,
+    _instantiationToken: fmi3String,
+    _resourcePath: fmi3String,
+    _visible: fmi3Boolean,
+    _loggingOn: fmi3Boolean,
+    instanceEnvironment: fmi3InstanceEnvironment,
+    logMessage: fmi3LogMessageCallback,
+) -> fmi3Instance {
+    refuse_interface(
+        "ModelExchange",
+        instanceName,
+        instanceEnvironment,
+        logMessage,
+    )
+}
+const _: fmi3InstantiateModelExchangeTYPE = Some(fmi3InstantiateModelExchange);
+
+/// Always null: the FMU supports co-simulation only (the refusal is logged).
+#[no_mangle]
+pub extern "C" fn fmi3InstantiateScheduledExecution(
+    instanceName: fmi3String,
+    _instantiationToken: fmi3String,
+    _resourcePath: fmi3String,
+    _visible: fmi3Boolean,
+    _loggingOn: fmi3Boolean,
+    instanceEnvironment: fmi3InstanceEnvironment,
+    logMessage: fmi3LogMessageCallback,
+    _clockUpdate: fmi3ClockUpdateCallback,
+    _lockPreemption: fmi3LockPreemptionCallback,
+    _unlockPreemption: fmi3UnlockPreemptionCallback,
+) -> fmi3Instance {
+    refuse_interface(
+        "ScheduledExecution",
+        instanceName,
+        instanceEnvironment,
+        logMessage,
+    )
+}
+const _: fmi3InstantiateScheduledExecutionTYPE = Some(fmi3InstantiateScheduledExecution);
+
+/// Frees the instance and every FMU state it handed out; a null or already freed instance is
+/// ignored. Allowed in every state, the fatal one included.
+#[no_mangle]
+pub extern "C" fn fmi3FreeInstance(instance: fmi3Instance) {
+    if instance.is_null() {
+        return;
+    }
+    let ptr = instance as *mut Handle;
+    // SAFETY: instance came from fmi3InstantiateCoSimulation (Box::into_raw) and is freed at most
+    // once by contract; the live marker catches the common double free before ownership returns.
+    unsafe {
+        if (*ptr).live != LIVE {
+            return;
+        }
+        (*ptr).live = 0;
+        drop(Box::from_raw(ptr));
+    }
+}
+const _: fmi3FreeInstanceTYPE = Some(fmi3FreeInstance);
+
+/// As fmi2SetDebugLogging: no categories switch all; unknown names are refused.
+#[no_mangle]
+pub extern "C" fn fmi3SetDebugLogging(
+    instance: fmi3Instance,
+    loggingOn: fmi3Boolean,
+    nCategories: usize,
+    categories: *const fmi3String,
+) -> fmi3Status {
+    entry(instance, "fmi3SetDebugLogging", state::ANY, |h| {
+        // SAFETY: FMI passes an array of nCategories C strings.
+        let names = unsafe { texts(categories, nCategories, "categories") }?;
+        h.instance.logger.set_debug_logging(loggingOn, &names)?;
+        Ok(Status::Ok)
+    })
+}
+const _: fmi3SetDebugLoggingTYPE = Some(fmi3SetDebugLogging);
+
+// ----- configuration, initialisation, termination, reset ---------------------------------------
+
+/// Enters configuration mode, where the structural parameter `modes.size` may be set.
+#[no_mangle]
+pub extern "C" fn fmi3EnterConfigurationMode(instance: fmi3Instance) -> fmi3Status {
+    entry(
+        instance,
+        "fmi3EnterConfigurationMode",
+        state::ENTER_FROM_INSTANTIATED,
+        |h| {
+            h.configuration = true;
+            Ok(Status::Ok)
+        },
+    )
+}
+const _: fmi3EnterConfigurationModeTYPE = Some(fmi3EnterConfigurationMode);
+
+/// Leaves configuration mode for the instantiated state.
+#[no_mangle]
+pub extern "C" fn fmi3ExitConfigurationMode(instance: fmi3Instance) -> fmi3Status {
+    entry(
+        instance,
+        "fmi3ExitConfigurationMode",
+        state::EXIT_CONFIGURATION,
+        |h| {
+            h.configuration = false;
+            Ok(Status::Ok)
+        },
+    )
+}
+const _: fmi3ExitConfigurationModeTYPE = Some(fmi3ExitConfigurationMode);
+
+/// Sets up the experiment as fmi2SetupExperiment does (start time, optional stop time, optional
+/// tolerance that becomes the integrator's relative tolerance unless `solver.relTol` was set) and
+/// enters initialisation mode; inadmissible times or tolerance are refused, changing nothing.
+#[no_mangle]
+pub extern "C" fn fmi3EnterInitializationMode(
+    instance: fmi3Instance,
+    toleranceDefined: fmi3Boolean,
+    tolerance: fmi3Float64,
+    startTime: fmi3Float64,
+    stopTimeDefined: fmi3Boolean,
+    stopTime: fmi3Float64,
+) -> fmi3Status {
+    entry(
+        instance,
+        "fmi3EnterInitializationMode",
+        state::ENTER_FROM_INSTANTIATED,
+        |h| {
+            let setup = h.instance.setup_experiment(
+                startTime,
+                stopTimeDefined.then_some(stopTime),
+                toleranceDefined.then_some(tolerance),
+            )?;
+            Ok(setup.max(h.instance.enter_initialization()?))
+        },
+    )
+}
+const _: fmi3EnterInitializationModeTYPE = Some(fmi3EnterInitializationMode);
+
+/// Builds the model (as fmi2ExitInitializationMode) and enters step mode directly: without event
+/// mode there is no event mode to pass through.
+#[no_mangle]
+pub extern "C" fn fmi3ExitInitializationMode(instance: fmi3Instance) -> fmi3Status {
+    entry(
+        instance,
+        "fmi3ExitInitializationMode",
+        state::EXIT_INITIALIZATION,
+        |h| h.instance.exit_initialization(),
+    )
+}
+const _: fmi3ExitInitializationModeTYPE = Some(fmi3ExitInitializationMode);
+
+/// Always refused: the FMU has no event mode (hasEventMode=false).
+#[no_mangle]
+pub extern "C" fn fmi3EnterEventMode(instance: fmi3Instance) -> fmi3Status {
+    entry(instance, "fmi3EnterEventMode", state::UNSUPPORTED, |_| {
+        Err("this FMU has no event mode (hasEventMode=false)".into())
+    })
+}
+const _: fmi3EnterEventModeTYPE = Some(fmi3EnterEventMode);
+
+/// Always refused: step mode is entered by fmi3ExitInitializationMode, event mode does not exist.
+#[no_mangle]
+pub extern "C" fn fmi3EnterStepMode(instance: fmi3Instance) -> fmi3Status {
+    entry(instance, "fmi3EnterStepMode", state::UNSUPPORTED, |_| {
+        Err("this FMU has no event mode to leave (hasEventMode=false)".into())
+    })
+}
+const _: fmi3EnterStepModeTYPE = Some(fmi3EnterStepMode);
+
+/// Ends the simulation: values can still be read, no step taken.
+#[no_mangle]
+pub extern "C" fn fmi3Terminate(instance: fmi3Instance) -> fmi3Status {
+    entry(instance, "fmi3Terminate", state::TERMINATE, |h| {
+        h.instance.terminate()
+    })
+}
+const _: fmi3TerminateTYPE = Some(fmi3Terminate);
+
+/// Back to the instantiated state with start values (also out of the error state); FMU states
+/// handed out stay valid.
+#[no_mangle]
+pub extern "C" fn fmi3Reset(instance: fmi3Instance) -> fmi3Status {
+    entry(instance, "fmi3Reset", state::ANY, |h| {
+        h.configuration = false;
+        h.error = false;
+        h.modes_size = MODES_SIZE_MAX;
+        h.instance.reset()
+    })
+}
+const _: fmi3ResetTYPE = Some(fmi3Reset);
+
+// ----- getting and setting values --------------------------------------------------------------
+
+/// `fmi3GetXXX` for the model's types: the values behind `vr` (arrays row-major), converted.
+fn get_values<T: Typed, C>(
+    instance: fmi3Instance,
+    function: &'static str,
+    vr: *const fmi3ValueReference,
+    nvr: usize,
+    value: *mut C,
+    n_values: usize,
+    convert: impl Fn(T) -> C,
+    time: impl Fn(f64) -> Option<C>,
+) -> fmi3Status {
+    entry(instance, function, state::GET_VALUES, |h| {
+        before_initialization(h)?;
+        // SAFETY: FMI passes nvr value references and room for nValues values.
+        let (vrs, out) = unsafe { (array(vr, nvr, "vr")?, array_mut(value, n_values, "values")?) };
+        let slots = resolve::<T>(vrs, h.modes_size, n_values)?;
+        let elements: Vec<usize> = slots
+            .iter()
+            .filter_map(|s| match s {
+                Slot::Element(i) => Some(*i),
+                Slot::Time => None,
+            })
+            .collect();
+        let mut read = h.instance.get::<T>(&elements)?.into_iter();
+        let now = h.instance.core.time;
+        for (o, s) in out.iter_mut().zip(&slots) {
+            *o = match s {
+                Slot::Element(_) => convert(read.next().ok_or("value count")?),
+                Slot::Time => time(now).ok_or("time")?,
+            };
+        }
+        Ok(Status::Ok)
+    })
+}
+
+/// `fmi3SetXXX` for the model's types: all values checked before any is applied (by the
+/// instance), `time` refused.
+fn set_values<T: Typed, C: Copy>(
+    instance: fmi3Instance,
+    function: &'static str,
+    vr: *const fmi3ValueReference,
+    nvr: usize,
+    value: *const C,
+    n_values: usize,
+    convert: impl Fn(C) -> Result<T, String>,
+) -> fmi3Status {
+    entry(instance, function, state::SET_VALUES, |h| {
+        // SAFETY: FMI passes nvr value references and nValues values.
+        let (vrs, given) = unsafe { (array(vr, nvr, "vr")?, array(value, n_values, "values")?) };
+        let slots = resolve::<T>(vrs, h.modes_size, n_values)?;
+        let mut elements = Vec::with_capacity(slots.len());
+        for s in slots {
+            match s {
+                Slot::Element(i) => elements.push(i),
+                Slot::Time => {
+                    return Err("time is the independent variable and cannot be set".into())
+                }
+            }
+        }
+        let values = given
+            .iter()
+            .map(|x| convert(*x))
+            .collect::<Result<Vec<T>, String>>()?;
+        h.instance.set::<T>(&elements, &values)
+    })
+}
+
+/// Refuses reading in the error state entered before initialisation: a calculated parameter
+/// read there would build the model as a side effect of a diagnostic read.
+fn before_initialization(h: &Handle) -> Result<(), String> {
+    if h.instance.phase() == Phase2::Instantiated {
+        return Err("nothing to read before initialisation".into());
+    }
+    Ok(())
+}
+
+/// A C `bool` read as its byte: a value other than 0 or 1 is refused instead of being undefined
+/// behaviour.
+fn boolean(b: u8) -> Result<bool, String> {
+    match b {
+        0 => Ok(false),
+        1 => Ok(true),
+        other => Err(format!(
+            "Boolean value {other} is neither true (1) nor false (0)"
+        )),
+    }
+}
+
+/// Reads Float64 variables and arrays (`time` too); calculated parameters (the natural modes) are
+/// computed when first read, outputs read in initialisation mode build the model first.
+#[no_mangle]
+pub extern "C" fn fmi3GetFloat64(
+    instance: fmi3Instance,
+    valueReferences: *const fmi3ValueReference,
+    nValueReferences: usize,
+    values: *mut fmi3Float64,
+    nValues: usize,
+) -> fmi3Status {
+    get_values::<f64, _>(
+        instance,
+        "fmi3GetFloat64",
+        valueReferences,
+        nValueReferences,
+        values,
+        nValues,
+        |x| x,
+        Some,
+    )
+}
+const _: fmi3GetFloat64TYPE = Some(fmi3GetFloat64);
+
+/// Reads Int32 variables (the solver counters, `modes.count`, the Integer parameters).
+#[no_mangle]
+pub extern "C" fn fmi3GetInt32(
+    instance: fmi3Instance,
+    valueReferences: *const fmi3ValueReference,
+    nValueReferences: usize,
+    values: *mut fmi3Int32,
+    nValues: usize,
+) -> fmi3Status {
+    get_values::<i32, _>(
+        instance,
+        "fmi3GetInt32",
+        valueReferences,
+        nValueReferences,
+        values,
+        nValues,
+        |x| x,
+        |_| None,
+    )
+}
+const _: fmi3GetInt32TYPE = Some(fmi3GetInt32);
+
+/// Reads Boolean variables (the effect switches and other Boolean parameters).
+#[no_mangle]
+pub extern "C" fn fmi3GetBoolean(
+    instance: fmi3Instance,
+    valueReferences: *const fmi3ValueReference,
+    nValueReferences: usize,
+    values: *mut fmi3Boolean,
+    nValues: usize,
+) -> fmi3Status {
+    get_values::<bool, _>(
+        instance,
+        "fmi3GetBoolean",
+        valueReferences,
+        nValueReferences,
+        values,
+        nValues,
+        |x| x,
+        |_| None,
+    )
+}
+const _: fmi3GetBooleanTYPE = Some(fmi3GetBoolean);
+
+/// Reads String variables; the pointers stay valid until the next fmi3GetString on this instance
+/// or until it is freed.
+#[no_mangle]
+pub extern "C" fn fmi3GetString(
+    instance: fmi3Instance,
+    valueReferences: *const fmi3ValueReference,
+    nValueReferences: usize,
+    values: *mut fmi3String,
+    nValues: usize,
+) -> fmi3Status {
+    entry(instance, "fmi3GetString", state::GET_VALUES, |h| {
+        before_initialization(h)?;
+        // SAFETY: FMI passes nValueReferences value references and nValues string slots.
+        let (vrs, out) = unsafe {
+            (
+                array(valueReferences, nValueReferences, "valueReferences")?,
+                array_mut(values, nValues, "values")?,
+            )
+        };
+        let slots = resolve::<String>(vrs, h.modes_size, nValues)?;
+        let elements: Vec<usize> = slots
+            .iter()
+            .filter_map(|s| match s {
+                Slot::Element(i) => Some(*i),
+                Slot::Time => None,
+            })
+            .collect();
+        let read = h.instance.get::<String>(&elements)?;
+        h.returned_strings = read
+            .iter()
+            .map(|t| CString::new(t.replace('\0', "")).unwrap_or_default())
+            .collect();
+        for (o, t) in out.iter_mut().zip(&h.returned_strings) {
+            *o = t.as_ptr();
+        }
+        Ok(Status::Ok)
+    })
+}
+const _: fmi3GetStringTYPE = Some(fmi3GetString);
+
+/// Reads the structural parameter `modes.size`, the one UInt64 variable.
+#[no_mangle]
+pub extern "C" fn fmi3GetUInt64(
+    instance: fmi3Instance,
+    valueReferences: *const fmi3ValueReference,
+    nValueReferences: usize,
+    values: *mut fmi3UInt64,
+    nValues: usize,
+) -> fmi3Status {
+    entry(instance, "fmi3GetUInt64", state::GET_STRUCTURAL, |h| {
+        // SAFETY: FMI passes nValueReferences value references and room for nValues values.
+        let (vrs, out) = unsafe {
+            (
+                array(valueReferences, nValueReferences, "valueReferences")?,
+                array_mut(values, nValues, "values")?,
+            )
+        };
+        structural(vrs, nValues)?;
+        out.iter_mut().for_each(|o| *o = h.modes_size);
+        Ok(Status::Ok)
+    })
+}
+const _: fmi3GetUInt64TYPE = Some(fmi3GetUInt64);
+
+/// Sets the structural parameter `modes.size` (1 to the 2.0 table's slots), in configuration
+/// mode only.
+#[no_mangle]
+pub extern "C" fn fmi3SetUInt64(
+    instance: fmi3Instance,
+    valueReferences: *const fmi3ValueReference,
+    nValueReferences: usize,
+    values: *const fmi3UInt64,
+    nValues: usize,
+) -> fmi3Status {
+    entry(instance, "fmi3SetUInt64", state::SET_STRUCTURAL, |h| {
+        // SAFETY: FMI passes nValueReferences value references and nValues values.
+        let (vrs, given) = unsafe {
+            (
+                array(valueReferences, nValueReferences, "valueReferences")?,
+                array(values, nValues, "values")?,
+            )
+        };
+        structural(vrs, nValues)?;
+        if let Some(bad) = given.iter().find(|n| !(1..=MODES_SIZE_MAX).contains(*n)) {
+            return Err(format!(
+                "modes.size = {bad} is outside [1, {MODES_SIZE_MAX}]"
+            ));
+        }
+        if let Some(last) = given.last() {
+            h.modes_size = *last;
+        }
+        Ok(Status::Ok)
+    })
+}
+const _: fmi3SetUInt64TYPE = Some(fmi3SetUInt64);
+
+/// Checks that `vrs` name `modes.size` only, one value each.
+fn structural(vrs: &[u32], n_values: usize) -> Result<(), String> {
+    if let Some(vr) = vrs.iter().find(|vr| **vr != MODES_SIZE) {
+        return Err(unknown(*vr, "UInt64"));
+    }
+    if n_values != vrs.len() {
+        return Err(format!(
+            "nValues = {n_values} for {} scalar variables",
+            vrs.len()
+        ));
+    }
+    Ok(())
+}
+
+/// Sets Float64 inputs and parameters (arrays row-major), all checked before any is applied;
+/// `time` is refused. An input set between steps takes effect at the next fmi3DoStep, held or
+/// continued with the slope of the last values as in FMI 2.0.
+#[no_mangle]
+pub extern "C" fn fmi3SetFloat64(
+    instance: fmi3Instance,
+    valueReferences: *const fmi3ValueReference,
+    nValueReferences: usize,
+    values: *const fmi3Float64,
+    nValues: usize,
+) -> fmi3Status {
+    set_values::<f64, _>(
+        instance,
+        "fmi3SetFloat64",
+        valueReferences,
+        nValueReferences,
+        values,
+        nValues,
+        Ok,
+    )
+}
+const _: fmi3SetFloat64TYPE = Some(fmi3SetFloat64);
+
+/// Sets Int32 parameters (`scene`, `solver.maxOrder`, …), all checked before any is applied.
+#[no_mangle]
+pub extern "C" fn fmi3SetInt32(
+    instance: fmi3Instance,
+    valueReferences: *const fmi3ValueReference,
+    nValueReferences: usize,
+    values: *const fmi3Int32,
+    nValues: usize,
+) -> fmi3Status {
+    set_values::<i32, _>(
+        instance,
+        "fmi3SetInt32",
+        valueReferences,
+        nValueReferences,
+        values,
+        nValues,
+        Ok,
+    )
+}
+const _: fmi3SetInt32TYPE = Some(fmi3SetInt32);
+
+/// Sets Boolean parameters; a byte other than 0 or 1 is refused.
+#[no_mangle]
+pub extern "C" fn fmi3SetBoolean(
+    instance: fmi3Instance,
+    valueReferences: *const fmi3ValueReference,
+    nValueReferences: usize,
+    values: *const fmi3Boolean,
+    nValues: usize,
+) -> fmi3Status {
+    // C bools are read as bytes: a stray value must not become an invalid Rust bool.
+    set_values::<bool, u8>(
+        instance,
+        "fmi3SetBoolean",
+        valueReferences,
+        nValueReferences,
+        values as *const u8,
+        nValues,
+        boolean,
+    )
+}
+const _: fmi3SetBooleanTYPE = Some(fmi3SetBoolean);
+
+/// Sets String parameters (`configFile`, `chassis.cacheDir`); null or non-UTF-8 is refused.
+#[no_mangle]
+pub extern "C" fn fmi3SetString(
+    instance: fmi3Instance,
+    valueReferences: *const fmi3ValueReference,
+    nValueReferences: usize,
+    values: *const fmi3String,
+    nValues: usize,
+) -> fmi3Status {
+    set_values::<String, _>(
+        instance,
+        "fmi3SetString",
+        valueReferences,
+        nValueReferences,
+        values,
+        nValues,
+        |p| {
+            // SAFETY: each entry of an FMI string array is null or NUL-terminated.
+            unsafe { text(p) }.ok_or_else(|| "a value is NULL or not UTF-8".to_owned())
+        },
+    )
+}
+const _: fmi3SetStringTYPE = Some(fmi3SetString);
+
+/// The getters and setters of the types this FMU has no variable of: an empty call succeeds,
+/// any value reference is refused (naming the variable's real type if it has one).
+macro_rules! no_such_type {
+    ($get:ident, $get_ty:ident, $set:ident, $set_ty:ident, $c:ty, $name:literal) => {
+        #[doc = concat!("Refuses every value reference: this FMU has no ", $name, " variable.")]
+        #[no_mangle]
+        pub extern "C" fn $get(
+            instance: fmi3Instance,
+            valueReferences: *const fmi3ValueReference,
+            nValueReferences: usize,
+            _values: *mut $c,
+            _nValues: usize,
+        ) -> fmi3Status {
+            entry(instance, stringify!($get), state::GET_VALUES, |_| {
+                none_of_type(valueReferences, nValueReferences, $name)
+            })
+        }
+        const _: $get_ty = Some($get);
+
+        #[doc = concat!("Refuses every value reference: this FMU has no ", $name, " variable.")]
+        #[no_mangle]
+        pub extern "C" fn $set(
+            instance: fmi3Instance,
+            valueReferences: *const fmi3ValueReference,
+            nValueReferences: usize,
+            _values: *const $c,
+            _nValues: usize,
+        ) -> fmi3Status {
+            entry(instance, stringify!($set), state::SET_VALUES, |_| {
+                none_of_type(valueReferences, nValueReferences, $name)
+            })
+        }
+        const _: $set_ty = Some($set);
+    };
+}
+
+/// Ok for no value references, otherwise the refusal of the first.
+fn none_of_type(vr: *const fmi3ValueReference, nvr: usize, ty: &str) -> Outcome {
+    // SAFETY: FMI passes nvr value references.
+    let vrs = unsafe { array(vr, nvr, "valueReferences") }?;
+    match vrs.first() {
+        None => Ok(Status::Ok),
+        Some(vr) => Err(unknown(*vr, ty)),
+    }
+}
+
+no_such_type!(
+    fmi3GetFloat32,
+    fmi3GetFloat32TYPE,
+    fmi3SetFloat32,
+    fmi3SetFloat32TYPE,
+    fmi3Float32,
+    "Float32"
+);
+no_such_type!(
+    fmi3GetInt8,
+    fmi3GetInt8TYPE,
+    fmi3SetInt8,
+    fmi3SetInt8TYPE,
+    fmi3Int8,
+    "Int8"
+);
+no_such_type!(
+    fmi3GetUInt8,
+    fmi3GetUInt8TYPE,
+    fmi3SetUInt8,
+    fmi3SetUInt8TYPE,
+    fmi3UInt8,
+    "UInt8"
+);
+no_such_type!(
+    fmi3GetInt16,
+    fmi3GetInt16TYPE,
+    fmi3SetInt16,
+    fmi3SetInt16TYPE,
+    fmi3Int16,
+    "Int16"
+);
+no_such_type!(
+    fmi3GetUInt16,
+    fmi3GetUInt16TYPE,
+    fmi3SetUInt16,
+    fmi3SetUInt16TYPE,
+    fmi3UInt16,
+    "UInt16"
+);
+no_such_type!(
+    fmi3GetUInt32,
+    fmi3GetUInt32TYPE,
+    fmi3SetUInt32,
+    fmi3SetUInt32TYPE,
+    fmi3UInt32,
+    "UInt32"
+);
+no_such_type!(
+    fmi3GetInt64,
+    fmi3GetInt64TYPE,
+    fmi3SetInt64,
+    fmi3SetInt64TYPE,
+    fmi3Int64,
+    "Int64"
+);
+
+/// Refuses every value reference: this FMU has no Binary variable.
+#[no_mangle]
+pub extern "C" fn fmi3GetBinary(
+    instance: fmi3Instance,
+    valueReferences: *const fmi3ValueReference,
+    nValueReferences: usize,
+    _valueSizes: *mut usize,
+    _values: *mut fmi3Binary,
+    _nValues: usize,
+) -> fmi3Status {
+    entry(instance, "fmi3GetBinary", state::GET_VALUES, |_| {
+        none_of_type(valueReferences, nValueReferences, "Binary")
+    })
+}
+const _: fmi3GetBinaryTYPE = Some(fmi3GetBinary);
+
+/// Refuses every value reference: this FMU has no Binary variable.
+#[no_mangle]
+pub extern "C" fn fmi3SetBinary(
+    instance: fmi3Instance,
+    valueReferences: *const fmi3ValueReference,
+    nValueReferences: usize,
+    _valueSizes: *const usize,
+    _values: *const fmi3Binary,
+    _nValues: usize,
+) -> fmi3Status {
+    entry(instance, "fmi3SetBinary", state::SET_VALUES, |_| {
+        none_of_type(valueReferences, nValueReferences, "Binary")
+    })
+}
+const _: fmi3SetBinaryTYPE = Some(fmi3SetBinary);
+
+/// Refuses every value reference: this FMU has no clocks.
+#[no_mangle]
+pub extern "C" fn fmi3GetClock(
+    instance: fmi3Instance,
+    valueReferences: *const fmi3ValueReference,
+    nValueReferences: usize,
+    _values: *mut fmi3Clock,
+) -> fmi3Status {
+    entry(instance, "fmi3GetClock", state::GET_VALUES, |_| {
+        none_of_type(valueReferences, nValueReferences, "Clock")
+    })
+}
+const _: fmi3GetClockTYPE = Some(fmi3GetClock);
+
+/// Refuses every value reference: this FMU has no clocks.
+#[no_mangle]
+pub extern "C" fn fmi3SetClock(
+    instance: fmi3Instance,
+    valueReferences: *const fmi3ValueReference,
+    nValueReferences: usize,
+    _values: *const fmi3Clock,
+) -> fmi3Status {
+    entry(instance, "fmi3SetClock", state::SET_VALUES, |_| {
+        none_of_type(valueReferences, nValueReferences, "Clock")
+    })
+}
+const _: fmi3SetClockTYPE = Some(fmi3SetClock);
+
+// ----- clocks, discrete states, dependencies, derivatives: not provided ------------------------
+
+/// Generates entry points that always refuse with the reason given (the model description does
+/// not declare what they serve).
+macro_rules! refused {
+    ($name:ident, $ty:ident, $reason:literal, ($($arg:ident: $argty:ty),*)) => {
+        #[doc = concat!("Always refused with fmi3Error: ", $reason, ".")]
+        #[no_mangle]
+        pub extern "C" fn $name(instance: fmi3Instance, $($arg: $argty),*) -> fmi3Status {
+            $(let _ = $arg;)*
+            entry(instance, stringify!($name), state::UNSUPPORTED, |_| Err($reason.into()))
+        }
+        const _: $ty = Some($name);
+    };
+}
+
+refused!(fmi3GetIntervalDecimal, fmi3GetIntervalDecimalTYPE, "this FMU has no clocks",
+    (vr: *const fmi3ValueReference, nvr: usize, intervals: *mut fmi3Float64,
+     qualifiers: *mut fmi3IntervalQualifier));
+refused!(fmi3GetIntervalFraction, fmi3GetIntervalFractionTYPE, "this FMU has no clocks",
+    (vr: *const fmi3ValueReference, nvr: usize, counters: *mut fmi3UInt64,
+     resolutions: *mut fmi3UInt64, qualifiers: *mut fmi3IntervalQualifier));
+refused!(fmi3GetShiftDecimal, fmi3GetShiftDecimalTYPE, "this FMU has no clocks",
+    (vr: *const fmi3ValueReference, nvr: usize, shifts: *mut fmi3Float64));
+refused!(fmi3GetShiftFraction, fmi3GetShiftFractionTYPE, "this FMU has no clocks",
+    (vr: *const fmi3ValueReference, nvr: usize, counters: *mut fmi3UInt64,
+     resolutions: *mut fmi3UInt64));
+refused!(fmi3SetIntervalDecimal, fmi3SetIntervalDecimalTYPE, "this FMU has no clocks",
+    (vr: *const fmi3ValueReference, nvr: usize, intervals: *const fmi3Float64));
+refused!(fmi3SetIntervalFraction, fmi3SetIntervalFractionTYPE, "this FMU has no clocks",
+    (vr: *const fmi3ValueReference, nvr: usize, counters: *const fmi3UInt64,
+     resolutions: *const fmi3UInt64));
+refused!(fmi3SetShiftDecimal, fmi3SetShiftDecimalTYPE, "this FMU has no clocks",
+    (vr: *const fmi3ValueReference, nvr: usize, shifts: *const fmi3Float64));
+refused!(fmi3SetShiftFraction, fmi3SetShiftFractionTYPE, "this FMU has no clocks",
+    (vr: *const fmi3ValueReference, nvr: usize, counters: *const fmi3UInt64,
+     resolutions: *const fmi3UInt64));
+refused!(
+    fmi3EvaluateDiscreteStates,
+    fmi3EvaluateDiscreteStatesTYPE,
+    "not provided (providesEvaluateDiscreteStates=false)",
+    ()
+);
+refused!(fmi3UpdateDiscreteStates, fmi3UpdateDiscreteStatesTYPE,
+    "this FMU has no event mode (hasEventMode=false)",
+    (discreteStatesNeedUpdate: *mut fmi3Boolean, terminateSimulation: *mut fmi3Boolean,
+     nominalsOfContinuousStatesChanged: *mut fmi3Boolean,
+     valuesOfContinuousStatesChanged: *mut fmi3Boolean, nextEventTimeDefined: *mut fmi3Boolean,
+     nextEventTime: *mut fmi3Float64));
+refused!(fmi3GetNumberOfVariableDependencies, fmi3GetNumberOfVariableDependenciesTYPE,
+    "not provided (providesPerElementDependencies=false; the model structure lists the dependencies)",
+    (valueReference: fmi3ValueReference, nDependencies: *mut usize));
+refused!(fmi3GetVariableDependencies, fmi3GetVariableDependenciesTYPE,
+    "not provided (providesPerElementDependencies=false; the model structure lists the dependencies)",
+    (dependent: fmi3ValueReference, elementIndicesOfDependent: *mut usize,
+     independents: *mut fmi3ValueReference, elementIndicesOfIndependents: *mut usize,
+     dependencyKinds: *mut fmi3DependencyKind, nDependencies: usize));
+refused!(fmi3GetDirectionalDerivative, fmi3GetDirectionalDerivativeTYPE,
+    "not provided (providesDirectionalDerivative=false)",
+    (unknowns: *const fmi3ValueReference, nUnknowns: usize, knowns: *const fmi3ValueReference,
+     nKnowns: usize, seed: *const fmi3Float64, nSeed: usize, sensitivity: *mut fmi3Float64,
+     nSensitivity: usize));
+refused!(fmi3GetAdjointDerivative, fmi3GetAdjointDerivativeTYPE,
+    "not provided (providesAdjointDerivatives=false)",
+    (unknowns: *const fmi3ValueReference, nUnknowns: usize, knowns: *const fmi3ValueReference,
+     nKnowns: usize, seed: *const fmi3Float64, nSeed: usize, sensitivity: *mut fmi3Float64,
+     nSensitivity: usize));
+
+/// The first time derivatives (order 1, `maxOutputDerivativeOrder="1"`) of continuous Float64
+/// outputs at the current communication point, along the trajectory the integrator follows
+/// there: from the state derivative of the equations of motion, by a central difference of the
+/// outputs along it ([`crate::cosim::Simulation::output_derivatives`]). Arrays give all their
+/// elements; another order, a non-output or a count that does not match is refused.
+#[no_mangle]
+pub extern "C" fn fmi3GetOutputDerivatives(
+    instance: fmi3Instance,
+    valueReferences: *const fmi3ValueReference,
+    nValueReferences: usize,
+    orders: *const fmi3Int32,
+    values: *mut fmi3Float64,
+    nValues: usize,
+) -> fmi3Status {
+    entry(
+        instance,
+        "fmi3GetOutputDerivatives",
+        state::GET_OUTPUT_DERIVATIVES,
+        |h| {
+            // SAFETY: FMI passes nValueReferences value references and orders, and room for
+            // nValues values.
+            let (vrs, orders, out) = unsafe {
+                (
+                    array(valueReferences, nValueReferences, "valueReferences")?,
+                    array(orders, nValueReferences, "orders")?,
+                    array_mut(values, nValues, "values")?,
+                )
+            };
+            if let Some(order) = orders.iter().find(|o| **o != 1) {
+                return Err(format!(
+                    "derivative order {order} is not provided (maxOutputDerivativeOrder=1)"
+                ));
+            }
+            let mut elements = Vec::with_capacity(nValues);
+            for s in resolve::<f64>(vrs, h.modes_size, nValues)? {
+                match s {
+                    Slot::Element(i) => elements.push(i),
+                    Slot::Time => return Err("time is not an output".into()),
+                }
+            }
+            let derivatives = h.instance.output_derivatives(&elements)?;
+            out.copy_from_slice(&derivatives);
+            Ok(Status::Ok)
+        },
+    )
+}
+const _: fmi3GetOutputDerivativesTYPE = Some(fmi3GetOutputDerivatives);
+
+// ----- model exchange and scheduled execution: never instantiated ------------------------------
+
+// Masters such as fmpy resolve every function of fmi3Functions.h, so the model-exchange and
+// scheduled-execution ones exist too; a co-simulation instance refuses them.
+
+refused!(
+    fmi3EnterContinuousTimeMode,
+    fmi3EnterContinuousTimeModeTYPE,
+    "model exchange only; this is a co-simulation instance",
+    ()
+);
+refused!(fmi3CompletedIntegratorStep, fmi3CompletedIntegratorStepTYPE,
+    "model exchange only; this is a co-simulation instance",
+    (noSetFMUStatePriorToCurrentPoint: fmi3Boolean, enterEventMode: *mut fmi3Boolean,
+     terminateSimulation: *mut fmi3Boolean));
+refused!(fmi3SetTime, fmi3SetTimeTYPE,
+    "model exchange only; this is a co-simulation instance", (time: fmi3Float64));
+refused!(fmi3SetContinuousStates, fmi3SetContinuousStatesTYPE,
+    "model exchange only; this is a co-simulation instance",
+    (continuousStates: *const fmi3Float64, nContinuousStates: usize));
+refused!(fmi3GetContinuousStateDerivatives, fmi3GetContinuousStateDerivativesTYPE,
+    "model exchange only; this is a co-simulation instance",
+    (derivatives: *mut fmi3Float64, nContinuousStates: usize));
+refused!(fmi3GetEventIndicators, fmi3GetEventIndicatorsTYPE,
+    "model exchange only; this is a co-simulation instance",
+    (eventIndicators: *mut fmi3Float64, nEventIndicators: usize));
+refused!(fmi3GetContinuousStates, fmi3GetContinuousStatesTYPE,
+    "model exchange only; this is a co-simulation instance",
+    (continuousStates: *mut fmi3Float64, nContinuousStates: usize));
+refused!(fmi3GetNominalsOfContinuousStates, fmi3GetNominalsOfContinuousStatesTYPE,
+    "model exchange only; this is a co-simulation instance",
+    (nominals: *mut fmi3Float64, nContinuousStates: usize));
+refused!(fmi3GetNumberOfEventIndicators, fmi3GetNumberOfEventIndicatorsTYPE,
+    "model exchange only; this is a co-simulation instance", (nEventIndicators: *mut usize));
+refused!(fmi3GetNumberOfContinuousStates, fmi3GetNumberOfContinuousStatesTYPE,
+    "model exchange only; this is a co-simulation instance", (nContinuousStates: *mut usize));
+refused!(fmi3ActivateModelPartition, fmi3ActivateModelPartitionTYPE,
+    "scheduled execution only; this is a co-simulation instance",
+    (clockReference: fmi3ValueReference, activationTime: fmi3Float64));
+
+// ----- FMU state -------------------------------------------------------------------------------
+
+/// Copies the instance's complete state (values, input signals, time, integrator history) into a
+/// new FMU state, or into the given one if `*FMUState` is a state of this instance.
+#[no_mangle]
+pub extern "C" fn fmi3GetFMUState(
+    instance: fmi3Instance,
+    FMUState: *mut fmi3FMUState,
+) -> fmi3Status {
+    entry(instance, "fmi3GetFMUState", state::GET_FMU_STATE, |h| {
+        // SAFETY: FMUState points to a writable fmi3FMUState slot (FMI 3.0 §2.3.6.5).
+        let slot = unsafe { place(FMUState, "FMUState") }?;
+        let core = h.instance.core.clone();
+        h.store_state(slot, core)
+    })
+}
+const _: fmi3GetFMUStateTYPE = Some(fmi3GetFMUState);
+
+/// Restores a state this instance handed out (also out of the error state). Refused if it was
+/// taken with other parameters than the model this instance has built.
+#[no_mangle]
+pub extern "C" fn fmi3SetFMUState(instance: fmi3Instance, FMUState: fmi3FMUState) -> fmi3Status {
+    entry(instance, "fmi3SetFMUState", state::ANY, |h| {
+        let i = h.state(FMUState)?;
+        h.instance.check_state_fits(&h.states[i].core)?;
+        h.instance.core = h.states[i].core.clone();
+        h.error = false;
+        h.configuration = false;
+        Ok(Status::Ok)
+    })
+}
+const _: fmi3SetFMUStateTYPE = Some(fmi3SetFMUState);
+
+/// Frees an FMU state of this instance and sets `*FMUState` to null; null is ignored, a foreign
+/// pointer refused.
+#[no_mangle]
+pub extern "C" fn fmi3FreeFMUState(
+    instance: fmi3Instance,
+    FMUState: *mut fmi3FMUState,
+) -> fmi3Status {
+    entry(instance, "fmi3FreeFMUState", state::ANY, |h| {
+        // SAFETY: FMUState is null or points to a slot holding null or a state we handed out.
+        let Some(slot) = (unsafe { FMUState.as_mut() }) else {
+            return Ok(Status::Ok);
+        };
+        if slot.is_null() {
+            return Ok(Status::Ok);
+        }
+        let i = h.state(*slot)?;
+        h.states.swap_remove(i);
+        *slot = std::ptr::null_mut();
+        Ok(Status::Ok)
+    })
+}
+const _: fmi3FreeFMUStateTYPE = Some(fmi3FreeFMUState);
+
+/// Writes the number of bytes [`fmi3SerializeFMUState`] needs for this state.
+#[no_mangle]
+pub extern "C" fn fmi3SerializedFMUStateSize(
+    instance: fmi3Instance,
+    FMUState: fmi3FMUState,
+    size: *mut usize,
+) -> fmi3Status {
+    entry(instance, "fmi3SerializedFMUStateSize", state::ANY, |h| {
+        let i = h.state(FMUState)?;
+        // SAFETY: size points to a writable usize.
+        let size = unsafe { place(size, "size") }?;
+        *size = snapshot::serialize(&h.states[i].core, h.instance.guid()).len();
+        Ok(Status::Ok)
+    })
+}
+const _: fmi3SerializedFMUStateSizeTYPE = Some(fmi3SerializedFMUStateSize);
+
+/// Serialises an FMU state of this instance into a buffer of exactly the size
+/// [`fmi3SerializedFMUStateSize`] reported (the 2.0 FMU's format: the bytes are interchangeable
+/// between the two FMUs).
+#[no_mangle]
+pub extern "C" fn fmi3SerializeFMUState(
+    instance: fmi3Instance,
+    FMUState: fmi3FMUState,
+    serializedState: *mut fmi3Byte,
+    size: usize,
+) -> fmi3Status {
+    entry(instance, "fmi3SerializeFMUState", state::ANY, |h| {
+        let i = h.state(FMUState)?;
+        let bytes = snapshot::serialize(&h.states[i].core, h.instance.guid());
+        if bytes.len() != size {
+            return Err(format!(
+                "buffer has {size} bytes, the state needs {}",
+                bytes.len()
+            ));
+        }
+        // SAFETY: the caller provides a writable buffer of `size` bytes.
+        let out = unsafe { array_mut(serializedState, size, "serializedState") }?;
+        out.copy_from_slice(&bytes);
+        Ok(Status::Ok)
+    })
+}
+const _: fmi3SerializeFMUStateTYPE = Some(fmi3SerializeFMUState);
+
+/// Creates an FMU state from serialised bytes (of either FMU, possibly another process);
+/// bytes of another model, malformed or inadmissible, are refused. The model is rebuilt from
+/// the state's own parameters.
+#[no_mangle]
+pub extern "C" fn fmi3DeserializeFMUState(
+    instance: fmi3Instance,
+    serializedState: *const fmi3Byte,
+    size: usize,
+    FMUState: *mut fmi3FMUState,
+) -> fmi3Status {
+    entry(instance, "fmi3DeserializeFMUState", state::ANY, |h| {
+        // SAFETY: the caller provides `size` readable bytes and a writable state slot.
+        let (bytes, slot) = unsafe {
+            (
+                array(serializedState, size, "serializedState")?,
+                place(FMUState, "FMUState")?,
+            )
+        };
+        let inst = &h.instance;
+        let core = snapshot::deserialize(bytes, inst.guid(), |core, dynamic| {
+            inst.restore_simulation(core, dynamic)
+        })?;
+        h.store_state(slot, core)
+    })
+}
+const _: fmi3DeserializeFMUStateTYPE = Some(fmi3DeserializeFMUState);
+
+// ----- co-simulation ---------------------------------------------------------------------------
+
+/// Integrates from `currentCommunicationPoint` (the FMU's time) over `communicationStepSize`
+/// (> 0, not past the stop time), exactly as fmi2DoStep. Never returns early and never needs
+/// event handling. fmi3Warning if an input ramp was bent onto a bound; fmi3Discard if the
+/// integrator failed: `lastSuccessfulTime` is where it stopped and `terminateSimulation` is true
+/// (afterwards only fmi3Terminate, reading values or restoring an FMU state continue).
+#[no_mangle]
+pub extern "C" fn fmi3DoStep(
+    instance: fmi3Instance,
+    currentCommunicationPoint: fmi3Float64,
+    communicationStepSize: fmi3Float64,
+    _noSetFMUStatePriorToCurrentPoint: fmi3Boolean,
+    eventHandlingNeeded: *mut fmi3Boolean,
+    terminateSimulation: *mut fmi3Boolean,
+    earlyReturn: *mut fmi3Boolean,
+    lastSuccessfulTime: *mut fmi3Float64,
+) -> fmi3Status {
+    entry(instance, "fmi3DoStep", state::DO_STEP, |h| {
+        // SAFETY: FMI 3.0 passes four writable out-arguments.
+        let (event, terminate, early, last) = unsafe {
+            (
+                place(eventHandlingNeeded, "eventHandlingNeeded")?,
+                place(terminateSimulation, "terminateSimulation")?,
+                place(earlyReturn, "earlyReturn")?,
+                place(lastSuccessfulTime, "lastSuccessfulTime")?,
+            )
+        };
+        *event = false;
+        *early = false;
+        if h.instance.core.phase == Phase2::StepFailed {
+            *terminate = true;
+            *last = h.instance.last_successful_time();
+            return Err("an earlier step failed (terminateSimulation); call fmi3Terminate or restore an FMU state".into());
+        }
+        let result = h
+            .instance
+            .do_step(currentCommunicationPoint, communicationStepSize);
+        *terminate = h.instance.core.terminated;
+        *last = h.instance.last_successful_time();
+        result
+    })
+}
+const _: fmi3DoStepTYPE = Some(fmi3DoStep);
