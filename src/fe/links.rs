@@ -84,15 +84,6 @@ fn interpolation_equations(
     link: &InterpolationLink,
 ) -> Result<Vec<LinkEquation>, FeError> {
     let origin = format!("interpolation link {index}");
-    let framed = std::iter::once(link.reference)
-        .chain(link.sources.iter().flat_map(|g| g.nodes.iter().copied()))
-        .find(|n| mesh.displacement_frames.contains_key(n));
-    if let Some(node) = framed {
-        return Err(FeError::InvalidInput(format!(
-            "{origin}: node {node} has a displacement frame (GRID CD); interpolation links on \
-             such nodes are not supported"
-        )));
-    }
     let xr = mesh.position(&origin, link.reference)?;
     let mut sources = Vec::new();
     for group in &link.sources {
@@ -135,9 +126,17 @@ fn interpolation_equations(
             group.weight * length * length
         }
     };
+    // Source components are those of each source node's displacement frame (GRID CD):
+    // Sⱼ maps the reference's global motion to them; the reference's own components are
+    // B_refᵀ times its global motion.
+    let frames = &mesh.displacement_frames;
+    let source_map = |node: usize, d: &Vector3<f64>| {
+        nodal_frames::node_block(frames, node).transpose() * rigid_map(d)
+    };
+    let to_reference = nodal_frames::node_block(frames, link.reference).transpose();
     let mut normal = Matrix6::<f64>::zeros();
-    for (_, d, group) in &sources {
-        let s = rigid_map(d);
+    for (node, d, group) in &sources {
+        let s = source_map(*node, d);
         let w = Matrix6::from_diagonal(&SMatrix::<f64, 6, 1>::from_fn(|c, _| weight_of(group, c)));
         normal += s.transpose() * w * s;
     }
@@ -151,6 +150,7 @@ fn interpolation_equations(
         if eig.eigenvalues[k] > 1e-10 * largest {
             pinv += v * v.transpose() / eig.eigenvalues[k];
         } else {
+            let v = to_reference * v;
             for (c, _) in link
                 .reference_components
                 .iter()
@@ -167,6 +167,7 @@ fn interpolation_equations(
             }
         }
     }
+    let pinv = to_reference * pinv;
     let mut out = Vec::new();
     for (row, _) in link
         .reference_components
@@ -176,7 +177,7 @@ fn interpolation_equations(
     {
         let mut terms = Vec::new();
         for (node, d, group) in &sources {
-            let s = rigid_map(d);
+            let s = source_map(*node, d);
             // Row `row` of pinv · Sⱼᵀ Wⱼ: the coefficient of each source component.
             let coupling = pinv.row(row) * s.transpose();
             for c in 0..DOF_PER_NODE {
@@ -334,6 +335,53 @@ mod tests {
             let dof = eq.dependent % 6;
             let mean = (0..4).map(|n| arbitrary(6 * n + dof)).sum::<f64>() / 4.0;
             assert!((evaluate(eq, &arbitrary) - mean).abs() < 1e-12);
+        }
+    }
+
+    #[test]
+    fn interpolation_link_on_framed_nodes_is_exact_for_rigid_motion_in_their_components() {
+        let mut mesh = Mesh::default();
+        for p in [
+            [1.0, 0.0, 0.0],
+            [0.0, 2.0, 0.0],
+            [-1.0, 0.0, 0.5],
+            [0.0, -2.0, -0.5],
+        ] {
+            mesh.add_node(Vector3::from(p));
+        }
+        let reference = mesh.add_node(Vector3::new(0.4, 0.1, 0.2));
+        for (node, (axis, deg)) in [
+            (0, (Vector3::z(), 30.0)),
+            (2, (Vector3::x(), -70.0)),
+            (4, (Vector3::new(1.0, 1.0, 0.3), 50.0)),
+        ] {
+            let r = nalgebra::Rotation3::from_axis_angle(
+                &nalgebra::Unit::new_normalize(axis),
+                f64::to_radians(deg),
+            );
+            mesh.displacement_frames.insert(node, *r.matrix());
+        }
+        mesh.interpolation_links.push(InterpolationLink {
+            reference,
+            reference_components: [true, false, true, true, true, false],
+            sources: vec![InterpolationSource {
+                nodes: vec![0, 1, 2, 3],
+                weight: 1.0,
+                components: [true, true, true, false, false, false],
+            }],
+        });
+        let (t, w) = (Vector3::new(-1.0, 0.5, 2.0), Vector3::new(0.2, 0.7, -0.1));
+        let global = rigid_field(&mesh, t, w);
+        // The rigid motion seen in each node's own components.
+        let own = |slot: usize| {
+            let (node, dof) = (slot / 6, slot % 6);
+            let g = SMatrix::<f64, 6, 1>::from_fn(|d, _| global(node * 6 + d));
+            (nodal_frames::node_block(&mesh.displacement_frames, node).transpose() * g)[dof]
+        };
+        let eqs = equations(&mesh).unwrap();
+        assert_eq!(eqs.len(), 4);
+        for eq in &eqs {
+            assert!((evaluate(eq, &own) - own(eq.dependent)).abs() < 1e-12);
         }
     }
 

@@ -5,7 +5,7 @@
 //! Elements and masses are formed in global axes; [`super::dof::DofMap`] expresses the global
 //! motion of a framed node through the node's own equations, so assembling through it forms
 //! Bᵀ K B (B = diag(R, R) per node) without touching the element code. Scalar springs and
-//! dampers, constraints and rigid-link components name a node's own components; the few
+//! dampers, constraints and rigid/interpolation link components name a node's own components; the few
 //! matrices given per node component are carried to global axes here first
 //! ([`to_global_axes`]), so that the assembly's Bᵀ (·) B gives them back unchanged.
 

@@ -31,11 +31,11 @@
 //!   components along the CD system's axes at the grid (CORD2R axes; CORD2C r, θ, z and CORD2S
 //!   r, θ, φ directions there, θ = φ = 0 on the axis). SPC/SPC1/PS components, CELAS/CDAMP
 //!   components, RBE2 CM (of the dependent grid) and the RBE2 independent grid's six DOFs,
-//!   CBAR/CBEAM G vectors (OFFT) and the CBUSH X1..X3 (in GA's CD) are in CD, as in Nastran;
-//!   elements and masses are formed in their own systems and transformed
-//!   ([`crate::fe::nodal_frames`]). Motions recovered through [`crate::fe::dof::DofMap`] (mount
-//!   and output points of a reduced body, mode shapes) are in basic. An unknown CD is refused
-//!   naming the GRID and line; RBE3 on a grid with a CD is refused naming the RBE3 and line.
+//!   RBE3 REFC (of the reference grid) and Ci (of each source grid), CBAR/CBEAM G vectors
+//!   (OFFT) and the CBUSH X1..X3 (in GA's CD) are in CD, as in Nastran; elements and masses are
+//!   formed in their own systems and transformed ([`crate::fe::nodal_frames`]). Motions
+//!   recovered through [`crate::fe::dof::DofMap`] (mount and output points of a reduced body,
+//!   mode shapes) are in basic. An unknown CD is refused naming the GRID and line.
 //! - MAT1: two of E, G, NU given, the third by E = 2(1+ν)G (Nastran's rule); all three given:
 //!   beams keep E and G, shells need G within 1 % of E/2(1+ν). RHO; GE/A/TREF ignored
 //!   (structural damping is added modally by the caller). MAT2 (G11..G33, RHO) and MAT8 (E1, E2,

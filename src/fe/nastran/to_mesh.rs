@@ -972,19 +972,6 @@ fn add_links(c: &Cards, body: &mut NastranBody) -> Result<(), FeError> {
     for (&id, e) in &c.interpolation {
         let user = format!("RBE3 {id}");
         let reference = node_of(body, e.reference, &e.line, &user)?;
-        let grids = std::iter::once(&e.reference).chain(e.groups.iter().flat_map(|g| &g.2));
-        if let Some(g) = grids
-            .into_iter()
-            .find(|g| c.grids.get(g).is_some_and(|g| g.cd.is_some()))
-        {
-            return Err(mesh_error(
-                &e.line,
-                format!(
-                    "{user}: GRID {g} has a displacement coordinate system (CD); RBE3 on grids \
-                     with CD is not supported (give the RBE3's grids CD 0)"
-                ),
-            ));
-        }
         let mut sources = Vec::new();
         for (weight, components, grids) in &e.groups {
             if weight.is_nan() || *weight <= 0.0 {
