@@ -42,6 +42,7 @@ pub mod chassis_config;
 pub mod checks;
 pub mod dof;
 pub mod eigen;
+pub mod eigen_slicing;
 pub mod error;
 pub mod export;
 pub mod links;
