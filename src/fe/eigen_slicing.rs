@@ -694,9 +694,14 @@ pub fn sliced_modes(
         if let SliceStop::Count(c) = stop {
             // Enough found already: one more count just above the c-th proves it.
             let have = all.iter().filter(|&&l| l > lower).count();
-            if have > c {
-                let above: Vec<f64> = all.iter().copied().filter(|&l| l > lower).collect();
-                target = 0.5 * (above[c - 1] + above[c]);
+            let above: Vec<f64> = all.iter().copied().filter(|&l| l > lower).collect();
+            if above.len() >= c {
+                // Not inside a cluster of (nearly) equal eigenvalues: past its last member.
+                let last = above[c - 1];
+                let tol = 1e-8 * last.abs().max(f64::MIN_POSITIVE);
+                if let Some(&next) = above[c..].iter().find(|&&l| l > last + tol) {
+                    target = 0.5 * (last + next);
+                }
             }
         }
         let mut sigma = gap_midpoint(target, &estimates, &all, top);
