@@ -17,7 +17,7 @@ use super::sparse_ops::{sparse_times_dense, Partition};
 use super::spec::ModeSelection;
 use crate::fe::assembly::SparseMat;
 use crate::fe::eigen::{lowest_modes, Modes};
-use crate::fe::eigen_slicing::{eigenvalue_count, sliced_modes, SliceStop, SLICING_MIN_MODES};
+use crate::fe::eigen_slicing::{eigenvalue_count, prefer_slicing, sliced_modes, SliceStop};
 use crate::fe::FeError;
 
 /// The orthogonalised Craig-Bampton modes of a structure, in the full DOF space.
@@ -62,8 +62,8 @@ fn lowest_of_interior(k_ii: &SparseMat, m_ii: &SparseMat, count: usize) -> Resul
 
 /// Fixed-interface normal modes of (K_II, M_II) as selected.
 ///
-/// Few modes (below [`SLICING_MIN_MODES`]) come from one shift-invert Lanczos run, many from
-/// spectrum slicing. A cut-off is turned into a mode count first by a Sturm count at the
+/// Few modes of a small body come from one shift-invert Lanczos run, many modes or a large
+/// body from spectrum slicing ([`prefer_slicing`]). A cut-off is turned into a mode count first by a Sturm count at the
 /// cut-off (one LDLᵀ of K_II − λ_cut M_II), so no solve is repeated with a larger request.
 fn fixed_interface_modes(
     k_ii: &SparseMat,
@@ -83,7 +83,7 @@ fn fixed_interface_modes(
                     "selection.count = {count} exceeds the {n} interior DOFs"
                 )));
             }
-            if count < SLICING_MIN_MODES {
+            if !prefer_slicing(n, count) {
                 lowest_of_interior(k_ii, m_ii, count)
             } else {
                 Ok(sliced_modes(k_ii, m_ii, 0.0, SliceStop::Count(count))?)
@@ -100,7 +100,7 @@ fn fixed_interface_modes(
             let (_, count) = eigenvalue_count(k_ii, m_ii, lambda_cut)?;
             let modes = if count == 0 {
                 return Ok(none());
-            } else if count < SLICING_MIN_MODES {
+            } else if !prefer_slicing(n, count) {
                 lowest_of_interior(k_ii, m_ii, count.min(n))?
             } else {
                 sliced_modes(k_ii, m_ii, 0.0, SliceStop::Upper(lambda_cut))?

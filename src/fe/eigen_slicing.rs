@@ -35,15 +35,15 @@
 //! orthogonality (the Craig-Bampton reduction does) re-orthogonalises in its reduced space.
 //!
 //! [`lowest_modes_auto`] and [`modes_in_interval`] choose between this and the single-shift
-//! solver by the number of modes: below [`SLICING_MIN_MODES`] one Lanczos run is faster (one
-//! factorization, no counting).
+//! solver by [`prefer_slicing`]: for few modes of a small model one Lanczos run is as fast (one
+//! factorization, no counting); for many modes, or a model so large that the single-shift basis
+//! would not fit in a gigabyte, slicing.
 
 use faer::dyn_stack::{MemBuffer, MemStack};
 use faer::linalg::cholesky::ldlt::factor::LdltRegularization;
 use faer::sparse::linalg::cholesky::supernodal::SupernodalLdltRef;
 use faer::sparse::linalg::cholesky::{
-    factorize_symbolic_cholesky, LdltRef, SymbolicCholesky, SymbolicCholeskyRaw,
-    SymmetricOrdering,
+    factorize_symbolic_cholesky, LdltRef, SymbolicCholesky, SymbolicCholeskyRaw, SymmetricOrdering,
 };
 use faer::sparse::{SparseColMat, SymbolicSparseColMat, Triplet};
 use faer::{Conj, Mat, MatRef, Par, Side};
@@ -52,10 +52,23 @@ use super::assembly::SparseMat;
 use super::eigen::{lowest_modes, Modes};
 use super::error::FeError;
 
-/// Mode count from which [`lowest_modes_auto`] and [`modes_in_interval`] slice the spectrum.
-/// Measured on the 15,300-DOF default body (docs, evidence "Production size"): below about 150
-/// modes the single-shift solver is as fast or faster, above it slicing wins by a growing factor.
-pub const SLICING_MIN_MODES: usize = 150;
+/// Mode count from which [`prefer_slicing`] picks spectrum slicing. Measured on the
+/// 15,300-DOF default body (docs, evidence "Production size"): 80 modes take 1.1 s either way,
+/// 209 modes 4.4 s single-shift against 3.3 s sliced, 1,044 modes 486 s against 33 s.
+pub const SLICING_MIN_MODES: usize = 120;
+
+/// Largest Krylov basis (bytes) [`prefer_slicing`] lets the single-shift solver allocate: it
+/// keeps 2 × n × (6m + 64) numbers for m modes, 8 GB for 80 modes of a million-DOF body, and
+/// its reorthogonalisation time grows with the same product.
+pub const SINGLE_SHIFT_MAX_BASIS_BYTES: usize = 1 << 30;
+
+/// Whether `n_modes` eigenpairs of an `n`-DOF pencil are computed by spectrum slicing rather
+/// than by one shift-invert Lanczos run: from [`SLICING_MIN_MODES`] modes on, or when the
+/// single-shift basis would exceed [`SINGLE_SHIFT_MAX_BASIS_BYTES`].
+pub fn prefer_slicing(n: usize, n_modes: usize) -> bool {
+    let basis = n.min((6 * n_modes + 64).max(n_modes + 100));
+    n_modes >= SLICING_MIN_MODES || 2 * 8 * n * basis > SINGLE_SHIFT_MAX_BASIS_BYTES
+}
 
 /// New modes aimed for per slice. Larger slices need fewer factorizations but a larger Krylov
 /// basis (memory n × basis, cost n·basis²).
@@ -112,7 +125,9 @@ impl Pencil {
                 for p in cp[j]..cp[j + 1] {
                     if ri[p] >= j {
                         // Rows of a column are sorted in the pattern built from triplets.
-                        let at = rows.binary_search(&ri[p]).expect("entry in the union pattern");
+                        let at = rows
+                            .binary_search(&ri[p])
+                            .expect("entry in the union pattern");
                         v[pcp[j] + at] += val[p];
                     }
                 }
@@ -200,8 +215,10 @@ impl<'a> Factorizer<'a> {
         let a = self.pencil.shifted(sigma);
         let mut values = vec![0.0; self.symbolic.len_val()];
         let params = Default::default();
-        let mut mem =
-            MemBuffer::new(self.symbolic.factorize_numeric_ldlt_scratch::<f64>(self.par, params));
+        let mut mem = MemBuffer::new(
+            self.symbolic
+                .factorize_numeric_ldlt_scratch::<f64>(self.par, params),
+        );
         self.symbolic
             .factorize_numeric_ldlt(
                 &mut values,
@@ -416,32 +433,31 @@ fn lanczos_run(
 
     // M-orthogonalises the columns of `z` against the deflation set and q[..len] (twice).
     // Returns the coefficients on q (len × cols).
-    let orthogonalise =
-        |z: &mut Mat<f64>, q: &Mat<f64>, len: usize| -> Mat<f64> {
-            let mut total = Mat::<f64>::zeros(len, z.ncols());
-            for _ in 0..2 {
-                let mz = m.as_ref() * z.as_ref();
-                for d in deflate {
-                    let c = d.transpose() * &mz;
-                    *z -= *d * &c;
-                }
-                if len > 0 {
-                    let qs = q.as_ref().subcols(0, len);
-                    let c = qs.transpose() * &mz;
-                    *z -= qs * &c;
-                    total += &c;
-                }
+    let orthogonalise = |z: &mut Mat<f64>, q: &Mat<f64>, len: usize| -> Mat<f64> {
+        let mut total = Mat::<f64>::zeros(len, z.ncols());
+        for _ in 0..2 {
+            let mz = m.as_ref() * z.as_ref();
+            for d in deflate {
+                let c = d.transpose() * &mz;
+                *z -= *d * &c;
             }
-            total
-        };
+            if len > 0 {
+                let qs = q.as_ref().subcols(0, len);
+                let c = qs.transpose() * &mz;
+                *z -= qs * &c;
+                total += &c;
+            }
+        }
+        total
+    };
     // Appends the columns of `z` (orthogonal to the basis) one by one, orthonormalised among
     // themselves; a column that vanishes is replaced by a fresh random direction. Returns, per
     // column, its coefficients on the vectors this call added (the last one its norm).
     let push_block = |z: Mat<f64>,
-                          q: &mut Mat<f64>,
-                          len: &mut usize,
-                          scales: &[f64],
-                          rng: &mut Xorshift|
+                      q: &mut Mat<f64>,
+                      len: &mut usize,
+                      scales: &[f64],
+                      rng: &mut Xorshift|
      -> Result<Vec<Vec<f64>>, FeError> {
         let start = *len;
         let mut coefs = Vec::with_capacity(z.ncols());
@@ -693,7 +709,6 @@ pub fn sliced_modes(
         let mut target = top + SLICE_MODES as f64 / density.max(f64::MIN_POSITIVE);
         if let SliceStop::Count(c) = stop {
             // Enough found already: one more count just above the c-th proves it.
-            let have = all.iter().filter(|&&l| l > lower).count();
             let above: Vec<f64> = all.iter().copied().filter(|&l| l > lower).collect();
             if above.len() >= c {
                 // Not inside a cluster of (nearly) equal eigenvalues: past its last member.
@@ -830,25 +845,24 @@ fn run_slice(
     }
 }
 
-/// The `n_modes` lowest eigenpairs above `shift`: the single-shift solver
-/// ([`lowest_modes`]) below [`SLICING_MIN_MODES`] modes, spectrum slicing ([`sliced_modes`])
-/// from there on.
+/// The `n_modes` lowest eigenpairs above `shift`: the single-shift solver ([`lowest_modes`])
+/// or spectrum slicing ([`sliced_modes`]), as [`prefer_slicing`] decides.
 pub fn lowest_modes_auto(
     k: &SparseMat,
     m: &SparseMat,
     n_modes: usize,
     shift: f64,
 ) -> Result<Modes, FeError> {
-    if n_modes < SLICING_MIN_MODES {
+    if !prefer_slicing(k.nrows(), n_modes) {
         lowest_modes(k, m, n_modes, shift)
     } else {
         sliced_modes(k, m, shift, SliceStop::Count(n_modes))
     }
 }
 
-/// Every eigenpair with eigenvalue in (lower, upper\], ascending. A Sturm count at `upper`
-/// gives their number; below [`SLICING_MIN_MODES`] the single-shift solver computes them (one
-/// run with the count known, no retries), from there on spectrum slicing.
+/// Every eigenpair with eigenvalue in (lower, upper\], ascending. Sturm counts give their
+/// number; then the single-shift solver (one run with the count known, no retries) or spectrum
+/// slicing computes them, as [`prefer_slicing`] decides.
 pub fn modes_in_interval(
     k: &SparseMat,
     m: &SparseMat,
@@ -873,7 +887,7 @@ pub fn modes_in_interval(
             shapes: Mat::zeros(n, 0),
         });
     }
-    if count < SLICING_MIN_MODES {
+    if !prefer_slicing(n, count) {
         // One more than the count when possible, so the gap above the last one is resolved.
         let request = (count + 1).min(n);
         let modes = lowest_modes(k, m, request, lower)?;
@@ -904,8 +918,8 @@ mod tests {
         }
         let exact = (1..=n)
             .map(|j| {
-                let s = ((2 * j - 1) as f64 * std::f64::consts::PI / (2.0 * (2 * n + 1) as f64))
-                    .sin();
+                let s =
+                    ((2 * j - 1) as f64 * std::f64::consts::PI / (2.0 * (2 * n + 1) as f64)).sin();
                 4.0 * s * s
             })
             .collect();
@@ -921,7 +935,11 @@ mod tests {
         let (k, m, exact) = chain(300);
         for sigma in [0.01, 0.5, 1.7, 3.99] {
             let (used, count) = eigenvalue_count(&k, &m, sigma).unwrap();
-            assert_eq!(count, exact.iter().filter(|&&l| l < used).count(), "σ = {sigma}");
+            assert_eq!(
+                count,
+                exact.iter().filter(|&&l| l < used).count(),
+                "σ = {sigma}"
+            );
         }
     }
 

@@ -57,7 +57,8 @@ fn quality(k: &SparseMat, m: &SparseMat, modes: &Modes) -> (f64, f64) {
     let mut residual: f64 = 0.0;
     for (c, &l) in modes.eigenvalues.iter().enumerate() {
         let r = &kp.col(c) - l * &mp.col(c);
-        residual = residual.max(r.norm_l2() / (kp.col(c).norm_l2() + l.abs() * mp.col(c).norm_l2()));
+        residual =
+            residual.max(r.norm_l2() / (kp.col(c).norm_l2() + l.abs() * mp.col(c).norm_l2()));
     }
     let g = modes.shapes.transpose() * &mp;
     let id = Mat::<f64>::identity(g.nrows(), g.ncols());
@@ -119,7 +120,11 @@ fn chains(copies: usize, n: usize, stiffness: f64) -> (SparseMat, SparseMat, Vec
             k.push(Triplet::new(
                 g,
                 g,
-                if i + 1 < n { 2.0 * stiffness } else { stiffness },
+                if i + 1 < n {
+                    2.0 * stiffness
+                } else {
+                    stiffness
+                },
             ));
             if i + 1 < n {
                 k.push(Triplet::new(g, g + 1, -stiffness));
