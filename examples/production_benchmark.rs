@@ -122,7 +122,7 @@ fn modes_table() -> Res<()> {
     println!("| cut-off | modes (Sturm count) | single shift (s) | slicing (s) | speed-up | max rel. frequency difference |");
     println!("|---:|---:|---:|---:|---:|---:|");
     for cutoff in [225.0, 500.0, 1000.0, 2000.0] {
-        let lambda = (2.0 * std::f64::consts::PI * cutoff as f64).powi(2);
+        let lambda = (2.0 * std::f64::consts::PI * cutoff).powi(2);
         let (_, count) = eigenvalue_count(&k, &m, lambda)?;
         let t0 = Instant::now();
         let sliced = sliced_modes(&k, &m, 0.0, SliceStop::Upper(lambda))?;
@@ -193,10 +193,7 @@ fn write_deck(r: usize, dir: &Path) -> Res<()> {
             continue;
         }
         if !line.starts_with('*') && !line.starts_with('+') && !line.starts_with(' ') {
-            let name = line
-                .split(|c: char| c == ',' || c == ' ' || c == '*')
-                .next()
-                .unwrap_or("");
+            let name = line.split([',', ' ', '*']).next().unwrap_or("");
             current = parts
                 .iter()
                 .position(|(_, cards)| cards.contains(&name))
@@ -281,11 +278,13 @@ fn run_deck(dir: &Path, cutoff_hz: f64, modes: usize) -> Res<()> {
     drop(body);
     let hwm_read = vm_hwm_mb();
 
-    let mut vehicle = VehicleConfig::default();
-    vehicle.body = BodyConfig::Nastran {
-        path: main.clone(),
-        points: points_of(dir)?,
-        include_root: None,
+    let vehicle = VehicleConfig {
+        body: BodyConfig::Nastran {
+            path: main.clone(),
+            points: points_of(dir)?,
+            include_root: None,
+        },
+        ..VehicleConfig::default()
     };
     let options = BodyOptions {
         mode_cutoff_hz: cutoff_hz,

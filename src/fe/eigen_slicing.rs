@@ -252,7 +252,7 @@ impl<'a> Factorizer<'a> {
         let r = &kx - sigma * &mx - &b;
         let scale = b.norm_l2() + kx.norm_l2() + sigma.abs() * mx.norm_l2();
         let rel = r.norm_l2() / scale;
-        if !(rel <= SOLVE_RESIDUAL_LIMIT) {
+        if rel.is_nan() || rel > SOLVE_RESIDUAL_LIMIT {
             return Err(format!(
                 "relative solve residual {rel:.1e} at shift {sigma}"
             ));
@@ -462,7 +462,7 @@ fn lanczos_run(
         let start = *len;
         let mut coefs = Vec::with_capacity(z.ncols());
         let mut mq_new: Vec<Vec<f64>> = Vec::new();
-        for c in 0..z.ncols() {
+        for (c, &scale) in scales.iter().enumerate().take(z.ncols()) {
             let mut v: Vec<f64> = z.col(c).iter().copied().collect();
             let mut coef = vec![0.0; *len - start];
             for _ in 0..2 {
@@ -480,7 +480,7 @@ fn lanczos_run(
             }
             let rest = v.iter().map(|x| x * x).sum::<f64>().sqrt();
             let mut coupled = true;
-            if !(rest > 1e-10 * scales[c]) {
+            if rest.is_nan() || rest <= 1e-10 * scale {
                 // Invariant subspace: continue with a fresh direction, no coupling.
                 coupled = false;
                 let mut fresh = Mat::<f64>::from_fn(n, 1, |_, _| rng.next());
@@ -499,7 +499,8 @@ fn lanczos_run(
                         }
                     }
                 }
-                if !(fresh.norm_l2() > 1e-8 * before) {
+                let after = fresh.norm_l2();
+                if after.is_nan() || after <= 1e-8 * before {
                     return Err(FeError::Numerical(
                         "could not extend the Krylov basis with a new direction".into(),
                     ));
@@ -771,7 +772,7 @@ fn gap_midpoint(target: f64, estimates: &[f64], found: &[f64], floor: f64) -> f6
         .collect();
     points.push(floor);
     points.sort_by(f64::total_cmp);
-    let below = points.iter().copied().filter(|&x| x <= target).last();
+    let below = points.iter().copied().rfind(|&x| x <= target);
     let above = points.iter().copied().find(|&x| x > target);
     match (below, above) {
         (Some(lo), Some(hi)) => 0.5 * (lo + hi),

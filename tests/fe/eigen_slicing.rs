@@ -56,7 +56,7 @@ fn quality(k: &SparseMat, m: &SparseMat, modes: &Modes) -> (f64, f64) {
     let mp = m.as_ref() * modes.shapes.as_ref();
     let mut residual: f64 = 0.0;
     for (c, &l) in modes.eigenvalues.iter().enumerate() {
-        let r = &kp.col(c) - l * &mp.col(c);
+        let r = kp.col(c) - l * mp.col(c);
         residual =
             residual.max(r.norm_l2() / (kp.col(c).norm_l2() + l.abs() * mp.col(c).norm_l2()));
     }
