@@ -17,6 +17,7 @@ use super::sparse_ops::{sparse_times_dense, Partition};
 use super::spec::ModeSelection;
 use crate::fe::assembly::SparseMat;
 use crate::fe::eigen::{lowest_modes, Modes};
+use crate::fe::eigen_slicing::{eigenvalue_count, prefer_slicing, sliced_modes, SliceStop};
 use crate::fe::FeError;
 
 /// The orthogonalised Craig-Bampton modes of a structure, in the full DOF space.
@@ -32,11 +33,6 @@ pub struct CraigBampton {
     /// Number of constraint modes (= interface DOFs).
     pub n_constraint_modes: usize,
 }
-
-/// First request of fixed-interface modes when selecting by cut-off frequency.
-const FIRST_CUTOFF_REQUEST: usize = 40;
-/// Extra modes asked for beyond the estimated count below the cut-off.
-const CUTOFF_MARGIN: usize = 16;
 
 /// The `count` lowest eigenpairs of (K_II, M_II).
 ///
@@ -65,25 +61,33 @@ fn lowest_of_interior(k_ii: &SparseMat, m_ii: &SparseMat, count: usize) -> Resul
 }
 
 /// Fixed-interface normal modes of (K_II, M_II) as selected.
+///
+/// Few modes of a small body come from one shift-invert Lanczos run, many modes or a large
+/// body from spectrum slicing ([`prefer_slicing`]). A cut-off is turned into a mode count first by a Sturm count at the
+/// cut-off (one LDLᵀ of K_II − λ_cut M_II), so no solve is repeated with a larger request.
 fn fixed_interface_modes(
     k_ii: &SparseMat,
     m_ii: &SparseMat,
     selection: ModeSelection,
 ) -> Result<Modes, CmsError> {
     let n = k_ii.nrows();
-    let solve = |count: usize| lowest_of_interior(k_ii, m_ii, count);
+    let none = || Modes {
+        eigenvalues: Vec::new(),
+        shapes: Mat::zeros(n, 0),
+    };
     match selection {
-        ModeSelection::Count(0) => Ok(Modes {
-            eigenvalues: Vec::new(),
-            shapes: Mat::zeros(n, 0),
-        }),
+        ModeSelection::Count(0) => Ok(none()),
         ModeSelection::Count(count) => {
             if count > n {
                 return Err(CmsError::InvalidInput(format!(
                     "selection.count = {count} exceeds the {n} interior DOFs"
                 )));
             }
-            solve(count)
+            if !prefer_slicing(n, count) {
+                lowest_of_interior(k_ii, m_ii, count)
+            } else {
+                Ok(sliced_modes(k_ii, m_ii, 0.0, SliceStop::Count(count))?)
+            }
         }
         ModeSelection::CutoffHz(cutoff) => {
             if !(cutoff.is_finite() && cutoff > 0.0) {
@@ -91,27 +95,45 @@ fn fixed_interface_modes(
                     "selection.cutoff_hz = {cutoff} must be finite and > 0"
                 )));
             }
-            let mut request = FIRST_CUTOFF_REQUEST.min(n);
-            loop {
-                let modes = solve(request)?;
-                let hz = modes.frequencies_hz();
-                let top = hz.last().copied().unwrap_or(0.0);
-                if top >= cutoff || request == n {
-                    let keep = hz.iter().take_while(|&&f| f < cutoff).count();
-                    return Ok(Modes {
-                        eigenvalues: modes.eigenvalues[..keep].to_vec(),
-                        shapes: modes.shapes.subcols(0, keep).to_owned(),
-                    });
-                }
-                // The mode count of this shell-and-beam body grows like f^1.2 to f^1.5 (40 modes
-                // below 137 Hz, 80 below 217 Hz, 192 below 445 Hz); aim beyond the cut-off,
-                // since a retry solves anew.
-                let ratio = cutoff / top.max(1e-3);
-                let estimate = (request as f64 * ratio.powf(1.3)).ceil() as usize + CUTOFF_MARGIN;
-                request = estimate.clamp(request + CUTOFF_MARGIN, 8 * request).min(n);
-            }
+            let lambda_cut = (2.0 * std::f64::consts::PI * cutoff).powi(2);
+            // K_II is positive definite: every eigenvalue lies above 0.
+            let (_, count) = eigenvalue_count(k_ii, m_ii, lambda_cut)?;
+            let modes = if count == 0 {
+                return Ok(none());
+            } else if !prefer_slicing(n, count) {
+                lowest_of_interior(k_ii, m_ii, count.min(n))?
+            } else {
+                sliced_modes(k_ii, m_ii, 0.0, SliceStop::Upper(lambda_cut))?
+            };
+            let keep = modes
+                .frequencies_hz()
+                .iter()
+                .take_while(|&&f| f < cutoff)
+                .count();
+            Ok(Modes {
+                eigenvalues: modes.eigenvalues[..keep].to_vec(),
+                shapes: modes.shapes.subcols(0, keep).to_owned(),
+            })
         }
     }
+}
+
+/// Columns of T per block in [`projected`] and rows per block in the final T X: bounds the
+/// temporaries to a few MB each instead of a second n × r matrix.
+const PROJECTION_CHUNK: usize = 4096;
+
+/// Tᵀ A T, with A T formed a block of T's columns at a time.
+fn projected(a: &SparseMat, t: &Mat<f64>) -> Mat<f64> {
+    let r = t.ncols();
+    let mut out = Mat::<f64>::zeros(r, r);
+    let width = (PROJECTION_CHUNK / 64).max(1);
+    for start in (0..r).step_by(width) {
+        let w = width.min(r - start);
+        let at = sparse_times_dense(a, t.as_ref().subcols(start, w));
+        let block = t.transpose() * &at;
+        out.as_mut().subcols_mut(start, w).copy_from(&block);
+    }
+    out
 }
 
 /// Symmetric part of a square matrix.
@@ -207,8 +229,12 @@ pub fn craig_bampton_basis(
         }
     }
     llt.solve_in_place(psi.as_mut());
+    // At a million DOF every n × r matrix is gigabytes: free what is no longer needed.
+    drop(llt);
 
     let normal = fixed_interface_modes(&k_ii, &m_ii, selection)?;
+    drop((k_ii, m_ii));
+    let fixed_interface_hz = normal.frequencies_hz();
     let (nf, nb) = (normal.len(), interface.len());
     let r = nf + nb;
 
@@ -225,14 +251,15 @@ pub fn craig_bampton_basis(
         t[(g, nf + b)] = 1.0;
     }
     drop(psi);
+    drop(normal);
 
-    let m_r = symmetrised(&(t.transpose() * sparse_times_dense(m, t.as_ref())));
-    let k_r = symmetrised(&(t.transpose() * sparse_times_dense(k, t.as_ref())));
+    let m_r = symmetrised(&projected(m, &t));
+    let k_r = symmetrised(&projected(k, &t));
     Ok(CraigBamptonBasis {
         t,
         k_r,
         m_r,
-        fixed_interface_hz: normal.frequencies_hz(),
+        fixed_interface_hz,
         n_constraint_modes: nb,
     })
 }
@@ -293,13 +320,27 @@ pub fn craig_bampton(
     interface: &[usize],
     selection: ModeSelection,
 ) -> Result<CraigBampton, CmsError> {
-    let basis = craig_bampton_basis(k, m, interface, selection)?;
-    let (omega, coefficients) = orthogonalise(&basis.k_r, &basis.m_r)?;
+    let CraigBamptonBasis {
+        mut t,
+        k_r,
+        m_r,
+        fixed_interface_hz,
+        n_constraint_modes,
+    } = craig_bampton_basis(k, m, interface, selection)?;
+    let (omega, x) = orthogonalise(&k_r, &m_r)?;
+    // shapes = T X, row block by row block into T's own storage: at a million DOF a second
+    // n × r matrix would be gigabytes.
+    let n = t.nrows();
+    for start in (0..n).step_by(PROJECTION_CHUNK) {
+        let len = PROJECTION_CHUNK.min(n - start);
+        let rows = t.as_ref().subrows(start, len) * &x;
+        t.as_mut().subrows_mut(start, len).copy_from(&rows);
+    }
     Ok(CraigBampton {
         omega,
-        shapes: &basis.t * &coefficients,
-        fixed_interface_hz: basis.fixed_interface_hz,
-        n_constraint_modes: basis.n_constraint_modes,
+        shapes: t,
+        fixed_interface_hz,
+        n_constraint_modes,
     })
 }
 

@@ -8,7 +8,8 @@
 //!
 //! Pipeline: [`ReductionSpec`] → [`reduce`] (builds and assembles the body, interface = the
 //! translational, or all six, DOFs of the layout's mount nodes) → [`craig_bampton()`] (constraint
-//! modes by sparse Cholesky, fixed-interface modes by the FE module's shift-invert Lanczos,
+//! modes by sparse Cholesky, fixed-interface modes by the FE module's shift-invert Lanczos, with
+//! spectrum slicing for many modes or large bodies ([`crate::fe::eigen_slicing`]),
 //! orthogonalisation) → [`ReducedChassis`] with the rows of the recovery points only.
 //! [`reduce_cached`] keeps the result in the user's cache directory.
 //!

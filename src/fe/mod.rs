@@ -9,7 +9,8 @@
 //! [`checks::check_mesh`]) → [`assembly::assemble`] (faer `SparseColMat` K, M, C and a
 //! [`dof::DofMap`]) → [`eigen::lowest_modes`] (sparse Cholesky + shift-invert block Lanczos) →
 //! [`modal::describe`] (torsion, bending, steering wheel, front end …); [`export`] writes K, M
-//! (Matrix Market) and the node/DOF tables.
+//! (Matrix Market) and the node/DOF tables. Hundreds of modes: [`eigen_slicing`] (spectrum
+//! slicing over several shifts, completeness by Sturm counts).
 //!
 //! ```no_run
 //! use engine_mount_chassis::fe::{assembly, chassis, chassis_config, eigen, modal};
@@ -42,6 +43,7 @@ pub mod chassis_config;
 pub mod checks;
 pub mod dof;
 pub mod eigen;
+pub mod eigen_slicing;
 pub mod error;
 pub mod export;
 pub mod links;

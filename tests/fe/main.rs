@@ -6,6 +6,7 @@ mod deck_cards;
 mod deck_properties;
 mod deck_reader;
 mod eigen;
+mod eigen_slicing;
 mod elements;
 mod nastran;
 mod solids;

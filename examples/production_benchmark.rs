@@ -1,0 +1,481 @@
+//! Production-size benchmark: many modes and million-DOF bulk decks.
+//!
+//! `cargo run --release --example production_benchmark -- modes`
+//!   (a) The fixed-interface eigenproblem of the default body (4 mounts × 3 translations held)
+//!   for cut-offs of 225 Hz, 500 Hz, 1 kHz and 2 kHz: the single-shift Lanczos solver
+//!   (`fe::eigen::lowest_modes`, given the exact mode count from a Sturm count, so without the
+//!   retries the reduction used to need) against spectrum slicing
+//!   (`fe::eigen_slicing::sliced_modes`), time and largest frequency difference.
+//!
+//! `cargo run --release --example production_benchmark -- sizes [refinements…] [--modes N]`
+//!   (b) For each refinement r (default 1 2 4 8: grid spacing / r, about 15 k, 60 k, 240 k and
+//!   950 k DOF) the procedural body is written as a multi-file bulk deck (`main.bdf` with
+//!   `INCLUDE`s of `grids.bdf`, `shells.bdf`, `properties.bdf`, `beams_masses_links.bdf` and
+//!   `welds.bdf`: CBUSH spot welds across every 40th shell's diagonal) by one child process, then
+//!   read with the streaming reader, reduced (default 225 Hz cut-off) and run through the coupled
+//!   model for 0.1 s by a second child process, whose peak resident memory (VmHWM) is the one
+//!   reported. Growth exponents are log-log least-squares fits against DOF. With `--modes N`
+//!   the largest size is also reduced keeping N fixed-interface modes (a third child process).
+//!   Solid elements (`CHEXA` mount brackets) are not in the deck yet: `deck_parts` is where a
+//!   `solids.bdf` part goes once the reader has solids.
+//!
+//! Internal subcommands (run by `sizes` as child processes): `write <r> <dir>`,
+//! `run <r> <dir> <cutoff_hz|0> <modes|0>`.
+
+use std::collections::BTreeMap;
+use std::fmt::Write as _;
+use std::path::{Path, PathBuf};
+use std::process::Command;
+use std::time::Instant;
+
+use engine_mount_chassis::cms::{reduce, InterfaceDofs};
+use engine_mount_chassis::fe::assembly::{assemble, SparseMat};
+use engine_mount_chassis::fe::chassis::{Chassis, MountLayout};
+use engine_mount_chassis::fe::chassis_config::ChassisConfig;
+use engine_mount_chassis::fe::eigen::lowest_modes;
+use engine_mount_chassis::fe::eigen_slicing::{eigenvalue_count, sliced_modes, SliceStop};
+use engine_mount_chassis::fe::nastran::{read_bulk_deck_with, write_bulk_deck, DeckOptions};
+use engine_mount_chassis::model::scene::{reduction_spec, BodyOptions};
+use engine_mount_chassis::model::{BodyConfig, CoupledModel, VehicleConfig};
+use engine_mount_chassis::ode::{Bdf, BdfOptions, Tolerance};
+use faer::sparse::{SparseColMat, Triplet};
+
+type Res<T> = Result<T, Box<dyn std::error::Error>>;
+
+fn vm_hwm_mb() -> f64 {
+    std::fs::read_to_string("/proc/self/status")
+        .ok()
+        .and_then(|s| {
+            let line = s.lines().find(|l| l.starts_with("VmHWM:"))?.to_owned();
+            line.split_whitespace().nth(1)?.parse::<f64>().ok()
+        })
+        .map_or(f64::NAN, |kb| kb / 1024.0)
+}
+
+/// CPU time (user + system) of this process so far, s: on a shared machine the wall time
+/// depends on the other processes, this does not.
+fn cpu_s() -> f64 {
+    let stat = std::fs::read_to_string("/proc/self/stat").unwrap_or_default();
+    let rest = stat.rsplit_once(')').map_or("", |(_, r)| r);
+    let f: Vec<f64> = rest
+        .split_whitespace()
+        .map(|w| w.parse().unwrap_or(f64::NAN))
+        .collect();
+    // Fields 14 and 15 of proc(5), counted from the state (field 3) here; 100 ticks per second.
+    (f.get(11).copied().unwrap_or(f64::NAN) + f.get(12).copied().unwrap_or(f64::NAN)) / 100.0
+}
+
+fn load() -> String {
+    std::fs::read_to_string("/proc/loadavg")
+        .map(|s| s.split_whitespace().take(3).collect::<Vec<_>>().join(" "))
+        .unwrap_or_else(|_| "n/a".into())
+}
+
+/// Rows and columns of `a` not in `interface`.
+fn interior(a: &SparseMat, interface: &[usize]) -> SparseMat {
+    let n = a.nrows();
+    let mut map = vec![usize::MAX; n];
+    let mut next = 0;
+    for (i, slot) in map.iter_mut().enumerate() {
+        if !interface.contains(&i) {
+            *slot = next;
+            next += 1;
+        }
+    }
+    let (cp, ri, v) = (a.symbolic().col_ptr(), a.symbolic().row_idx(), a.val());
+    let mut t = Vec::new();
+    for j in 0..n {
+        for p in cp[j]..cp[j + 1] {
+            if map[ri[p]] != usize::MAX && map[j] != usize::MAX {
+                t.push(Triplet::new(map[ri[p]], map[j], v[p]));
+            }
+        }
+    }
+    SparseColMat::try_new_from_triplets(next, next, &t).expect("interior block")
+}
+
+fn hz(l: &[f64]) -> Vec<f64> {
+    l.iter()
+        .map(|x| x.max(0.0).sqrt() / (2.0 * std::f64::consts::PI))
+        .collect()
+}
+
+fn modes_table() -> Res<()> {
+    let chassis = Chassis::build(&ChassisConfig::default())?;
+    let asm = assemble(&chassis.mesh)?;
+    let ids: Vec<usize> = chassis
+        .mount_nodes(MountLayout::Four)?
+        .iter()
+        .map(|(_, id)| *id)
+        .collect();
+    let interface = asm
+        .dofs
+        .indices_of(&ids, InterfaceDofs::Translations.local())?;
+    let (k, m) = (interior(&asm.k, &interface), interior(&asm.m, &interface));
+    println!(
+        "default body: {} DOF, {} interior; load average at start {}",
+        asm.dofs.n_free(),
+        k.nrows(),
+        load()
+    );
+    println!();
+    println!("| cut-off | modes (Sturm count) | single shift (s) | slicing (s) | speed-up | max rel. frequency difference |");
+    println!("|---:|---:|---:|---:|---:|---:|");
+    for cutoff in [225.0, 500.0, 1000.0, 2000.0] {
+        let lambda = (2.0 * std::f64::consts::PI * cutoff).powi(2);
+        let (_, count) = eigenvalue_count(&k, &m, lambda)?;
+        let t0 = Instant::now();
+        let sliced = sliced_modes(&k, &m, 0.0, SliceStop::Upper(lambda))?;
+        let t_sliced = t0.elapsed().as_secs_f64();
+        let t0 = Instant::now();
+        let single = lowest_modes(&k, &m, count, 0.0)?;
+        let t_single = t0.elapsed().as_secs_f64();
+        let (a, b) = (hz(&single.eigenvalues), hz(&sliced.eigenvalues));
+        let diff = if a.len() == b.len() {
+            a.iter()
+                .zip(&b)
+                .map(|(x, y)| (x / y - 1.0).abs())
+                .fold(0.0, f64::max)
+        } else {
+            f64::NAN
+        };
+        println!(
+            "| {cutoff:.0} Hz | {count} (sliced {}) | {t_single:.2} | {t_sliced:.2} | {:.1}x | {diff:.1e} |",
+            b.len(),
+            t_single / t_sliced
+        );
+    }
+    println!("\nload average at end {}", load());
+    Ok(())
+}
+
+fn config(r: usize) -> ChassisConfig {
+    let mut c = ChassisConfig::default();
+    c.geometry.grid_dx /= r as f64;
+    c.geometry.grid_dy /= r as f64;
+    c.geometry.grid_dz /= r as f64;
+    c
+}
+
+/// Deck files and the cards each holds (by card name); the rest go to the last part.
+fn deck_parts() -> Vec<(&'static str, &'static [&'static str])> {
+    vec![
+        ("grids.bdf", &["GRID"]),
+        ("shells.bdf", &["CQUAD4", "CTRIA3"]),
+        (
+            "properties.bdf",
+            &["PSHELL", "PBAR", "PBEAM", "MAT1", "PBUSH"],
+        ),
+        ("welds.bdf", &["CBUSH"]),
+        // Solid mount brackets (CHEXA/PSOLID) join here as "solids.bdf" once the reader has them.
+        ("beams_masses_links.bdf", &[]),
+    ]
+}
+
+/// Writes the body of refinement `r` into `dir` as a multi-file deck; prints GRID ids of the
+/// named points as `point <name> <grid>` lines for the parent.
+fn write_deck(r: usize, dir: &Path) -> Res<()> {
+    let t0 = Instant::now();
+    let chassis = Chassis::build(&config(r))?;
+    let text = write_bulk_deck(&chassis.mesh)?;
+    std::fs::create_dir_all(dir)?;
+    let parts = deck_parts();
+    let mut bodies: Vec<String> = vec![String::new(); parts.len()];
+    let mut header = String::new();
+    let mut current = usize::MAX;
+    for line in text.lines() {
+        if line.starts_with('$') {
+            header.push_str(line);
+            header.push('\n');
+            continue;
+        }
+        if line == "BEGIN BULK" || line == "ENDDATA" {
+            continue;
+        }
+        if !line.starts_with('*') && !line.starts_with('+') && !line.starts_with(' ') {
+            let name = line.split([',', ' ', '*']).next().unwrap_or("");
+            current = parts
+                .iter()
+                .position(|(_, cards)| cards.contains(&name))
+                .unwrap_or(parts.len() - 1);
+        }
+        bodies[current].push_str(line);
+        bodies[current].push('\n');
+    }
+    drop(text);
+    // Spot welds: a CBUSH across the diagonal of every 40th shell (stiff translational springs,
+    // soft rotational ones, basic axes), as a body-in-white's weld spots tie flange pairs.
+    let weld_pid = 9001;
+    let _ = writeln!(
+        bodies[2],
+        "PBUSH,{weld_pid},K,2.0e7,2.0e7,2.0e7,50.,50.,50."
+    );
+    let mut eid = 9_000_000;
+    for s in chassis.mesh.shells.iter().step_by(40) {
+        eid += 1;
+        let _ = writeln!(
+            bodies[3],
+            "CBUSH,{eid},{weld_pid},{},{},,,,0",
+            s.nodes[0] + 1,
+            s.nodes[2] + 1
+        );
+    }
+    let mut main = header;
+    main.push_str("BEGIN BULK\n");
+    for ((file, _), body) in parts.iter().zip(&bodies) {
+        std::fs::write(dir.join(file), body)?;
+        let _ = writeln!(main, "INCLUDE '{file}'");
+    }
+    main.push_str("ENDDATA\n");
+    std::fs::write(dir.join("main.bdf"), main)?;
+    let bytes: u64 = std::fs::read_dir(dir)?
+        .filter_map(|e| e.ok()?.metadata().ok())
+        .map(|m| m.len())
+        .sum();
+    let vehicle = VehicleConfig::default();
+    let mut names: Vec<String> = vehicle
+        .mounts
+        .iter()
+        .filter_map(|m| m.body_node.clone())
+        .collect();
+    names.extend(vehicle.outputs.iter().cloned());
+    for n in names {
+        println!("point {n} {}", chassis.node(&n)? + 1);
+    }
+    println!(
+        "written {} nodes {} shells {} welds {:.0} MB {:.1} s",
+        chassis.mesh.nodes.len(),
+        chassis.mesh.shells.len(),
+        eid - 9_000_000,
+        bytes as f64 / 1e6,
+        t0.elapsed().as_secs_f64()
+    );
+    Ok(())
+}
+
+fn points_of(dir: &Path) -> Res<BTreeMap<String, u32>> {
+    let text = std::fs::read_to_string(dir.join("points.txt"))?;
+    let mut points = BTreeMap::new();
+    for line in text.lines() {
+        let mut w = line.split_whitespace();
+        if let (Some("point"), Some(n), Some(g)) = (w.next(), w.next(), w.next()) {
+            points.insert(n.to_owned(), g.parse()?);
+        }
+    }
+    Ok(points)
+}
+
+/// Reads, reduces and simulates the deck in `dir`; prints one `result` line.
+fn run_deck(dir: &Path, cutoff_hz: f64, modes: usize) -> Res<()> {
+    let main = dir.join("main.bdf");
+    let t0 = Instant::now();
+    let c0 = cpu_s();
+    let (body, _) = read_bulk_deck_with(&main, &DeckOptions::default())?;
+    let t_read = t0.elapsed().as_secs_f64();
+    let c_read = cpu_s() - c0;
+    let n_nodes = body.mesh.nodes.len();
+    let n_bushes = body.mesh.bushes.len();
+    drop(body);
+    let hwm_read = vm_hwm_mb();
+
+    let vehicle = VehicleConfig {
+        body: BodyConfig::Nastran {
+            path: main.clone(),
+            points: points_of(dir)?,
+            include_root: None,
+        },
+        ..VehicleConfig::default()
+    };
+    let options = BodyOptions {
+        mode_cutoff_hz: cutoff_hz,
+        max_modes: modes,
+        cache: engine_mount_chassis::cms::CacheSetting::Disabled,
+        ..BodyOptions::default()
+    };
+    let (spec, _) = reduction_spec(&vehicle, &options)?;
+    let t0 = Instant::now();
+    let c0 = cpu_s();
+    // Reads the deck again (the reduction starts from the file), assembles, reduces.
+    let chassis = reduce(&spec)?;
+    let t_reduce_total = t0.elapsed().as_secs_f64();
+    let c_reduce_total = cpu_s() - c0;
+    let n_modes = chassis.n_modes();
+    let top_hz = chassis
+        .omega
+        .iter()
+        .map(|w| w / (2.0 * std::f64::consts::PI))
+        .fold(0.0, f64::max);
+    let first_elastic_hz =
+        chassis.omega.first().copied().unwrap_or(0.0) / (2.0 * std::f64::consts::PI);
+
+    let t0 = Instant::now();
+    let mut model = CoupledModel::with_body(&vehicle, chassis)?;
+    let w = 1800.0 * std::f64::consts::PI / 30.0;
+    model.set_crank_speed(0.0, w, 0.0)?;
+    let y0 = model.static_equilibrium(0.0)?;
+    let opts = BdfOptions {
+        rtol: 1e-6,
+        atol: Tolerance::Scalar(1e-9),
+        ..Default::default()
+    };
+    let mut bdf = Bdf::new(&mut model, 0.0, &y0, opts)?;
+    bdf.advance_to(&mut model, 0.1)?;
+    let steps = bdf.stats().steps;
+    let t_sim = t0.elapsed().as_secs_f64();
+    println!(
+        "result nodes={n_nodes} bushes={n_bushes} read_s={t_read:.2} hwm_read_mb={hwm_read:.0} \
+         reduce_total_s={t_reduce_total:.2} read_cpu_s={c_read:.2} \
+         reduce_total_cpu_s={c_reduce_total:.2} modes={n_modes} lowest_hz={first_elastic_hz:.3} \
+         top_hz={top_hz:.1} sim_s={t_sim:.2} steps={steps} hwm_mb={:.0} load={}",
+        vm_hwm_mb(),
+        load().replace(' ', "/")
+    );
+    Ok(())
+}
+
+fn field(line: &str, key: &str) -> f64 {
+    line.split_whitespace()
+        .find_map(|w| w.strip_prefix(&format!("{key}=")))
+        .and_then(|v| v.parse().ok())
+        .unwrap_or(f64::NAN)
+}
+
+fn child(args: &[String]) -> Res<String> {
+    let exe = std::env::current_exe()?;
+    let out = Command::new(exe).args(args).output()?;
+    if !out.status.success() {
+        return Err(format!(
+            "child {args:?} failed: {}",
+            String::from_utf8_lossy(&out.stderr)
+        )
+        .into());
+    }
+    Ok(String::from_utf8(out.stdout)?)
+}
+
+/// Least-squares slope of log y against log x.
+fn exponent(x: &[f64], y: &[f64]) -> f64 {
+    let lx: Vec<f64> = x.iter().map(|v| v.ln()).collect();
+    let ly: Vec<f64> = y.iter().map(|v| v.ln()).collect();
+    let n = lx.len() as f64;
+    let (mx, my) = (lx.iter().sum::<f64>() / n, ly.iter().sum::<f64>() / n);
+    let sxy: f64 = lx.iter().zip(&ly).map(|(a, b)| (a - mx) * (b - my)).sum();
+    let sxx: f64 = lx.iter().map(|a| (a - mx) * (a - mx)).sum();
+    sxy / sxx
+}
+
+fn sizes_table(refinements: &[usize], extra_modes: usize) -> Res<()> {
+    let root = std::env::temp_dir().join(format!("production-benchmark-{}", std::process::id()));
+    println!("| refinement | nodes | DOF (6/node) | deck MB | write (s) | read (s) | reduce (s) | reduce CPU (s) | reduced modes | simulate 0.1 s (s) | peak memory (GB) | load |");
+    println!("|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---|");
+    let mut rows: Vec<(f64, f64, f64, f64)> = Vec::new();
+    let mut last_dir = PathBuf::new();
+    for &r in refinements {
+        let dir = root.join(format!("r{r}"));
+        let written = child(&["write".into(), r.to_string(), dir.display().to_string()])?;
+        std::fs::write(dir.join("points.txt"), &written)?;
+        let summary = written
+            .lines()
+            .find(|l| l.starts_with("written"))
+            .unwrap_or("")
+            .to_owned();
+        let w: Vec<&str> = summary.split_whitespace().collect();
+        let result = child(&[
+            "run".into(),
+            r.to_string(),
+            dir.display().to_string(),
+            "0".into(),
+            "0".into(),
+        ])?;
+        let line = result
+            .lines()
+            .find(|l| l.starts_with("result"))
+            .unwrap_or("")
+            .to_owned();
+        let nodes = field(&line, "nodes");
+        let dof = 6.0 * nodes;
+        let read = field(&line, "read_s");
+        let reduce = field(&line, "reduce_total_s") - read;
+        let hwm = field(&line, "hwm_mb") / 1024.0;
+        let reduce_cpu = field(&line, "reduce_total_cpu_s") - field(&line, "read_cpu_s");
+        println!(
+            "| {r} | {nodes:.0} | {dof:.0} | {} | {} | {read:.2} | {reduce:.1} | {reduce_cpu:.1} | {} | {:.2} | {hwm:.2} | {} |",
+            w.get(7).unwrap_or(&"?"),
+            w.get(9).unwrap_or(&"?"),
+            field(&line, "modes"),
+            field(&line, "sim_s"),
+            line.split("load=").nth(1).unwrap_or("?")
+        );
+        eprintln!("{line}");
+        rows.push((dof, read, reduce_cpu, hwm));
+        last_dir = dir;
+    }
+    if rows.len() >= 2 {
+        let x: Vec<f64> = rows.iter().map(|r| r.0).collect();
+        let fit = |f: fn(&(f64, f64, f64, f64)) -> f64| {
+            exponent(&x, &rows.iter().map(f).collect::<Vec<_>>())
+        };
+        println!(
+            "\ngrowth exponents against DOF (log-log least squares): read time {:.2}, reduction \
+             CPU time {:.2}, peak memory {:.2}",
+            fit(|r| r.1),
+            fit(|r| r.2),
+            fit(|r| r.3)
+        );
+    }
+    if extra_modes > 0 {
+        let result = child(&[
+            "run".into(),
+            "0".into(),
+            last_dir.display().to_string(),
+            "0".into(),
+            extra_modes.to_string(),
+        ])?;
+        let line = result
+            .lines()
+            .find(|l| l.starts_with("result"))
+            .unwrap_or("")
+            .to_owned();
+        eprintln!("{line}");
+        println!(
+            "\nlargest deck, {extra_modes} fixed-interface modes: read {:.2} s, reduce {:.1} s \
+             ({:.1} s CPU), {} reduced modes up to {:.0} Hz, simulate 0.1 s {:.2} s, peak memory {:.2} GB, load {}",
+            field(&line, "read_s"),
+            field(&line, "reduce_total_s") - field(&line, "read_s"),
+            field(&line, "reduce_total_cpu_s") - field(&line, "read_cpu_s"),
+            field(&line, "modes"),
+            field(&line, "top_hz"),
+            field(&line, "sim_s"),
+            field(&line, "hwm_mb") / 1024.0,
+            line.split("load=").nth(1).unwrap_or("?")
+        );
+    }
+    let _ = std::fs::remove_dir_all(&root);
+    Ok(())
+}
+
+fn main() -> Res<()> {
+    let args: Vec<String> = std::env::args().skip(1).collect();
+    match args.first().map(String::as_str) {
+        Some("modes") => modes_table(),
+        Some("write") => write_deck(args[1].parse()?, Path::new(&args[2])),
+        Some("run") => run_deck(Path::new(&args[2]), args[3].parse()?, args[4].parse()?),
+        Some("sizes") => {
+            let mut refinements = Vec::new();
+            let mut modes = 0;
+            let mut it = args[1..].iter();
+            while let Some(a) = it.next() {
+                if a == "--modes" {
+                    modes = it.next().ok_or("--modes needs a number")?.parse()?;
+                } else {
+                    refinements.push(a.parse()?);
+                }
+            }
+            if refinements.is_empty() {
+                refinements = vec![1, 2, 4, 8];
+            }
+            sizes_table(&refinements, modes)
+        }
+        _ => Err("usage: production_benchmark modes | sizes [r…] [--modes N]".into()),
+    }
+}
