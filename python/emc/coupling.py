@@ -233,17 +233,19 @@ class CoupledPair:
         mass)."""
         return jacobian(self.body, BODY_A, FORCES, *self.a_groups)
 
-    def body_response(self, t: float, H: float, probe: float = 1000.0) -> tuple[np.ndarray, np.ndarray]:
+    def body_response(self, t: float, H: float, probe: float = 1000.0,
+                      ramp: bool = True) -> tuple[np.ndarray, np.ndarray]:
         """S_r, S_v: the change of the body's mount displacement and velocity at t+H per unit
-        force increment ΔF ramped in over [t, t+H], measured with the body's state saved and
-        restored (exact: the body is linear)."""
+        force increment ΔF ramped in over [t, t+H] (``ramp=False``: applied at t and held),
+        measured with the body's state saved and restored (exact: the body is linear)."""
         b, vr = self.body, self.vr
         state = b.slave.getFMUstate()
         base = self.F.copy()
 
         def probe_step(slopes):
             b.slave.setFMUstate(state)
-            b.slave.setReal(vr["Fb"], list(base))
+            b.slave.setReal(vr["Fb"], list(base if ramp else base + slopes * H))
+            slopes = slopes if ramp else np.zeros(12)
             b.slave.setRealInputDerivatives(vr["Fb"], [1] * 12, list(slopes))
             b.slave.doStep(t, H)
             return np.array(b.slave.getReal(vr["r"])), np.array(b.slave.getReal(vr["v"]))
@@ -464,13 +466,31 @@ STEPS = (1e-4, 5e-4, 1e-3, 2e-3, 5e-3, 1e-2, 2e-2, 5e-2)
 GROWTH_LIMIT = 5.0
 
 
-def interface_numbers(engine_fmu, body_fmu, rpm: float, cache_dir) -> dict:
+def interface_numbers(engine_fmu, body_fmu, rpm: float, cache_dir, steps=STEPS,
+                      engine_parameters=None, t_end: float = 1.0) -> dict:
     """Mount stiffness and damping, interface compliance and the explicit-coupling estimate at
-    the coupled static equilibrium."""
-    with CoupledPair(engine_fmu, body_fmu, rpm, 0.01, cache_dir=cache_dir) as pair:
+    the coupled static equilibrium.
+
+    Explicit exchange (Jacobi; Gauss-Seidel alike for the body's own feedback) of a mount of
+    tangent stiffness k and damping c on a body of mobility λ (1/kg), the force held over H and
+    the body integrated exactly: x' = x + H v − λH²/2 (k x + c v), v' = v − λH (k x + c v). The
+    determinant of that map is 1 − λcH + λkH²/2, so per step the amplitude grows by
+    ≈ (λH/2)(kH/2 − c): unstable for H > 2c/k whatever the mass, and the growth over a time t is
+    exp(t λ (kH/4 − c/2)). Which λ: the body's response over the step to a held force,
+    λ_eff(H) = λmax(P_v(H))/H with P_v measured on the body (λ_eff → λmax(A) for small H; it
+    falls once H passes the periods of the body modes at the mounts)."""
+    with CoupledPair(engine_fmu, body_fmu, rpm, 0.01, cache_dir=cache_dir,
+                     engine_parameters=engine_parameters) as pair:
         K, C = pair.mount_stiffness()
         A = pair.interface_compliance()
         S = {H: pair.body_response(0.0, H) for H in (1e-3, 1e-2)}
+        held = {H: pair.body_response(0.0, H, ramp=False)[1] for H in steps}
+    diag_k, diag_c = -np.diag(K), -np.diag(C)
+    axis = int(np.argmax(diag_k / diag_c))
+    k_axis, c_axis = float(diag_k[axis]), float(diag_c[axis])
+    lam_eff = {H: float(np.max(np.linalg.eigvalsh((P + P.T) / 2))) / H for H, P in held.items()}
+    predicted = {H: float(np.exp(t_end * lam * (k_axis * H / 4 - c_axis / 2)))
+                 for H, lam in lam_eff.items()}
     # Interface mode of the body on the mounts (engine held: it is 100 times heavier).
     w2, modes = np.linalg.eig(-A @ K)
     k = int(np.argmax(w2.real))
@@ -486,34 +506,44 @@ def interface_numbers(engine_fmu, body_fmu, rpm: float, cache_dir) -> dict:
                   float(np.linalg.norm(S[H][1] - A * H / 2) / np.linalg.norm(S[H][1])))
               for H in S}
     return dict(k_max=max(stiff), lambda_A=float(np.max(np.linalg.eigvalsh((A + A.T) / 2))),
-                omega=omega, zeta=two_zeta_omega / (2 * omega), approx=approx)
+                omega=omega, zeta=two_zeta_omega / (2 * omega), approx=approx,
+                explicit_limit=2 * c_axis / k_axis, lambda_eff=lam_eff, predicted_growth=predicted)
 
 
 def table(engine_fmu, body_fmu, rpms=(1100.0, 2000.0), steps=STEPS, algorithms=ALGORITHMS,
-          t_end: float = 1.0, cache_dir=None, out=sys.stdout) -> list[dict]:
+          t_end: float = 1.0, cache_dir=None, out=sys.stdout,
+          engine_parameters: dict | None = None) -> list[dict]:
     cache_dir = cache_dir or pathlib.Path(tempfile.gettempdir()) / "emc-coupling-cache"
     rows = []
     for rpm in rpms:
-        fine = monolithic(engine_fmu, rpm, 1e-4, t_end, cache_dir=cache_dir)
-        coarse = monolithic(engine_fmu, rpm, 5e-4, t_end, cache_dir=cache_dir)
-        numbers = interface_numbers(engine_fmu, body_fmu, rpm, cache_dir)
+        fine = monolithic(engine_fmu, rpm, 1e-4, t_end, cache_dir=cache_dir,
+                          engine_parameters=engine_parameters)
+        coarse = monolithic(engine_fmu, rpm, 5e-4, t_end, cache_dir=cache_dir,
+                            engine_parameters=engine_parameters)
+        numbers = interface_numbers(engine_fmu, body_fmu, rpm, cache_dir, steps,
+                                    engine_parameters, t_end)
         print(f"\n{rpm:g} rpm: scene 2 wall time {fine.wall:.2f} s at 0.1 ms steps, "
               f"{coarse.wall:.2f} s at 0.5 ms (fmpy low-level loop, 1 s simulated)", file=out)
         print(f"  largest mount tangent stiffness {numbers['k_max'] / 1e3:.1f} N/mm, "
               f"λmax(A) {numbers['lambda_A']:.4g} 1/kg, interface mode ω = sqrt(λmax(−A K)) "
               f"= {numbers['omega']:.4g} rad/s ({numbers['omega'] / 2 / np.pi:.1f} Hz), "
               f"ζ = {numbers['zeta']:.3f}; explicit limit 4ζ/ω = {4 * numbers['zeta'] / numbers['omega'] * 1e3:.3g} ms, "
-              f"2/ω = {2 / numbers['omega'] * 1e3:.3g} ms", file=out)
+              f"2/ω = {2 / numbers['omega'] * 1e3:.3g} ms; explicit limit 2c/k = "
+              f"{numbers['explicit_limit'] * 1e3:.3g} ms", file=out)
         for H, (er, ev) in numbers["approx"].items():
             print(f"  body ramp response vs A·H²/6, A·H/2 at H = {H * 1e3:g} ms: "
                   f"{er * 100:.1f} %, {ev * 100:.1f} % off", file=out)
+        print("  explicit exchange, predicted growth over the run exp(t λ_eff (kH/4 − c/2)): " + ", ".join(
+            f"{H * 1e3:g} ms: λ_eff {numbers['lambda_eff'][H]:.3g} 1/kg, ×{numbers['predicted_growth'][H]:.3g}"
+            for H in steps), file=out)
         print(f"  {'H (ms)':>7} {'algorithm':<19} {'status':<10} {'growth':>7} {'dev (%)':>9} "
               f"{'dev group (%)':>13} {'where (group floor)':<28} {'wall (s)':>8} {'/scene 2':>8}",
               file=out)
         for H in steps:
             ref = fine if H < 5e-4 else coarse
             for algorithm in algorithms:
-                run = coupled(engine_fmu, body_fmu, rpm, algorithm, H, t_end, cache_dir=cache_dir)
+                run = coupled(engine_fmu, body_fmu, rpm, algorithm, H, t_end, cache_dir=cache_dir,
+                              engine_parameters=engine_parameters)
                 dev = dev_group = grow = float("nan")
                 where = ""
                 status = run.status
@@ -547,11 +577,14 @@ def main(argv=None):
                         help="coupling steps in ms")
     parser.add_argument("--algorithms", nargs="*", default=list(ALGORITHMS), choices=ALGORITHMS)
     parser.add_argument("--t-end", type=float, default=1.0)
+    parser.add_argument("--stiffness-scale", type=float, default=1.0,
+                        help="mount[i].stiffnessScale of the engine (both scene 2 and scene 3)")
     args = parser.parse_args(argv)
     if not args.table:
         parser.error("nothing to do: pass --table")
+    scale = {f"mount[{i}].stiffnessScale": args.stiffness_scale for i in range(1, MOUNTS + 1)}
     table(args.engine, args.body, args.rpm, [s * 1e-3 for s in args.steps], args.algorithms,
-          args.t_end)
+          args.t_end, engine_parameters=scale if args.stiffness_scale != 1.0 else None)
 
 
 if __name__ == "__main__":
