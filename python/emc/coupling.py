@@ -523,7 +523,7 @@ def table(engine_fmu, body_fmu, rpms=(1100.0, 2000.0), steps=STEPS, algorithms=A
         numbers = interface_numbers(engine_fmu, body_fmu, rpm, cache_dir, steps,
                                     engine_parameters, t_end)
         print(f"\n{rpm:g} rpm: scene 2 wall time {fine.wall:.2f} s at 0.1 ms steps, "
-              f"{coarse.wall:.2f} s at 0.5 ms (fmpy low-level loop, 1 s simulated)", file=out)
+              f"{coarse.wall:.2f} s at 0.5 ms (fmpy low-level loop, {t_end:g} s simulated)", file=out)
         print(f"  largest mount tangent stiffness {numbers['k_max'] / 1e3:.1f} N/mm, "
               f"λmax(A) {numbers['lambda_A']:.4g} 1/kg, interface mode ω = sqrt(λmax(−A K)) "
               f"= {numbers['omega']:.4g} rad/s ({numbers['omega'] / 2 / np.pi:.1f} Hz), "
