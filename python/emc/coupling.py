@@ -8,10 +8,9 @@
     ramp from the engine's force at t to its force at t+H.
 ``interface_jacobian``
     A linearly implicit coupling step in the spirit of Kübler & Schiehlen (2000, "Two methods of
-    simulator coupling", linearly implicit modular integration) and of the interface-Jacobian
-    co-simulation of Sadjina et al. (2017, "Energy conservation and power bonds in co-simulations:
-    non-iterative adaptive step size control and error estimation"): the unknown of the step is
-    the force increment ΔF over it. The interface condition at t+H — the force the engine
+    simulator coupling", linearly implicit modular integration) and of the interface-Jacobian-
+    based co-simulation of Sadjina et al. (2019, "Distributed co-simulation of maritime systems
+    and operations"): the unknown of the step is the force increment ΔF over it. The interface condition at t+H — the force the engine
     applies equals the force the body was driven with — is linearised with the partial
     derivatives the FMUs provide (``fmi2GetDirectionalDerivative``): the engine's mount tangent
     stiffness K = ∂F/∂r and damping C = ∂F/∂v w.r.t. the body motion, and the body's response
