@@ -68,7 +68,8 @@ FORCE_LIMIT = 1e6
 
 
 class Diverged(RuntimeError):
-    """The coupled run left the physical range (or an FMU refused a step)."""
+    """The coupled run left the physical range: a mount force not finite or beyond
+    :data:`FORCE_LIMIT`."""
 
 
 class Fmu:
@@ -89,7 +90,7 @@ class Fmu:
     def refs(self, names):
         return [self.vr[n] for n in names]
 
-    def start(self, values: dict, stop_time: float):
+    def start(self, values: dict):
         # No stop time declared: the master may probe a step past t_end (body_response).
         self.slave.setupExperiment(startTime=0.0)
         for name, value in values.items():
@@ -116,11 +117,12 @@ class Fmu:
         shutil.rmtree(self.unzipdir, ignore_errors=True)
 
 
-def dependency_groups(fmu: Fmu, outputs: list[str], inputs: list[str]) -> list[list[int]]:
+def dependency_groups(fmu: Fmu, outputs: list[str],
+                      inputs: list[str]) -> tuple[list[list[int]], dict[int, set[int]]]:
     """Inputs (indices into ``inputs``) grouped so that no output depends on two inputs of one
     group, from the dependencies the model description declares: one directional derivative per
     group then gives every column of the group (the engine's mounts are independent, so 3 calls
-    instead of 12)."""
+    instead of 12). Also returns, per output index, the input indices it depends on."""
     index = {fmu.vr[n]: k for k, n in enumerate(inputs)}
     depends: dict[int, set[int]] = {}
     for unknown in fmu.md.outputs:
@@ -183,8 +185,8 @@ class CoupledPair:
         self.body = Fmu(body_fmu, "body")
         cache = {} if cache_dir is None else {"chassis.cacheDir": str(cache_dir)}
         self.engine.start({"scene": 3, "rpm": rpm, "solver.relTol": rel_tol, **cache,
-                           **(engine_parameters or {})}, t_end)
-        self.body.start(cache, t_end)
+                           **(engine_parameters or {})})
+        self.body.start(cache)
         e, b = self.engine, self.body
         self.vr = dict(F=e.refs(FORCES), Fb=b.refs(FORCES), r=b.refs(BODY_R), v=b.refs(BODY_V),
                        a=b.refs(BODY_A), re=e.refs(ENGINE_R), ve=e.refs(ENGINE_V),
@@ -289,7 +291,10 @@ class CoupledPair:
         FMUs are then stepped in H/h_out pieces on the same held or ramped inputs, which changes
         nothing but where the outputs are read). For ``interface_jacobian`` the engine's K and C
         are refreshed every step once H reaches ``jacobian_every`` s, else every
-        ``jacobian_every`` s of simulated time."""
+        ``jacobian_every`` s of simulated time, and the body motion the engine steps on is
+        predicted for a force ramp continuing the previous step's increment (``extrapolate``) or
+        for the force held (at 1100 rpm and 1-20 ms their deviations from scene 2 differ by less
+        than 0.05 percentage points)."""
         if algorithm not in ALGORITHMS:
             raise ValueError(f"algorithm must be one of {ALGORITHMS}, got {algorithm!r}")
         h_out = min(H, 5e-4) if h_out is None else h_out
@@ -337,7 +342,8 @@ class CoupledPair:
                     b.slave.setRealInputDerivatives(vr["Fb"], ones12, list((F_end - self.F) / H))
                     self._advance(b, t, H, m, rec_body)
                 else:
-                    # Body motion predicted for the force ramp of the previous step (exact for it).
+                    # The body motion for the guessed ramp (exact for that ramp: the body is
+                    # linear); the engine steps on it, the correction comes at the end.
                     state = b.slave.getFMUstate()
                     b.slave.setRealInputDerivatives(vr["Fb"], ones12, list(dF / H))
                     b.slave.doStep(t, H)
@@ -397,7 +403,7 @@ def monolithic(engine_fmu, rpm: float, h: float = 1e-4, t_end: float = 1.0,
     try:
         cache = {} if cache_dir is None else {"chassis.cacheDir": str(cache_dir)}
         fmu.start({"scene": 2, "rpm": rpm, "solver.relTol": rel_tol, **cache,
-                   **(engine_parameters or {})}, t_end)
+                   **(engine_parameters or {})})
         fmu.slave.enterInitializationMode()
         fmu.slave.exitInitializationMode()
         vr = fmu.refs(SIGNALS)
