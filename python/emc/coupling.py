@@ -456,12 +456,16 @@ def largest_deviation(reference: Run, run: Run, rpm: float, revolutions: int = 8
 
 def growth(reference: Run, run: Run, rpm: float, revolutions: int = 8) -> float:
     """Largest ratio over the mount forces of the peak-to-peak value in the last ``revolutions``
-    to scene 2's: an interface oscillation that grows (or settles on a large limit cycle on the
-    stiffening mount curves instead of reaching the force limit) shows here."""
-    n = int(round(revolutions * 60.0 / rpm / run.h))
+    (before the end, or before the run failed) to scene 2's over the same time: an interface
+    oscillation that grows (or settles on a large limit cycle on the stiffening mount curves
+    instead of reaching the force limit) shows here."""
     step = int(round(run.h / reference.h))
-    return max(np.ptp(run.signals[f][-n:]) / np.ptp(reference.signals[f][step - 1::step][-n:])
-               for f in FORCES)
+    end = int(round(run.t_reached / run.h))
+    n = min(end, int(round(revolutions * 60.0 / rpm / run.h)))
+    if n < 2:
+        return float("nan")
+    return max(np.ptp(run.signals[f][end - n:end])
+               / np.ptp(reference.signals[f][step - 1::step][end - n:end]) for f in FORCES)
 
 
 # ----- the table ---------------------------------------------------------------------------------
@@ -541,7 +545,7 @@ def table(engine_fmu, body_fmu, rpms=(1100.0, 2000.0), steps=STEPS, algorithms=A
         print("  explicit exchange, predicted growth over the run exp(t λ_eff (kH/4 − c/2)): " + ", ".join(
             f"{H * 1e3:g} ms: λ_eff {numbers['lambda_eff'][H]:.3g} 1/kg, ×{numbers['predicted_growth'][H]:.3g}"
             for H in steps), file=out)
-        print(f"  {'H (ms)':>7} {'algorithm':<19} {'status':<10} {'growth':>7} {'dev (%)':>9} "
+        print(f"  {'H (ms)':>7} {'algorithm':<19} {'status':<12} {'growth':>7} {'dev (%)':>9} "
               f"{'dev group (%)':>13} {'where (group floor)':<28} {'wall (s)':>8} {'/scene 2':>8}",
               file=out)
         for H in steps:
@@ -559,12 +563,14 @@ def table(engine_fmu, body_fmu, rpms=(1100.0, 2000.0), steps=STEPS, algorithms=A
                     if grow > GROWTH_LIMIT:
                         status = "unstable"
                 else:
-                    status = "diverged" if run.status.startswith("diverged") else "error"
+                    grow = growth(fine, run, rpm)
+                    kind = "diverged" if run.status.startswith("diverged") else "error"
+                    status = f"{kind}@{run.t_reached:.2f}s"
                 row = dict(rpm=rpm, H=H, algorithm=algorithm, status=status, detail=run.status,
                            growth=grow, deviation=dev, deviation_group=dev_group, where=where,
                            wall=run.wall, wall_ratio=run.wall / ref.wall, **numbers)
                 rows.append(row)
-                print(f"  {H * 1e3:7.1f} {algorithm:<19} {status:<10} {grow:7.3g} {dev * 100:9.3g} "
+                print(f"  {H * 1e3:7.1f} {algorithm:<19} {status:<12} {grow:7.3g} {dev * 100:9.3g} "
                       f"{dev_group * 100:13.3g} {where:<28} {run.wall:8.2f} {run.wall / ref.wall:8.2f}",
                       file=out, flush=True)
     return rows

@@ -53,14 +53,18 @@ def test_the_partial_derivatives_describe_the_interface(fmus, cache):
 
 def test_stiff_mounts_at_1_ms_only_the_interface_jacobian_master_holds(fmus, cache):
     """Mounts 20 times stiffer (about 1000 N/mm), coupling step 1 ms, 2000 rpm: Jacobi and
-    Gauss-Seidel diverge (the explicit interface limit is below 0.3 ms, see the user guide);
-    the interface-Jacobian step stays stable and within 8 % of scene 2 in every order above
-    1 % of its group's largest (measured: 4.2 %)."""
+    Gauss-Seidel are beyond the explicit interface limit 2c/k = 0.24 ms (see the user guide)
+    and fail (the engine's integrator gives up on the grown jumps of its held inputs; were it
+    to carry on, they would be off by far more than 20 %: 532 % and 357 % at 1100 rpm); the
+    interface-Jacobian step stays stable and within 8 % of scene 2 in every order above 1 % of
+    its group's largest (measured: 4.2 %)."""
     rpm = 2000.0
     reference = monolithic(fmus[0], rpm, 1e-4, 1.0, cache_dir=cache, engine_parameters=STIFF)
     for algorithm in ("jacobi", "gauss_seidel"):
         run = coupled(*fmus, rpm, algorithm, 1e-3, 1.0, cache_dir=cache, engine_parameters=STIFF)
-        assert not run.ok or growth(reference, run, rpm) > 5.0, f"{algorithm}: {run.status}"
+        if run.ok:
+            deviation, where = largest_deviation(reference, run, rpm, floor="group")
+            assert growth(reference, run, rpm) > 5.0 or deviation > 0.2, f"{algorithm}: {where}"
     run = coupled(*fmus, rpm, "interface_jacobian", 1e-3, 1.0, cache_dir=cache,
                   engine_parameters=STIFF)
     assert run.ok, run.status
