@@ -449,19 +449,25 @@ fn write_variable(w: &mut Writer<Vec<u8>>, v: &Var3) -> std::io::Result<()> {
     Ok(())
 }
 
-/// Terminals: the engine's inputs, the mount ports (forces and the scales of their
-/// characteristics), the powertrain's motion and the comfort points.
+/// Terminals: the engine's inputs, the mounts' port to the body (the external body's motion
+/// in, the mount forces out), the scales of the mount characteristics, the powertrain's motion
+/// and the comfort points.
 fn write_terminals(w: &mut Writer<Vec<u8>>, vars: &[Var3]) -> std::io::Result<()> {
-    let terminals: [(&str, &str, &[&str]); 4] = [
+    let terminals: [(&str, &str, &[&str]); 5] = [
         (
             "engine",
             "Engine operating point: speed set-point and drivetrain load torque",
             &["rpm", "loadTorque"],
         ),
         (
+            "bodyPort",
+            "The mounts' port to the body: per mount the body point's displacement and velocity in (scene 3, an external body), the mount's force on the body out; connects one to one to EngineMountBody's mount.r, mount.v and mount.F",
+            &["mount.body.r", "mount.body.v", "mount.F"],
+        ),
+        (
             "mounts",
-            "The engine mounts: forces on the ground/chassis side and the scales of their stiffness and damping",
-            &["mount.F", "mount.stiffnessScale", "mount.dampingScale"],
+            "The engine mounts' characteristics: scales of their stiffness and damping",
+            &["mount.stiffnessScale", "mount.dampingScale"],
         ),
         (
             "powertrain",

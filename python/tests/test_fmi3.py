@@ -76,7 +76,8 @@ def test_terminals_name_existing_variables_and_match_the_schema(fmu3_path):
     names = {v.name for v in read_model_description(str(fmu3_path)).modelVariables}
     terminals = {t.get("name"): [m.get("variableName") for m in t] for t in root.iter("Terminal")}
     assert terminals["engine"] == ["rpm", "loadTorque"]
-    assert "mount.F" in terminals["mounts"]
+    assert terminals["bodyPort"] == ["mount.body.r", "mount.body.v", "mount.F"]
+    assert "mount.stiffnessScale" in terminals["mounts"]
     assert terminals["comfort"] == ["steeringWheel.a", "seat.a"]
     assert all(m in names for members in terminals.values() for m in members)
 

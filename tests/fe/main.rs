@@ -9,5 +9,5 @@ mod eigen;
 mod eigen_slicing;
 mod elements;
 mod nastran;
-mod solids;
 mod shell_cards;
+mod solids;
