@@ -431,6 +431,70 @@ fn model_description(table: &Value, scalars: &[Scalar], families: &[Family], fmu
     xml
 }
 
+/// The parts of a model description that FMI 2.0 and 3.0 share, in the order both schemas
+/// want them: `UnitDefinitions`, `LogCategories`, `DefaultExperiment`.
+fn write_units_categories_experiment(
+    w: &mut Writer<Vec<u8>>,
+    table: &Value,
+) -> std::io::Result<()> {
+    let array = |key: &str| -> Vec<Value> {
+        table
+            .get(key)
+            .and_then(Value::as_array)
+            .cloned()
+            .unwrap_or_default()
+    };
+    w.create_element("UnitDefinitions")
+        .write_inner_content(|w| {
+            for u in array("units") {
+                let name = vec![attr("name", str_field(&u, "name"))];
+                element(w, "Unit", &name).write_inner_content(|w| {
+                    let mut base: Attributes = u
+                        .get("base")
+                        .and_then(Value::as_object)
+                        .into_iter()
+                        .flatten()
+                        .map(|(k, v)| attr(k, v))
+                        .collect();
+                    if let Some(f) = u.get("factor").and_then(Value::as_f64) {
+                        base.push(attr("factor", format!("{f:?}")));
+                    }
+                    element(w, "BaseUnit", &base).write_empty()?;
+                    for d in u
+                        .get("display")
+                        .and_then(Value::as_array)
+                        .into_iter()
+                        .flatten()
+                    {
+                        let factor = d.get("factor").and_then(Value::as_f64).unwrap_or(1.0);
+                        let display = vec![
+                            attr("name", str_field(d, "name")),
+                            attr("factor", format!("{factor:?}")),
+                        ];
+                        element(w, "DisplayUnit", &display).write_empty()?;
+                    }
+                    Ok(())
+                })?;
+            }
+            Ok(())
+        })?;
+    w.create_element("LogCategories").write_inner_content(|w| {
+        for c in array("logCategories") {
+            let category = vec![
+                attr("name", str_field(&c, "name")),
+                attr("description", str_field(&c, "description")),
+            ];
+            element(w, "Category", &category).write_empty()?;
+        }
+        Ok(())
+    })?;
+    if let Some(de) = table.get("defaultExperiment").and_then(Value::as_object) {
+        let experiment: Attributes = de.iter().map(|(k, v)| attr(k, v)).collect();
+        element(w, "DefaultExperiment", &experiment).write_empty()?;
+    }
+    Ok(())
+}
+
 /// The direct dependencies of output `s` among the FMU's variables `visible` (1-based indices of
 /// the XML's variable list), as its family's `feedthrough` declares them.
 fn feedthrough_of(s: &Scalar, visible: &[&Scalar], families: &[Family]) -> Vec<usize> {
@@ -454,13 +518,6 @@ fn write_model_description(
     fmu: &Fmu,
 ) -> std::io::Result<()> {
     let scalars: Vec<&Scalar> = scalars.iter().filter(|s| s.fmus & fmu.mask != 0).collect();
-    let array = |key: &str| -> Vec<Value> {
-        table
-            .get(key)
-            .and_then(Value::as_array)
-            .cloned()
-            .unwrap_or_default()
-    };
     w.write_event(Event::Decl(BytesDecl::new("1.0", Some("UTF-8"), None)))?;
     let root = vec![
         attr("fmiVersion", "2.0"),
@@ -488,54 +545,7 @@ fn write_model_description(
             attr("providesDirectionalDerivative", true),
         ];
         element(w, "CoSimulation", &co_simulation).write_empty()?;
-        w.create_element("UnitDefinitions")
-            .write_inner_content(|w| {
-                for u in array("units") {
-                    let name = vec![attr("name", str_field(&u, "name"))];
-                    element(w, "Unit", &name).write_inner_content(|w| {
-                        let mut base: Attributes = u
-                            .get("base")
-                            .and_then(Value::as_object)
-                            .into_iter()
-                            .flatten()
-                            .map(|(k, v)| attr(k, v))
-                            .collect();
-                        if let Some(f) = u.get("factor").and_then(Value::as_f64) {
-                            base.push(attr("factor", format!("{f:?}")));
-                        }
-                        element(w, "BaseUnit", &base).write_empty()?;
-                        for d in u
-                            .get("display")
-                            .and_then(Value::as_array)
-                            .into_iter()
-                            .flatten()
-                        {
-                            let factor = d.get("factor").and_then(Value::as_f64).unwrap_or(1.0);
-                            let display = vec![
-                                attr("name", str_field(d, "name")),
-                                attr("factor", format!("{factor:?}")),
-                            ];
-                            element(w, "DisplayUnit", &display).write_empty()?;
-                        }
-                        Ok(())
-                    })?;
-                }
-                Ok(())
-            })?;
-        w.create_element("LogCategories").write_inner_content(|w| {
-            for c in array("logCategories") {
-                let category = vec![
-                    attr("name", str_field(&c, "name")),
-                    attr("description", str_field(&c, "description")),
-                ];
-                element(w, "Category", &category).write_empty()?;
-            }
-            Ok(())
-        })?;
-        if let Some(de) = table.get("defaultExperiment").and_then(Value::as_object) {
-            let experiment: Attributes = de.iter().map(|(k, v)| attr(k, v)).collect();
-            element(w, "DefaultExperiment", &experiment).write_empty()?;
-        }
+        write_units_categories_experiment(w, table)?;
         w.create_element("ModelVariables")
             .write_inner_content(|w| {
                 for (index, s) in scalars.iter().enumerate() {

@@ -11,9 +11,7 @@
 //! scalar keeps its 2.0 value reference and arrays never overlap; `time` and `modes.size`, which
 //! have no 2.0 counterpart, sit above the 2.0 ranges.
 
-use super::{
-    attr, element, fail, opt_str, str_field, value_text, vr_base, Attributes, Family, VR_BASE,
-};
+use super::{attr, element, fail, opt_str, str_field, value_text, vr_base, Family, VR_BASE};
 use quick_xml::events::{BytesDecl, Event};
 use quick_xml::Writer;
 use serde_json::Value;
@@ -220,13 +218,6 @@ fn write_model_description(
     vars: &[Var3],
     guid: &str,
 ) -> std::io::Result<()> {
-    let array = |key: &str| -> Vec<Value> {
-        table
-            .get(key)
-            .and_then(Value::as_array)
-            .cloned()
-            .unwrap_or_default()
-    };
     w.write_event(Event::Decl(BytesDecl::new("1.0", Some("UTF-8"), None)))?;
     let root = vec![
         attr("fmiVersion", "3.0"),
@@ -259,54 +250,7 @@ fn write_model_description(
             attr("providesEvaluateDiscreteStates", false),
         ];
         element(w, "CoSimulation", &co_simulation).write_empty()?;
-        w.create_element("UnitDefinitions")
-            .write_inner_content(|w| {
-                for u in array("units") {
-                    let name = vec![attr("name", str_field(&u, "name"))];
-                    element(w, "Unit", &name).write_inner_content(|w| {
-                        let mut base: Attributes = u
-                            .get("base")
-                            .and_then(Value::as_object)
-                            .into_iter()
-                            .flatten()
-                            .map(|(k, v)| attr(k, v))
-                            .collect();
-                        if let Some(f) = u.get("factor").and_then(Value::as_f64) {
-                            base.push(attr("factor", format!("{f:?}")));
-                        }
-                        element(w, "BaseUnit", &base).write_empty()?;
-                        for d in u
-                            .get("display")
-                            .and_then(Value::as_array)
-                            .into_iter()
-                            .flatten()
-                        {
-                            let factor = d.get("factor").and_then(Value::as_f64).unwrap_or(1.0);
-                            let display = vec![
-                                attr("name", str_field(d, "name")),
-                                attr("factor", format!("{factor:?}")),
-                            ];
-                            element(w, "DisplayUnit", &display).write_empty()?;
-                        }
-                        Ok(())
-                    })?;
-                }
-                Ok(())
-            })?;
-        w.create_element("LogCategories").write_inner_content(|w| {
-            for c in array("logCategories") {
-                let category = vec![
-                    attr("name", str_field(&c, "name")),
-                    attr("description", str_field(&c, "description")),
-                ];
-                element(w, "Category", &category).write_empty()?;
-            }
-            Ok(())
-        })?;
-        if let Some(de) = table.get("defaultExperiment").and_then(Value::as_object) {
-            let experiment: Attributes = de.iter().map(|(k, v)| attr(k, v)).collect();
-            element(w, "DefaultExperiment", &experiment).write_empty()?;
-        }
+        super::write_units_categories_experiment(w, table)?;
         let max = modes_max(vars);
         w.create_element("ModelVariables")
             .write_inner_content(|w| {
