@@ -48,7 +48,7 @@ def test_booleans_accept_the_usual_spellings(variables, text, value):
     ("effects.balanceShaft=", "a Boolean is one of"),
     ("effects.balanceShat=off", "did you mean effects.balanceShaft"),
     ("solver.relTol=5", "outside the declared range"),
-    ("scene=3", "outside the declared range [1, 2]"),
+    ("scene=4", "outside the declared range [1, 3]"),
     ("scene=two", "not an Integer"),
     ("scene.maxRpm=fast", "not a Real"),
     ("scene.maxRpm=nan", "must be finite"),
@@ -109,7 +109,7 @@ def test_options_are_range_checked(fmu_path, tmp_path, capsys, command, options,
 
 
 @pytest.mark.parametrize("options,message", [
-    (["--scene", "3"], "--scene must be >= 1 and <= 2"),
+    (["--scene", "4"], "--scene must be >= 1 and <= 3"),
     (["--seconds", "0"], "--seconds must be > 0.0"),
     (["--rpm-point", "0"], "--rpm-point must be > 0.0"),
     (["--signal-name", "mount[1].F[4]"], "not an output of the FMU"),
