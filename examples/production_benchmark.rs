@@ -10,14 +10,14 @@
 //! `cargo run --release --example production_benchmark -- sizes [refinements…] [--modes N]`
 //!   (b) For each refinement r (default 1 2 4 8: grid spacing / r, about 15 k, 60 k, 240 k and
 //!   950 k DOF) the procedural body is written as a multi-file bulk deck (`main.bdf` with
-//!   `INCLUDE`s of `grids.bdf`, `shells.bdf`, `properties.bdf`, `beams_masses_links.bdf` and
-//!   `welds.bdf`: CBUSH spot welds across every 40th shell's diagonal) by one child process, then
+//!   `INCLUDE`s of `grids.bdf`, `shells.bdf`, `properties.bdf`, `beams_masses_links.bdf`,
+//!   `welds.bdf`: CBUSH spot welds across every 40th shell's diagonal, and `brackets.bdf`: a
+//!   steel block of 2 × 2 × 2 CHEXA under each engine mount node, hung on it by an RBE2) by one
+//!   child process, then
 //!   read with the streaming reader, reduced (default 225 Hz cut-off) and run through the coupled
 //!   model for 0.1 s by a second child process, whose peak resident memory (VmHWM) is the one
 //!   reported. Growth exponents are log-log least-squares fits against DOF. With `--modes N`
 //!   the largest size is also reduced keeping N fixed-interface modes (a third child process).
-//!   Solid elements (`CHEXA` mount brackets) are not in the deck yet: `deck_parts` is where a
-//!   `solids.bdf` part goes once the reader has solids.
 //!
 //! Internal subcommands (run by `sizes` as child processes): `write <r> <dir>`,
 //! `run <r> <dir> <cutoff_hz|0> <modes|0>`.
@@ -167,7 +167,7 @@ fn deck_parts() -> Vec<(&'static str, &'static [&'static str])> {
             &["PSHELL", "PBAR", "PBEAM", "MAT1", "PBUSH"],
         ),
         ("welds.bdf", &["CBUSH"]),
-        // Solid mount brackets (CHEXA/PSOLID) join here as "solids.bdf" once the reader has them.
+        ("brackets.bdf", &["CHEXA", "PSOLID"]),
         ("beams_masses_links.bdf", &[]),
     ]
 }
@@ -220,6 +220,10 @@ fn write_deck(r: usize, dir: &Path) -> Res<()> {
             s.nodes[2] + 1
         );
     }
+    let [.., solids, links] = &mut bodies[..] else {
+        return Err("deck parts end with the brackets and the links".into());
+    };
+    let brackets = write_brackets(&chassis, solids, links)?;
     let mut main = header;
     main.push_str("BEGIN BULK\n");
     for ((file, _), body) in parts.iter().zip(&bodies) {
@@ -243,7 +247,7 @@ fn write_deck(r: usize, dir: &Path) -> Res<()> {
         println!("point {n} {}", chassis.node(&n)? + 1);
     }
     println!(
-        "written {} nodes {} shells {} welds {:.0} MB {:.1} s",
+        "written {} nodes {} shells {} welds {:.0} MB {:.1} s {brackets} bracket-hexas",
         chassis.mesh.nodes.len(),
         chassis.mesh.shells.len(),
         eid - 9_000_000,
@@ -251,6 +255,75 @@ fn write_deck(r: usize, dir: &Path) -> Res<()> {
         t0.elapsed().as_secs_f64()
     );
     Ok(())
+}
+
+/// Cast mount brackets as production decks carry them: under each engine mount's body node a
+/// steel block of 2 × 2 × 2 `CHEXA` (8 cm cube, 27 grids), its top face tied to the mount node by
+/// an `RBE2` (solid grids carry translations only, so the bracket hangs on the node through the
+/// link). Returns the number of hexahedra written.
+fn write_brackets(chassis: &Chassis, solids: &mut String, links: &mut String) -> Res<usize> {
+    const SIZE: f64 = 0.08;
+    let (pid, mid) = (9101, 9101);
+    let _ = writeln!(solids, "MAT1,{mid},2.1e11,,0.3,7850.");
+    let _ = writeln!(solids, "PSOLID,{pid},{mid}");
+    let (mut grid, mut eid, mut rbe) = (9_500_000u32, 9_600_000u32, 9_700_000u32);
+    let mut hexas = 0;
+    for m in VehicleConfig::default().mounts {
+        let Some(name) = m.body_node else { continue };
+        let node = chassis.node(&name)?;
+        let p = chassis.mesh.nodes[node];
+        let first = grid + 1;
+        let id = |i: u32, j: u32, k: u32| first + i + 3 * j + 9 * k;
+        for k in 0..3u32 {
+            for j in 0..3u32 {
+                for i in 0..3u32 {
+                    grid += 1;
+                    let h = SIZE / 2.0;
+                    let _ = writeln!(
+                        solids,
+                        "GRID,{grid},,{:.6},{:.6},{:.6}",
+                        p[0] - h + h * f64::from(i),
+                        p[1] - h + h * f64::from(j),
+                        p[2] - SIZE + h * f64::from(k)
+                    );
+                }
+            }
+        }
+        for k in 0..2 {
+            for j in 0..2 {
+                for i in 0..2 {
+                    eid += 1;
+                    hexas += 1;
+                    let _ = writeln!(
+                        solids,
+                        "CHEXA,{eid},{pid},{},{},{},{},{},{}\n,{},{}",
+                        id(i, j, k),
+                        id(i + 1, j, k),
+                        id(i + 1, j + 1, k),
+                        id(i, j + 1, k),
+                        id(i, j, k + 1),
+                        id(i + 1, j, k + 1),
+                        id(i + 1, j + 1, k + 1),
+                        id(i, j + 1, k + 1)
+                    );
+                }
+            }
+        }
+        rbe += 1;
+        let top: Vec<String> = (0..3)
+            .flat_map(|j| (0..3).map(move |i| (i, j)))
+            .map(|(i, j)| id(i, j, 2).to_string())
+            .collect();
+        // Free field: eight fields after the name, the rest on a continuation.
+        let _ = writeln!(
+            links,
+            "RBE2,{rbe},{},123,{}\n,{}",
+            node + 1,
+            top[..5].join(","),
+            top[5..].join(",")
+        );
+    }
+    Ok(hexas)
 }
 
 fn points_of(dir: &Path) -> Res<BTreeMap<String, u32>> {
