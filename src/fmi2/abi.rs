@@ -15,7 +15,8 @@ use std::panic::{catch_unwind, AssertUnwindSafe};
 
 use fmi_sys::fmi2::*;
 
-use super::instance::{Core, Instance, Outcome, Status};
+use super::fmu_states::FmuStates;
+use super::instance::{Instance, Outcome, Status};
 use super::logger::{Level, Logger};
 use super::snapshot;
 use super::state::{self, Mask, Phase};
@@ -36,41 +37,8 @@ struct Handle {
     /// Strings returned by fmi2GetString stay valid until the next call on this instance.
     returned_strings: Vec<CString>,
     /// The FMU states this instance handed out (fmi2GetFMUstate, fmi2DeSerializeFMUstate) and
-    /// that are not freed yet: they belong to it and are freed with it. A state pointer is
-    /// recognised by its address among these, never dereferenced on trust. Boxed so that a
-    /// state keeps its address, which the master holds, when the vector grows.
-    #[allow(clippy::vec_box)]
-    states: Vec<Box<StateHandle>>,
-}
-
-/// An FMU state handed out by `fmi2GetFMUstate`.
-struct StateHandle {
-    core: Core,
-}
-
-impl Handle {
-    /// The state behind `state`, if this instance handed it out.
-    fn state(&self, state: fmi2FMUstate) -> Result<usize, String> {
-        self.states
-            .iter()
-            .position(|s| std::ptr::eq(&**s, state as *const StateHandle))
-            .ok_or_else(|| "not an FMU state of this instance".to_owned())
-    }
-
-    /// Puts `core` into the state slot the master passed: a new state for a null slot, the
-    /// same state overwritten for one of ours.
-    fn store_state(&mut self, slot: &mut fmi2FMUstate, core: Core) -> Outcome {
-        if slot.is_null() {
-            let mut boxed = Box::new(StateHandle { core });
-            let ptr: *mut StateHandle = &mut *boxed;
-            self.states.push(boxed);
-            *slot = ptr as fmi2FMUstate;
-        } else {
-            let i = self.state(*slot)?;
-            self.states[i].core = core;
-        }
-        Ok(Status::Ok)
-    }
+    /// that are not freed yet: they belong to it and are freed with it.
+    states: FmuStates,
 }
 
 fn status(s: Status) -> fmi2Status {
@@ -318,7 +286,7 @@ pub extern "C" fn fmi2Instantiate(
             live: LIVE,
             instance: Instance::new(&name, kind, logger, resource_dir),
             returned_strings: Vec::new(),
-            states: Vec::new(),
+            states: FmuStates::default(),
         });
         Box::into_raw(handle) as fmi2Component
     }));
@@ -639,7 +607,7 @@ pub extern "C" fn fmi2GetFMUstate(c: fmi2Component, FMUstate: *mut fmi2FMUstate)
         // SAFETY: FMUstate points to a writable fmi2FMUstate slot (FMI 2.0 §2.1.8).
         let slot = unsafe { place(FMUstate, "FMUstate") }?;
         let core = h.instance.core.clone();
-        h.store_state(slot, core)
+        h.states.store(slot, core)
     })
 }
 const _: fmi2GetFMUstateTYPE = Some(fmi2GetFMUstate);
@@ -649,9 +617,9 @@ const _: fmi2GetFMUstateTYPE = Some(fmi2GetFMUstate);
 #[no_mangle]
 pub extern "C" fn fmi2SetFMUstate(c: fmi2Component, FMUstate: fmi2FMUstate) -> fmi2Status {
     entry(c, "fmi2SetFMUstate", state::FMU_STATE, |h| {
-        let i = h.state(FMUstate)?;
-        h.instance.check_state_fits(&h.states[i].core)?;
-        h.instance.core = h.states[i].core.clone();
+        let core = h.states.core(FMUstate)?;
+        h.instance.check_state_fits(core)?;
+        h.instance.core = core.clone();
         Ok(Status::Ok)
     })
 }
@@ -666,13 +634,7 @@ pub extern "C" fn fmi2FreeFMUstate(c: fmi2Component, FMUstate: *mut fmi2FMUstate
         let Some(slot) = (unsafe { FMUstate.as_mut() }) else {
             return Ok(Status::Ok);
         };
-        if slot.is_null() {
-            return Ok(Status::Ok);
-        }
-        let i = h.state(*slot)?;
-        h.states.swap_remove(i);
-        *slot = std::ptr::null_mut();
-        Ok(Status::Ok)
+        h.states.free(slot)
     })
 }
 const _: fmi2FreeFMUstateTYPE = Some(fmi2FreeFMUstate);
@@ -685,10 +647,10 @@ pub extern "C" fn fmi2SerializedFMUstateSize(
     size: *mut usize,
 ) -> fmi2Status {
     entry(c, "fmi2SerializedFMUstateSize", state::FMU_STATE, |h| {
-        let i = h.state(FMUstate)?;
+        let bytes = h.states.serialized(FMUstate, h.instance.guid())?;
         // SAFETY: size points to a writable usize.
         let size = unsafe { place(size, "size") }?;
-        *size = snapshot::serialize(&h.states[i].core, h.instance.guid()).len();
+        *size = bytes.len();
         Ok(Status::Ok)
     })
 }
@@ -704,17 +666,9 @@ pub extern "C" fn fmi2SerializeFMUstate(
     size: usize,
 ) -> fmi2Status {
     entry(c, "fmi2SerializeFMUstate", state::FMU_STATE, |h| {
-        let i = h.state(FMUstate)?;
-        let bytes = snapshot::serialize(&h.states[i].core, h.instance.guid());
-        if bytes.len() != size {
-            return Err(format!(
-                "buffer has {size} bytes, the state needs {}",
-                bytes.len()
-            ));
-        }
         // SAFETY: the caller provides a writable buffer of `size` bytes.
         let out = unsafe { array_mut(serializedState as *mut u8, size, "serializedState") }?;
-        out.copy_from_slice(&bytes);
+        h.states.serialize_into(FMUstate, h.instance.guid(), out)?;
         Ok(Status::Ok)
     })
 }
@@ -742,7 +696,7 @@ pub extern "C" fn fmi2DeSerializeFMUstate(
         let core = snapshot::deserialize(bytes, inst.guid(), |core, dynamic| {
             inst.restore_simulation(core, dynamic)
         })?;
-        h.store_state(slot, core)
+        h.states.store(slot, core)
     })
 }
 const _: fmi2DeSerializeFMUstateTYPE = Some(fmi2DeSerializeFMUstate);

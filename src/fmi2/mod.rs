@@ -18,6 +18,7 @@
 //! No physics lives here: the model is driven through [`crate::cosim::Simulation`].
 
 pub mod abi;
+pub mod fmu_states;
 pub mod input_track;
 pub mod instance;
 pub mod logger;

@@ -19,7 +19,8 @@ use fmi_sys::fmi3::*;
 use super::state::{self, Mask, Phase};
 use super::values::{resolve, unknown, Slot};
 use crate::fmi2::abi::{array, array_mut, place, text, texts};
-use crate::fmi2::instance::{Core, Instance, Outcome, Status};
+use crate::fmi2::fmu_states::FmuStates;
+use crate::fmi2::instance::{Instance, Outcome, Status};
 use crate::fmi2::logger::{Level, Logger};
 use crate::fmi2::snapshot;
 use crate::fmi2::state::Phase as Phase2;
@@ -44,42 +45,12 @@ struct Handle {
     /// Strings returned by fmi3GetString stay valid until the next call on this instance.
     returned_strings: Vec<CString>,
     /// The FMU states this instance handed out and has not freed, recognised by address.
-    #[allow(clippy::vec_box)]
-    states: Vec<Box<StateHandle>>,
-}
-
-/// An FMU state handed out by `fmi3GetFMUState`: the 2.0 instance's state, which the 2.0
-/// snapshot functions serialize.
-struct StateHandle {
-    core: Core,
+    states: FmuStates,
 }
 
 impl Handle {
     fn phase(&self) -> Phase {
         Phase::of(self.instance.phase(), self.configuration, self.error)
-    }
-
-    /// The state behind `state`, if this instance handed it out.
-    fn state(&self, state: fmi3FMUState) -> Result<usize, String> {
-        self.states
-            .iter()
-            .position(|s| std::ptr::eq(&**s, state as *const StateHandle))
-            .ok_or_else(|| "not an FMU state of this instance".to_owned())
-    }
-
-    /// Puts `core` into the slot the master passed: a new state for a null slot, the same state
-    /// overwritten for one of ours.
-    fn store_state(&mut self, slot: &mut fmi3FMUState, core: Core) -> Outcome {
-        if slot.is_null() {
-            let mut boxed = Box::new(StateHandle { core });
-            let ptr: *mut StateHandle = &mut *boxed;
-            self.states.push(boxed);
-            *slot = ptr as fmi3FMUState;
-        } else {
-            let i = self.state(*slot)?;
-            self.states[i].core = core;
-        }
-        Ok(Status::Ok)
     }
 }
 
@@ -257,7 +228,7 @@ pub extern "C" fn fmi3InstantiateCoSimulation(
             error: false,
             modes_size: MODES_SIZE_MAX,
             returned_strings: Vec::new(),
-            states: Vec::new(),
+            states: FmuStates::default(),
         });
         Box::into_raw(handle) as fmi3Instance
     }));
@@ -1166,7 +1137,7 @@ pub extern "C" fn fmi3GetFMUState(
         // SAFETY: FMUState points to a writable fmi3FMUState slot (FMI 3.0 §2.3.6.5).
         let slot = unsafe { place(FMUState, "FMUState") }?;
         let core = h.instance.core.clone();
-        h.store_state(slot, core)
+        h.states.store(slot, core)
     })
 }
 const _: fmi3GetFMUStateTYPE = Some(fmi3GetFMUState);
@@ -1176,9 +1147,9 @@ const _: fmi3GetFMUStateTYPE = Some(fmi3GetFMUState);
 #[no_mangle]
 pub extern "C" fn fmi3SetFMUState(instance: fmi3Instance, FMUState: fmi3FMUState) -> fmi3Status {
     entry(instance, "fmi3SetFMUState", state::ANY, |h| {
-        let i = h.state(FMUState)?;
-        h.instance.check_state_fits(&h.states[i].core)?;
-        h.instance.core = h.states[i].core.clone();
+        let core = h.states.core(FMUState)?;
+        h.instance.check_state_fits(core)?;
+        h.instance.core = core.clone();
         h.error = false;
         h.configuration = false;
         Ok(Status::Ok)
@@ -1198,13 +1169,7 @@ pub extern "C" fn fmi3FreeFMUState(
         let Some(slot) = (unsafe { FMUState.as_mut() }) else {
             return Ok(Status::Ok);
         };
-        if slot.is_null() {
-            return Ok(Status::Ok);
-        }
-        let i = h.state(*slot)?;
-        h.states.swap_remove(i);
-        *slot = std::ptr::null_mut();
-        Ok(Status::Ok)
+        h.states.free(slot)
     })
 }
 const _: fmi3FreeFMUStateTYPE = Some(fmi3FreeFMUState);
@@ -1217,10 +1182,10 @@ pub extern "C" fn fmi3SerializedFMUStateSize(
     size: *mut usize,
 ) -> fmi3Status {
     entry(instance, "fmi3SerializedFMUStateSize", state::ANY, |h| {
-        let i = h.state(FMUState)?;
+        let bytes = h.states.serialized(FMUState, h.instance.guid())?;
         // SAFETY: size points to a writable usize.
         let size = unsafe { place(size, "size") }?;
-        *size = snapshot::serialize(&h.states[i].core, h.instance.guid()).len();
+        *size = bytes.len();
         Ok(Status::Ok)
     })
 }
@@ -1237,17 +1202,9 @@ pub extern "C" fn fmi3SerializeFMUState(
     size: usize,
 ) -> fmi3Status {
     entry(instance, "fmi3SerializeFMUState", state::ANY, |h| {
-        let i = h.state(FMUState)?;
-        let bytes = snapshot::serialize(&h.states[i].core, h.instance.guid());
-        if bytes.len() != size {
-            return Err(format!(
-                "buffer has {size} bytes, the state needs {}",
-                bytes.len()
-            ));
-        }
         // SAFETY: the caller provides a writable buffer of `size` bytes.
         let out = unsafe { array_mut(serializedState, size, "serializedState") }?;
-        out.copy_from_slice(&bytes);
+        h.states.serialize_into(FMUState, h.instance.guid(), out)?;
         Ok(Status::Ok)
     })
 }
@@ -1275,7 +1232,7 @@ pub extern "C" fn fmi3DeserializeFMUState(
         let core = snapshot::deserialize(bytes, inst.guid(), |core, dynamic| {
             inst.restore_simulation(core, dynamic)
         })?;
-        h.store_state(slot, core)
+        h.states.store(slot, core)
     })
 }
 const _: fmi3DeserializeFMUStateTYPE = Some(fmi3DeserializeFMUState);
