@@ -10,35 +10,46 @@
 //! `cargo run --release --example production_benchmark -- sizes [refinements…] [--modes N]`
 //!   (b) For each refinement r (default 1 2 4 8: grid spacing / r, about 15 k, 60 k, 240 k and
 //!   950 k DOF) the procedural body is written as a multi-file bulk deck (`main.bdf` with
-//!   `INCLUDE`s of `grids.bdf`, `shells.bdf`, `properties.bdf`, `beams_masses_links.bdf`,
+//!   `INCLUDE`s of `grids.bdf`, `shells.bdf` — the floor panels with ZOFFS = −t/2 —,
+//!   `properties.bdf`, `beams_masses_links.bdf` — the sills with 3 cm CBAR offsets —,
 //!   `welds.bdf`: CBUSH spot welds across every 40th shell's diagonal, and `brackets.bdf`: a
 //!   steel block of 2 × 2 × 2 CHEXA under each engine mount node, hung on it by an RBE2) by one
-//!   child process, then
-//!   read with the streaming reader, reduced (default 225 Hz cut-off) and run through the coupled
-//!   model for 0.1 s by a second child process, whose peak resident memory (VmHWM) is the one
-//!   reported. Growth exponents are log-log least-squares fits against DOF. With `--modes N`
-//!   the largest size is also reduced keeping N fixed-interface modes (a third child process).
+//!   child process. A second child process reads it with the streaming reader alone, then goes
+//!   from the file to a running FMU: it loads the FMU's binary (`cargo build --release` makes
+//!   it; the FMU tests' host drives it), points `configFile` at a vehicle JSON naming the deck
+//!   (scene 2, cache off), initialises (the FMU reads and reduces the deck — default 225 Hz
+//!   cut-off — and finds the static equilibrium) and makes 100 `fmi2DoStep`s of 1 ms at
+//!   1800 rpm. Its peak resident memory (VmHWM) is the one reported. Growth exponents are
+//!   log-log least-squares fits against DOF. With `--modes N` the largest size is also run
+//!   keeping N fixed-interface modes (`chassis.maxModes`, a third child process).
 //!
 //! Internal subcommands (run by `sizes` as child processes): `write <r> <dir>`,
 //! `run <r> <dir> <cutoff_hz|0> <modes|0>`.
 
-use std::collections::BTreeMap;
+use std::collections::{BTreeMap, BTreeSet};
 use std::fmt::Write as _;
 use std::path::{Path, PathBuf};
 use std::process::Command;
 use std::time::Instant;
 
-use engine_mount_chassis::cms::{reduce, InterfaceDofs};
+use engine_mount_chassis::cms::InterfaceDofs;
 use engine_mount_chassis::fe::assembly::{assemble, SparseMat};
-use engine_mount_chassis::fe::chassis::{Chassis, MountLayout};
+use engine_mount_chassis::fe::chassis::{region, Chassis, MountLayout};
 use engine_mount_chassis::fe::chassis_config::ChassisConfig;
 use engine_mount_chassis::fe::eigen::lowest_modes;
 use engine_mount_chassis::fe::eigen_slicing::{eigenvalue_count, sliced_modes, SliceStop};
+use engine_mount_chassis::fe::mesh::{Material, Mesh};
 use engine_mount_chassis::fe::nastran::{read_bulk_deck_with, write_bulk_deck, DeckOptions};
-use engine_mount_chassis::model::scene::{reduction_spec, BodyOptions};
-use engine_mount_chassis::model::{BodyConfig, CoupledModel, VehicleConfig};
-use engine_mount_chassis::ode::{Bdf, BdfOptions, Tolerance};
+use engine_mount_chassis::fe::shell::ShellSection;
+use engine_mount_chassis::model::{BodyConfig, VehicleConfig};
 use faer::sparse::{SparseColMat, Triplet};
+
+use fmu_host::{boolean, integer, real, string};
+use nalgebra::Vector3;
+
+/// The FMI 2.0 host the FMU tests drive the binary with (dlopen, fmi2 symbols, log capture).
+#[path = "../tests/fmi/common/mod.rs"]
+mod fmu_host;
 
 type Res<T> = Result<T, Box<dyn std::error::Error>>;
 
@@ -176,7 +187,8 @@ fn deck_parts() -> Vec<(&'static str, &'static [&'static str])> {
 /// named points as `point <name> <grid>` lines for the parent.
 fn write_deck(r: usize, dir: &Path) -> Res<()> {
     let t0 = Instant::now();
-    let chassis = Chassis::build(&config(r))?;
+    let mut chassis = Chassis::build(&config(r))?;
+    let (offset_shells, offset_beams) = add_offsets(&mut chassis.mesh);
     let text = write_bulk_deck(&chassis.mesh)?;
     std::fs::create_dir_all(dir)?;
     let parts = deck_parts();
@@ -247,7 +259,8 @@ fn write_deck(r: usize, dir: &Path) -> Res<()> {
         println!("point {n} {}", chassis.node(&n)? + 1);
     }
     println!(
-        "written {} nodes {} shells {} welds {:.0} MB {:.1} s {brackets} bracket-hexas",
+        "written {} nodes {} shells {} welds {:.0} MB {:.1} s {brackets} bracket-hexas \
+         {offset_shells} offset-shells {offset_beams} offset-beams",
         chassis.mesh.nodes.len(),
         chassis.mesh.shells.len(),
         eid - 9_000_000,
@@ -255,6 +268,49 @@ fn write_deck(r: usize, dir: &Path) -> Res<()> {
         t0.elapsed().as_secs_f64()
     );
     Ok(())
+}
+
+/// Offsets as production decks carry them: the floor panels meshed on their upper face (ZOFFS
+/// = −t/2 on every floor CQUAD4/CTRIA3, the mid-plane half a thickness below the grids) and the
+/// sills' section centroids 3 cm below their grid line (CBAR offsets WA = WB). Returns the numbers
+/// of offset shells and beams.
+fn add_offsets(mesh: &mut Mesh) -> (usize, usize) {
+    let in_region = |name: &str| -> BTreeSet<usize> {
+        mesh.regions
+            .get(name)
+            .map(|nodes| nodes.iter().copied().collect())
+            .unwrap_or_default()
+    };
+    let (floor, sill) = (in_region(region::FLOOR), in_region(region::SILL));
+    let offset_sheet = |material: &Material, t: f64, bending_t: f64| {
+        Some(Box::new(ShellSection {
+            offset: -t / 2.0,
+            ..ShellSection::isotropic(material, t, bending_t)
+        }))
+    };
+    let mut shells = 0;
+    for s in &mut mesh.shells {
+        if s.nodes.iter().all(|n| floor.contains(n)) {
+            s.section = offset_sheet(&s.material, s.thickness, s.bending_thickness);
+            shells += 1;
+        }
+    }
+    for s in &mut mesh.triangles {
+        if s.nodes.iter().all(|n| floor.contains(n)) {
+            s.section = offset_sheet(&s.material, s.thickness, s.bending_thickness);
+            shells += 1;
+        }
+    }
+    let below = Vector3::new(0.0, 0.0, -0.03);
+    let mut beams = 0;
+    for (i, b) in mesh.beams.iter().enumerate() {
+        if b.nodes.iter().all(|n| sill.contains(n)) {
+            let ends = mesh.beam_ends.entry(i).or_default();
+            ends.offsets = [below; 2];
+            beams += 1;
+        }
+    }
+    (shells, beams)
 }
 
 /// Cast mount brackets as production decks carry them: under each engine mount's body node a
@@ -338,7 +394,11 @@ fn points_of(dir: &Path) -> Res<BTreeMap<String, u32>> {
     Ok(points)
 }
 
-/// Reads, reduces and simulates the deck in `dir`; prints one `result` line.
+/// Reads the deck in `dir` with the streaming reader alone, then loads the FMU's binary (the
+/// cdylib `cargo build --release` makes, which `packaging/package.py` puts into the FMU),
+/// instantiates it on a vehicle JSON naming the deck, initialises it — the FMU reads the deck,
+/// reduces it and finds the static equilibrium — and runs 100 communication steps of 1 ms at
+/// 1800 rpm; prints one `result` line.
 fn run_deck(dir: &Path, cutoff_hz: f64, modes: usize) -> Res<()> {
     let main = dir.join("main.bdf");
     let t0 = Instant::now();
@@ -359,58 +419,120 @@ fn run_deck(dir: &Path, cutoff_hz: f64, modes: usize) -> Res<()> {
         },
         ..VehicleConfig::default()
     };
-    let options = BodyOptions {
-        mode_cutoff_hz: cutoff_hz,
-        max_modes: modes,
-        cache: engine_mount_chassis::cms::CacheSetting::Disabled,
-        ..BodyOptions::default()
+    let config_file = dir.join("vehicle.json");
+    std::fs::write(&config_file, serde_json::to_string_pretty(&vehicle)?)?;
+
+    let fmu = fmu_host::Fmu::load();
+    let slave = fmu
+        .instantiate_with(
+            "benchmark",
+            fmu_host::GUID,
+            Some(&fmu_host::resources_uri()),
+        )
+        .ok_or("fmi2Instantiate returned NULL")?;
+    let failed = |what: &str| format!("{what} failed: {:?}", slave.logs());
+    let ok = |status: u32, what: &str| -> Res<()> {
+        if status == fmu_host::OK {
+            Ok(())
+        } else {
+            Err(failed(what).into())
+        }
     };
-    let (spec, _) = reduction_spec(&vehicle, &options)?;
+    // Every log category: the FMU's note on the reduced body (modes, range, seconds) is read
+    // back from the log below.
+    slave.log_everything();
+    let config_path = config_file.to_str().ok_or("non-UTF-8 temporary path")?;
+    ok(slave.set_integer(&[integer::SCENE], &[2]), "scene")?;
+    ok(
+        slave.set_string(&[string::CONFIG_FILE], &[config_path]),
+        "configFile",
+    )?;
+    ok(
+        slave.set_boolean(&[boolean::CHASSIS_CACHE_ENABLED], &[false]),
+        "chassis.cacheEnabled",
+    )?;
+    ok(
+        slave.set_real(&[real::CHASSIS_MODE_CUTOFF], &[cutoff_hz]),
+        "chassis.modeCutoff",
+    )?;
+    ok(
+        slave.set_integer(&[integer::CHASSIS_MAX_MODES], &[i32::try_from(modes)?]),
+        "chassis.maxModes",
+    )?;
+    ok(slave.set_real(&[real::RPM], &[1800.0]), "rpm")?;
+    ok(slave.setup(0.0, None), "fmi2SetupExperiment")?;
     let t0 = Instant::now();
     let c0 = cpu_s();
-    // Reads the deck again (the reduction starts from the file), assembles, reduces.
-    let chassis = reduce(&spec)?;
-    let t_reduce_total = t0.elapsed().as_secs_f64();
-    let c_reduce_total = cpu_s() - c0;
-    let n_modes = chassis.n_modes();
-    let top_hz = chassis
-        .omega
-        .iter()
-        .map(|w| w / (2.0 * std::f64::consts::PI))
-        .fold(0.0, f64::max);
-    let first_elastic_hz =
-        chassis.omega.first().copied().unwrap_or(0.0) / (2.0 * std::f64::consts::PI);
+    ok(slave.enter_init(), "fmi2EnterInitializationMode")?;
+    ok(slave.exit_init(), "fmi2ExitInitializationMode")?;
+    let t_init = t0.elapsed().as_secs_f64();
+    let c_init = cpu_s() - c0;
+    // "…: <n> modes, <lowest>..<highest> Hz, in <s> s" (model::scene::body).
+    let note = slave
+        .logs()
+        .into_iter()
+        .find(|l| l.contains(" modes, ") && l.contains(" Hz, in "))
+        .ok_or_else(|| failed("the reduced body's log note"))?;
+    let words: Vec<&str> = note.split_whitespace().collect();
+    let after = |key: &str| -> f64 {
+        words
+            .iter()
+            .position(|w| *w == key)
+            .and_then(|k| words.get(k + 1))
+            .and_then(|w| w.trim_end_matches(',').parse().ok())
+            .unwrap_or(f64::NAN)
+    };
+    let before = |key: &str| -> String {
+        words
+            .iter()
+            .position(|w| w.starts_with(key))
+            .and_then(|k| k.checked_sub(1))
+            .map_or_else(|| "?".into(), |k| words[k].trim_end_matches(',').to_owned())
+    };
+    let (n_modes, range_hz, t_reduce) = (before("modes,"), before("Hz,"), after("in"));
+    let (status, frequencies) = slave.get_real(&real::MODE_FREQUENCY[..1]);
+    ok(status, "mode[1].frequency")?;
 
     let t0 = Instant::now();
-    let mut model = CoupledModel::with_body(&vehicle, chassis)?;
-    let w = 1800.0 * std::f64::consts::PI / 30.0;
-    model.set_crank_speed(0.0, w, 0.0)?;
-    let y0 = model.static_equilibrium(0.0)?;
-    let opts = BdfOptions {
-        rtol: 1e-6,
-        atol: Tolerance::Scalar(1e-9),
-        ..Default::default()
-    };
-    let mut bdf = Bdf::new(&mut model, 0.0, &y0, opts)?;
-    bdf.advance_to(&mut model, 0.1)?;
-    let steps = bdf.stats().steps;
+    let h = 1e-3;
+    let forces: Vec<u32> = real::MOUNT_F.iter().flatten().copied().collect();
+    let mut largest_force = 0.0_f64;
+    for k in 0..100 {
+        ok(slave.do_step(k as f64 * h, h), "fmi2DoStep")?;
+        let (status, f) = slave.get_real(&forces);
+        ok(status, "mount.F")?;
+        if f.iter().any(|v| !v.is_finite()) {
+            return Err(failed("finite mount forces").into());
+        }
+        largest_force = f.iter().fold(largest_force, |m, v| m.max(v.abs()));
+    }
     let t_sim = t0.elapsed().as_secs_f64();
+    let (status, steps) = slave.get_integer(&[integer::SOLVER_STEPS]);
+    ok(status, "solver.steps")?;
+    ok(slave.terminate(), "fmi2Terminate")?;
+    drop(slave);
     println!(
         "result nodes={n_nodes} bushes={n_bushes} read_s={t_read:.2} hwm_read_mb={hwm_read:.0} \
-         reduce_total_s={t_reduce_total:.2} read_cpu_s={c_read:.2} \
-         reduce_total_cpu_s={c_reduce_total:.2} modes={n_modes} lowest_hz={first_elastic_hz:.3} \
-         top_hz={top_hz:.1} sim_s={t_sim:.2} steps={steps} hwm_mb={:.0} load={}",
+         fmu_init_s={t_init:.2} read_cpu_s={c_read:.2} fmu_init_cpu_s={c_init:.2} \
+         reduce_s={t_reduce:.2} modes={n_modes} range_hz={range_hz} mode1_hz={:.3} \
+         sim_s={t_sim:.2} steps={} largest_force_n={largest_force:.1} hwm_mb={:.0} load={}",
+        frequencies[0],
+        steps[0],
         vm_hwm_mb(),
         load().replace(' ', "/")
     );
     Ok(())
 }
 
-fn field(line: &str, key: &str) -> f64 {
+fn text_field(line: &str, key: &str) -> String {
     line.split_whitespace()
         .find_map(|w| w.strip_prefix(&format!("{key}=")))
-        .and_then(|v| v.parse().ok())
-        .unwrap_or(f64::NAN)
+        .unwrap_or("?")
+        .to_owned()
+}
+
+fn field(line: &str, key: &str) -> f64 {
+    text_field(line, key).parse().unwrap_or(f64::NAN)
 }
 
 fn child(args: &[String]) -> Res<String> {
@@ -439,8 +561,8 @@ fn exponent(x: &[f64], y: &[f64]) -> f64 {
 
 fn sizes_table(refinements: &[usize], extra_modes: usize) -> Res<()> {
     let root = std::env::temp_dir().join(format!("production-benchmark-{}", std::process::id()));
-    println!("| refinement | nodes | DOF (6/node) | deck MB | write (s) | read (s) | reduce (s) | reduce CPU (s) | reduced modes | simulate 0.1 s (s) | peak memory (GB) | load |");
-    println!("|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---|");
+    println!("| refinement | nodes | DOF (6/node) | deck MB | write (s) | read (s) | FMU initialisation (s) | of which reduction (s) | initialisation CPU (s) | reduced modes | their range (Hz) | 100 doSteps of 1 ms (s) | peak memory (GB) | load |");
+    println!("|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---|");
     let mut rows: Vec<(f64, f64, f64, f64)> = Vec::new();
     let mut last_dir = PathBuf::new();
     for &r in refinements {
@@ -468,19 +590,21 @@ fn sizes_table(refinements: &[usize], extra_modes: usize) -> Res<()> {
         let nodes = field(&line, "nodes");
         let dof = 6.0 * nodes;
         let read = field(&line, "read_s");
-        let reduce = field(&line, "reduce_total_s") - read;
+        let init_cpu = field(&line, "fmu_init_cpu_s");
         let hwm = field(&line, "hwm_mb") / 1024.0;
-        let reduce_cpu = field(&line, "reduce_total_cpu_s") - field(&line, "read_cpu_s");
         println!(
-            "| {r} | {nodes:.0} | {dof:.0} | {} | {} | {read:.2} | {reduce:.1} | {reduce_cpu:.1} | {} | {:.2} | {hwm:.2} | {} |",
+            "| {r} | {nodes:.0} | {dof:.0} | {} | {} | {read:.2} | {:.1} | {:.1} | {init_cpu:.1} | {} | {} | {:.3} | {hwm:.2} | {} |",
             w.get(7).unwrap_or(&"?"),
             w.get(9).unwrap_or(&"?"),
-            field(&line, "modes"),
+            field(&line, "fmu_init_s"),
+            field(&line, "reduce_s"),
+            text_field(&line, "modes"),
+            text_field(&line, "range_hz"),
             field(&line, "sim_s"),
-            line.split("load=").nth(1).unwrap_or("?")
+            text_field(&line, "load")
         );
-        eprintln!("{line}");
-        rows.push((dof, read, reduce_cpu, hwm));
+        eprintln!("{summary}\n{line}");
+        rows.push((dof, read, init_cpu, hwm));
         last_dir = dir;
     }
     if rows.len() >= 2 {
@@ -489,8 +613,8 @@ fn sizes_table(refinements: &[usize], extra_modes: usize) -> Res<()> {
             exponent(&x, &rows.iter().map(f).collect::<Vec<_>>())
         };
         println!(
-            "\ngrowth exponents against DOF (log-log least squares): read time {:.2}, reduction \
-             CPU time {:.2}, peak memory {:.2}",
+            "\ngrowth exponents against DOF (log-log least squares): read time {:.2}, FMU \
+             initialisation CPU time {:.2}, peak memory {:.2}",
             fit(|r| r.1),
             fit(|r| r.2),
             fit(|r| r.3)
@@ -511,16 +635,18 @@ fn sizes_table(refinements: &[usize], extra_modes: usize) -> Res<()> {
             .to_owned();
         eprintln!("{line}");
         println!(
-            "\nlargest deck, {extra_modes} fixed-interface modes: read {:.2} s, reduce {:.1} s \
-             ({:.1} s CPU), {} reduced modes up to {:.0} Hz, simulate 0.1 s {:.2} s, peak memory {:.2} GB, load {}",
+            "\nlargest deck, {extra_modes} fixed-interface modes: read {:.2} s, FMU \
+             initialisation {:.1} s ({:.1} s CPU) of which reduction {:.1} s, {} reduced modes \
+             ({} Hz), 100 doSteps of 1 ms {:.3} s, peak memory {:.2} GB, load {}",
             field(&line, "read_s"),
-            field(&line, "reduce_total_s") - field(&line, "read_s"),
-            field(&line, "reduce_total_cpu_s") - field(&line, "read_cpu_s"),
-            field(&line, "modes"),
-            field(&line, "top_hz"),
+            field(&line, "fmu_init_s"),
+            field(&line, "fmu_init_cpu_s"),
+            field(&line, "reduce_s"),
+            text_field(&line, "modes"),
+            text_field(&line, "range_hz"),
             field(&line, "sim_s"),
             field(&line, "hwm_mb") / 1024.0,
-            line.split("load=").nth(1).unwrap_or("?")
+            text_field(&line, "load")
         );
     }
     let _ = std::fs::remove_dir_all(&root);

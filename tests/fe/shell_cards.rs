@@ -413,6 +413,56 @@ fn a_beaded_sheet_written_as_a_deck_reads_back_as_the_same_sheet() {
     );
 }
 
+#[test]
+fn an_offset_sheet_written_as_a_deck_reads_back_with_its_offset_and_stiffness() {
+    // Quadrilaterals and triangles offset by ZOFFS and turned by THETA, on an isotropic PSHELL
+    // with transverse shear (MID3): the writer puts ZOFFS and THETA on the element cards, and
+    // the deck read back assembles to the same stiffness and mass.
+    let (length, width, t, z0) = (1.0, 0.05, 0.01, 0.02);
+    let cards = format!("MAT1,1,{E:?},,0.,{RHO:?}\nPSHELL,1,1,{t:?},1,,1,0.8333333333333334\n");
+    for triangles in [false, true] {
+        let mut strip = Strip::new(8, length, width);
+        strip.triangles = triangles;
+        strip.layers = vec![(1, 30.0, z0)];
+        let first = parse_str(&strip.deck(&cards, "")).unwrap();
+        let written = write_bulk_deck(&first.mesh).unwrap();
+        let again = parse_str(&written).unwrap();
+        let sections = |b: &NastranBody| -> Vec<(f64, f64)> {
+            let quads = b.mesh.shells.iter().map(|s| s.section.as_deref());
+            let tris = b.mesh.triangles.iter().map(|s| s.section.as_deref());
+            quads
+                .chain(tris)
+                .map(|s| s.map_or((0.0, 0.0), |s| (s.offset, s.material_angle)))
+                .collect()
+        };
+        for ((o1, a1), (o2, a2)) in sections(&first).into_iter().zip(sections(&again)) {
+            assert_eq!(o1, z0);
+            assert!(
+                (o2 - o1).abs() < 1e-15 && (a2 - a1).abs() < 1e-15,
+                "{o2} {a2}"
+            );
+        }
+        let (a, b) = (
+            assemble(&first.mesh).unwrap(),
+            assemble(&again.mesh).unwrap(),
+        );
+        for (x, y) in [(&a.k, &b.k), (&a.m, &b.m)] {
+            let (x, y) = (x.to_dense(), y.to_dense());
+            let rel = (&x - &y).norm_max() / x.norm_max();
+            println!("triangles {triangles}: written and read back, largest difference {rel:.1e}");
+            assert!(rel < 1e-12, "{rel:e}");
+        }
+    }
+    // A section the writer cannot express is refused, naming the shell.
+    let orthotropic = "MAT8,8,1.4e11,1.0e10,0.3,5.0e9,,,1600.\nPSHELL,1,8,0.01,8,,8\n";
+    let body = parse_str(&Strip::new(2, 1.0, 0.1).deck(orthotropic, "")).unwrap();
+    let err = write_bulk_deck(&body.mesh).unwrap_err().to_string();
+    assert!(
+        err.contains("shell 0") && err.contains("general section"),
+        "{err}"
+    );
+}
+
 // ---------------------------------------------------------------------------------------------
 // Errors.
 

@@ -2,7 +2,8 @@
 //! more significant digits; most values of a generated mesh are written exactly).
 //!
 //! GRID ids are node index + 1 (all in basic: a mesh with displacement frames is refused);
-//! beam offsets and pin flags are written on the CBAR (OFFT GGG = basic here); elements are
+//! beam offsets and pin flags are written on the CBAR (OFFT GGG = basic here), shell offsets and
+//! material angles on the CQUAD4/CTRIA3 (ZOFFS, THETA) of an isotropic sheet; elements are
 //! numbered from 1 in the order CQUAD4, CTRIA3, CBAR, CONM2, CELAS2, CDAMP2, RBE2, RBE3,
 //! CTETRA/CPENTA/CHEXA. Supports are SPC1 set 1 (a Nastran run needs `SPC = 1` in its
 //! case control; [`super::parse_str`] applies the only set present). Named nodes are listed in
@@ -13,6 +14,7 @@ use std::fmt::Write;
 
 use crate::fe::error::FeError;
 use crate::fe::mesh::{Beam, Material, Mesh};
+use crate::fe::shell::ShellSection;
 use crate::fe::solid::SolidKind;
 
 /// A field of a card being written.
@@ -245,31 +247,45 @@ impl<'m> Deck<'m> {
         Ok(pid)
     }
 
-    /// A CQUAD4 or CTRIA3 of property `pid` on `nodes`.
-    fn plate(&mut self, name: &str, what: &str, pid: u64, nodes: &[usize]) -> Result<(), FeError> {
+    /// A CQUAD4 or CTRIA3 of property `pid` on `nodes`, with THETA and ZOFFS when the sheet is
+    /// offset.
+    fn plate(
+        &mut self,
+        name: &str,
+        what: &str,
+        pid: u64,
+        nodes: &[usize],
+        placement: Option<[f64; 2]>,
+    ) -> Result<(), FeError> {
         let mut fields = vec![self.next_element(), Out::Int(pid)];
         for &n in nodes {
             fields.push(self.grid_id(what, n)?);
+        }
+        if let Some([theta, zoffs]) = placement {
+            fields.push(Out::Real(theta.to_degrees()));
+            fields.push(Out::Real(zoffs));
         }
         self.card(name, &fields)
     }
 
     fn cquad4(&mut self) -> Result<(), FeError> {
         for (i, s) in self.mesh.shells.iter().enumerate() {
-            no_section(&format!("shell {i}"), s.section.is_some())?;
+            let what = format!("shell {i}");
             let sheet = [s.thickness, s.bending_thickness, s.extra_mass_per_area];
+            let placement = placement(&what, &s.material, sheet, s.section.as_deref())?;
             let pid = self.pshell(&s.material, sheet)?;
-            self.plate("CQUAD4", &format!("shell {i}"), pid, &s.nodes)?;
+            self.plate("CQUAD4", &what, pid, &s.nodes, placement)?;
         }
         Ok(())
     }
 
     fn ctria3(&mut self) -> Result<(), FeError> {
         for (i, t) in self.mesh.triangles.iter().enumerate() {
-            no_section(&format!("triangle {i}"), t.section.is_some())?;
+            let what = format!("triangle {i}");
             let sheet = [t.thickness, t.bending_thickness, t.extra_mass_per_area];
+            let placement = placement(&what, &t.material, sheet, t.section.as_deref())?;
             let pid = self.pshell(&t.material, sheet)?;
-            self.plate("CTRIA3", &format!("triangle {i}"), pid, &t.nodes)?;
+            self.plate("CTRIA3", &what, pid, &t.nodes, placement)?;
         }
         Ok(())
     }
@@ -512,16 +528,45 @@ pub fn write_bulk_deck(mesh: &Mesh) -> Result<String, FeError> {
     Ok(deck.out)
 }
 
-/// The writer emits isotropic PSHELL/MAT1 sheets only; a general section (MAT2/MAT8, MID2/MID3
-/// materials, offsets) would be written wrong, so it is refused.
-fn no_section(what: &str, has_section: bool) -> Result<(), FeError> {
-    if has_section {
+/// THETA (rad) and ZOFFS of a sheet with a section, `None` without one.
+///
+/// The writer emits isotropic PSHELL/MAT1 sheets only, so a section is written when it is that
+/// sheet placed by an offset and a material angle (what production decks carry: panels meshed on
+/// a surface rather than the mid-plane); a general section (MAT2/MAT8, separate bending or shear
+/// materials) would be written wrong, so it is refused. The comparison allows rounding (1e-12 of
+/// each matrix's largest entry) since a section read from a deck is built in another order.
+fn placement(
+    what: &str,
+    material: &Material,
+    [t, bending_t, _]: [f64; 3],
+    section: Option<&ShellSection>,
+) -> Result<Option<[f64; 2]>, FeError> {
+    let Some(section) = section else {
+        return Ok(None);
+    };
+    let sheet = ShellSection::isotropic(material, t, bending_t);
+    let close = |a: &[f64], b: &[f64], tol: f64| {
+        let scale = b.iter().fold(0.0_f64, |m, v| m.max(v.abs()));
+        a.iter().zip(b).all(|(x, y)| (x - y).abs() <= tol * scale)
+    };
+    // Nastran's default TS/T is 0.833333, 5/6 to 4e-7: the reader also takes it as the sheet's.
+    let shear = match (&section.transverse_shear, &sheet.transverse_shear) {
+        (Some(a), Some(b)) => close(a.as_slice(), b.as_slice(), 1e-5),
+        _ => false,
+    };
+    if !(close(
+        section.membrane.as_slice(),
+        sheet.membrane.as_slice(),
+        1e-12,
+    ) && close(section.bending.as_slice(), sheet.bending.as_slice(), 1e-12)
+        && shear)
+    {
         return Err(FeError::InvalidInput(format!(
             "{what}: shells with a general section (anisotropic materials, separate bending or \
-             shear material, offset) are not written"
+             shear material) are not written; an isotropic sheet with an offset is"
         )));
     }
-    Ok(())
+    Ok(Some([section.material_angle, section.offset]))
 }
 
 #[cfg(test)]
