@@ -301,7 +301,15 @@ mod tests {
     fn rigid_body_motions_cost_no_energy_for_a_skew_beam() {
         let p1 = Vector3::new(0.1, -0.2, 0.3);
         let p2 = Vector3::new(0.9, 0.4, -0.1);
-        let k = stiffness(0, &beam_along(Vector3::new(0.0, 0.0, 1.0)), &p1, &p2).unwrap();
+        let mut shear_flexible = beam_along(Vector3::new(0.0, 0.0, 1.0));
+        shear_flexible.section.shear_factor_y = Some(0.4);
+        shear_flexible.section.shear_factor_z = Some(0.7);
+        for b in [beam_along(Vector3::new(0.0, 0.0, 1.0)), shear_flexible] {
+            rigid_motions_are_free(&stiffness(0, &b, &p1, &p2).unwrap(), &p1, &p2);
+        }
+    }
+
+    fn rigid_motions_are_free(k: &Mat12, p1: &Vector3<f64>, p2: &Vector3<f64>) {
         let scale = k.abs().max();
         for mode in 0..6 {
             let mut u = SMatrix::<f64, 12, 1>::zeros();
@@ -322,6 +330,18 @@ mod tests {
                 (k * u).norm() < 1e-9 * scale,
                 "rigid mode {mode} strains the beam"
             );
+        }
+    }
+
+    #[test]
+    fn a_negative_or_non_finite_shear_factor_is_refused() {
+        let p1 = Vector3::zeros();
+        let p2 = Vector3::new(1.0, 0.0, 0.0);
+        for k in [-0.5, 0.0, f64::NAN] {
+            let mut b = beam_along(Vector3::new(0.0, 1.0, 0.0));
+            b.section.shear_factor_z = Some(k);
+            let err = stiffness(2, &b, &p1, &p2).unwrap_err().to_string();
+            assert!(err.contains("beam 2: shear_factor_z"), "{err}");
         }
     }
 
