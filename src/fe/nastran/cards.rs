@@ -363,7 +363,7 @@ fn shear_factor(
 ) -> Result<Option<f64>, FeError> {
     match r.opt_real(i, name)? {
         None => Ok(blank),
-        Some(k) if k == 0.0 => Ok(None),
+        Some(0.0) => Ok(None),
         Some(k) if k > 0.0 => Ok(Some(k)),
         Some(k) => Err(r.error(i, name, format!("{k}: a shear area factor must be >= 0"))),
     }
