@@ -12,6 +12,13 @@
 //! factor is φ = 0, the Euler-Bernoulli matrix bit for bit. The element reproduces a cantilever's
 //! tip deflection P L³/(3 E I) + P L/(k A G) with any number of elements.
 //!
+//! The bulk-data reader takes k from PBAR/PBEAM K1, K2 as Nastran defines them: shear stiffness
+//! K1·A·G in plane 1, K2·A·G in plane 2. PBAR: blank is infinite (shear flexibility neglected;
+//! Autodesk Nastran reference, PBAR remark 4) and 0.0 is read as infinite as well (Altair
+//! OptiStruct PBAR comments). PBEAM: blank is 1.0, and 0.0 sets the shear flexibility to zero,
+//! "to obtain the Bernoulli-Euler beam theory" (MSC Nastran 2022.4 Quick Reference Guide, PBEAM
+//! remarks 8 and 12).
+//!
 //! The mass does not depend on the shear factors: the HRZ lumping below (bending rotary inertia
 //! from the Euler-Bernoulli consistent matrix) is kept, so a shear-flexible section changes K
 //! alone. Nastran's diagonal mass (PARAM,COUPMASS off) is likewise the scaled diagonal of its
