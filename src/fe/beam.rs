@@ -1,6 +1,29 @@
-//! Two-node 3D Euler-Bernoulli beam: stiffness and HRZ-lumped mass in global axes, with
-//! Nastran's end conditions ([`BeamEnds`]): pin flags released by static condensation in
-//! element axes, then rigid offsets from the nodes to the element ends.
+//! Two-node 3D beam (Timoshenko, Euler-Bernoulli when rigid in shear): stiffness and HRZ-lumped
+//! mass in global axes, with Nastran's end conditions ([`BeamEnds`]): pin flags released by
+//! static condensation in element axes, then rigid offsets from the nodes to the element ends.
+//!
+//! Bending in each element plane uses the exact stiffness of a uniform prismatic member with
+//! transverse shear deformation (Przemieniecki, *Theory of Matrix Structural Analysis*, 1968,
+//! §5.6; the form of Nastran's CBAR): with φ = 12 E I / (k A G L²),
+//! k_vv = 12 E I / ((1 + φ) L³), k_vθ = 6 E I / ((1 + φ) L²), k_θθ = (4 + φ) E I / ((1 + φ) L)
+//! at the same end and (2 − φ) E I / ((1 + φ) L) across the element. k is the section's shear
+//! area factor of that plane ([`crate::fe::mesh::BeamSection`] `shear_factor_y` for the x-y
+//! plane with `iz`, Nastran's K1/I1 of plane 1; `shear_factor_z` for x-z with `iy`, K2/I2); no
+//! factor is φ = 0, the Euler-Bernoulli matrix bit for bit. The element reproduces a cantilever's
+//! tip deflection P L³/(3 E I) + P L/(k A G) with any number of elements.
+//!
+//! The bulk-data reader takes k from PBAR/PBEAM K1, K2 as Nastran defines them: shear stiffness
+//! K1·A·G in plane 1, K2·A·G in plane 2. PBAR: blank is infinite (shear flexibility neglected;
+//! Autodesk Nastran reference, PBAR remark 4) and 0.0 is read as infinite as well (Altair
+//! OptiStruct PBAR comments). PBEAM: blank is 1.0, and 0.0 sets the shear flexibility to zero,
+//! "to obtain the Bernoulli-Euler beam theory" (MSC Nastran 2022.4 Quick Reference Guide, PBEAM
+//! remarks 8 and 12).
+//!
+//! The mass does not depend on the shear factors: the HRZ lumping below (bending rotary inertia
+//! from the Euler-Bernoulli consistent matrix) is kept, so a shear-flexible section changes K
+//! alone. Nastran's diagonal mass (PARAM,COUPMASS off) is likewise the scaled diagonal of its
+//! coupled matrix, rotary inertia included (Autodesk Nastran reference, PARAM COUPMASS); whether
+//! its coupled CBAR mass carries shear terms is not documented there.
 //!
 //! With offsets the element runs between the offset ends p₁ + w₁ and p₂ + w₂ (its axis, length
 //! and orientation come from them); each end moves rigidly with its node, u_end = u + θ × w,
@@ -8,10 +31,11 @@
 //! which stays lumped at the element ends (the offset arm carries the lever-arm coupling).
 //!
 //! A pin flag releases element DOFs at an end: the released DOFs are condensed out one at a
-//! time (K ← K − K·ᵢ Kᵢ· / Kᵢᵢ); a released DOF left without stiffness by earlier releases
-//! (axial released at both ends, say) is dropped, as NASTRAN does, so a beam that becomes a
-//! mechanism on its own still assembles and carries what it still can. The lumped mass does not
-//! depend on the pin flags (Nastran's lumped mass does not either).
+//! time (K ← K − K·ᵢ Kᵢ· / Kᵢᵢ) from the shear-flexible element stiffness; a released DOF left
+//! without stiffness by earlier releases (axial released at both ends, say) is dropped, as
+//! NASTRAN does, so a beam that becomes a mechanism on its own still assembles and carries what
+//! it still can. The lumped mass does not depend on the pin flags (Nastran's lumped mass does
+//! not either).
 
 use nalgebra::{Matrix3, SMatrix, Vector3};
 
@@ -91,6 +115,14 @@ fn validate(index: usize, beam: &Beam) -> Result<(), FeError> {
     require_positive(&name("youngs_modulus"), m.youngs_modulus)?;
     require_non_negative(&name("density"), m.density)?;
     require_non_negative(&name("extra_mass_per_length"), beam.extra_mass_per_length)?;
+    for (k, what) in [
+        (s.shear_factor_y, "shear_factor_y"),
+        (s.shear_factor_z, "shear_factor_z"),
+    ] {
+        if let Some(k) = k {
+            require_positive(&name(what), k)?;
+        }
+    }
     if !(m.poisson_ratio > -1.0 && m.poisson_ratio < 0.5) {
         return Err(FeError::InvalidInput(format!(
             "beam {index}: poisson_ratio must be in (-1, 0.5), got {}",
@@ -181,30 +213,45 @@ pub fn stiffness_with_ends(
     put(3, 3, gj);
     put(9, 9, gj);
     put(3, 9, -gj);
-    // Bending in the local x-y plane: v and rz.
-    let ei = e * s.iz;
-    put(1, 1, 12.0 * ei / l.powi(3));
-    put(1, 5, 6.0 * ei / l.powi(2));
-    put(1, 7, -12.0 * ei / l.powi(3));
-    put(1, 11, 6.0 * ei / l.powi(2));
-    put(5, 5, 4.0 * ei / l);
-    put(5, 7, -6.0 * ei / l.powi(2));
-    put(5, 11, 2.0 * ei / l);
-    put(7, 7, 12.0 * ei / l.powi(3));
-    put(7, 11, -6.0 * ei / l.powi(2));
-    put(11, 11, 4.0 * ei / l);
-    // Bending in the local x-z plane: w and ry (a positive ry tilts the axis downwards).
-    let ei = e * s.iy;
-    put(2, 2, 12.0 * ei / l.powi(3));
-    put(2, 4, -6.0 * ei / l.powi(2));
-    put(2, 8, -12.0 * ei / l.powi(3));
-    put(2, 10, -6.0 * ei / l.powi(2));
-    put(4, 4, 4.0 * ei / l);
-    put(4, 8, 6.0 * ei / l.powi(2));
-    put(4, 10, 2.0 * ei / l);
-    put(8, 8, 12.0 * ei / l.powi(3));
-    put(8, 10, 6.0 * ei / l.powi(2));
-    put(10, 10, 4.0 * ei / l);
+    // φ = 12 E I / (k A G L²); rigid in shear (no factor) is φ = 0, Euler-Bernoulli.
+    let phi = |i: f64, k: Option<f64>| k.map_or(0.0, |k| 12.0 * e * i / (k * s.area * g * l * l));
+    // One bending plane with its translation, rotation DOFs [v₁, θ₁, v₂, θ₂]: the exact
+    // stiffness of a uniform Timoshenko member. With φ = 0 every term divides by exactly 1, so
+    // a section rigid in shear gives the Euler-Bernoulli matrix bit for bit.
+    let bend = |put: &mut dyn FnMut(usize, usize, f64),
+                [v1, t1, v2, t2]: [usize; 4],
+                sign: f64,
+                ei: f64,
+                phi: f64| {
+        let d = 1.0 + phi;
+        put(v1, v1, 12.0 * ei / l.powi(3) / d);
+        put(v1, t1, sign * 6.0 * ei / l.powi(2) / d);
+        put(v1, v2, -12.0 * ei / l.powi(3) / d);
+        put(v1, t2, sign * 6.0 * ei / l.powi(2) / d);
+        put(t1, t1, (4.0 + phi) * ei / l / d);
+        put(t1, v2, -sign * 6.0 * ei / l.powi(2) / d);
+        put(t1, t2, (2.0 - phi) * ei / l / d);
+        put(v2, v2, 12.0 * ei / l.powi(3) / d);
+        put(v2, t2, -sign * 6.0 * ei / l.powi(2) / d);
+        put(t2, t2, (4.0 + phi) * ei / l / d);
+    };
+    // Bending in the local x-y plane (Nastran's plane 1, I1, K1): v and rz.
+    bend(
+        &mut put,
+        [1, 5, 7, 11],
+        1.0,
+        e * s.iz,
+        phi(s.iz, s.shear_factor_y),
+    );
+    // Bending in the local x-z plane (plane 2, I2, K2): w and ry (a positive ry tilts the axis
+    // downwards, hence the opposite sign of the v-θ coupling).
+    bend(
+        &mut put,
+        [2, 4, 8, 10],
+        -1.0,
+        e * s.iy,
+        phi(s.iy, s.shear_factor_z),
+    );
     release(&mut k, &ends.pins);
     let t = end_transform(&r, &ends.offsets);
     Ok(t.transpose() * k * t)
@@ -261,7 +308,15 @@ mod tests {
     fn rigid_body_motions_cost_no_energy_for_a_skew_beam() {
         let p1 = Vector3::new(0.1, -0.2, 0.3);
         let p2 = Vector3::new(0.9, 0.4, -0.1);
-        let k = stiffness(0, &beam_along(Vector3::new(0.0, 0.0, 1.0)), &p1, &p2).unwrap();
+        let mut shear_flexible = beam_along(Vector3::new(0.0, 0.0, 1.0));
+        shear_flexible.section.shear_factor_y = Some(0.4);
+        shear_flexible.section.shear_factor_z = Some(0.7);
+        for b in [beam_along(Vector3::new(0.0, 0.0, 1.0)), shear_flexible] {
+            rigid_motions_are_free(&stiffness(0, &b, &p1, &p2).unwrap(), &p1, &p2);
+        }
+    }
+
+    fn rigid_motions_are_free(k: &Mat12, p1: &Vector3<f64>, p2: &Vector3<f64>) {
         let scale = k.abs().max();
         for mode in 0..6 {
             let mut u = SMatrix::<f64, 12, 1>::zeros();
@@ -282,6 +337,18 @@ mod tests {
                 (k * u).norm() < 1e-9 * scale,
                 "rigid mode {mode} strains the beam"
             );
+        }
+    }
+
+    #[test]
+    fn a_negative_or_non_finite_shear_factor_is_refused() {
+        let p1 = Vector3::zeros();
+        let p2 = Vector3::new(1.0, 0.0, 0.0);
+        for k in [-0.5, 0.0, f64::NAN] {
+            let mut b = beam_along(Vector3::new(0.0, 1.0, 0.0));
+            b.section.shear_factor_z = Some(k);
+            let err = stiffness(2, &b, &p1, &p2).unwrap_err().to_string();
+            assert!(err.contains("beam 2: shear_factor_z"), "{err}");
         }
     }
 

@@ -65,7 +65,9 @@ impl SectionSpec {
                 }
                 BeamSection::circular_tube(d, t)
             }
-            SectionSpec::Explicit { area, iy, iz, j } => BeamSection { area, iy, iz, j },
+            SectionSpec::Explicit { area, iy, iz, j } => {
+                BeamSection::rigid_in_shear(area, iy, iz, j)
+            }
         };
         if [s.area, s.iy, s.iz, s.j]
             .iter()

@@ -33,6 +33,10 @@ impl Material {
 }
 
 /// Beam cross-section. `iy` resists bending in the local x-z plane, `iz` in the local x-y plane.
+///
+/// The shear area factors give the transverse shear stiffness k·A·G of each plane (Timoshenko,
+/// see [`crate::fe::beam`]); `None` is rigid in shear, the Euler-Bernoulli beam of that plane
+/// (what the procedural body's beams and a PBAR without K1/K2 are).
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
 pub struct BeamSection {
     /// Area (m²).
@@ -43,6 +47,14 @@ pub struct BeamSection {
     pub iz: f64,
     /// Saint-Venant torsion constant (m⁴).
     pub j: f64,
+    /// Shear area factor of the local x-y plane (shear force along y, bending with `iz`;
+    /// Nastran's K1, plane 1): shear stiffness `shear_factor_y`·A·G. `None`: rigid in shear.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub shear_factor_y: Option<f64>,
+    /// Shear area factor of the local x-z plane (shear force along z, bending with `iy`;
+    /// Nastran's K2, plane 2). `None`: rigid in shear.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub shear_factor_z: Option<f64>,
 }
 
 impl BeamSection {
@@ -55,7 +67,7 @@ impl BeamSection {
         // Bredt: J = 4 A_m² t / perimeter of the wall mid-line.
         let (bm, hm) = (b - t, h - t);
         let j = 4.0 * (bm * hm).powi(2) * t / (2.0 * (bm + hm));
-        Self { area, iy, iz, j }
+        Self::rigid_in_shear(area, iy, iz, j)
     }
 
     /// Thin-walled circular tube, outer diameter `d`, wall `t`.
@@ -63,11 +75,19 @@ impl BeamSection {
         let di = (d - 2.0 * t).max(0.0);
         let area = std::f64::consts::PI / 4.0 * (d * d - di * di);
         let i = std::f64::consts::PI / 64.0 * (d.powi(4) - di.powi(4));
+        Self::rigid_in_shear(area, i, i, 2.0 * i)
+    }
+
+    /// Section with area, second moments and torsion constant, rigid in transverse shear
+    /// (Euler-Bernoulli in both planes).
+    pub fn rigid_in_shear(area: f64, iy: f64, iz: f64, j: f64) -> Self {
         Self {
             area,
-            iy: i,
-            iz: i,
-            j: 2.0 * i,
+            iy,
+            iz,
+            j,
+            shear_factor_y: None,
+            shear_factor_z: None,
         }
     }
 }

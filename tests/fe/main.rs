@@ -1,6 +1,7 @@
 //! Integration tests of the finite elements and the procedural chassis (`src/fe`) against analytic results.
 
 mod beam_cards;
+mod beam_shear;
 mod chassis;
 mod deck_cards;
 mod deck_properties;

@@ -144,7 +144,12 @@ fn cantilever_beams_match_euler_bernoulli_in_both_planes() {
         let mut deck = String::from("BEGIN BULK\n");
         deck.push_str(STEEL);
         if card == "CBEAM" {
-            let _ = writeln!(deck, "PBEAM,5,1,{area:e},{i1:e},{i2:e},0.,{:e}", i1 + i2);
+            // K1 = K2 = 0.0: rigid in shear (blank would be Nastran's shear-flexible 1.0).
+            let _ = writeln!(
+                deck,
+                "PBEAM,5,1,{area:e},{i1:e},{i2:e},0.,{:e}\n,,,,,,,,\n,0.,0.",
+                i1 + i2
+            );
         } else {
             let _ = writeln!(deck, "PBAR,5,1,{area:e},{i1:e},{i2:e},{:e}", i1 + i2);
         }

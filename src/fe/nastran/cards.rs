@@ -348,7 +348,25 @@ pub struct BeamProperty {
     pub i2: f64,
     pub j: f64,
     pub nsm: f64,
+    /// Shear area factors K1 (plane 1) and K2 (plane 2); `None` is rigid in shear.
+    pub k: [Option<f64>; 2],
     pub line: Loc,
+}
+
+/// A shear area factor: `blank` is what a blank field means (PBAR: rigid, PBEAM: 1.0); 0.0 is
+/// rigid in shear on both cards; negative is refused.
+fn shear_factor(
+    r: &Reader,
+    i: usize,
+    name: &str,
+    blank: Option<f64>,
+) -> Result<Option<f64>, FeError> {
+    match r.opt_real(i, name)? {
+        None => Ok(blank),
+        Some(0.0) => Ok(None),
+        Some(k) if k > 0.0 => Ok(Some(k)),
+        Some(k) => Err(r.error(i, name, format!("{k}: a shear area factor must be >= 0"))),
+    }
 }
 
 pub(crate) fn pbar(r: &Reader) -> Result<BeamProperty, FeError> {
@@ -363,11 +381,8 @@ pub(crate) fn pbar(r: &Reader) -> Result<BeamProperty, FeError> {
         (13, "E2"),
         (14, "F1"),
         (15, "F2"),
-        (16, "K1"),
-        (17, "K2"),
     ] {
-        // Stress recovery points; K1/K2 (shear flexibility, default rigid): the element is
-        // Euler-Bernoulli, so finite K1/K2 are read and not used.
+        // Stress recovery points: no part of K or M.
         r.opt_real(k, n)?;
     }
     r.require_blank(18, "I12", "unsymmetric sections are not supported")?;
@@ -379,6 +394,11 @@ pub(crate) fn pbar(r: &Reader) -> Result<BeamProperty, FeError> {
         i2: r.real_or(4, "I2", 0.0)?,
         j: r.real_or(5, "J", 0.0)?,
         nsm: r.real_or(6, "NSM", 0.0)?,
+        // Blank or 0.0: infinite K, shear flexibility neglected (the MSC/Autodesk PBAR remark).
+        k: [
+            shear_factor(r, 16, "K1", None)?,
+            shear_factor(r, 17, "K2", None)?,
+        ],
         line: r.card().loc(),
     })
 }
@@ -392,6 +412,7 @@ pub(crate) fn pbeam(r: &Reader) -> Result<BeamProperty, FeError> {
         i2: r.real_or(4, "I2(A)", 0.0)?,
         j: r.real_or(6, "J(A)", 0.0)?,
         nsm: r.real_or(7, "NSM(A)", 0.0)?,
+        k: [None, None],
         line: r.card().loc(),
     };
     r.require_blank(5, "I12(A)", "unsymmetric sections are not supported")?;
@@ -436,10 +457,14 @@ pub(crate) fn pbeam(r: &Reader) -> Result<BeamProperty, FeError> {
             i += 8;
         }
     }
-    // K1 K2 (shear area factors: the element is Euler-Bernoulli, read and not used), S1 S2
+    // K1 K2 (shear area factors: blank 1.0, 0.0 rigid in shear, the MSC PBEAM remark), S1 S2
     // (shear relief for tapered beams: irrelevant for a constant section), then features that
     // change K or M.
-    for (k, name) in [(0, "K1"), (1, "K2"), (2, "S1"), (3, "S2")] {
+    let k = [
+        shear_factor(r, i, "K1", Some(1.0))?,
+        shear_factor(r, i + 1, "K2", Some(1.0))?,
+    ];
+    for (k, name) in [(2, "S1"), (3, "S2")] {
         r.opt_real(i + k, name)?;
     }
     let why = "non-structural mass inertia, warping and offsets of the centre of gravity or \
@@ -461,7 +486,7 @@ pub(crate) fn pbeam(r: &Reader) -> Result<BeamProperty, FeError> {
         r.require_blank(i + k, name, why)?;
     }
     r.at_most(i + 16)?;
-    Ok(end_a)
+    Ok(BeamProperty { k, ..end_a })
 }
 
 /// How a bar's element y axis is given.

@@ -68,9 +68,11 @@
 //!   the reference plane lies ZOFFS along the element normal from the grid plane, carried
 //!   rigidly (u_ref = u + θ × ZOFFS·n): K = Tᵀ K_ref T and the lumped mass likewise, which couples
 //!   membrane and bending. Corner thicknesses (TFLAG, T1..T4) are refused.
-//! - PBAR (A, I1, I2, J, NSM; I12 must be 0), PBEAM (constant section only), CBAR/CBEAM with
-//!   X1..X3 or G0. The element is Euler-Bernoulli: shear flexibility (PBAR/PBEAM K1, K2) is not
-//!   modelled. I1 bends in Nastran's plane 1 (element x-y) → `iz`, I2 → `iy`.
+//! - PBAR (A, I1, I2, J, NSM, K1, K2; I12 must be 0), PBEAM (constant section only; K1, K2),
+//!   CBAR/CBEAM with X1..X3 or G0. I1 bends in Nastran's plane 1 (element x-y) → `iz`, I2 →
+//!   `iy`; K1 (plane 1, shear along element y) → `shear_factor_y`, K2 → `shear_factor_z`: a
+//!   Timoshenko beam with shear stiffness K·A·G ([`crate::fe::beam`]). PBAR K blank or 0.0 is
+//!   rigid in shear (Euler-Bernoulli); PBEAM K blank is 1.0, 0.0 rigid in shear.
 //! - CBAR/CBEAM offsets W1A..W3B and OFFT (blank = GGG) → [`crate::fe::mesh::BeamEnds`]
 //!   `offsets` in basic: OFFT letter 1 is the system of X1..X3 (G: GA's CD, B: basic), letters
 //!   2 and 3 those of the offsets at A and B (G: that grid's CD, O: the offset system, x from GA

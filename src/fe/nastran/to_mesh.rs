@@ -597,12 +597,15 @@ fn add_beams(c: &Cards, body: &mut NastranBody) -> Result<(), FeError> {
                 poisson_ratio: nu_for_g,
                 density: m.rho * c.mass_scale,
             },
-            // Nastran's plane 1 (element x-y) bends about z with I1; plane 2 about y with I2.
+            // Nastran's plane 1 (element x-y) bends about z with I1 and shears along y with K1;
+            // plane 2 about y with I2, along z with K2.
             section: BeamSection {
                 area: p.a,
                 iy: p.i2,
                 iz: p.i1,
                 j: p.j,
+                shear_factor_y: p.k[0],
+                shear_factor_z: p.k[1],
             },
             orientation,
             extra_mass_per_length: p.nsm * c.mass_scale,

@@ -295,21 +295,26 @@ impl<'m> Deck<'m> {
         let mid = self.mat1(&b.material)?;
         let s = &b.section;
         let nsm = b.extra_mass_per_length;
-        let values = [1.0, mid as f64, s.area, s.iz, s.iy, s.j, nsm];
+        // PBAR K1/K2 = 0.0 reads back as rigid in shear, the same as blank.
+        let k = [s.shear_factor_y, s.shear_factor_z].map(|k| k.unwrap_or(0.0));
+        let values = [1.0, mid as f64, s.area, s.iz, s.iy, s.j, nsm, k[0], k[1]];
         let (pid, new) = self.properties.id(&values);
         if new {
-            self.card(
-                "PBAR",
-                &[
-                    Out::Int(pid),
-                    Out::Int(mid),
-                    Out::Real(s.area),
-                    Out::Real(s.iz),
-                    Out::Real(s.iy),
-                    Out::Real(s.j),
-                    Out::Real(nsm),
-                ],
-            )?;
+            let mut fields = vec![
+                Out::Int(pid),
+                Out::Int(mid),
+                Out::Real(s.area),
+                Out::Real(s.iz),
+                Out::Real(s.iy),
+                Out::Real(s.j),
+                Out::Real(nsm),
+            ];
+            if k.iter().any(|&k| k != 0.0) {
+                // Field 9 and the stress recovery points C1 … F2 stay blank.
+                fields.extend((0..9).map(|_| Out::Blank));
+                fields.extend([Out::Real(k[0]), Out::Real(k[1])]);
+            }
+            self.card("PBAR", &fields)?;
         }
         Ok(pid)
     }
