@@ -125,6 +125,7 @@
 mod cards;
 mod dmig;
 mod lexer;
+mod names;
 mod reader;
 mod solid_cards;
 mod to_mesh;
@@ -135,6 +136,7 @@ use std::path::Path;
 
 pub use dmig::{parse_dmig_str, read_dmig_file, write_dmig_file, DmigDof, DmigFile, DmigMatrix};
 pub use lexer::{classify, lex, parse_real, Deck, Field, Loc, RawCard, Value};
+pub use names::DeckNames;
 pub use reader::{DeckLimits, DeckOptions};
 pub use writer::write_bulk_deck;
 
@@ -175,6 +177,13 @@ pub struct NastranBody {
     pub element_ids: ElementIds,
     /// The SPC set applied, if any.
     pub spc_set: Option<u32>,
+    /// Element id → (where the card is, card name), for messages.
+    pub element_cards: BTreeMap<u32, (Loc, &'static str)>,
+    /// GRIDs no element, spring, damper, bush, mass or link references: all six DOFs
+    /// constrained (no DOFs), as Nastran's AUTOSPC does.
+    pub unused_grids: Vec<u32>,
+    /// What the reader decided that the user should know (dropped grids), one log line each.
+    pub notes: Vec<String>,
 }
 
 impl NastranBody {
