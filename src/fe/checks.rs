@@ -8,7 +8,8 @@
 //! stiffness does (beam, shell, triangle, solid, scalar spring, bush, link). A connected node
 //! that is not held (only a point mass) is refused; a node held only by springs or bushes is
 //! accepted, and a DOF the springs leave without stiffness shows up in [`check_assembled`] or
-//! as a singular interior in the reduction.
+//! as a singular interior in the reduction. A part that shares no element with the largest one
+//! is refused unless ground holds it (a spring or bush to ground, an SPC).
 
 use nalgebra::Vector3;
 
@@ -544,8 +545,9 @@ fn find(parent: &mut [usize], mut i: usize) -> usize {
     i
 }
 
-/// Parts of the structure (connected through elements and two-node springs) other than the
-/// largest one, each described by its size and first node.
+/// Parts of the structure (connected through elements, two-node springs, bushes and links)
+/// other than the largest one and not held by ground (a spring or bush to ground, a
+/// constrained DOF), each described by its size and first node.
 fn disconnected_parts(
     mesh: &Mesh,
     connected: &[bool],
@@ -586,12 +588,28 @@ fn disconnected_parts(
             parts.entry(root).or_default().push(k);
         }
     }
+    // Ground holds a part too: a spring or bush to ground, or a constrained DOF.
+    let mut grounded = vec![false; n];
+    let ground_ends = mesh
+        .ground_springs
+        .iter()
+        .map(|s| s.node)
+        .chain(mesh.bushes.iter().filter(|b| b.b.is_none()).map(|b| b.a))
+        .chain(mesh.constraints.iter().map(|&(k, _)| k));
+    for k in ground_ends {
+        if let Some(g) = grounded.get_mut(k) {
+            *g = true;
+        }
+    }
     let largest = parts.values().map(Vec::len).max().unwrap_or(0);
     let mut skipped_largest = false;
     let mut out = Vec::new();
     for nodes in parts.values() {
         if nodes.len() == largest && !skipped_largest {
             skipped_largest = true;
+            continue;
+        }
+        if nodes.iter().any(|&k| grounded[k]) {
             continue;
         }
         let p = mesh.nodes[nodes[0]];

@@ -3,6 +3,7 @@
 mod beam_cards;
 mod chassis;
 mod deck_cards;
+mod deck_diagnostics;
 mod deck_properties;
 mod deck_reader;
 mod eigen;
