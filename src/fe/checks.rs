@@ -778,7 +778,7 @@ mod tests {
             .unwrap_err()
             .to_string();
         assert!(
-            err.contains(&format!("node {hanging}: carries only masses")),
+            err.contains(&format!("node {hanging}: carries only point masses")),
             "{err}"
         );
     }
