@@ -113,7 +113,15 @@
 //! - SPC1 (with THRU), SPC (zero displacement) of the set chosen by case control, or of the only
 //!   set in the file.
 //! - PARAM WTMASS (scales all mass), PARAM POST/GRDPNT/… (output only) and EIGRL/EIGR
-//!   (extraction requests) are accepted; any other card is an error naming card and line.
+//!   (extraction requests) are accepted; any other card is an error naming card and line and
+//!   listing the supported cards (one table, which the card dispatch uses).
+//! - GRIDs that no element, spring, damper, bush, mass or link references (coordinate
+//!   definition grids, leftovers) get no DOFs: all six are constrained, as Nastran's AUTOSPC
+//!   does, and [`NastranBody::unused_grids`] and a note in [`NastranBody::notes`] name them.
+//!
+//! Checks of the body ([`crate::fe::checks::check_mesh_named`] with [`DeckNames`] and
+//! [`crate::fe::checks::CheckLimits::nastran_deck`]) name GRID ids and element cards with their
+//! line, refuse only elements whose matrices would be wrong and count poor shapes as warnings.
 //!
 //! Writing: [`write_bulk_deck`] emits large-field cards for a mesh of the supported elements
 //! (solids as CTETRA/CPENTA/CHEXA with one PSOLID per material; isotropic sheets only: a shell

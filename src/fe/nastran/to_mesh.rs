@@ -542,6 +542,8 @@ pub(crate) fn build(cards: Collector, spc_selection: Option<u32>) -> Result<Nast
     add_supports(&c, spc_selection, &mut body)?;
     check_dependents(&c, &body)?;
     drop_unused_grids(&mut body);
+    // One order whatever the cards' order: a body written and read back is the same mesh.
+    body.mesh.constraints.sort_unstable();
     body.element_cards = std::mem::take(&mut c.element_lines);
     Ok(body)
 }
@@ -1198,7 +1200,10 @@ mod tests {
                 );
             }
         }
-        let raw = crate::fe::nastran::lex("CTRIA6,1\n").unwrap().cards.remove(0);
+        let raw = crate::fe::nastran::lex("CTRIA6,1\n")
+            .unwrap()
+            .cards
+            .remove(0);
         let err = Collector::new().card(raw).err().unwrap().to_string();
         assert!(err.contains(&SUPPORTED_CARDS.join(", ")), "{err}");
     }
