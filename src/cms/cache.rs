@@ -19,7 +19,7 @@ use serde::{Deserialize, Serialize};
 
 use super::error::CmsError;
 use super::hash::sha256_hex;
-use super::reduce::reduce;
+use super::reduce::reduce_with_notes;
 use super::reduced::ReducedChassis;
 use super::spec::ReductionSpec;
 
@@ -69,24 +69,32 @@ pub enum CacheOutcome {
 struct Entry {
     format: u32,
     key: String,
-    /// SHA-256 of the reduction's JSON: an entry edited after it was written is not served.
+    /// SHA-256 of the reduction's JSON (and of the notes, if any): an entry edited after it
+    /// was written is not served.
     checksum: String,
     reduced: ReducedChassis,
+    /// The notes on the body ([`crate::cms::Reduction::notes`]): a cache hit logs them too.
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    notes: Vec<String>,
 }
 
 impl Entry {
-    fn new(key: String, reduced: ReducedChassis) -> Result<Self, String> {
+    fn new(key: String, reduced: ReducedChassis, notes: Vec<String>) -> Result<Self, String> {
         Ok(Self {
             format: FORMAT_VERSION,
             key,
-            checksum: checksum(&reduced)?,
+            checksum: checksum(&reduced, &notes)?,
             reduced,
+            notes,
         })
     }
 }
 
-fn checksum(reduced: &ReducedChassis) -> Result<String, String> {
-    let json = serde_json::to_string(reduced).map_err(|e| format!("serialising: {e}"))?;
+fn checksum(reduced: &ReducedChassis, notes: &[String]) -> Result<String, String> {
+    let mut json = serde_json::to_string(reduced).map_err(|e| format!("serialising: {e}"))?;
+    if !notes.is_empty() {
+        json += &serde_json::to_string(notes).map_err(|e| format!("serialising: {e}"))?;
+    }
     Ok(sha256_hex(json.as_bytes()))
 }
 
@@ -184,7 +192,7 @@ fn check_consistent(r: &ReducedChassis) -> Result<(), String> {
 }
 
 /// Reads the entry at `path` if it holds a valid reduction for `key`.
-fn load(path: &Path, key: &str) -> Result<ReducedChassis, String> {
+fn load(path: &Path, key: &str) -> Result<(ReducedChassis, Vec<String>), String> {
     let text = crate::text_file::read_limited(path, crate::text_file::DATA_LIMIT)
         .map_err(|e| format!("unreadable: {e}"))?;
     let entry: Entry = serde_json::from_str(&text).map_err(|e| format!("corrupt: {e}"))?;
@@ -197,11 +205,11 @@ fn load(path: &Path, key: &str) -> Result<ReducedChassis, String> {
     if entry.key != key {
         return Err("written for different inputs".into());
     }
-    if checksum(&entry.reduced)? != entry.checksum {
+    if checksum(&entry.reduced, &entry.notes)? != entry.checksum {
         return Err("altered after it was written (checksum mismatch)".into());
     }
     check_consistent(&entry.reduced).map_err(|e| format!("inconsistent: {e}"))?;
-    Ok(entry.reduced)
+    Ok((entry.reduced, entry.notes))
 }
 
 /// Writes `entry` to `path` atomically: a unique temporary file in the same directory, then a
@@ -228,43 +236,56 @@ pub fn reduce_cached(
     spec: &ReductionSpec,
     cache: &CacheSetting,
 ) -> Result<(ReducedChassis, CacheOutcome), CmsError> {
+    reduce_cached_with_notes(spec, cache).map(|(reduced, outcome, _)| (reduced, outcome))
+}
+
+/// [`reduce_cached`] with the notes on the body for the log ([`crate::cms::Reduction::notes`]),
+/// kept in the cache entry so that a cache hit reports them as the reduction did.
+pub fn reduce_cached_with_notes(
+    spec: &ReductionSpec,
+    cache: &CacheSetting,
+) -> Result<(ReducedChassis, CacheOutcome, Vec<String>), CmsError> {
     let dir = match cache {
-        CacheSetting::Disabled => return Ok((reduce(spec)?, CacheOutcome::Disabled)),
+        CacheSetting::Disabled => {
+            let (reduced, notes) = reduce_with_notes(spec)?;
+            return Ok((reduced, CacheOutcome::Disabled, notes));
+        }
         CacheSetting::Dir(d) => Some(d.clone()),
         CacheSetting::Default => default_dir(),
     };
     spec.validate()?;
     let key = key_text(spec)?;
     let Some(dir) = dir else {
-        let reduced = reduce(spec)?;
+        let (reduced, notes) = reduce_with_notes(spec)?;
         let reason = "no cache directory: neither XDG_CACHE_HOME nor HOME is an absolute path";
         return Ok((
             reduced,
             CacheOutcome::NotStored {
                 reason: reason.into(),
             },
+            notes,
         ));
     };
     let path = dir.join(format!("cms-{}.json", &sha256_hex(key.as_bytes())[..16]));
     let rejected = if path.exists() {
         match load(&path, &key) {
-            Ok(reduced) => return Ok((reduced, CacheOutcome::Hit(path))),
+            Ok((reduced, notes)) => return Ok((reduced, CacheOutcome::Hit(path), notes)),
             Err(reason) => Some(reason),
         }
     } else {
         None
     };
-    let reduced = reduce(spec)?;
-    let entry = match Entry::new(key, reduced.clone()) {
+    let (reduced, notes) = reduce_with_notes(spec)?;
+    let entry = match Entry::new(key, reduced.clone(), notes.clone()) {
         Ok(entry) => entry,
-        Err(reason) => return Ok((reduced, CacheOutcome::NotStored { reason })),
+        Err(reason) => return Ok((reduced, CacheOutcome::NotStored { reason }, notes)),
     };
     let outcome = match (store(&path, &entry), rejected) {
         (Ok(()), None) => CacheOutcome::Stored(path),
         (Ok(()), Some(reason)) => CacheOutcome::Replaced { path, reason },
         (Err(reason), _) => CacheOutcome::NotStored { reason },
     };
-    Ok((entry.reduced, outcome))
+    Ok((entry.reduced, outcome, entry.notes))
 }
 
 #[cfg(test)]
@@ -308,14 +329,19 @@ mod tests {
     fn store_then_load_round_trips_and_rejects_other_keys() {
         let dir = std::env::temp_dir().join(format!("cms-cache-unit-{}", std::process::id()));
         let path = dir.join("entry.json");
-        let entry = Entry::new("k1".into(), tiny()).unwrap();
+        let notes = vec!["3 GRID(s) … were dropped".to_string()];
+        let entry = Entry::new("k1".into(), tiny(), notes.clone()).unwrap();
         store(&path, &entry).unwrap();
-        assert_eq!(load(&path, "k1").unwrap(), tiny());
+        assert_eq!(load(&path, "k1").unwrap(), (tiny(), notes));
         assert!(load(&path, "k2").unwrap_err().contains("different inputs"));
         // a reduction edited in place (still valid JSON, still consistent) is refused
-        let mut altered = Entry::new("k1".into(), tiny()).unwrap();
+        let mut altered = Entry::new("k1".into(), tiny(), Vec::new()).unwrap();
         altered.reduced.omega[0] *= 1.01;
         store(&path, &altered).unwrap();
+        assert!(load(&path, "k1").unwrap_err().contains("checksum"));
+        let mut renoted = Entry::new("k1".into(), tiny(), Vec::new()).unwrap();
+        renoted.notes.push("edited".into());
+        store(&path, &renoted).unwrap();
         assert!(load(&path, "k1").unwrap_err().contains("checksum"));
         fs::write(&path, "{\"format\": 1, \"key\": \"k1\", \"reduced\": {").unwrap();
         assert!(load(&path, "k1").unwrap_err().contains("corrupt"));

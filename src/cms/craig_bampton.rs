@@ -298,6 +298,7 @@ pub fn orthogonalise(k_r: &Mat<f64>, m_r: &Mat<f64>) -> Result<(Vec<f64>, Mat<f6
     let m_s = Mat::from_fn(r, r, |i, j| m_r[(i, j)] * scale[i] * scale[j]);
     let k_s = Mat::from_fn(r, r, |i, j| k_r[(i, j)] * scale[i] * scale[j]);
     let (lambda, x) = reduced_eigen(&k_s, &m_s)?;
+    check_held(&lambda)?;
     if let Some(bad) = lambda.iter().position(|l| !(l.is_finite() && *l > 0.0)) {
         return Err(CmsError::Numerical(format!(
             "reduced mode {bad} has eigenvalue {}: K is not positive definite",
@@ -306,6 +307,45 @@ pub fn orthogonalise(k_r: &Mat<f64>, m_r: &Mat<f64>) -> Result<(Vec<f64>, Mat<f6
     }
     let coefficients = Mat::from_fn(r, r, |i, j| scale[i] * x[(i, j)]);
     Ok((lambda.iter().map(|l| l.sqrt()).collect(), coefficients))
+}
+
+/// Lowest frequency (Hz) a held body may have: a car body on its suspension has its lowest
+/// modes (bounce, pitch, roll) near 1 Hz, two decades above; a rigid-body mode that round-off
+/// makes slightly positive lies far below.
+pub const RIGID_BODY_HZ: f64 = 0.01;
+
+/// Round-off of an eigenvalue relative to the largest of the reduced pencil: a rigid-body mode
+/// comes out as a few thousand ε·λ_max at most (ε the machine epsilon; the reduced matrices are
+/// dense products of length n_reduced). This term only matters for λ_max above ~1e10 (s⁻²).
+const ROUND_OFF_FACTOR: f64 = 1e3;
+
+/// Refuses a reduced pencil with rigid-body modes (eigenvalues ω² ≈ 0, of either sign): the body
+/// is not held (free-free, or a mechanism), which the coupled model cannot carry. The threshold
+/// is the larger of (2π·[`RIGID_BODY_HZ`])² and [`ROUND_OFF_FACTOR`]·ε·λ_max; a clearly negative
+/// eigenvalue is left to the positive-definiteness check (a K that is wrong, not unheld).
+fn check_held(lambda: &[f64]) -> Result<(), CmsError> {
+    let largest = lambda.iter().fold(0.0f64, |m, l| m.max(l.abs()));
+    let floor = (2.0 * std::f64::consts::PI * RIGID_BODY_HZ)
+        .powi(2)
+        .max(ROUND_OFF_FACTOR * f64::EPSILON * largest);
+    let free: Vec<f64> = lambda
+        .iter()
+        .copied()
+        .filter(|l| l.abs() <= floor)
+        .collect();
+    if free.is_empty() {
+        return Ok(());
+    }
+    let hz = |l: f64| l.abs().sqrt() / (2.0 * std::f64::consts::PI);
+    Err(CmsError::InvalidInput(format!(
+        "the body is not held: {} reduced mode(s) have |ω²| ≤ {floor:.3e} s⁻² (below {:.3} Hz; \
+         lowest ω² = {:.3e} s⁻²), i.e. it can move as a rigid body or mechanism without \
+         deforming (6 such modes: free-free, no SPC and no springs to ground). Add SPCs or \
+         springs to ground (CELAS2, CBUSH) at the wheel centres, as the suspension holds the body",
+        free.len(),
+        hz(floor),
+        free.iter().fold(f64::INFINITY, |m, &l| m.min(l))
+    )))
 }
 
 /// Craig-Bampton reduction of the pencil (K, M) onto the interface equations `interface`,

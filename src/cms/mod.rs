@@ -67,7 +67,9 @@ mod sparse_ops;
 mod spec;
 mod transfer;
 
-pub use cache::{reduce_cached, CacheOutcome, CacheSetting, FORMAT_VERSION};
+pub use cache::{
+    reduce_cached, reduce_cached_with_notes, CacheOutcome, CacheSetting, FORMAT_VERSION,
+};
 pub use craig_bampton::{
     craig_bampton, craig_bampton_basis, orthogonalise, CraigBampton, CraigBamptonBasis,
 };
@@ -75,7 +77,7 @@ pub use damping::{DampingBand, DampingTable};
 pub use error::CmsError;
 pub use external::{dmig_of_reduction, reduce_external, DmigBody, ExternalBody};
 pub use hash::sha256_hex;
-pub use reduce::{reduce, reduce_detailed, Reduction};
+pub use reduce::{reduce, reduce_detailed, reduce_with_notes, Reduction};
 pub use reduced::{RecoveryPoint, ReducedChassis};
 pub use spec::{BulkDeckBody, InterfaceDofs, ModeSelection, ReductionSpec};
 pub use transfer::{PointDof, Response};

@@ -11,9 +11,11 @@ use super::spec::ReductionSpec;
 use crate::fe::assembly::{assemble, mat_vec, Assembled, SparseMat};
 use crate::fe::chassis::Chassis;
 use crate::fe::chassis_config::ChassisConfig;
+use crate::fe::checks::{check_mesh_named, CheckLimits, MeshIndices, Naming, DOF_NAMES};
 use crate::fe::dof::{DofMap, DOF_PER_NODE};
 use crate::fe::eigen::Modes;
 use crate::fe::modal::{describe, ModeDescription};
+use crate::fe::nastran::DeckNames;
 
 /// A reduction together with the full model it came from, for verification and tools. The
 /// coupled model needs only [`Reduction::reduced`]; use [`reduce`] to drop the rest.
@@ -29,6 +31,9 @@ pub struct Reduction {
     pub modes: CraigBampton,
     /// What the coupled model gets.
     pub reduced: ReducedChassis,
+    /// What the user should know about the body (a deck's dropped grids and element-shape
+    /// warnings), one log line each.
+    pub notes: Vec<String>,
 }
 
 impl Reduction {
@@ -48,6 +53,13 @@ pub fn reduce(spec: &ReductionSpec) -> Result<ReducedChassis, CmsError> {
     Ok(reduce_detailed(spec)?.reduced)
 }
 
+/// The reduced chassis described by `spec` and the notes on its body for the log
+/// ([`Reduction::notes`]).
+pub fn reduce_with_notes(spec: &ReductionSpec) -> Result<(ReducedChassis, Vec<String>), CmsError> {
+    let r = reduce_detailed(spec)?;
+    Ok((r.reduced, r.notes))
+}
+
 /// The body of `spec` built and assembled, its interface: the named mount nodes and their
 /// global interface equations (mount by mount, DOF order of the spec).
 pub(crate) struct Model {
@@ -55,13 +67,18 @@ pub(crate) struct Model {
     pub assembled: Assembled,
     pub mounts: Vec<(String, usize)>,
     pub interface: Vec<usize>,
+    pub notes: Vec<String>,
 }
 
 /// Builds and assembles the body `spec` describes.
 pub(crate) fn model(spec: &ReductionSpec) -> Result<Model, CmsError> {
     spec.validate()?;
-    let chassis = match &spec.deck {
-        None => Chassis::build(&spec.chassis)?,
+    let (chassis, names, notes) = match &spec.deck {
+        None => (
+            Chassis::build(&spec.chassis)?,
+            BodyNames::Mesh(MeshIndices),
+            Vec::new(),
+        ),
         Some(deck) => deck_body(deck)?,
     };
     let assembled = assemble(&chassis.mesh)?;
@@ -70,6 +87,12 @@ pub(crate) fn model(spec: &ReductionSpec) -> Result<Model, CmsError> {
         .iter()
         .map(|name| Ok((name.clone(), chassis.node(name)?)))
         .collect::<Result<Vec<_>, CmsError>>()?;
+    check_interface(
+        &assembled.dofs,
+        &mounts,
+        spec.interface_dofs.local(),
+        &names,
+    )?;
     let mount_ids: Vec<usize> = mounts.iter().map(|(_, id)| *id).collect();
     let interface = assembled
         .dofs
@@ -79,7 +102,66 @@ pub(crate) fn model(spec: &ReductionSpec) -> Result<Model, CmsError> {
         assembled,
         mounts,
         interface,
+        notes,
     })
+}
+
+/// How the body's messages name nodes: the procedural body by mesh index, a deck body by its
+/// GRID ids (and which grids it dropped).
+enum BodyNames {
+    Mesh(MeshIndices),
+    Deck {
+        names: DeckNames,
+        unused: std::collections::BTreeSet<u32>,
+    },
+}
+
+impl BodyNames {
+    fn naming(&self) -> &dyn Naming {
+        match self {
+            BodyNames::Mesh(m) => m,
+            BodyNames::Deck { names, .. } => names,
+        }
+    }
+}
+
+/// Every interface DOF must be an equation of its own: not constrained, not dependent in a
+/// link, not on a grid dropped for lack of elements. Messages name the point and its GRID.
+fn check_interface(
+    dofs: &DofMap,
+    mounts: &[(String, usize)],
+    local: &[usize],
+    names: &BodyNames,
+) -> Result<(), CmsError> {
+    for (point, node) in mounts {
+        let grid = names.naming().node(*node);
+        if let BodyNames::Deck { names, unused } = names {
+            if names.grid(*node).is_some_and(|g| unused.contains(&g)) {
+                return Err(CmsError::InvalidInput(format!(
+                    "interface point '{point}' is {grid}, which no element, spring, bush, mass \
+                     or link references: the reader dropped it (no DOFs, as Nastran's AUTOSPC); \
+                     name a grid of the structure"
+                )));
+            }
+        }
+        for &d in local {
+            let dof = DOF_NAMES.get(d).copied().unwrap_or("?");
+            if dofs.is_dependent(*node, d) {
+                return Err(CmsError::InvalidInput(format!(
+                    "interface point '{point}' ({grid}) dof {dof} is dependent in a rigid or \
+                     interpolation link (RBE2/RBE3) and has no equation of its own: use the \
+                     link's independent grid"
+                )));
+            }
+            if dofs.global(*node, d).is_none() {
+                return Err(CmsError::InvalidInput(format!(
+                    "interface point '{point}' ({grid}) dof {dof} is constrained (SPC, GRID PS, \
+                     or a rotation no element holds): an interface DOF must be free"
+                )));
+            }
+        }
+    }
+    Ok(())
 }
 
 /// The recovered points in order: the mounts, then the outputs not among them.
@@ -136,12 +218,14 @@ pub fn reduce_detailed(spec: &ReductionSpec) -> Result<Reduction, CmsError> {
         interface: model.interface,
         modes,
         reduced,
+        notes: model.notes,
     })
 }
 
-/// The body of a bulk data deck, its points named; the content must still be what the spec's
-/// checksum says (the cache key was made from it).
-fn deck_body(deck: &BulkDeckBody) -> Result<Chassis, CmsError> {
+/// The body of a bulk data deck, its points named, checked (poor element shapes are warnings,
+/// as in Nastran), with its names and the notes for the log; the content must still be what
+/// the spec's checksum says (the cache key was made from it).
+fn deck_body(deck: &BulkDeckBody) -> Result<(Chassis, BodyNames, Vec<String>), CmsError> {
     let options = crate::fe::nastran::DeckOptions {
         include_root: deck.include_root.clone(),
         ..Default::default()
@@ -155,11 +239,20 @@ fn deck_body(deck: &BulkDeckBody) -> Result<Chassis, CmsError> {
         )));
     }
     body.name_points(&deck.points)?;
-    crate::fe::checks::check_mesh(&body.mesh, &crate::fe::checks::CheckLimits::default())?;
-    Ok(Chassis {
-        mesh: body.mesh,
-        config: ChassisConfig::default(),
-    })
+    let names = DeckNames::new(&body);
+    let warnings = check_mesh_named(&body.mesh, &CheckLimits::nastran_deck(), &names)
+        .map_err(|e| CmsError::InvalidInput(format!("bulk data deck: {e}")))?;
+    let mut notes = std::mem::take(&mut body.notes);
+    notes.extend(warnings);
+    let unused = body.unused_grids.iter().copied().collect();
+    Ok((
+        Chassis {
+            mesh: body.mesh,
+            config: ChassisConfig::default(),
+        },
+        BodyNames::Deck { names, unused },
+        notes,
+    ))
 }
 
 /// `φ_kᵀ C φ_k` of mode `k`.

@@ -3,8 +3,8 @@
 //! scene needs (scene 2, Table 1 middle column).
 
 use crate::cms::{
-    reduce_cached, reduce_external, BulkDeckBody, CacheOutcome, CacheSetting, ExternalBody,
-    InterfaceDofs, ModeSelection, ReducedChassis, ReductionSpec,
+    reduce_cached_with_notes, reduce_external, BulkDeckBody, CacheOutcome, CacheSetting,
+    ExternalBody, InterfaceDofs, ModeSelection, ReducedChassis, ReductionSpec,
 };
 use crate::fe::chassis_config::ChassisConfig;
 
@@ -379,7 +379,7 @@ pub fn body(
     let (body, origin) = match &vehicle.body {
         BodyConfig::Procedural { .. } | BodyConfig::Nastran { .. } => {
             let (spec, origin) = reduction_spec(vehicle, options)?;
-            let (body, outcome) = reduce_cached(&spec, &options.cache)
+            let (body, outcome, notes) = reduce_cached_with_notes(&spec, &options.cache)
                 .map_err(|e| format!("chassis reduction: {e}"))?;
             let source = match outcome {
                 CacheOutcome::Hit(path) => format!("read from cache {}", path.display()),
@@ -406,7 +406,9 @@ pub fn body(
                     )
                 }
             };
-            (body, format!("{what}, {source}"))
+            // The deck's notes (dropped grids, element-shape warnings) go to the log with it.
+            let notes: String = notes.iter().map(|n| format!("; {n}")).collect();
+            (body, format!("{what}, {source}{notes}"))
         }
         BodyConfig::Dmig {
             path,

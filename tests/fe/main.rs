@@ -4,6 +4,7 @@ mod beam_cards;
 mod beam_shear;
 mod chassis;
 mod deck_cards;
+mod deck_diagnostics;
 mod deck_properties;
 mod deck_reader;
 mod eigen;

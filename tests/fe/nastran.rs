@@ -505,7 +505,10 @@ fn grids_and_masses_in_nested_cord2r_systems_land_in_basic() {
 fn spc1_thru_takes_the_grids_that_exist_and_wtmass_scales_all_mass() {
     let deck = "GRID,1,,0.,0.,0.\nGRID,2,,1.,0.,0.\nGRID,5,,2.,0.,0.\nGRID,9,,3.,0.,0.\n\
                 SPC1,1,123,2,THRU,8\nPARAM,WTMASS,0.5\nCONM2,3,9,,10.\nPARAM,POST,-1\n";
-    let body = parse_str(deck).unwrap();
+    // Springs use GRIDs 1, 2, 5 (an unused grid would be dropped, all six DOFs held).
+    let deck = format!("{deck}CELAS2,11,1.,1,1\nCELAS2,12,1.,2,1\nCELAS2,13,1.,5,1\n");
+    let body = parse_str(&deck).unwrap();
+    assert!(body.unused_grids.is_empty());
     let mut fixed: Vec<(usize, usize)> = body.mesh.constraints.clone();
     fixed.sort_unstable();
     assert_eq!(fixed, vec![(1, 0), (1, 1), (1, 2), (2, 0), (2, 1), (2, 2)]);

@@ -115,7 +115,15 @@
 //! - SPC1 (with THRU), SPC (zero displacement) of the set chosen by case control, or of the only
 //!   set in the file.
 //! - PARAM WTMASS (scales all mass), PARAM POST/GRDPNT/… (output only) and EIGRL/EIGR
-//!   (extraction requests) are accepted; any other card is an error naming card and line.
+//!   (extraction requests) are accepted; any other card is an error naming card and line and
+//!   listing the supported cards (one table, which the card dispatch uses).
+//! - GRIDs that no element, spring, damper, bush, mass or link references (coordinate
+//!   definition grids, leftovers) get no DOFs: all six are constrained, as Nastran's AUTOSPC
+//!   does, and [`NastranBody::unused_grids`] and a note in [`NastranBody::notes`] name them.
+//!
+//! Checks of the body ([`crate::fe::checks::check_mesh_named`] with [`DeckNames`] and
+//! [`crate::fe::checks::CheckLimits::nastran_deck`]) name GRID ids and element cards with their
+//! line, refuse only elements whose matrices would be wrong and count poor shapes as warnings.
 //!
 //! Writing: [`write_bulk_deck`] emits large-field cards for a mesh of the supported elements
 //! (solids as CTETRA/CPENTA/CHEXA with one PSOLID per material; isotropic sheets only: a shell
@@ -127,6 +135,7 @@
 mod cards;
 mod dmig;
 mod lexer;
+mod names;
 mod reader;
 mod solid_cards;
 mod to_mesh;
@@ -137,6 +146,7 @@ use std::path::Path;
 
 pub use dmig::{parse_dmig_str, read_dmig_file, write_dmig_file, DmigDof, DmigFile, DmigMatrix};
 pub use lexer::{classify, lex, parse_real, Deck, Field, Loc, RawCard, Value};
+pub use names::DeckNames;
 pub use reader::{DeckLimits, DeckOptions};
 pub use writer::write_bulk_deck;
 
@@ -177,6 +187,13 @@ pub struct NastranBody {
     pub element_ids: ElementIds,
     /// The SPC set applied, if any.
     pub spc_set: Option<u32>,
+    /// Element id → (where the card is, card name), for messages.
+    pub element_cards: BTreeMap<u32, (Loc, &'static str)>,
+    /// GRIDs no element, spring, damper, bush, mass or link references: all six DOFs
+    /// constrained (no DOFs), as Nastran's AUTOSPC does.
+    pub unused_grids: Vec<u32>,
+    /// What the reader decided that the user should know (dropped grids), one log line each.
+    pub notes: Vec<String>,
 }
 
 impl NastranBody {

@@ -17,10 +17,29 @@ use crate::fe::mesh::{
 
 mod shell_cards;
 
+/// Every bulk data card the reader accepts: the dispatch in `Cards::add` takes exactly these
+/// (a test feeds each one), and the refusal of any other card lists them.
+pub(crate) const SUPPORTED_CARDS: [&str; 35] = [
+    "GRID", "CORD2R", "CORD2C", "CORD2S", "MAT1", "MAT2", "MAT8", "PSHELL", "PBAR", "PBEAM",
+    "PELAS", "PDAMP", "PBUSH", "PSOLID", "CQUAD4", "CTRIA3", "CBAR", "CBEAM", "CTETRA", "CPENTA",
+    "CHEXA", "CONM1", "CONM2", "CBUSH", "CELAS1", "CELAS2", "CDAMP1", "CDAMP2", "RBE2", "RBE3",
+    "SPC", "SPC1", "PARAM", "EIGRL", "EIGR",
+];
+
 /// Parameters that only steer output or solution bookkeeping: accepted and ignored.
 const IGNORED_PARAMS: [&str; 8] = [
     "POST", "GRDPNT", "AUTOSPC", "PRGPST", "MAXRATIO", "OGEOM", "NOCOMPS", "BAILOUT",
 ];
+
+fn unsupported(card: &str, line: &Loc) -> FeError {
+    mesh_error(
+        line,
+        format!(
+            "card {card} is not supported (supported: {})",
+            SUPPORTED_CARDS.join(", ")
+        ),
+    )
+}
 
 fn mesh_error(line: impl std::fmt::Display, message: impl std::fmt::Display) -> FeError {
     FeError::InvalidInput(format!("Nastran bulk data line {line}: {message}"))
@@ -49,7 +68,7 @@ struct Cards {
     solids: BTreeMap<u32, solid_cards::SolidElement>,
     solid_properties: BTreeMap<u32, solid_cards::Psolid>,
     supports: Vec<(cards::Support, Loc)>,
-    element_lines: BTreeMap<u32, (Loc, String)>,
+    element_lines: BTreeMap<u32, (Loc, &'static str)>,
     mass_scale: f64,
 }
 
@@ -68,15 +87,14 @@ fn insert_unique<T>(
 
 impl Cards {
     /// Element ids are unique over all element cards, as in Nastran.
-    fn element_id(&mut self, id: u32, line: &Loc, name: &str) -> Result<(), FeError> {
+    fn element_id(&mut self, id: u32, line: &Loc, name: &'static str) -> Result<(), FeError> {
         if let Some((first, other)) = self.element_lines.get(&id) {
             return Err(mesh_error(
                 line,
                 format!("{name} {id}: element id already used by {other} at line {first}"),
             ));
         }
-        self.element_lines
-            .insert(id, (line.clone(), name.to_string()));
+        self.element_lines.insert(id, (line.clone(), name));
         Ok(())
     }
 
@@ -93,7 +111,10 @@ impl Cards {
         {
             let r = Reader::new(raw);
             let line = raw.loc();
-            match raw.name.as_str() {
+            let Some(&name) = SUPPORTED_CARDS.iter().find(|c| **c == raw.name) else {
+                return Err(unsupported(&raw.name, &line));
+            };
+            match name {
                 "GRID" => {
                     let g = cards::grid(&r)?;
                     insert_unique(&mut c.grids, "GRID", g.id, &line, g)?;
@@ -155,7 +176,7 @@ impl Cards {
                 }
                 "CBAR" | "CBEAM" => {
                     let b = cards::bar(&r, raw.name == "CBEAM")?;
-                    c.element_id(b.id, &line, &raw.name)?;
+                    c.element_id(b.id, &line, name)?;
                     c.bars.insert(b.id, b);
                 }
                 "CQUAD4" | "CTRIA3" => {
@@ -189,12 +210,12 @@ impl Cards {
                 }
                 "CELAS1" | "CELAS2" => {
                     let s = cards::scalar(&r, raw.name == "CELAS2", true)?;
-                    c.element_id(s.id, &line, &raw.name)?;
+                    c.element_id(s.id, &line, name)?;
                     c.springs.insert(s.id, s);
                 }
                 "CDAMP1" | "CDAMP2" => {
                     let s = cards::scalar(&r, raw.name == "CDAMP2", false)?;
-                    c.element_id(s.id, &line, &raw.name)?;
+                    c.element_id(s.id, &line, name)?;
                     c.dampers.insert(s.id, s);
                 }
                 "RBE2" => {
@@ -217,10 +238,6 @@ impl Cards {
                         .extend(list.into_iter().map(|s| (s, line.clone())));
                 }
                 "CTETRA" | "CPENTA" | "CHEXA" => {
-                    let name = ["CTETRA", "CPENTA", "CHEXA"]
-                        .into_iter()
-                        .find(|n| *n == raw.name)
-                        .unwrap_or("CHEXA");
                     let e = solid_cards::element(&r, name)?;
                     c.element_id(e.id, &line, name)?;
                     c.solids.insert(e.id, e);
@@ -232,18 +249,8 @@ impl Cards {
                 "PARAM" => c.param(&r)?,
                 // Eigenvalue extraction requests: the caller chooses the modes.
                 "EIGRL" | "EIGR" => {}
-                other => {
-                    return Err(mesh_error(
-                        &line,
-                        format!(
-                            "card {other} is not supported (supported: GRID, CORD2R, CORD2C, \
-                             CORD2S, MAT1, \
-                             PSHELL, PBAR, PBEAM, PELAS, PDAMP, CQUAD4, CTRIA3, CBAR, CBEAM, \
-                             CONM1, CONM2, CBUSH, PBUSH, CTETRA, CPENTA, CHEXA, PSOLID, CELAS1, CELAS2, CDAMP1, CDAMP2, RBE2, RBE3, SPC1, SPC, \
-                             PARAM, EIGRL, EIGR)"
-                        ),
-                    ))
-                }
+                // A listed card without an arm: the table test names it.
+                other => return Err(unsupported(other, &line)),
             }
         }
         Ok(())
@@ -494,13 +501,16 @@ impl CardSink for Collector {
 
 /// Builds the body from the cards read and the SPC set the case control selects.
 pub(crate) fn build(cards: Collector, spc_selection: Option<u32>) -> Result<NastranBody, FeError> {
-    let c = cards.0;
+    let mut c = cards.0;
     let systems = Systems::new(&c.systems)?;
     let mut body = NastranBody {
         mesh: Mesh::default(),
         grid_index: BTreeMap::new(),
         element_ids: Default::default(),
         spc_set: None,
+        element_cards: BTreeMap::new(),
+        unused_grids: Vec::new(),
+        notes: Vec::new(),
     };
     for (&id, g) in &c.grids {
         let x = Vector3::from(g.x);
@@ -531,7 +541,85 @@ pub(crate) fn build(cards: Collector, spc_selection: Option<u32>) -> Result<Nast
     add_links(&c, &mut body)?;
     add_supports(&c, spc_selection, &mut body)?;
     check_dependents(&c, &body)?;
+    drop_unused_grids(&mut body);
+    // One order whatever the cards' order: a body written and read back is the same mesh.
+    body.mesh.constraints.sort_unstable();
+    body.element_cards = std::mem::take(&mut c.element_lines);
     Ok(body)
+}
+
+/// How many dropped GRID ids a note lists.
+const LISTED_UNUSED: usize = 10;
+
+/// GRIDs that no element, spring, damper, bush, mass or link references (coordinate-definition
+/// grids, leftovers of meshing) get no DOFs: all six are constrained, as Nastran's AUTOSPC
+/// constrains them. Their ids go to [`NastranBody::unused_grids`] and a note.
+fn drop_unused_grids(body: &mut NastranBody) {
+    let mesh = &body.mesh;
+    let mut used = vec![false; mesh.nodes.len()];
+    let referenced = mesh
+        .beams
+        .iter()
+        .flat_map(|b| b.nodes)
+        .chain(mesh.shells.iter().flat_map(|s| s.nodes))
+        .chain(mesh.triangles.iter().flat_map(|t| t.nodes))
+        .chain(mesh.solids.iter().flat_map(|s| s.nodes.iter().copied()))
+        .chain(mesh.masses.iter().map(|m| m.node))
+        .chain(mesh.ground_springs.iter().map(|s| s.node))
+        .chain(mesh.springs.iter().flat_map(|s| s.nodes))
+        .chain(
+            mesh.bushes
+                .iter()
+                .flat_map(|b| std::iter::once(b.a).chain(b.b)),
+        )
+        .chain(
+            mesh.rigid_links
+                .iter()
+                .flat_map(|l| std::iter::once(l.independent).chain(l.dependent.iter().copied())),
+        )
+        .chain(mesh.interpolation_links.iter().flat_map(|l| {
+            std::iter::once(l.reference)
+                .chain(l.sources.iter().flat_map(|s| s.nodes.iter().copied()))
+        }));
+    for k in referenced {
+        if let Some(u) = used.get_mut(k) {
+            *u = true;
+        }
+    }
+    let unused: Vec<(u32, usize)> = body
+        .grid_index
+        .iter()
+        .filter(|(_, &node)| !used[node])
+        .map(|(&g, &node)| (g, node))
+        .collect();
+    if unused.is_empty() {
+        return;
+    }
+    let held: BTreeSet<(usize, usize)> = body.mesh.constraints.iter().copied().collect();
+    for &(_, node) in &unused {
+        for d in 0..6 {
+            if !held.contains(&(node, d)) {
+                body.mesh.constraints.push((node, d));
+            }
+        }
+    }
+    let listed: Vec<String> = unused
+        .iter()
+        .take(LISTED_UNUSED)
+        .map(|(g, _)| g.to_string())
+        .collect();
+    body.notes.push(format!(
+        "{} GRID(s) not referenced by any element, spring, damper, bush, mass or link were \
+         dropped (no DOFs, as Nastran's AUTOSPC): GRID {}{}",
+        unused.len(),
+        listed.join(", "),
+        if unused.len() > LISTED_UNUSED {
+            ", …"
+        } else {
+            ""
+        }
+    ));
+    body.unused_grids = unused.into_iter().map(|(g, _)| g).collect();
 }
 
 /// Solids take an isotropic MAT1 (E, G, NU consistent within 1 %, as shells need).
@@ -1092,4 +1180,34 @@ fn add_supports(c: &Cards, selected: Option<u32>, body: &mut NastranBody) -> Res
         }
     }
     Ok(())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// Every listed card reaches an arm of the dispatch (a card with blank fields fails in its
+    /// own parser, never as unsupported), and any other name is refused listing them all.
+    #[test]
+    fn the_supported_card_table_is_the_dispatch() {
+        for card in SUPPORTED_CARDS {
+            let mut collector = Collector::new();
+            let raw = crate::fe::nastran::lex(&format!("{card},1\n"))
+                .unwrap()
+                .cards
+                .remove(0);
+            if let Err(e) = collector.card(raw) {
+                assert!(
+                    !e.to_string().contains("is not supported (supported"),
+                    "{card}: {e}"
+                );
+            }
+        }
+        let raw = crate::fe::nastran::lex("CTRIA6,1\n")
+            .unwrap()
+            .cards
+            .remove(0);
+        let err = Collector::new().card(raw).err().unwrap().to_string();
+        assert!(err.contains(&SUPPORTED_CARDS.join(", ")), "{err}");
+    }
 }

@@ -1,0 +1,191 @@
+//! A deck body's reduction: interface errors name the point and its GRID, a free-free body is
+//! refused as not held (not by the chance sign of a round-off eigenvalue), and the deck's notes
+//! (dropped grids, element-shape warnings) come back with the reduction, from the cache too.
+
+use std::collections::BTreeMap;
+use std::path::PathBuf;
+
+use engine_mount_chassis::cms::{
+    reduce_cached_with_notes, reduce_with_notes, BulkDeckBody, CacheOutcome, CacheSetting,
+    InterfaceDofs, ModeSelection, ReductionSpec,
+};
+use engine_mount_chassis::fe::nastran::{deck_digest, DeckOptions};
+
+/// A 6 × 3 plate of 0.1 m CQUAD4s (GRID 1000 + 10 j + i) with `extra` cards; `lift` raises
+/// GRID 1036 (z, m).
+fn plate(extra: &str, lift: f64) -> String {
+    let mut deck = String::from("BEGIN BULK\nMAT1,1,2.1e11,,0.3,7850.\nPSHELL,1,1,0.002,1,,1\n");
+    for j in 0..4 {
+        for i in 0..7 {
+            let z = if (i, j) == (6, 3) { lift } else { 0.0 };
+            deck += &format!(
+                "GRID,{},,{:?},{:?},{z:?}\n",
+                1000 + 10 * j + i,
+                0.1 * i as f64,
+                0.1 * j as f64
+            );
+        }
+    }
+    for j in 0..3 {
+        for i in 0..6 {
+            let g = 1000 + 10 * j + i;
+            deck += &format!(
+                "CQUAD4,{},1,{g},{},{},{}\n",
+                1 + 6 * j + i,
+                g + 1,
+                g + 11,
+                g + 10
+            );
+        }
+    }
+    deck + extra + "ENDDATA\n"
+}
+
+/// CELAS2 springs to ground on the translations of the plate's corners: the body is held.
+fn corner_springs() -> String {
+    let mut cards = String::new();
+    for (k, g) in [1000, 1006, 1030, 1036].into_iter().enumerate() {
+        for c in 1..=3 {
+            cards += &format!("CELAS2,{},1.e5,{g},{c}\n", 900 + 3 * k + c);
+        }
+    }
+    cards
+}
+
+/// A reduction spec for `deck` written to a fresh folder, mounts at four interior grids
+/// (`mount_c` at `third_mount`).
+fn spec(name: &str, deck: &str, third_mount: u32) -> (ReductionSpec, PathBuf) {
+    let dir = std::env::temp_dir().join(format!("emc-diag-{name}-{}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&dir);
+    std::fs::create_dir_all(&dir).unwrap();
+    let path = dir.join("plate.bdf");
+    std::fs::write(&path, deck).unwrap();
+    let points: BTreeMap<String, u32> = [
+        ("mount_a", 1011),
+        ("mount_b", 1015),
+        ("mount_c", third_mount),
+        ("mount_d", 1025),
+    ]
+    .into_iter()
+    .map(|(n, g)| (n.to_string(), g))
+    .collect();
+    let spec = ReductionSpec {
+        deck: Some(BulkDeckBody {
+            sha256: deck_digest(&path, &DeckOptions::default()).unwrap(),
+            path,
+            points: points.clone(),
+            include_root: None,
+        }),
+        interface: points.keys().cloned().collect(),
+        interface_dofs: InterfaceDofs::Translations,
+        selection: ModeSelection::Count(6),
+        outputs: Vec::new(),
+        ..ReductionSpec::default()
+    };
+    (spec, dir)
+}
+
+#[test]
+fn a_held_plate_reduces_and_its_notes_come_back_from_the_cache() {
+    // GRID 5000 is unused (dropped), CQUAD4 18 is warped 0.1 (> Q4_WARP 0.05): both used to
+    // refuse the deck; now they are notes.
+    let deck = plate(&format!("{}GRID,5000,,3.,3.,3.\n", corner_springs()), 0.04);
+    let (spec, dir) = spec("held", &deck, 1021);
+    let (reduced, notes) = reduce_with_notes(&spec).unwrap();
+    assert_eq!(reduced.n_modes(), 6 + 12);
+    let all = notes.join("\n");
+    assert!(
+        all.contains("1 GRID(s)") && all.contains("GRID 5000"),
+        "{all}"
+    );
+    assert!(all.contains("warped") && all.contains("CQUAD4 18"), "{all}");
+    let cache = CacheSetting::Dir(dir.join("cache"));
+    let (_, first, stored) = reduce_cached_with_notes(&spec, &cache).unwrap();
+    assert!(matches!(first, CacheOutcome::Stored(_)), "{first:?}");
+    let (_, second, read) = reduce_cached_with_notes(&spec, &cache).unwrap();
+    assert!(matches!(second, CacheOutcome::Hit(_)), "{second:?}");
+    assert_eq!((stored, read), (notes.clone(), notes));
+    let _ = std::fs::remove_dir_all(&dir);
+}
+
+#[test]
+fn interface_errors_name_the_point_and_its_grid() {
+    // mount_c on GRID 1021, held in z by an SPC.
+    let deck = plate(&format!("{}SPC1,1,3,1021\n", corner_springs()), 0.0);
+    let (s, dir) = spec("spc", &deck, 1021);
+    let err = reduce_with_notes(&s).unwrap_err().to_string();
+    assert!(
+        err.contains("interface point 'mount_c' (GRID 1021) dof uz is constrained"),
+        "{err}"
+    );
+    let _ = std::fs::remove_dir_all(&dir);
+    // mount_c on a grid no element references.
+    let deck = plate(&format!("{}GRID,5000,,3.,3.,3.\n", corner_springs()), 0.0);
+    let (s, dir) = spec("unused", &deck, 5000);
+    let err = reduce_with_notes(&s).unwrap_err().to_string();
+    assert!(
+        err.contains("interface point 'mount_c' is GRID 5000") && err.contains("dropped"),
+        "{err}"
+    );
+    let _ = std::fs::remove_dir_all(&dir);
+}
+
+#[test]
+fn a_free_free_body_is_refused_as_not_held() {
+    let (s, dir) = spec("free", &plate("", 0.0), 1021);
+    let err = reduce_with_notes(&s).unwrap_err().to_string();
+    assert!(
+        err.contains("the body is not held: 6 reduced mode(s)")
+            && err.contains("springs to ground"),
+        "{err}"
+    );
+    let _ = std::fs::remove_dir_all(&dir);
+}
+
+#[test]
+fn the_deck_notes_reach_the_body_log_line() {
+    use engine_mount_chassis::fe::chassis::Chassis;
+    use engine_mount_chassis::fe::chassis_config::ChassisConfig;
+    use engine_mount_chassis::fe::nastran::write_bulk_deck;
+    use engine_mount_chassis::model::scene::{body, BodyOptions};
+    use engine_mount_chassis::model::{BodyConfig, VehicleConfig};
+
+    // The procedural chassis as a deck with a leftover GRID: the scene's log line for the body
+    // (which the FMU logs at instantiation) carries the note that it was dropped.
+    let procedural = VehicleConfig::default();
+    let chassis = Chassis::build(&ChassisConfig::default()).unwrap();
+    let dir = std::env::temp_dir().join(format!("emc-diag-log-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let path = dir.join("chassis.bdf");
+    let deck = write_bulk_deck(&chassis.mesh)
+        .unwrap()
+        .replace("ENDDATA\n", "GRID,999999,,9.,9.,9.\nENDDATA\n");
+    std::fs::write(&path, deck).unwrap();
+    let mut names: Vec<String> = procedural
+        .mounts
+        .iter()
+        .filter_map(|m| m.body_node.clone())
+        .collect();
+    names.extend(procedural.outputs.iter().cloned());
+    let points: BTreeMap<String, u32> = names
+        .iter()
+        .map(|n| (n.clone(), chassis.node(n).unwrap() as u32 + 1))
+        .collect();
+    let mut vehicle = procedural.clone();
+    vehicle.body = BodyConfig::Nastran {
+        path,
+        points,
+        include_root: None,
+    };
+    let options = BodyOptions {
+        mode_cutoff_hz: 60.0,
+        cache: CacheSetting::Disabled,
+        ..BodyOptions::default()
+    };
+    let (_, note) = body(&vehicle, &options).unwrap();
+    assert!(
+        note.contains("bulk data deck") && note.contains("1 GRID(s)") && note.contains("999999"),
+        "{note}"
+    );
+    let _ = std::fs::remove_dir_all(&dir);
+}
