@@ -4,9 +4,13 @@
 //! θ = 1/(λ − σ) belong to the λ nearest above σ. K − σM is factored once by faer's sparse
 //! Cholesky, so σ must lie below the lowest eigenvalue (use a small negative σ for structures
 //! with rigid-body modes). The Krylov basis is grown a block at a time with full
-//! M-reorthogonalisation (twice, Gram-Schmidt), which keeps it orthogonal to working precision;
-//! the block width (8) resolves eigenvalues of multiplicity up to 8, e.g. the six rigid-body
-//! modes of a free structure. Ritz pairs are accepted when their Lanczos residual is small.
+//! M-reorthogonalisation (Gram-Schmidt, repeated until a pass no longer cancels most of the
+//! vector), which keeps it orthogonal to working precision; the block width (8) resolves
+//! eigenvalues of multiplicity up to 8, e.g. the six rigid-body modes of a free structure. Ritz
+//! pairs are accepted when their Lanczos residual is small against their own θ. Converged Ritz
+//! pairs whose θ stands more than 1000 times above the next (the rigid-body modes at σ = −1)
+//! are locked and the process restarts M-orthogonal to them, so that the projected eigenproblem,
+//! solved to ε times its largest θ, keeps the much smaller θ of the other modes accurate.
 //!
 //! Why not faer's matrix-free `partial_self_adjoint_eigen`: it works in the Euclidean inner
 //! product with a single start vector. The pencil would first have to be symmetrised with M^-1/2
@@ -52,6 +56,8 @@ impl Modes {
 
 const BLOCK: usize = 8;
 const RESIDUAL_TOLERANCE: f64 = 1e-9;
+/// Ratio of a converged Ritz value to the next one above which the leading ones are locked.
+const LOCK_GAP: f64 = 1e3;
 
 /// K − σM as a new sparse matrix.
 fn shifted(k: &SparseMat, m: &SparseMat, shift: f64) -> Result<SparseMat, FeError> {
@@ -66,6 +72,10 @@ fn shifted(k: &SparseMat, m: &SparseMat, shift: f64) -> Result<SparseMat, FeErro
     }
     SparseColMat::try_new_from_triplets(k.nrows(), k.ncols(), &entries)
         .map_err(|e| FeError::Numerical(format!("forming K - shift*M: {e:?}")))
+}
+
+fn norm2(v: &[f64]) -> f64 {
+    v.iter().map(|x| x * x).sum::<f64>().sqrt()
 }
 
 /// Deterministic pseudo-random start vectors (xorshift), so results are reproducible.
@@ -226,6 +236,7 @@ pub fn lowest_modes(
     }
 
     let mut done = 0; // columns whose operator image has been added to the basis
+    let mut locked = 0; // leading columns frozen as converged Ritz vectors
     loop {
         let width = (basis.len - done).min(BLOCK);
         // A block whose new directions would not fit makes the residuals unknowable, unless the
@@ -249,14 +260,37 @@ pub fn lowest_modes(
             }
             let mut v: Vec<f64> = z.col(c).iter().copied().collect();
             let scale = scales[c];
+            let mut before = norm2(&v);
             // Against the vectors this block has added so far.
             let coef = basis.orthogonalise(&mut v, len_before);
             for (k, value) in coef.iter().enumerate() {
                 h[(len_before + k, done + c)] = *value;
             }
-            let rest = v.iter().map(|x| x * x).sum::<f64>().sqrt();
+            let mut rest = norm2(&v);
+            // Whenever a pass cancels most of the vector, its rounding (ε times the norm before)
+            // is no longer small against what is left, and it lies along the whole basis, not
+            // only along the vectors this pass used: repeat against everything until a pass
+            // keeps at least half (Daniel-Gragg-Kaufman-Stewart).
+            let mut independent = true;
+            for pass in 0.. {
+                if rest >= 0.5 * before {
+                    break;
+                }
+                if pass == 3 {
+                    independent = false;
+                    break;
+                }
+                let coef = basis.orthogonalise(&mut v, 0);
+                for (r, value) in coef.iter().enumerate() {
+                    h[(r, done + c)] += *value;
+                }
+                before = rest;
+                rest = norm2(&v);
+            }
             if basis.len < n {
-                if rest > 1e-10 * scale {
+                // What is left may be 1e-13 of the image and still a genuine direction: the
+                // elastic part of a rigid-body-dominated image when θ spans 13 decades.
+                if independent && rest > 1e-14 * scale {
                     let norm = basis.push(&v);
                     h[(basis.len - 1, done + c)] = norm;
                 } else {
@@ -266,49 +300,105 @@ pub fn lowest_modes(
             }
         }
         done += width;
-        if done < n_modes.min(n) {
-            continue;
-        }
-        // Rayleigh-Ritz on the columns whose images are known.
-        let mut t = Mat::<f64>::zeros(done, done);
-        for j in 0..done {
-            for i in 0..done {
-                t[(i, j)] = 0.5 * (h[(i, j)] + h[(j, i)]);
+        // Rayleigh-Ritz on the columns whose images are known, apart from the locked ones.
+        let active = done - locked;
+        let mut t = Mat::<f64>::zeros(active, active);
+        for j in 0..active {
+            for i in 0..active {
+                t[(i, j)] = 0.5 * (h[(locked + i, locked + j)] + h[(locked + j, locked + i)]);
             }
         }
         let evd = t
             .self_adjoint_eigen(Side::Lower)
             .map_err(|e| FeError::Numerical(format!("projected eigenproblem failed: {e:?}")))?;
         let (s, u) = (evd.S(), evd.U());
-        // Largest θ first.
-        let picked: Vec<usize> = (0..done).rev().take(n_modes).collect();
-        let mut all_converged = done == n;
-        if !all_converged {
-            all_converged = picked.iter().all(|&col| {
-                let theta = s[col];
-                let mut residual = 0.0;
-                for r in done..basis.len {
-                    let mut acc = 0.0;
-                    for i in 0..done {
-                        acc += h[(r, i)] * u[(i, col)];
-                    }
-                    residual += acc * acc;
+        let residual = |col: usize| -> f64 {
+            let mut sum = 0.0;
+            for r in done..basis.len {
+                let mut acc = 0.0;
+                for i in 0..active {
+                    acc += h[(r, locked + i)] * u[(i, col)];
                 }
-                theta > 0.0 && residual.sqrt() <= RESIDUAL_TOLERANCE * theta
-            });
+                sum += acc * acc;
+            }
+            sum.sqrt()
+        };
+        let converged = |col: usize| s[col] > 0.0 && residual(col) <= RESIDUAL_TOLERANCE * s[col];
+        // Locking. The dense eigen solve above is accurate to ε‖T‖ = ε θ_max, so a θ far
+        // below the largest is known only to ε θ_max / θ: with σ = −1 on a free steel block
+        // (rigid-body θ = 1, first elastic θ ≈ 1e-9) the elastic eigenvalues would carry
+        // relative errors of 1e-7. Converged Ritz pairs standing far above the rest are
+        // therefore frozen, and the Krylov process restarts M-orthogonal to them: later
+        // projected problems hold only the remaining θ.
+        if done < n && active > 1 {
+            let mut lock = 0;
+            for rank in 0..active - 1 {
+                let col = active - 1 - rank;
+                if !converged(col) {
+                    break;
+                }
+                if s[col] >= LOCK_GAP * s[col - 1].max(0.0) {
+                    lock = rank + 1;
+                }
+            }
+            if lock > 0 {
+                let mut picked_u = Mat::<f64>::zeros(active, lock);
+                for r in 0..lock {
+                    picked_u.col_mut(r).copy_from(u.col(active - 1 - r));
+                }
+                let y = basis.q.as_ref().subcols(locked, active) * &picked_u;
+                let my = basis.mq.as_ref().subcols(locked, active) * &picked_u;
+                basis.q.as_mut().subcols_mut(locked, lock).copy_from(&y);
+                basis.mq.as_mut().subcols_mut(locked, lock).copy_from(&my);
+                let kept: Vec<f64> = (0..locked).map(|i| h[(i, i)]).collect();
+                h.fill(0.0);
+                for (i, theta) in kept.into_iter().enumerate() {
+                    h[(i, i)] = theta;
+                }
+                for r in 0..lock {
+                    h[(locked + r, locked + r)] = s[active - 1 - r];
+                }
+                locked += lock;
+                done = locked;
+                basis.len = locked;
+                for _ in 0..BLOCK.min(n - locked) {
+                    add_fresh(&mut basis, &mut rng)?;
+                }
+                continue;
+            }
         }
+        if done < n_modes.min(n) {
+            continue;
+        }
+        // Largest θ first, locked and active together: (θ, locked basis column or column of u).
+        let mut ritz: Vec<(f64, Result<usize, usize>)> = (0..locked)
+            .map(|i| (h[(i, i)], Ok(i)))
+            .chain((0..active).map(|c| (s[c], Err(c))))
+            .collect();
+        ritz.sort_by(|a, b| b.0.total_cmp(&a.0));
+        ritz.truncate(n_modes);
+        let all_converged = done == n
+            || ritz
+                .iter()
+                .all(|&(_, col)| col.is_ok() || col.is_err_and(converged));
         if all_converged {
             let mut selected = Mat::<f64>::zeros(done, n_modes);
             let mut eigenvalues = Vec::with_capacity(n_modes);
-            for (out, &col) in picked.iter().enumerate() {
-                let theta = s[col];
+            for (out, &(theta, col)) in ritz.iter().enumerate() {
                 if theta.is_nan() || theta <= 0.0 {
                     return Err(FeError::Numerical(format!(
                         "non-positive Ritz value {theta}: K - shift*M is not positive definite"
                     )));
                 }
                 eigenvalues.push(shift + 1.0 / theta);
-                selected.col_mut(out).copy_from(u.col(col));
+                match col {
+                    Ok(i) => selected[(i, out)] = 1.0,
+                    Err(c) => selected
+                        .as_mut()
+                        .col_mut(out)
+                        .subrows_mut(locked, active)
+                        .copy_from(u.col(c)),
+                }
             }
             let shapes = basis.q.as_ref().subcols(0, done) * &selected;
             return Ok(Modes {
