@@ -231,7 +231,7 @@ fn store(path: &Path, entry: &Entry) -> Result<(), String> {
     written.map_err(|e| format!("writing {}: {e}", path.display()))
 }
 
-/// [`reduce`] through the cache selected by `cache`.
+/// [`reduce`](super::reduce::reduce) through the cache selected by `cache`.
 pub fn reduce_cached(
     spec: &ReductionSpec,
     cache: &CacheSetting,

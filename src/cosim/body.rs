@@ -1,5 +1,5 @@
 //! The body FMU's runtime: the vehicle's reduced body alone
-//! ([`BodyAlone`](crate::model::body_alone::BodyAlone)), stepped from one communication point
+//! ([`crate::model::body_alone::BodyAlone`]), stepped from one communication point
 //! to the next under the mount forces given as ramps. Its modal equations are propagated
 //! exactly, so it has no integrator settings; it starts in static equilibrium under the forces
 //! at the start time.

@@ -25,7 +25,7 @@
 //! thickness direction, adequate as a filler in hexahedral meshes.
 //!
 //! Nodes of solids carry no rotational stiffness: assembly removes the rotations of nodes that
-//! receive no rotational stiffness from anything ([`remove_free_rotations`]), as Nastran's
+//! receive no rotational stiffness from anything (`remove_free_rotations`), as Nastran's
 //! AUTOSPC does.
 
 use faer::sparse::Triplet;
