@@ -5,43 +5,9 @@
 use engine_mount_chassis::fe::checks::{check_mesh, check_mesh_named, CheckLimits};
 use engine_mount_chassis::fe::nastran::{parse_str, DeckNames, NastranBody};
 
-/// A 6 × 3 plate of 0.1 m CQUAD4s (GRID 1000 + 10 j + i, CQUAD4 1 + 6 j + i) held by
-/// CELAS2 springs at its corners, with `extra` cards; `lift` raises GRID 1036 (z, m).
-pub fn plate(extra: &str, lift: f64) -> String {
-    let mut deck = String::from("BEGIN BULK\nMAT1,1,2.1e11,,0.3,7850.\nPSHELL,1,1,0.002,1,,1\n");
-    for j in 0..4 {
-        for i in 0..7 {
-            let z = if (i, j) == (6, 3) { lift } else { 0.0 };
-            deck += &format!(
-                "GRID,{},,{:?},{:?},{z:?}\n",
-                1000 + 10 * j + i,
-                0.1 * i as f64,
-                0.1 * j as f64
-            );
-        }
-    }
-    for j in 0..3 {
-        for i in 0..6 {
-            let g = 1000 + 10 * j + i;
-            deck += &format!(
-                "CQUAD4,{},1,{g},{},{},{}\n",
-                1 + 6 * j + i,
-                g + 1,
-                g + 11,
-                g + 10
-            );
-        }
-    }
-    deck += extra;
-    deck += "ENDDATA\n";
-    deck
-}
-
-/// CELAS2 springs to ground on the three translations of the plate's corners.
-pub const CORNER_SPRINGS: &str = "CELAS2,901,1.e6,1000,1\nCELAS2,902,1.e6,1000,2\n\
-CELAS2,903,1.e6,1000,3\nCELAS2,904,1.e6,1006,1\nCELAS2,905,1.e6,1006,2\nCELAS2,906,1.e6,1006,3\n\
-CELAS2,907,1.e6,1030,1\nCELAS2,908,1.e6,1030,2\nCELAS2,909,1.e6,1030,3\nCELAS2,910,1.e6,1036,1\n\
-CELAS2,911,1.e6,1036,2\nCELAS2,912,1.e6,1036,3\n";
+#[path = "../common/plate_deck.rs"]
+mod plate_deck;
+use plate_deck::plate;
 
 fn checked(body: &NastranBody) -> Result<Vec<String>, String> {
     check_mesh_named(
@@ -54,8 +20,9 @@ fn checked(body: &NastranBody) -> Result<Vec<String>, String> {
 
 #[test]
 fn an_unused_grid_is_dropped_with_a_note_naming_it() {
+    let springs = plate_deck::corner_springs(1e6);
     let body = parse_str(&plate(
-        &format!("{CORNER_SPRINGS}GRID,5000,,3.,3.,3.\nGRID,5001,,4.,3.,3.\n"),
+        &format!("{springs}GRID,5000,,3.,3.,3.\nGRID,5001,,4.,3.,3.\n"),
         0.0,
     ))
     .unwrap();
@@ -86,9 +53,10 @@ fn an_unused_grid_is_dropped_with_a_note_naming_it() {
 
 #[test]
 fn messages_name_the_grid_and_the_card_with_its_line() {
+    let springs = plate_deck::corner_springs(1e6);
     // GRID 5000 carries only a CONM2; CQUAD4 40 has a reflex corner (inverted Jacobian).
     let extra = format!(
-        "{CORNER_SPRINGS}GRID,5000,,3.,3.,3.\nCONM2,77,5000,,1.\n\
+        "{springs}GRID,5000,,3.,3.,3.\nCONM2,77,5000,,1.\n\
          GRID,6000,,0.,1.,0.\nGRID,6001,,0.1,1.,0.\nGRID,6002,,0.02,1.02,0.\nGRID,6003,,0.,1.1,0.\n\
          CQUAD4,40,1,6000,6001,6002,6003\nCELAS2,913,1.e6,6000,3\n"
     );
@@ -114,7 +82,7 @@ fn messages_name_the_grid_and_the_card_with_its_line() {
 #[test]
 fn poor_shapes_of_a_deck_are_warnings_and_the_worst_element_is_named() {
     // GRID 1036 raised 0.04 m: CQUAD4 18 has warp 0.1 (limit 0.05 as GEOMCHECK Q4_WARP).
-    let body = parse_str(&plate(CORNER_SPRINGS, 0.04)).unwrap();
+    let body = parse_str(&plate(&plate_deck::corner_springs(1e6), 0.04)).unwrap();
     let notes = checked(&body).unwrap();
     assert_eq!(notes.len(), 1, "{notes:?}");
     assert!(
@@ -127,16 +95,17 @@ fn poor_shapes_of_a_deck_are_warnings_and_the_worst_element_is_named() {
         .to_string();
     assert!(err.contains("shell 17: warped"), "{err}");
     // A mild warp (0.025) that the strict limit (0.01) refused passes a deck silently.
-    let mild = parse_str(&plate(CORNER_SPRINGS, 0.01)).unwrap();
+    let mild = parse_str(&plate(&plate_deck::corner_springs(1e6), 0.01)).unwrap();
     assert_eq!(checked(&mild), Ok(Vec::new()));
     assert!(check_mesh(&mild.mesh, &CheckLimits::default()).is_err());
 }
 
 #[test]
 fn a_tapered_quad_is_counted_and_named() {
+    let springs = plate_deck::corner_springs(1e6);
     // A trapezoid with sides 0.6 and 0.1 m: taper 0.71 beyond the GEOMCHECK default 0.5.
     let extra = format!(
-        "{CORNER_SPRINGS}GRID,6000,,1.2,0.,0.\nGRID,6001,,0.75,-0.1,0.\nGRID,6002,,0.65,-0.1,0.\n\
+        "{springs}GRID,6000,,1.2,0.,0.\nGRID,6001,,0.75,-0.1,0.\nGRID,6002,,0.65,-0.1,0.\n\
          CQUAD4,41,1,1006,6000,6001,6002\n"
     );
     let body = parse_str(&plate(&extra, 0.0)).unwrap();
@@ -150,10 +119,11 @@ fn a_tapered_quad_is_counted_and_named() {
 
 #[test]
 fn grids_held_only_by_springs_or_bushes_are_connected() {
+    let springs = plate_deck::corner_springs(1e6);
     // A wheel-centre grid on a CBUSH to the plate and a grid on a CELAS2 to ground, each with
     // a mass: both were refused as carrying "only masses/springs".
     let extra = format!(
-        "{CORNER_SPRINGS}GRID,7000,,0.3,0.1,-0.2\nPBUSH,3,K,1.e5,1.e5,1.e5,1.e3,1.e3,1.e3\n\
+        "{springs}GRID,7000,,0.3,0.1,-0.2\nPBUSH,3,K,1.e5,1.e5,1.e5,1.e3,1.e3,1.e3\n\
          CBUSH,50,3,7000,1012,,,,0\nCONM2,51,7000,,20.\n\
          GRID,7001,,0.5,0.5,0.5\nCELAS2,52,1.e4,7001,3\nCONM2,53,7001,,1.\n"
     );
