@@ -2,7 +2,7 @@
 //! of a sparse matrix with a dense block of vectors that the reduction needs.
 
 use faer::sparse::{SparseColMat, Triplet};
-use faer::{Mat, MatRef};
+use faer::Mat;
 
 use super::error::CmsError;
 use crate::fe::assembly::SparseMat;
@@ -97,11 +97,6 @@ impl Partition {
     }
 }
 
-/// `A X` for a sparse `a` and a dense block `x` (faer's sparse-dense product).
-pub(crate) fn sparse_times_dense(a: &SparseMat, x: MatRef<'_, f64>) -> Mat<f64> {
-    a.as_ref() * x
-}
-
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -143,14 +138,6 @@ mod tests {
             }
             for (c, &gc) in [3usize, 1].iter().enumerate() {
                 assert_eq!(ib[(r, c)], d[(gr, gc)]);
-            }
-        }
-        let x = Mat::from_fn(4, 2, |i, j| (i * 3 + j) as f64 - 2.5);
-        let y = sparse_times_dense(&a, x.as_ref());
-        let expected = &d * &x;
-        for i in 0..4 {
-            for j in 0..2 {
-                assert!((y[(i, j)] - expected[(i, j)]).abs() < 1e-14);
             }
         }
     }

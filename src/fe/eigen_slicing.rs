@@ -41,12 +41,15 @@
 
 use faer::dyn_stack::{MemBuffer, MemStack};
 use faer::linalg::cholesky::ldlt::factor::LdltRegularization;
+use faer::linalg::matmul::matmul;
+use faer::reborrow::{Reborrow, ReborrowMut};
 use faer::sparse::linalg::cholesky::supernodal::SupernodalLdltRef;
 use faer::sparse::linalg::cholesky::{
     factorize_symbolic_cholesky, LdltRef, SymbolicCholesky, SymbolicCholeskyRaw, SymmetricOrdering,
 };
+use faer::sparse::linalg::matmul::sparse_dense_matmul;
 use faer::sparse::{SparseColMat, SymbolicSparseColMat, Triplet};
-use faer::{Conj, Mat, MatRef, Par, Side};
+use faer::{Accum, Conj, Mat, MatMut, MatRef, Par, Side};
 
 use super::assembly::SparseMat;
 use super::eigen::{lowest_modes, Modes};
@@ -246,7 +249,7 @@ impl<'a> Factorizer<'a> {
         let mut rng = Xorshift(0x2545_F491_4F6C_DD1D);
         let b = Mat::<f64>::from_fn(n, 1, |_, _| rng.next());
         let mut x = b.clone();
-        self.solve(&factor, &mut x);
+        self.solve(&factor, x.as_mut(), &mut self.solve_scratch(1));
         let kx = self.k.as_ref() * x.as_ref();
         let mx = self.m.as_ref() * x.as_ref();
         let r = &kx - sigma * &mx - &b;
@@ -260,16 +263,19 @@ impl<'a> Factorizer<'a> {
         Ok(factor)
     }
 
-    fn solve(&self, factor: &Factor, rhs: &mut Mat<f64>) {
-        let mut mem = MemBuffer::new(
-            self.symbolic
-                .solve_in_place_scratch::<f64>(rhs.ncols(), self.par),
-        );
+    /// Scratch for [`Self::solve`] of up to `cols` right-hand sides.
+    fn solve_scratch(&self, cols: usize) -> MemBuffer {
+        MemBuffer::new(self.symbolic.solve_in_place_scratch::<f64>(cols, self.par))
+    }
+
+    /// `rhs ← (K − σM)⁻¹ rhs` with `mem` from [`Self::solve_scratch`] for at least as many
+    /// columns.
+    fn solve(&self, factor: &Factor, rhs: MatMut<'_, f64>, mem: &mut MemBuffer) {
         LdltRef::new(&self.symbolic, &factor.values).solve_in_place_with_conj(
             Conj::No,
-            rhs.as_mut(),
+            rhs,
             self.par,
-            MemStack::new(&mut mem),
+            MemStack::new(mem),
         );
     }
 }
@@ -411,6 +417,122 @@ struct RunResult {
     complete: bool,
 }
 
+/// Buffers of the Lanczos runs of one sweep, allocated once. At a million DOF the basis is
+/// gigabytes and every n × 8 block 60 MB: allocated afresh on every use, the allocator maps
+/// them and the kernel zeroes every page again (13 % of the time of 500 modes at 928,000 DOF
+/// went to page faults before this).
+struct Workspace {
+    /// Krylov basis, n × capacity; columns beyond the current length are stale.
+    q: Mat<f64>,
+    /// The block being orthogonalised.
+    z: Mat<f64>,
+    /// M times a block.
+    mz: Mat<f64>,
+    /// M times the vectors of the block being appended.
+    mq: Mat<f64>,
+    /// Scratch of the LDLᵀ solves of one block.
+    solve: MemBuffer,
+}
+
+impl Workspace {
+    fn new(f: &Factorizer, capacity: usize) -> Self {
+        let n = f.k.nrows();
+        Workspace {
+            q: Mat::zeros(n, capacity),
+            z: Mat::zeros(n, BLOCK),
+            mz: Mat::zeros(n, BLOCK),
+            mq: Mat::zeros(n, BLOCK),
+            solve: f.solve_scratch(BLOCK),
+        }
+    }
+}
+
+fn dot(a: &[f64], b: &[f64]) -> f64 {
+    a.iter().zip(b).map(|(x, y)| x * y).sum()
+}
+
+/// `y -= alpha · x`.
+fn subtract_scaled(y: &mut [f64], alpha: f64, x: &[f64]) {
+    for (yi, xi) in y.iter_mut().zip(x) {
+        *yi -= alpha * xi;
+    }
+}
+
+/// `dst = M src`.
+fn m_times(m: &SparseMat, dst: MatMut<'_, f64>, src: MatRef<'_, f64>, par: Par) {
+    sparse_dense_matmul(dst, Accum::Replace, m.as_ref(), src, 1.0, par);
+}
+
+/// `(vᵀ mz)ᵀ = mzᵀ v` (mz.ncols() × v.ncols()): the M-inner products of a block with the
+/// vectors `v`. In this orientation faer's product streams `v` (the basis, gigabytes at a
+/// million DOF) 1.4× faster than as `vᵀ mz` (10 against 7 GB/s here): the few columns of
+/// the block are what it packs.
+fn coefficients(v: MatRef<'_, f64>, mz: MatRef<'_, f64>, par: Par) -> Mat<f64> {
+    let mut c = Mat::<f64>::zeros(mz.ncols(), v.ncols());
+    matmul(c.as_mut(), Accum::Replace, mz.transpose(), v, 1.0, par);
+    c
+}
+
+/// M-orthogonalises the columns of `z` against the deflation set and the basis `q`; `mz` is
+/// scratch of `z`'s shape. Returns the coefficients on `q` (q.ncols() × z.ncols()).
+///
+/// The image of a Lanczos block lies mostly along the two newest blocks (the block
+/// three-term recurrence): those are removed first, a cheap local pass. What is left along the
+/// rest of the basis and the deflation set is rounding, so one full pass removes it — the
+/// expensive part, reading the whole basis, memory-bound at a million DOF — and a second full
+/// pass follows only where the first still cancelled more than half of a column's M-norm
+/// (Daniel-Gragg-Kaufman-Stewart). Two full passes every time made 500 modes cost 30 % more
+/// at 234,000 DOF and 6 % more at 928,000 DOF, for the same eigenpairs.
+fn orthogonalise(
+    m: &SparseMat,
+    deflate: &[MatRef<'_, f64>],
+    q: MatRef<'_, f64>,
+    mut z: MatMut<'_, f64>,
+    mut mz: MatMut<'_, f64>,
+    par: Par,
+) -> Mat<f64> {
+    let (len, width) = (q.ncols(), z.ncols());
+    let mut total = Mat::<f64>::zeros(len, width);
+    let m_norms = |z: MatRef<'_, f64>, mz: MatRef<'_, f64>| -> Vec<f64> {
+        (0..width)
+            .map(|c| z.col(c).transpose() * mz.col(c))
+            .collect()
+    };
+    let local = len.min(2 * BLOCK);
+    if local > 0 && local < len {
+        let start = len - local;
+        m_times(m, mz.rb_mut(), z.rb(), par);
+        let qs = q.subcols(start, local);
+        let c = coefficients(qs, mz.rb(), par);
+        matmul(z.rb_mut(), Accum::Add, qs, c.transpose(), -1.0, par);
+        total
+            .as_mut()
+            .subrows_mut(start, local)
+            .copy_from(c.transpose());
+    }
+    m_times(m, mz.rb_mut(), z.rb(), par);
+    for pass in 0..2 {
+        let before = m_norms(z.rb(), mz.rb());
+        for d in deflate {
+            let c = coefficients(*d, mz.rb(), par);
+            matmul(z.rb_mut(), Accum::Add, *d, c.transpose(), -1.0, par);
+        }
+        if len > 0 {
+            let c = coefficients(q, mz.rb(), par);
+            matmul(z.rb_mut(), Accum::Add, q, c.transpose(), -1.0, par);
+            total += c.transpose();
+        }
+        if pass == 0 {
+            m_times(m, mz.rb_mut(), z.rb(), par);
+            let after = m_norms(z.rb(), mz.rb());
+            if before.iter().zip(&after).all(|(b, a)| *a >= 0.5 * b) {
+                break;
+            }
+        }
+    }
+    total
+}
+
 /// One restart-free block Lanczos process at `factor.shift` with at most `capacity` vectors,
 /// M-orthogonal to `deflate`.
 fn lanczos_run(
@@ -418,137 +540,92 @@ fn lanczos_run(
     factor: &Factor,
     deflate: &[MatRef<'_, f64>],
     goal: &Goal,
-    capacity: usize,
+    ws: &mut Workspace,
     seed: u64,
 ) -> Result<RunResult, FeError> {
     let n = f.k.nrows();
     let m = f.m;
+    let par = f.par;
     let shift = factor.shift;
     let deflated: usize = deflate.iter().map(|d| d.ncols()).sum();
-    let capacity = capacity.min(n.saturating_sub(deflated)).max(1);
-    let mut q = Mat::<f64>::zeros(n, capacity);
+    let capacity = ws.q.ncols().min(n.saturating_sub(deflated)).max(1);
     let mut len = 0usize;
     let mut h = Mat::<f64>::zeros(capacity, capacity);
     let mut rng = Xorshift(seed);
 
-    // M-orthogonalises the columns of `z` against the deflation set and q[..len]. Returns the
-    // coefficients on q (len × cols).
-    //
-    // The image of a Lanczos block lies mostly along the two newest blocks (the block
-    // three-term recurrence): those are removed first, a cheap local pass. What is left along the
-    // rest of the basis and the deflation set is rounding, so one full pass removes it — the
-    // expensive part, reading the whole basis, memory-bound at a million DOF — and a second full
-    // pass follows only where the first still cancelled more than half of a column's M-norm
-    // (Daniel-Gragg-Kaufman-Stewart). Two full passes every time made 500 modes cost 30 % more
-    // at 234,000 DOF and 6 % more at 928,000 DOF, for the same eigenpairs.
-    let orthogonalise = |z: &mut Mat<f64>, q: &Mat<f64>, len: usize| -> Mat<f64> {
-        let mut total = Mat::<f64>::zeros(len, z.ncols());
-        let m_norms = |z: &Mat<f64>, mz: &Mat<f64>| -> Vec<f64> {
-            (0..z.ncols())
-                .map(|c| z.col(c).transpose() * mz.col(c))
-                .collect()
-        };
-        let local = len.min(2 * BLOCK);
-        if local > 0 && local < len {
-            let start = len - local;
-            let mz = m.as_ref() * z.as_ref();
-            let qs = q.as_ref().subcols(start, local);
-            let c = qs.transpose() * &mz;
-            *z -= qs * &c;
-            total.as_mut().subrows_mut(start, local).copy_from(&c);
-        }
-        let mut mz = m.as_ref() * z.as_ref();
-        for pass in 0..2 {
-            let before = m_norms(z, &mz);
-            for d in deflate {
-                let c = d.transpose() * &mz;
-                *z -= *d * &c;
-            }
-            if len > 0 {
-                let qs = q.as_ref().subcols(0, len);
-                let c = qs.transpose() * &mz;
-                *z -= qs * &c;
-                total += &c;
-            }
-            if pass == 0 {
-                mz = m.as_ref() * z.as_ref();
-                let after = m_norms(z, &mz);
-                if before.iter().zip(&after).all(|(b, a)| *a >= 0.5 * b) {
-                    break;
-                }
-            }
-        }
-        total
-    };
-    // Appends the columns of `z` (orthogonal to the basis) one by one, orthonormalised among
-    // themselves; a column that vanishes is replaced by a fresh random direction. Returns, per
-    // column, its coefficients on the vectors this call added (the last one its norm).
-    let push_block = |z: Mat<f64>,
-                      q: &mut Mat<f64>,
+    // Appends the first `width` columns of the block buffer (orthogonal to the basis) one by
+    // one, orthonormalised among themselves; a column that vanishes is replaced by a fresh
+    // random direction. Returns, per column, its coefficients on the vectors this call added
+    // (the last one its norm).
+    let push_block = |ws: &mut Workspace,
+                      width: usize,
                       len: &mut usize,
                       scales: &[f64],
                       rng: &mut Xorshift|
      -> Result<Vec<Vec<f64>>, FeError> {
+        let Workspace { q, z, mz, mq, .. } = ws;
         let start = *len;
-        let mut coefs = Vec::with_capacity(z.ncols());
-        let mut mq_new: Vec<Vec<f64>> = Vec::new();
-        for (c, &scale) in scales.iter().enumerate().take(z.ncols()) {
-            let mut v: Vec<f64> = z.col(c).iter().copied().collect();
-            let mut coef = vec![0.0; *len - start];
+        let mut coefs = Vec::with_capacity(width);
+        // Removes from column `c` of z its components along the vectors added so far.
+        let in_block = |z: &mut Mat<f64>, q: &Mat<f64>, mq: &Mat<f64>, c: usize, added: usize| {
+            let mut coef = vec![0.0; added];
             for _ in 0..2 {
                 for (k, total) in coef.iter_mut().enumerate() {
-                    let dot: f64 = v.iter().zip(&mq_new[k]).map(|(a, b)| a * b).sum();
-                    for (vi, qi) in v.iter_mut().zip(q.col(start + k).iter()) {
-                        *vi -= dot * qi;
-                    }
-                    *total += dot;
+                    let v = z.col_as_slice_mut(c);
+                    let d = dot(v, mq.col_as_slice(k));
+                    subtract_scaled(v, d, q.col_as_slice(start + k));
+                    *total += d;
                 }
             }
+            coef
+        };
+        for (c, &scale) in scales.iter().enumerate().take(width) {
+            let added = *len - start;
+            let mut coef = in_block(z, q, mq, c, added);
             if *len >= capacity {
                 coefs.push(coef);
                 continue;
             }
-            let rest = v.iter().map(|x| x * x).sum::<f64>().sqrt();
+            let rest = dot(z.col_as_slice(c), z.col_as_slice(c)).sqrt();
             let mut coupled = true;
             if rest.is_nan() || rest <= 1e-10 * scale {
                 // Invariant subspace: continue with a fresh direction, no coupling.
                 coupled = false;
-                let mut fresh = Mat::<f64>::from_fn(n, 1, |_, _| rng.next());
-                let before = fresh.norm_l2();
-                orthogonalise(&mut fresh, q, *len);
-                for _ in 0..2 {
-                    for k in 0..(*len - start) {
-                        let dot: f64 = fresh
-                            .col(0)
-                            .iter()
-                            .zip(&mq_new[k])
-                            .map(|(a, b)| a * b)
-                            .sum();
-                        for i in 0..n {
-                            fresh[(i, 0)] -= dot * q[(i, start + k)];
-                        }
-                    }
+                for x in z.col_as_slice_mut(c) {
+                    *x = rng.next();
                 }
-                let after = fresh.norm_l2();
+                let before = dot(z.col_as_slice(c), z.col_as_slice(c)).sqrt();
+                orthogonalise(
+                    m,
+                    deflate,
+                    q.as_ref().subcols(0, *len),
+                    z.as_mut().subcols_mut(c, 1),
+                    mz.as_mut().subcols_mut(0, 1),
+                    par,
+                );
+                in_block(z, q, mq, c, added);
+                let after = dot(z.col_as_slice(c), z.col_as_slice(c)).sqrt();
                 if after.is_nan() || after <= 1e-8 * before {
                     return Err(FeError::Numerical(
                         "could not extend the Krylov basis with a new direction".into(),
                     ));
                 }
-                v = fresh.col(0).iter().copied().collect();
             }
-            let mv = m.as_ref() * faer::ColRef::from_slice(&v);
-            let norm = v
-                .iter()
-                .zip(mv.iter())
-                .map(|(a, b)| a * b)
-                .sum::<f64>()
+            m_times(
+                m,
+                mq.as_mut().subcols_mut(added, 1),
+                z.as_ref().subcols(c, 1),
+                par,
+            );
+            let norm = dot(z.col_as_slice(c), mq.col_as_slice(added))
                 .max(0.0)
                 .sqrt();
-            for i in 0..n {
-                q[(i, *len)] = v[i] / norm;
+            for (qi, vi) in q.col_as_slice_mut(*len).iter_mut().zip(z.col_as_slice(c)) {
+                *qi = vi / norm;
             }
-            mq_new.push(mv.iter().map(|x| x / norm).collect());
+            for x in mq.col_as_slice_mut(added) {
+                *x /= norm;
+            }
             *len += 1;
             coef.push(if coupled { norm } else { 0.0 });
             coefs.push(coef);
@@ -557,10 +634,21 @@ fn lanczos_run(
     };
 
     let width0 = BLOCK.min(capacity);
-    let mut start = Mat::<f64>::from_fn(n, width0, |_, _| rng.next());
-    orthogonalise(&mut start, &q, 0);
-    let ones = vec![start.norm_l2(); width0];
-    push_block(start, &mut q, &mut len, &ones, &mut rng)?;
+    for c in 0..width0 {
+        for x in ws.z.col_as_slice_mut(c) {
+            *x = rng.next();
+        }
+    }
+    orthogonalise(
+        m,
+        deflate,
+        ws.q.as_ref().subcols(0, 0),
+        ws.z.as_mut().subcols_mut(0, width0),
+        ws.mz.as_mut().subcols_mut(0, width0),
+        par,
+    );
+    let ones = vec![ws.z.as_ref().subcols(0, width0).norm_l2(); width0];
+    push_block(ws, width0, &mut len, &ones, &mut rng)?;
 
     let mut done = 0usize;
     let mut next_check = (goal.in_slice + goal.above).max(BLOCK);
@@ -568,17 +656,24 @@ fn lanczos_run(
         let width = (len - done).min(BLOCK);
         let full = width == 0 || len + width > capacity;
         if !full {
-            let mut z = Mat::<f64>::zeros(n, width);
-            for c in 0..width {
-                z.col_mut(c).copy_from(q.col(done + c));
-            }
-            let mut mz = m.as_ref() * z.as_ref();
-            f.solve(factor, &mut mz);
-            let mut z = mz;
-            let scales: Vec<f64> = (0..width).map(|c| z.col(c).norm_l2()).collect();
+            m_times(
+                m,
+                ws.z.as_mut().subcols_mut(0, width),
+                ws.q.as_ref().subcols(done, width),
+                par,
+            );
+            f.solve(factor, ws.z.as_mut().subcols_mut(0, width), &mut ws.solve);
+            let scales: Vec<f64> = (0..width).map(|c| ws.z.col(c).norm_l2()).collect();
             let len_before = len;
-            let block_coef = orthogonalise(&mut z, &q, len);
-            let coefs = push_block(z, &mut q, &mut len, &scales, &mut rng)?;
+            let block_coef = orthogonalise(
+                m,
+                deflate,
+                ws.q.as_ref().subcols(0, len),
+                ws.z.as_mut().subcols_mut(0, width),
+                ws.mz.as_mut().subcols_mut(0, width),
+                par,
+            );
+            let coefs = push_block(ws, width, &mut len, &scales, &mut rng)?;
             for c in 0..width {
                 for r in 0..len_before {
                     h[(r, done + c)] = block_coef[(r, c)];
@@ -641,7 +736,7 @@ fn lanczos_run(
             for (out, &c) in keep.iter().enumerate() {
                 selected.col_mut(out).copy_from(u.col(c));
             }
-            let shapes = q.as_ref().subcols(0, done) * &selected;
+            let shapes = ws.q.as_ref().subcols(0, done) * &selected;
             return Ok(RunResult {
                 eigenvalues: keep.iter().map(|&c| lambda(c)).collect(),
                 shapes,
@@ -688,7 +783,7 @@ pub fn sliced_modes(
     }
     let f = Factorizer::new(k, m)?;
     let mut found = Found { blocks: Vec::new() };
-    let capacity = (4 * SLICE_MODES + 4 * BLOCK).min(n);
+    let mut ws = Workspace::new(&f, (4 * SLICE_MODES + 4 * BLOCK).min(n));
 
     // First run at the lower end: the nearest modes above it, as the single-shift solver does.
     let first = f.factor(lower, lower.abs().max(1.0))?;
@@ -709,7 +804,7 @@ pub fn sliced_modes(
             in_slice: 0,
             above: first_goal,
         },
-        capacity,
+        &mut ws,
     )?;
     drop(first);
     let mut previous_width: Option<(f64, usize)> = None;
@@ -727,6 +822,8 @@ pub fn sliced_modes(
                 SliceStop::Count(c) => (a, c),
                 SliceStop::Upper(u) => (u, usize::MAX),
             };
+            // The basis is gigabytes at a million DOF: gone before the modes are gathered.
+            drop(ws);
             return Ok(found.into_modes(n, lower, hi, limit));
         }
         // Density of eigenvalues (per unit λ) from the last slice, else from what is found.
@@ -782,7 +879,7 @@ pub fn sliced_modes(
                 in_slice: in_slice - have,
                 above: 0,
             },
-            capacity,
+            &mut ws,
         )?;
         previous_width = Some((factor.shift - a, in_slice));
         a = factor.shift;
@@ -818,7 +915,7 @@ fn run_slice(
     factor: &Factor,
     found: &mut Found,
     goal: Goal,
-    capacity: usize,
+    ws: &mut Workspace,
 ) -> Result<Vec<f64>, FeError> {
     if goal.in_slice == 0 && goal.above == 0 {
         return Ok(Vec::new());
@@ -831,7 +928,7 @@ fn run_slice(
     loop {
         let result = {
             let deflate = found.near(from);
-            lanczos_run(f, factor, &deflate, &goal, capacity, seed)?
+            lanczos_run(f, factor, &deflate, &goal, ws, seed)?
         };
         seed = seed.wrapping_mul(6_364_136_223_846_793_005).wrapping_add(1);
         let new_in_slice = result

@@ -38,6 +38,7 @@
 
 pub mod assembly;
 pub mod beam;
+pub mod block_product;
 pub mod chassis;
 pub mod chassis_config;
 pub mod checks;
