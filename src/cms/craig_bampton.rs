@@ -18,7 +18,7 @@ use super::sparse_ops::Partition;
 use super::spec::ModeSelection;
 use crate::fe::assembly::SparseMat;
 use crate::fe::block_product::BlockProduct;
-use crate::fe::eigen::{lowest_modes, Modes};
+use crate::fe::eigen::{check_pencil, lowest_modes, Modes};
 use crate::fe::eigen_slicing::{eigenvalue_count, prefer_slicing, sliced_modes, SliceStop};
 use crate::fe::FeError;
 
@@ -242,21 +242,11 @@ pub fn craig_bampton_basis(
     interface: &[usize],
     selection: ModeSelection,
 ) -> Result<CraigBamptonBasis, CmsError> {
+    check_pencil(k, m).map_err(|e| match e {
+        FeError::InvalidInput(what) => CmsError::InvalidInput(what),
+        other => other.into(),
+    })?;
     let n = k.nrows();
-    if k.ncols() != n || m.nrows() != n || m.ncols() != n {
-        return Err(CmsError::InvalidInput(format!(
-            "K is {}x{}, M is {}x{}: both must be square and of equal size",
-            k.nrows(),
-            k.ncols(),
-            m.nrows(),
-            m.ncols()
-        )));
-    }
-    if k.val().iter().chain(m.val()).any(|v| !v.is_finite()) {
-        return Err(CmsError::InvalidInput(
-            "K or M contains a non-finite entry".into(),
-        ));
-    }
     let part = Partition::new(n, interface)?;
     let k_ii = part.interior_block(k, "K")?;
     let m_ii = part.interior_block(m, "M")?;

@@ -152,7 +152,10 @@ impl Basis<'_> {
     }
 }
 
-fn validate(k: &SparseMat, m: &SparseMat, n_modes: usize, shift: f64) -> Result<(), FeError> {
+/// Checks a pencil (K, M) before any solve: both square, of equal size, every entry finite.
+/// Shared by the eigensolvers here and in [`super::eigen_slicing`] and by the Craig-Bampton
+/// reduction.
+pub fn check_pencil(k: &SparseMat, m: &SparseMat) -> Result<(), FeError> {
     let n = k.nrows();
     if k.ncols() != n || m.nrows() != n || m.ncols() != n {
         return Err(FeError::InvalidInput(format!(
@@ -163,6 +166,17 @@ fn validate(k: &SparseMat, m: &SparseMat, n_modes: usize, shift: f64) -> Result<
             m.ncols()
         )));
     }
+    if k.val().iter().chain(m.val()).any(|v| !v.is_finite()) {
+        return Err(FeError::InvalidInput(
+            "K or M contains a non-finite entry".into(),
+        ));
+    }
+    Ok(())
+}
+
+fn validate(k: &SparseMat, m: &SparseMat, n_modes: usize, shift: f64) -> Result<(), FeError> {
+    check_pencil(k, m)?;
+    let n = k.nrows();
     if n_modes == 0 || n_modes > n {
         return Err(FeError::InvalidInput(format!(
             "n_modes = {n_modes} must be in 1..={n}"
@@ -172,11 +186,6 @@ fn validate(k: &SparseMat, m: &SparseMat, n_modes: usize, shift: f64) -> Result<
         return Err(FeError::InvalidInput(format!(
             "shift must be finite, got {shift}"
         )));
-    }
-    if k.val().iter().chain(m.val()).any(|v| !v.is_finite()) {
-        return Err(FeError::InvalidInput(
-            "K or M contains a non-finite entry".into(),
-        ));
     }
     Ok(())
 }

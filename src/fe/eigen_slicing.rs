@@ -52,7 +52,7 @@ use faer::sparse::{SparseColMat, SymbolicSparseColMat, Triplet};
 use faer::{Accum, Conj, Mat, MatMut, MatRef, Par, Side};
 
 use super::assembly::SparseMat;
-use super::eigen::{lowest_modes, Modes};
+use super::eigen::{check_pencil, lowest_modes, Modes};
 use super::error::FeError;
 
 /// Mode count from which [`prefer_slicing`] picks spectrum slicing. Measured on the
@@ -303,29 +303,10 @@ fn negative_pivots(symbolic: &SymbolicCholesky<usize>, values: &[f64]) -> usize 
 /// LDLᵀ = K − shift·M). The shift is moved up slightly if K − shift·M is singular or its
 /// factorization unstable there; the count is for the shift actually used, returned first.
 pub fn eigenvalue_count(k: &SparseMat, m: &SparseMat, shift: f64) -> Result<(f64, usize), FeError> {
-    validate(k, m)?;
+    check_pencil(k, m)?;
     let f = Factorizer::new(k, m)?;
     let factor = f.factor(shift, shift.abs().max(1.0))?;
     Ok((factor.shift, factor.below))
-}
-
-fn validate(k: &SparseMat, m: &SparseMat) -> Result<(), FeError> {
-    let n = k.nrows();
-    if k.ncols() != n || m.nrows() != n || m.ncols() != n {
-        return Err(FeError::InvalidInput(format!(
-            "K is {}x{}, M is {}x{}: both must be square and of equal size",
-            k.nrows(),
-            k.ncols(),
-            m.nrows(),
-            m.ncols()
-        )));
-    }
-    if k.val().iter().chain(m.val()).any(|v| !v.is_finite()) {
-        return Err(FeError::InvalidInput(
-            "K or M contains a non-finite entry".into(),
-        ));
-    }
-    Ok(())
 }
 
 /// Deterministic pseudo-random numbers (xorshift), so results are reproducible.
@@ -761,7 +742,7 @@ pub fn sliced_modes(
     lower: f64,
     stop: SliceStop,
 ) -> Result<Modes, FeError> {
-    validate(k, m)?;
+    check_pencil(k, m)?;
     let n = k.nrows();
     if !lower.is_finite() {
         return Err(FeError::InvalidInput(format!(
@@ -997,7 +978,7 @@ pub fn modes_in_interval(
     lower: f64,
     upper: f64,
 ) -> Result<Modes, FeError> {
-    validate(k, m)?;
+    check_pencil(k, m)?;
     let n = k.nrows();
     if !(lower.is_finite() && upper.is_finite() && upper > lower) {
         return Err(FeError::InvalidInput(format!(
