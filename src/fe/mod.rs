@@ -10,7 +10,8 @@
 //! [`dof::DofMap`]) → [`eigen::lowest_modes`] (sparse Cholesky + shift-invert block Lanczos) →
 //! [`modal::describe`] (torsion, bending, steering wheel, front end …); [`export`] writes K, M
 //! (Matrix Market) and the node/DOF tables. Hundreds of modes: [`eigen_slicing`] (spectrum
-//! slicing over several shifts, completeness by Sturm counts).
+//! slicing over several shifts, completeness by Sturm counts);
+//! [`block_product`] multiplies a sparse matrix by many vectors in one pass per eight of them.
 //!
 //! ```no_run
 //! use engine_mount_chassis::fe::{assembly, chassis, chassis_config, eigen, modal};
