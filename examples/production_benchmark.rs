@@ -32,7 +32,7 @@ use std::path::{Path, PathBuf};
 use std::process::Command;
 use std::time::Instant;
 
-use engine_mount_chassis::cms::InterfaceDofs;
+use engine_mount_chassis::cms::{InterfaceDofs, Partition};
 use engine_mount_chassis::fe::assembly::{assemble, SparseMat};
 use engine_mount_chassis::fe::chassis::{region, Chassis, MountLayout};
 use engine_mount_chassis::fe::chassis_config::ChassisConfig;
@@ -42,7 +42,6 @@ use engine_mount_chassis::fe::mesh::{Material, Mesh};
 use engine_mount_chassis::fe::nastran::{read_bulk_deck_with, write_bulk_deck, DeckOptions};
 use engine_mount_chassis::fe::shell::ShellSection;
 use engine_mount_chassis::model::{BodyConfig, VehicleConfig};
-use faer::sparse::{SparseColMat, Triplet};
 
 use fmu_host::{boolean, integer, real, string};
 use nalgebra::Vector3;
@@ -82,27 +81,11 @@ fn load() -> String {
         .unwrap_or_else(|_| "n/a".into())
 }
 
-/// Rows and columns of `a` not in `interface`.
+/// Rows and columns of `a` not in `interface` (the reduction's own partition).
 fn interior(a: &SparseMat, interface: &[usize]) -> SparseMat {
-    let n = a.nrows();
-    let mut map = vec![usize::MAX; n];
-    let mut next = 0;
-    for (i, slot) in map.iter_mut().enumerate() {
-        if !interface.contains(&i) {
-            *slot = next;
-            next += 1;
-        }
-    }
-    let (cp, ri, v) = (a.symbolic().col_ptr(), a.symbolic().row_idx(), a.val());
-    let mut t = Vec::new();
-    for j in 0..n {
-        for p in cp[j]..cp[j + 1] {
-            if map[ri[p]] != usize::MAX && map[j] != usize::MAX {
-                t.push(Triplet::new(map[ri[p]], map[j], v[p]));
-            }
-        }
-    }
-    SparseColMat::try_new_from_triplets(next, next, &t).expect("interior block")
+    Partition::new(a.nrows(), interface)
+        .and_then(|p| p.interior_block(a, "K or M"))
+        .expect("interior block")
 }
 
 fn hz(l: &[f64]) -> Vec<f64> {

@@ -50,7 +50,7 @@ import numpy as np
 from fmpy import extract, read_model_description
 from fmpy.fmi2 import FMU2Slave
 
-from .runner import logging_callbacks
+from .runner import logging_callbacks, set_value
 
 ALGORITHMS = ("jacobi", "gauss_seidel", "interface_jacobian")
 MOUNTS, AXES = 4, 3
@@ -94,15 +94,7 @@ class Fmu:
         # No stop time declared: the master may probe a step past t_end (body_response).
         self.slave.setupExperiment(startTime=0.0)
         for name, value in values.items():
-            kind, vr = self.kind[name], [self.vr[name]]
-            if kind == "Real":
-                self.slave.setReal(vr, [float(value)])
-            elif kind == "Integer":
-                self.slave.setInteger(vr, [int(value)])
-            elif kind == "Boolean":
-                self.slave.setBoolean(vr, [bool(value)])
-            else:
-                self.slave.setString(vr, [str(value)])
+            set_value(self.slave, self.kind[name], self.vr[name], value)
 
     def errors(self) -> str:
         lines = [line for line in self.log if line.startswith(("[error]", "[fatal]"))]

@@ -41,6 +41,18 @@ class PointFailed(RuntimeError):
         return "\n".join(lines)
 
 
+def set_value(slave: FMU2Slave, kind: str, vr: int, value) -> None:
+    """Sets one variable of type ``kind`` ("Real", "Integer", "Boolean" or "String")."""
+    if kind == "Real":
+        slave.setReal([vr], [float(value)])
+    elif kind == "Integer":
+        slave.setInteger([vr], [int(value)])
+    elif kind == "Boolean":
+        slave.setBoolean([vr], [bool(value)])
+    else:
+        slave.setString([vr], [str(value)])
+
+
 def logging_callbacks(sink: list) -> fmi2CallbackFunctions:
     """FMI callbacks whose logger appends "[status] category: message" lines to ``sink``."""
 
@@ -149,16 +161,7 @@ class Runner:
         return [v.name for v in self.md.modelVariables if v.causality == "output" and v.type == "Real"]
 
     def _set(self, name: str, value):
-        kind = self.kind[name]
-        vr = [self.vr[name]]
-        if kind == "Real":
-            self.slave.setReal(vr, [float(value)])
-        elif kind == "Integer":
-            self.slave.setInteger(vr, [int(value)])
-        elif kind == "Boolean":
-            self.slave.setBoolean(vr, [bool(value)])
-        else:
-            self.slave.setString(vr, [str(value)])
+        set_value(self.slave, self.kind[name], self.vr[name], value)
 
     def _start(self, start_values: dict):
         if not self.fresh:

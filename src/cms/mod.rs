@@ -79,5 +79,6 @@ pub use external::{dmig_of_reduction, reduce_external, DmigBody, ExternalBody};
 pub use hash::sha256_hex;
 pub use reduce::{reduce, reduce_detailed, reduce_with_notes, Reduction};
 pub use reduced::{RecoveryPoint, ReducedChassis};
+pub use sparse_ops::Partition;
 pub use spec::{BulkDeckBody, InterfaceDofs, ModeSelection, ReductionSpec};
 pub use transfer::{PointDof, Response};

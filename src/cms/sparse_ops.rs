@@ -1,5 +1,4 @@
-//! Partitioning of the sparse FE matrices into interior and interface blocks, and the products
-//! of a sparse matrix with a dense block of vectors that the reduction needs.
+//! Partitioning of the sparse FE matrices into interior and interface blocks.
 
 use faer::sparse::{SparseColMat, Triplet};
 use faer::Mat;
@@ -8,7 +7,7 @@ use super::error::CmsError;
 use crate::fe::assembly::SparseMat;
 
 /// Split of the equations into interior (I) and interface/boundary (B) sets.
-pub(crate) struct Partition {
+pub struct Partition {
     /// For every global equation: its interior index, or `None` if it is an interface DOF.
     interior_of: Vec<Option<usize>>,
     /// Global equation of every interior index.

@@ -78,11 +78,13 @@ fn norm2(v: &[f64]) -> f64 {
     v.iter().map(|x| x * x).sum::<f64>().sqrt()
 }
 
-/// Deterministic pseudo-random start vectors (xorshift), so results are reproducible.
-struct Xorshift(u64);
+/// Deterministic pseudo-random start vectors (xorshift), so results are reproducible; shared
+/// with [`super::eigen_slicing`].
+pub(super) struct Xorshift(pub(super) u64);
 
 impl Xorshift {
-    fn next(&mut self) -> f64 {
+    /// The next number, uniform in [−1, 1).
+    pub(super) fn next(&mut self) -> f64 {
         self.0 ^= self.0 << 13;
         self.0 ^= self.0 >> 7;
         self.0 ^= self.0 << 17;

@@ -52,7 +52,7 @@ use faer::sparse::{SparseColMat, SymbolicSparseColMat, Triplet};
 use faer::{Accum, Conj, Mat, MatMut, MatRef, Par, Side};
 
 use super::assembly::SparseMat;
-use super::eigen::{check_pencil, lowest_modes, Modes};
+use super::eigen::{check_pencil, lowest_modes, Modes, Xorshift};
 use super::error::FeError;
 
 /// Mode count from which [`prefer_slicing`] picks spectrum slicing. Measured on the
@@ -307,18 +307,6 @@ pub fn eigenvalue_count(k: &SparseMat, m: &SparseMat, shift: f64) -> Result<(f64
     let f = Factorizer::new(k, m)?;
     let factor = f.factor(shift, shift.abs().max(1.0))?;
     Ok((factor.shift, factor.below))
-}
-
-/// Deterministic pseudo-random numbers (xorshift), so results are reproducible.
-struct Xorshift(u64);
-
-impl Xorshift {
-    fn next(&mut self) -> f64 {
-        self.0 ^= self.0 << 13;
-        self.0 ^= self.0 >> 7;
-        self.0 ^= self.0 << 17;
-        (self.0 >> 11) as f64 / (1u64 << 53) as f64 * 2.0 - 1.0
-    }
 }
 
 /// Eigenpairs found so far, in blocks as they were found.

@@ -12,7 +12,7 @@
 
 use nalgebra::{Matrix2, Vector2, Vector3};
 
-use super::coupled::{ModelError, OutputPoint, MOUNT_MATCH_TOLERANCE};
+use super::coupled::{output_points, point_index, ModelError, OutputPoint, MOUNT_MATCH_TOLERANCE};
 use super::inputs::{InputError, RampInput};
 use super::mount::MountConfig;
 use crate::cms::ReducedChassis;
@@ -53,17 +53,6 @@ pub struct BodyAlone {
     outputs: Vec<OutputPoint>,
     /// Per configured mount: the force on the body, N, per vehicle axis.
     forces: Vec<[RampInput; 3]>,
-}
-
-fn point_index(body: &ReducedChassis, name: &str, what: &str) -> Result<usize, ModelError> {
-    body.points
-        .iter()
-        .position(|p| p.name == name)
-        .ok_or_else(|| {
-            ModelError::Body(format!(
-                "{what} refers to body point '{name}', which the body does not have"
-            ))
-        })
 }
 
 impl BodyAlone {
@@ -113,15 +102,7 @@ impl BodyAlone {
             }
             mount_points.push(Some(p));
         }
-        let outputs = outputs
-            .iter()
-            .map(|name| {
-                Ok(OutputPoint {
-                    name: name.clone(),
-                    point: point_index(&body, name, "an output")?,
-                })
-            })
-            .collect::<Result<Vec<_>, ModelError>>()?;
+        let outputs = output_points(&body, outputs)?;
         Ok(Self {
             forces: vec![[RampInput::ZERO; 3]; mounts.len()],
             body,

@@ -3,6 +3,7 @@
 //! every eigenvalue has a multiplicity above the Lanczos block width and clusters straddle
 //! slice boundaries.
 
+use engine_mount_chassis::cms::Partition;
 use engine_mount_chassis::fe::assembly::{assemble, SparseMat};
 use engine_mount_chassis::fe::chassis::{Chassis, MountLayout};
 use engine_mount_chassis::fe::chassis_config::ChassisConfig;
@@ -13,27 +14,11 @@ use engine_mount_chassis::fe::eigen_slicing::{
 use faer::sparse::{SparseColMat, Triplet};
 use faer::Mat;
 
-/// Rows and columns of `a` not listed in `held`.
+/// Rows and columns of `a` not listed in `held` (the reduction's own partition).
 fn interior(a: &SparseMat, held: &[usize]) -> SparseMat {
-    let n = a.nrows();
-    let mut map = vec![usize::MAX; n];
-    let mut next = 0;
-    for (i, slot) in map.iter_mut().enumerate() {
-        if !held.contains(&i) {
-            *slot = next;
-            next += 1;
-        }
-    }
-    let (cp, ri, v) = (a.symbolic().col_ptr(), a.symbolic().row_idx(), a.val());
-    let mut t = Vec::new();
-    for j in 0..n {
-        for p in cp[j]..cp[j + 1] {
-            if map[ri[p]] != usize::MAX && map[j] != usize::MAX {
-                t.push(Triplet::new(map[ri[p]], map[j], v[p]));
-            }
-        }
-    }
-    SparseColMat::try_new_from_triplets(next, next, &t).unwrap()
+    Partition::new(a.nrows(), held)
+        .and_then(|p| p.interior_block(a, "K or M"))
+        .expect("interior block")
 }
 
 /// The default body with its four mounts held in translation (the reduction's K_II, M_II).

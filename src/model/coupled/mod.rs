@@ -156,7 +156,13 @@ fn check_body(body: &ReducedChassis) -> Result<(), ModelError> {
     Ok(())
 }
 
-fn point_index(body: &ReducedChassis, name: &str, what: &str) -> Result<usize, ModelError> {
+/// Index of the body point `name`; `what` names the reference in the error (which lists the
+/// body's points).
+pub(super) fn point_index(
+    body: &ReducedChassis,
+    name: &str,
+    what: &str,
+) -> Result<usize, ModelError> {
     body.points
         .iter()
         .position(|p| p.name == name)
@@ -170,6 +176,22 @@ fn point_index(body: &ReducedChassis, name: &str, what: &str) -> Result<usize, M
                     .join(", ")
             ))
         })
+}
+
+/// The body points of the named `outputs`, in their order.
+pub(super) fn output_points(
+    body: &ReducedChassis,
+    outputs: &[String],
+) -> Result<Vec<OutputPoint>, ModelError> {
+    outputs
+        .iter()
+        .map(|name| {
+            Ok(OutputPoint {
+                name: name.clone(),
+                point: point_index(body, name, "an output")?,
+            })
+        })
+        .collect()
 }
 
 impl CoupledModel {
@@ -265,15 +287,7 @@ impl CoupledModel {
             }
             .into());
         }
-        let outputs = outputs
-            .iter()
-            .map(|name| {
-                Ok(OutputPoint {
-                    name: name.clone(),
-                    point: point_index(&body, name, "an output")?,
-                })
-            })
-            .collect::<Result<Vec<_>, ModelError>>()?;
+        let outputs = output_points(&body, outputs)?;
         let layout = StateLayout::new(
             powertrain.body_count(),
             follower.is_dynamic(),
