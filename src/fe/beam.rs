@@ -293,6 +293,7 @@ pub fn lumped_mass_with_ends(
 mod tests {
     use super::*;
     use crate::fe::mesh::{BeamSection, Material};
+    use crate::fe::test_support::rigid_motion;
 
     fn beam_along(orientation: Vector3<f64>) -> Beam {
         Beam {
@@ -321,20 +322,7 @@ mod tests {
     fn rigid_motions_are_free(k: &Mat12, p1: &Vector3<f64>, p2: &Vector3<f64>) {
         let scale = k.abs().max();
         for mode in 0..6 {
-            let mut u = SMatrix::<f64, 12, 1>::zeros();
-            for (n, p) in [p1, p2].into_iter().enumerate() {
-                if mode < 3 {
-                    u[6 * n + mode] = 1.0;
-                    continue;
-                }
-                let mut w = Vector3::zeros();
-                w[mode - 3] = 1.0;
-                let t = w.cross(p);
-                for d in 0..3 {
-                    u[6 * n + d] = t[d];
-                    u[6 * n + 3 + d] = w[d];
-                }
-            }
+            let u = SMatrix::<f64, 12, 1>::from_column_slice(&rigid_motion(&[*p1, *p2], mode));
             assert!(
                 (k * u).norm() < 1e-9 * scale,
                 "rigid mode {mode} strains the beam"

@@ -58,5 +58,7 @@ pub mod shell;
 pub mod shell3;
 pub mod solid;
 pub mod spring;
+#[cfg(test)]
+mod test_support;
 
 pub use error::FeError;

@@ -502,6 +502,7 @@ pub fn lumped_mass(index: usize, shell: &Shell, p: &[Vector3<f64>; 4]) -> Result
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::fe::test_support::rigid_motion;
 
     fn plate() -> Shell {
         Shell {
@@ -531,20 +532,7 @@ mod tests {
         let k = stiffness(0, &plate(), &p).unwrap();
         let scale = k.abs().max();
         for mode in 0..6 {
-            let mut u = SMatrix::<f64, 24, 1>::zeros();
-            for (n, x) in p.iter().enumerate() {
-                if mode < 3 {
-                    u[6 * n + mode] = 1.0;
-                } else {
-                    let mut w = Vector3::zeros();
-                    w[mode - 3] = 1.0;
-                    let t = w.cross(x);
-                    for d in 0..3 {
-                        u[6 * n + d] = t[d];
-                        u[6 * n + 3 + d] = w[d];
-                    }
-                }
-            }
+            let u = SMatrix::<f64, 24, 1>::from_column_slice(&rigid_motion(&p, mode));
             assert!(
                 (k * u).norm() < 1e-8 * scale,
                 "rigid mode {mode} strains the shell"

@@ -3,6 +3,7 @@
 //! coupled engine-in-body modes (paper Table 1, middle column) as the procedural chassis itself.
 
 use std::collections::BTreeMap;
+use std::path::Path;
 
 use engine_mount_chassis::cms::CacheSetting;
 use engine_mount_chassis::fe::chassis::Chassis;
@@ -34,31 +35,41 @@ fn modes(vehicle: &VehicleConfig) -> Vec<f64> {
     f
 }
 
-#[test]
-fn the_procedural_chassis_as_a_bulk_deck_gives_the_same_coupled_modes() {
-    let procedural = VehicleConfig::default();
+/// The default vehicle with its procedural chassis written as a bulk data deck
+/// (`dir/chassis.bdf`, the writer's text passed through `edit`), the points its mounts and
+/// outputs use named by GRID id (node index + 1).
+pub(crate) fn default_vehicle_as_deck(
+    dir: &Path,
+    edit: impl FnOnce(String) -> String,
+) -> VehicleConfig {
     let chassis = Chassis::build(&ChassisConfig::default()).expect("chassis");
-    let dir = std::env::temp_dir().join(format!("emc-deck-{}", std::process::id()));
-    std::fs::create_dir_all(&dir).unwrap();
+    std::fs::create_dir_all(dir).unwrap();
     let path = dir.join("chassis.bdf");
-    std::fs::write(&path, write_bulk_deck(&chassis.mesh).expect("deck")).unwrap();
-    // The deck's GRID ids are node index + 1; name the points the mounts and outputs use.
-    let mut names: Vec<String> = procedural
+    std::fs::write(&path, edit(write_bulk_deck(&chassis.mesh).expect("deck"))).unwrap();
+    let mut vehicle = VehicleConfig::default();
+    let mut names: Vec<String> = vehicle
         .mounts
         .iter()
         .filter_map(|m| m.body_node.clone())
         .collect();
-    names.extend(procedural.outputs.iter().cloned());
+    names.extend(vehicle.outputs.iter().cloned());
     let points: BTreeMap<String, u32> = names
         .iter()
         .map(|n| (n.clone(), chassis.node(n).expect("named node") as u32 + 1))
         .collect();
-    let mut from_deck = procedural.clone();
-    from_deck.body = BodyConfig::Nastran {
-        path: path.clone(),
+    vehicle.body = BodyConfig::Nastran {
+        path,
         points,
         include_root: None,
     };
+    vehicle
+}
+
+#[test]
+fn the_procedural_chassis_as_a_bulk_deck_gives_the_same_coupled_modes() {
+    let procedural = VehicleConfig::default();
+    let dir = std::env::temp_dir().join(format!("emc-deck-{}", std::process::id()));
+    let from_deck = default_vehicle_as_deck(&dir, |deck| deck);
     let (a, b) = (modes(&procedural), modes(&from_deck));
     assert_eq!(a.len(), b.len());
     for (x, y) in a.iter().zip(&b) {

@@ -112,39 +112,15 @@ fn a_free_free_body_is_refused_as_not_held() {
 
 #[test]
 fn the_deck_notes_reach_the_body_log_line() {
-    use engine_mount_chassis::fe::chassis::Chassis;
-    use engine_mount_chassis::fe::chassis_config::ChassisConfig;
-    use engine_mount_chassis::fe::nastran::write_bulk_deck;
+    use super::bulk_deck::default_vehicle_as_deck;
     use engine_mount_chassis::model::scene::{body, BodyOptions};
-    use engine_mount_chassis::model::{BodyConfig, VehicleConfig};
 
     // The procedural chassis as a deck with a leftover GRID: the scene's log line for the body
     // (which the FMU logs at instantiation) carries the note that it was dropped.
-    let procedural = VehicleConfig::default();
-    let chassis = Chassis::build(&ChassisConfig::default()).unwrap();
     let dir = std::env::temp_dir().join(format!("emc-diag-log-{}", std::process::id()));
-    std::fs::create_dir_all(&dir).unwrap();
-    let path = dir.join("chassis.bdf");
-    let deck = write_bulk_deck(&chassis.mesh)
-        .unwrap()
-        .replace("ENDDATA\n", "GRID,999999,,9.,9.,9.\nENDDATA\n");
-    std::fs::write(&path, deck).unwrap();
-    let mut names: Vec<String> = procedural
-        .mounts
-        .iter()
-        .filter_map(|m| m.body_node.clone())
-        .collect();
-    names.extend(procedural.outputs.iter().cloned());
-    let points: BTreeMap<String, u32> = names
-        .iter()
-        .map(|n| (n.clone(), chassis.node(n).unwrap() as u32 + 1))
-        .collect();
-    let mut vehicle = procedural.clone();
-    vehicle.body = BodyConfig::Nastran {
-        path,
-        points,
-        include_root: None,
-    };
+    let vehicle = default_vehicle_as_deck(&dir, |deck| {
+        deck.replace("ENDDATA\n", "GRID,999999,,9.,9.,9.\nENDDATA\n")
+    });
     let options = BodyOptions {
         mode_cutoff_hz: 60.0,
         cache: CacheSetting::Disabled,

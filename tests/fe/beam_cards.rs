@@ -10,15 +10,17 @@ use engine_mount_chassis::fe::eigen::lowest_modes;
 use engine_mount_chassis::fe::nastran::{parse_str, write_bulk_deck, NastranBody};
 use nalgebra::{DMatrix, DVector, Matrix3, Vector3};
 
-const E: f64 = 2.1e11;
-const NU: f64 = 0.3;
-const RHO: f64 = 7850.0;
-const A: f64 = 3.0e-4;
-const I1: f64 = 4.0e-8;
-const I2: f64 = 1.0e-8;
-const J: f64 = 5.0e-8;
+// The steel section of every beam test (also `beam_shear`).
+pub(crate) const E: f64 = 2.1e11;
+pub(crate) const NU: f64 = 0.3;
+pub(crate) const RHO: f64 = 7850.0;
+pub(crate) const A: f64 = 3.0e-4;
+pub(crate) const I1: f64 = 4.0e-8;
+pub(crate) const I2: f64 = 1.0e-8;
+pub(crate) const J: f64 = 5.0e-8;
 
-fn r(x: f64) -> String {
+/// A number as a bulk-data field.
+pub(crate) fn r(x: f64) -> String {
     format!("{x:e}")
 }
 

@@ -12,14 +12,10 @@ use engine_mount_chassis::fe::eigen::lowest_modes;
 use engine_mount_chassis::fe::nastran::{parse_str, write_bulk_deck, NastranBody};
 use nalgebra::{DMatrix, DVector};
 
-const E: f64 = 2.1e11;
-const NU: f64 = 0.3;
-const RHO: f64 = 7850.0;
-/// With the short spans below, shear deformation is 0.4–2 % of the deflections.
-const A: f64 = 3.0e-4;
-const I1: f64 = 4.0e-8;
-const I2: f64 = 1.0e-8;
-const J: f64 = 5.0e-8;
+// The steel section of `beam_cards` (A = 3e-4 m², I1 = 4e-8 m⁴, I2 = 1e-8 m⁴): with the short
+// spans below, shear deformation is 0.4–2 % of the deflections.
+use super::beam_cards::{r, A, E, I1, I2, J, NU, RHO};
+
 /// Different factors per plane, so swapping K1 and K2 (or I1 and I2) shows.
 const K1: f64 = 0.5;
 const K2: f64 = 0.8;
@@ -28,19 +24,18 @@ fn g() -> f64 {
     E / (2.0 * (1.0 + NU))
 }
 
-fn r(x: f64) -> String {
-    format!("{x:e}")
-}
-
 fn rel(a: f64, b: f64) -> f64 {
     (a - b).abs() / b.abs()
 }
 
-/// PBAR 5 with K1, K2 on its third line (blank fields for `None`).
-fn pbar(k: [Option<f64>; 2]) -> String {
+/// Property 5 of the section, `card` PBAR or PBEAM (constant section), with K1, K2 on the line
+/// after the stress points (blank fields for `None`: the card's default).
+fn property(card: &str, k: [Option<f64>; 2]) -> String {
     let f = |k: Option<f64>| k.map(r).unwrap_or_default();
+    // PBEAM has the product of inertia I12 before J; PBAR has it after, on its second line.
+    let i12 = if card == "PBEAM" { "0.," } else { "" };
     format!(
-        "PBAR,5,1,{},{},{},{}\n,,,,,,,,\n,{},{}\n",
+        "{card},5,1,{},{},{},{i12}{}\n,,,,,,,,\n,{},{}\n",
         r(A),
         r(I1),
         r(I2),
@@ -50,19 +45,12 @@ fn pbar(k: [Option<f64>; 2]) -> String {
     )
 }
 
-/// PBEAM 5, constant section, K1, K2 on the line after end A's stress points (blank: the
-/// card's default).
+fn pbar(k: [Option<f64>; 2]) -> String {
+    property("PBAR", k)
+}
+
 fn pbeam(k: [Option<f64>; 2]) -> String {
-    let f = |k: Option<f64>| k.map(r).unwrap_or_default();
-    format!(
-        "PBEAM,5,1,{},{},{},0.,{}\n,,,,,,,,\n,{},{}\n",
-        r(A),
-        r(I1),
-        r(I2),
-        r(J),
-        f(k[0]),
-        f(k[1])
-    )
+    property("PBEAM", k)
 }
 
 /// A straight line of `n` elements `card` (CBAR or CBEAM, property 5, element y = basic y)
