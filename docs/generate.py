@@ -266,12 +266,25 @@ def fmi3_terminals() -> str:
 
 
 # ---------------------------------------------------------------------------------------------
+# Supported bulk-data cards: the deck reader's table, printed by an example
+
+
+def supported_cards() -> str:
+    run = subprocess.run(["cargo", "run", "--release", "--quiet", "--example", "supported_cards"],
+                         cwd=ROOT, capture_output=True, text=True)
+    if run.returncode != 0:
+        sys.exit(f"generate: cargo run --example supported_cards failed:\n{run.stderr}")
+    return run.stdout
+
+
+# ---------------------------------------------------------------------------------------------
 # Pages
 
 SECTIONS = {
     "engine-variables": engine_variables,
     "body-variables": body_variables,
     "fmi3-terminals": fmi3_terminals,
+    "supported-cards": supported_cards,
 }
 
 
