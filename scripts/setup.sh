@@ -53,8 +53,9 @@ for p in "${apt_packages[@]}"; do
 done
 if [ ${#missing[@]} -gt 0 ]; then
   echo "setup: installing ${missing[*]} (apt)"
-  $sudo_cmd apt-get update -qq
-  DEBIAN_FRONTEND=noninteractive $sudo_cmd apt-get install -y -qq "${missing[@]}" >/dev/null
+  { $sudo_cmd apt-get update -qq &&
+    DEBIAN_FRONTEND=noninteractive $sudo_cmd apt-get install -y -qq "${missing[@]}" >/dev/null; } ||
+    missing_prerequisite "apt could not install ${missing[*]}: install them, then run this again"
 fi
 
 # --- Python >= 3.11 with venv. -------------------------------------------------------------------
@@ -67,8 +68,8 @@ fi
 version=$("$python" -c 'import sys; print(f"{sys.version_info[0]}.{sys.version_info[1]}")')
 if ! "$python" -c 'import ensurepip, venv' 2>/dev/null; then
   echo "setup: installing python$version-venv (apt): python3 -m venv needs it"
-  $sudo_cmd apt-get update -qq
-  DEBIAN_FRONTEND=noninteractive $sudo_cmd apt-get install -y -qq "python$version-venv" >/dev/null ||
+  { $sudo_cmd apt-get update -qq &&
+    DEBIAN_FRONTEND=noninteractive $sudo_cmd apt-get install -y -qq "python$version-venv" >/dev/null; } ||
     missing_prerequisite "python3 -m venv does not work: install python$version-venv"
 fi
 
