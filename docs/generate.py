@@ -46,6 +46,8 @@ CAUSALITY_ORDER = ["input", "output", "parameter", "calculatedParameter", "struc
 
 
 def fmu_text(fmu: pathlib.Path, member: str) -> str:
+    if not fmu.is_file():
+        sys.exit(f"generate: {fmu.relative_to(ROOT)} is missing: run bash packaging/package.sh first")
     with zipfile.ZipFile(fmu) as z:
         return z.read(member).decode("utf-8")
 
