@@ -126,11 +126,16 @@ fn mode_record(mode: &Mode) -> serde_json::Value {
     })
 }
 
-fn powertrain_record(rigid: &RigidPowertrain, modes: &[Mode]) -> serde_json::Value {
+fn powertrain_record(
+    rigid: &RigidPowertrain,
+    modes: &[Mode],
+    housing: &nalgebra::Vector3<f64>,
+) -> serde_json::Value {
     let axis = |a: &crate::model::coupled::Axis| json!({"point": vector(&a.point), "direction": vector(&a.direction)});
     json!({
         "directions": ["x", "y", "z", "rx", "ry", "rz"],
         "centre_of_mass": vector(&rigid.centre_of_mass),
+        "housing_centre_of_mass": vector(housing),
         "mass": matrix(&rigid.mass),
         "stiffness": matrix(&rigid.stiffness),
         "crank_axis": vector(&rigid.crank_axis),
@@ -231,7 +236,7 @@ fn engine(
     write_json(
         folder,
         "powertrain.json",
-        &powertrain_record(&rigid, &modes),
+        &powertrain_record(&rigid, &modes, &model.powertrain().housing_reference()),
     )?;
     written.files.push("powertrain.json");
     let linear = model.linearise(y)?;
