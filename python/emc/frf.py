@@ -89,7 +89,7 @@ def _tidy(rows: list[dict]) -> pd.DataFrame:
 
 def sine_response(fmu: str, parameters: dict, input_name: str, outputs: list[str],
                   frequency: float, amplitude: float, settle: float = 3.0, ramp: float = 0.5,
-                  cycles: int = 20, steps_per_cycle: int = 200) -> dict[str, complex]:
+                  cycles: int = 20, steps_per_cycle: int = 50) -> dict[str, complex]:
     """Steady response of ``outputs`` per unit of a sine on ``input_name`` at ``frequency``,
     from the FMU in the time domain: the sine's amplitude rises smoothly over ``ramp`` s (so
     that the modes far from the frequency are hardly excited), ``settle`` s pass, and the
@@ -137,4 +137,52 @@ def sine_response(fmu: str, parameters: dict, input_name: str, outputs: list[str
     u = 2.0 / applied.size * np.sum(applied * np.exp(-1j * w * at))
     return {o: y[k] / u for k, o in enumerate(outputs)}
 
-__all__ = ["AXES", "body_frf", "coupled_frf", "sine_response", "linear_output_name"]
+def plot(table: pd.DataFrame, path: str, unit: str, title: str, top: int | None = None,
+         checks: pd.DataFrame | None = None, marks: dict | None = None):
+    """Magnitude (log) and phase over frequency, one line per input (the ``top`` largest at
+    their peak if given); ``checks`` (frequency, input, amplitude, phase_deg) from the sine
+    excitation as points; ``marks`` {label: Hz} as vertical lines (e.g. an order at a speed)."""
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    inputs = list(dict.fromkeys(table.input))
+    if top is not None:
+        peaks = table.groupby("input").amplitude.max().sort_values(ascending=False)
+        inputs = [i for i in peaks.index[:top]]
+    fig, (ax, ax_phase) = plt.subplots(2, 1, figsize=(9, 7), sharex=True,
+                                       gridspec_kw={"height_ratios": [2, 1]})
+    for k, name in enumerate(inputs):
+        d = table[table.input == name].sort_values("frequency")
+        label = d.path.iloc[0]
+        ax.plot(d.frequency, d.amplitude, color=f"C{k % 10}", lw=1.3, label=label)
+        ax_phase.plot(d.frequency, d.phase_deg, color=f"C{k % 10}", lw=1.0)
+        if checks is not None:
+            c = checks[checks.input == name]
+            if len(c):
+                ax.scatter(c.frequency, c.amplitude, color=f"C{k % 10}", edgecolor="k", s=40,
+                           zorder=3, label="time-domain sine excitation" if k == 0 else None)
+                ax_phase.scatter(c.frequency, c.phase_deg, color=f"C{k % 10}", edgecolor="k",
+                                 s=30, zorder=3)
+    for label, hz in (marks or {}).items():
+        for a in (ax, ax_phase):
+            a.axvline(hz, color="0.4", ls=":", lw=1.0)
+        ax.text(hz, table.amplitude.max(), f" {label}",
+                fontsize=8, va="top", color="0.3")
+    ax.set_yscale("log")
+    ax.set_ylabel(f"magnitude [{unit}]")
+    ax.grid(True, which="both", alpha=0.3)
+    ax.legend(fontsize=8, ncol=2)
+    ax_phase.set_ylim(-180, 180)
+    ax_phase.set_yticks([-180, -90, 0, 90, 180])
+    ax_phase.set_ylabel("phase [deg]")
+    ax_phase.set_xlabel("frequency [Hz]")
+    ax_phase.grid(True, alpha=0.3)
+    ax.set_title(title, fontsize=10)
+    fig.tight_layout()
+    fig.savefig(path, dpi=120)
+    plt.close(fig)
+
+
+__all__ = ["AXES", "body_frf", "coupled_frf", "sine_response", "linear_output_name", "plot"]

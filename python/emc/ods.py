@@ -60,7 +60,7 @@ def operating_shape(export: Export, samples: dict, revolutions: int, rpm: float,
 
 
 def write_vtu(shape: dict, path: str):
-    """The shape as an unstructured grid (ASCII VTU through meshio): the body's cells, then the
+    """The shape as an unstructured grid (binary VTU through meshio): the body's cells, then the
     powertrain as lines from its centre to each bracket and between the brackets. Point data:
     ``displacement`` (real part: the shape at phase 0), ``displacement_imag`` (phase 90°),
     ``amplitude`` (m); cell data ``part`` (0 body, 1 powertrain)."""
@@ -83,7 +83,7 @@ def write_vtu(shape: dict, path: str):
                        point_data={"displacement": u.real, "displacement_imag": u.imag,
                                    "amplitude": np.sqrt(np.sum(np.abs(u) ** 2, axis=1))},
                        cell_data={"part": part})
-    meshio.write(path, mesh, file_format="vtu", binary=False)
+    meshio.write(path, mesh, file_format="vtu", binary=True, compression=None)
 
 
 def plot(shape: dict, path: str, title: str = "", scale: float | None = None,
@@ -110,21 +110,24 @@ def plot(shape: dict, path: str, title: str = "", scale: float | None = None,
     fig = plt.figure(figsize=(10, 6.5))
     ax = fig.add_subplot(projection="3d")
     cmap = plt.get_cmap("viridis")
-    top = amplitude.max() or 1.0
+    # The colour scale ends at the 97th percentile: a steering wheel swinging ten times more
+    # than the floor would otherwise leave the whole body one colour.
+    top = float(np.percentile(amplitude, 97.0)) or float(amplitude.max()) or 1.0
     for kind in ("quad", "triangle"):
         cells = np.asarray(shape["cells"].get(kind, []), dtype=int)
         if len(cells) == 0:
             continue
         ax.add_collection3d(Poly3DCollection(nodes[cells], facecolor="none", edgecolor="0.85",
                                              linewidths=0.2))
-        colours = cmap(amplitude[cells].mean(axis=1) / top)
+        colours = cmap(np.minimum(amplitude[cells].mean(axis=1) / top, 1.0))
         ax.add_collection3d(Poly3DCollection(deformed[cells], facecolors=colours,
-                                             edgecolor="0.3", linewidths=0.1, alpha=0.9))
+                                             edgecolor=colours, linewidths=0.1, alpha=0.45))
     beams = np.asarray(shape["cells"].get("line", []), dtype=int)
     if len(beams):
         ax.add_collection3d(Line3DCollection(deformed[beams],
-                                             colors=cmap(amplitude[beams].mean(axis=1) / top),
-                                             linewidths=1.2))
+                                             colors=cmap(np.minimum(
+                                                 amplitude[beams].mean(axis=1) / top, 1.0)),
+                                             linewidths=1.8))
     points = shape["points"] + scale * pt
     if len(points) > 1:
         segments = [[points[0], p] for p in points[1:]]
@@ -139,12 +142,13 @@ def plot(shape: dict, path: str, title: str = "", scale: float | None = None,
     ax.set_ylim(centre[1] - half, centre[1] + half)
     ax.set_zlim(centre[2] - half * 0.6, centre[2] + half * 0.6)
     ax.set_box_aspect((1, 1, 0.6))
-    ax.view_init(elev=22, azim=-135)
+    ax.view_init(elev=24, azim=-50)
     ax.set_xlabel("x [m]")
     ax.set_ylabel("y [m]")
     ax.set_zlabel("z [m]")
     mappable = plt.cm.ScalarMappable(cmap=cmap, norm=plt.Normalize(0, top * 1e6))
-    fig.colorbar(mappable, ax=ax, shrink=0.6, label="amplitude [µm]")
+    fig.colorbar(mappable, ax=ax, shrink=0.6, extend="max",
+                 label=f"amplitude [µm] (largest {amplitude.max() * 1e6:.0f} µm)")
     ax.set_title(title or f"Operating deflection shape, order {shape['order']:g} at "
                           f"{shape['rpm']:g} rpm ({shape['frequency']:.1f} Hz), "
                           f"magnified {scale:.0f}×", fontsize=10)

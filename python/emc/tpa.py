@@ -131,3 +131,84 @@ def dominant_path(table: pd.DataFrame, rpm: float, order: float, response: str,
     """The path with the largest in-phase share of the response at one speed and order."""
     r = ranked(table, rpm, order, response, case)
     return r.loc[r.in_phase.idxmax()]
+
+
+def _pyplot():
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    return plt
+
+
+def plot_ranked(table: pd.DataFrame, rpm: float, order: float, response: str, path: str,
+                names: dict | None = None, case: str = "", top: int = 12):
+    """Ranked path contributions at one speed and order: amplitude bars (the part in phase
+    with the total darker), each path's phase beside it, and the sum of the paths against the
+    simulated response."""
+    plt = _pyplot()
+    r = ranked(table, rpm, order, response, case).head(top)
+    at = table[(table.case == case) & (table.response == response) & (table.order == order)
+               & np.isclose(table.rpm, rpm)]
+    total = at[at.path == "sum"].amplitude.iloc[0]
+    simulated = at[at.path == "simulated"].amplitude
+    labels = [path_label(int(m), AXES.index(d) + 1, names) for m, d in zip(r.mount, r.direction)]
+    fig, (ax, ax_phase) = plt.subplots(1, 2, figsize=(10, 0.42 * len(r) + 2.4), sharey=True,
+                                       gridspec_kw={"width_ratios": [3, 1]})
+    y = np.arange(len(r))[::-1]
+    ax.barh(y, r.amplitude, color="tab:blue", alpha=0.35, label="|contribution|")
+    ax.barh(y, r.in_phase, color="tab:blue", label="part in phase with the total")
+    ax.axvline(total, color="tab:red", lw=1.5, label=f"sum of paths {total:.3g}")
+    if len(simulated):
+        ax.axvline(simulated.iloc[0], color="k", ls="--", lw=1.0,
+                   label=f"simulated {simulated.iloc[0]:.3g}")
+    ax.axvline(0, color="0.3", lw=0.6)
+    ax.set_yticks(y, labels, fontsize=8)
+    ax.set_xlabel(f"{response} order {order:g} [m/s²]")
+    ax.legend(fontsize=8, loc="lower right")
+    ax.grid(True, axis="x", alpha=0.3)
+    ax_phase.scatter(r.phase_deg, y, color="tab:blue")
+    total_phase = at[at.path == "sum"].phase_deg.iloc[0]
+    ax_phase.axvline(total_phase, color="tab:red", lw=1.5)
+    ax_phase.set_xlim(-180, 180)
+    ax_phase.set_xticks([-180, -90, 0, 90, 180])
+    ax_phase.set_xlabel("phase [deg]")
+    ax_phase.grid(True, alpha=0.3)
+    fig.suptitle(f"Transfer paths to {response}, order {order:g} at {rpm:g} rpm "
+                 f"({order * rpm / 60:.1f} Hz){': ' + case if case else ''}", fontsize=10)
+    fig.tight_layout()
+    fig.savefig(path, dpi=120)
+    plt.close(fig)
+
+
+def plot_over_speed(table: pd.DataFrame, order: float, response: str, path: str,
+                    names: dict | None = None, case: str = "", top: int = 6):
+    """The largest path contributions of one order over engine speed, with their sum and the
+    simulated response."""
+    plt = _pyplot()
+    data = table[(table.case == case) & (table.response == response) & (table.order == order)]
+    paths = data[~data.path.isin(["sum", "simulated"])]
+    biggest = paths.groupby("path").amplitude.max().sort_values(ascending=False).head(top).index
+    fig, ax = plt.subplots(figsize=(9, 5.5))
+    for k, p in enumerate(biggest):
+        d = paths[paths.path == p].sort_values("rpm")
+        m, direction = int(d.mount.iloc[0]), d.direction.iloc[0]
+        ax.plot(d.rpm, d.amplitude, color=f"C{k}", marker="o", ms=3, lw=1.2,
+                label=path_label(m, AXES.index(direction) + 1, names))
+    total = data[data.path == "sum"].sort_values("rpm")
+    ax.plot(total.rpm, total.amplitude, color="k", lw=2.2, label="sum of the 12 paths")
+    simulated = data[data.path == "simulated"].sort_values("rpm")
+    if len(simulated):
+        ax.plot(simulated.rpm, simulated.amplitude, color="w", ls="--", lw=1.0,
+                label="simulated (dashed over the sum)")
+    ax.set_yscale("log")
+    ax.set_xlabel("engine speed [rpm]")
+    ax.set_ylabel(f"{response}, order {order:g} [m/s²]")
+    ax.set_title(f"Path contributions of order {order:g} to {response}"
+                 f"{': ' + case if case else ''}", fontsize=10)
+    ax.grid(True, which="both", alpha=0.3)
+    ax.legend(fontsize=8)
+    fig.tight_layout()
+    fig.savefig(path, dpi=120)
+    plt.close(fig)

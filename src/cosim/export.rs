@@ -150,6 +150,7 @@ fn powertrain_record(
             "body_point": m.body_point,
             "stiffness": matrix(&m.stiffness),
             "damping": matrix(&m.damping),
+            "force": vector(&m.force),
         })).collect::<Vec<_>>(),
         "modes": modes.iter().map(mode_record).collect::<Vec<_>>(),
     })

@@ -51,6 +51,10 @@ pub struct MountStiffness {
     pub stiffness: Matrix3<f64>,
     /// The same for the relative velocity (N s/m), with the damping scale.
     pub damping: Matrix3<f64>,
+    /// The static force on the body at the equilibrium (N, vehicle axes): turning with the
+    /// powertrain, it adds the geometric stiffness `−[−F]× [x − c]×` that a 6×6 problem from
+    /// the tangent stiffness alone leaves out.
+    pub force: Vector3<f64>,
 }
 
 /// The powertrain as one rigid body on its mounts at the static equilibrium.
@@ -161,6 +165,7 @@ impl CoupledModel {
                 },
                 stiffness: k,
                 damping: -r.damping(),
+                force: -r.force,
             });
         }
         let crank_axis = ev.kinematics[0].rotation * Vector3::y();
