@@ -155,3 +155,22 @@ def plot(shape: dict, path: str, title: str = "", scale: float | None = None,
     fig.tight_layout()
     fig.savefig(path, dpi=120)
     plt.close(fig)
+
+
+def modal_contributions(shape: dict, export: Export, point: str, dof: int,
+                        top: int = 6) -> "pd.DataFrame":
+    """Which of the body's modes carry a point's motion in the shape: ``φ_point,k · η_k`` per
+    mode, largest first, with its share of the motion in phase with the whole."""
+    import pandas as pd
+
+    body = export.body
+    parts = body.point(point)[:, dof] * shape["modal"]
+    total = parts.sum()
+    in_phase = (parts * np.conj(total)).real / max(abs(total), 1e-300)
+    table = pd.DataFrame({"mode": np.arange(1, len(parts) + 1),
+                          "frequency_hz": body.omega / (2 * np.pi), "damping": body.zeta,
+                          "amplitude": np.abs(parts), "share": in_phase / max(abs(total), 1e-300)})
+    descriptions = (export.mesh or {}).get("mode_descriptions") or []
+    if len(descriptions) == len(parts):
+        table["description"] = descriptions
+    return table.sort_values("amplitude", ascending=False).head(top).reset_index(drop=True)

@@ -212,3 +212,31 @@ def plot_over_speed(table: pd.DataFrame, order: float, response: str, path: str,
     fig.tight_layout()
     fig.savefig(path, dpi=120)
     plt.close(fig)
+
+
+def plot_cases(table: pd.DataFrame, order: float, response: str, path_name: str,
+               cases: list[str], path: str, names: dict | None = None, at: float | None = None):
+    """One path and the whole response of one order over speed, case beside case: what a change
+    does to the path it aims at and to the response."""
+    plt = _pyplot()
+    fig, ax = plt.subplots(figsize=(9, 5.5))
+    data = table[(table.response == response) & (table.order == order)]
+    for k, case in enumerate(cases):
+        d = data[data.case == case]
+        total = d[d.path == "sum"].sort_values("rpm")
+        one = d[d.path == path_name].sort_values("rpm")
+        label = case or "model"
+        ax.plot(total.rpm, total.amplitude, color=f"C{k}", lw=2.0, label=f"{label}: {response}")
+        ax.plot(one.rpm, one.amplitude, color=f"C{k}", lw=1.2, ls="--",
+                label=f"{label}: path {path_name}")
+    if at is not None:
+        ax.axvline(at, color="0.5", lw=0.8, ls=":")
+    ax.set_yscale("log")
+    ax.set_xlabel("engine speed [rpm]")
+    ax.set_ylabel(f"order {order:g} [m/s²]")
+    ax.set_title(f"Order {order:g} of {response} and its path {path_name}, per case", fontsize=10)
+    ax.grid(True, which="both", alpha=0.3)
+    ax.legend(fontsize=8)
+    fig.tight_layout()
+    fig.savefig(path, dpi=120)
+    plt.close(fig)

@@ -108,6 +108,22 @@ def check_order(order: float):
 
 # ----- emc tpa ---------------------------------------------------------------------------------
 
+def tpa_case(args, variables: dict, label: str, parameters: dict, speeds: list[float],
+             responses: list[str]) -> tuple[pd.DataFrame, object]:
+    """One case: its export, its speed points, its path contributions."""
+    export = export_for(args, parameters)
+    if export.body is None:
+        raise _cli().UsageError("transfer paths need the elastic body: --set scene=2")
+    check_responses(responses, export, variables)
+    recorded = [r for r in responses if r in variables]
+    samples = run_points(args, parameters, speeds, tpa.force_signals(export) + recorded,
+                         args.revolutions, args.steps_per_rev, case=label)
+    table = pd.concat([tpa.contributions(export, r, samples[rpm], args.revolutions, rpm,
+                                         case=label)
+                       for rpm in speeds for r in responses], ignore_index=True)
+    return table, export
+
+
 def cmd_tpa(args) -> int:
     cli = _cli()
     cli.check_range("--count", args.count, 1)
@@ -115,60 +131,84 @@ def cmd_tpa(args) -> int:
     if args.revolutions < 2 or args.revolutions % 2:
         raise cli.UsageError(f"--revolutions must be even and >= 2, got {args.revolutions}")
     check_order(args.order)
-    variables, cases = cli.prepare(args, cases_wanted=False)
+    variables, cases = cli.prepare(args)
     cli.check_speeds(args.rpm, increasing=args.count > 1, highest=cli.highest_speed(variables))
-    parameters = with_closing_tolerance(cases[0][1])
+    cases = [(label, with_closing_tolerance(parameters)) for label, parameters in cases]
     at = args.at if args.at is not None else args.rpm[0]
     if not args.rpm[0] <= at <= args.rpm[1]:
         raise cli.UsageError(f"--at {at:g} rpm is outside the sweep --rpm {args.rpm[0]:g} "
                              f"{args.rpm[1]:g}")
-    cli.reduction_notice(parameters, variables)
-    export = export_for(args, parameters)
-    if export.body is None:
-        raise cli.UsageError("transfer paths need the elastic body: --set scene=2")
-    responses = check_responses(args.response or ["steeringWheel.a[3]"], export, variables)
+    responses = args.response or ["steeringWheel.a[3]"]
+    for r in responses:
+        try:
+            body_point_of(r)
+        except ValueError as error:
+            raise cli.UsageError(f"--response {r}: {error}") from None
+    cli.reduction_notice(cases[0][1], variables)
     speeds = sorted(set(np.round(np.linspace(args.rpm[0], args.rpm[1], args.count), 6)) | {at})
-    recorded = [r for r in responses if r in variables]
-    signals = tpa.force_signals(export) + recorded
     out = pathlib.Path(args.out)
     out.mkdir(parents=True, exist_ok=True)
     started = time.perf_counter()
-    samples = run_points(args, parameters, speeds, signals, args.revolutions, args.steps_per_rev)
-    tables = [tpa.contributions(export, r, samples[rpm], args.revolutions, rpm)
-              for rpm in speeds for r in responses]
+    tables, exports = [], {}
+    for label, parameters in cases:
+        table, exports[label] = tpa_case(args, variables, label, parameters, speeds, responses)
+        tables.append(table)
     table = pd.concat(tables, ignore_index=True)
     cli.save(table, str(out / "tpa.csv"))
-    names = _mount_names(export)
+    names = _mount_names(exports[cases[0][0]])
     summary = {}
+    recorded = [r for r in responses if r in variables]
     if recorded:
         closure = tpa.closure(table[table.response.isin(recorded)])
         cli.save(closure, str(out / "closure.csv"))
         significant = closure[closure.significant]
         summary["closure_max_relative_error"] = float(significant.relative_error.max())
+    labels = [label for label, _ in cases]
     for r in responses:
         name = cli.safe_name(r)
-        tpa.plot_ranked(table, at, args.order, r, str(out / f"tpa_ranked_{name}.png"), names)
-        if len(speeds) > 1:
-            tpa.plot_over_speed(table, args.order, r, str(out / f"tpa_over_speed_{name}.png"),
-                                names)
-        ranked = tpa.ranked(table, at, args.order, r)
-        print(f"{r}, order {args.order:g} at {at:g} rpm ({args.order * at / 60:.1f} Hz):")
-        shown = ranked[["path", "amplitude", "phase_deg", "in_phase", "share"]].head(6).copy()
-        shown["path"] = [tpa.path_label(int(m), tpa.AXES.index(d) + 1, names)
-                         for m, d in zip(ranked.mount[:6], ranked.direction[:6])]
-        print(shown.to_string(index=False, float_format=lambda v: f"{v:.4g}"))
-        dominant = tpa.dominant_path(table, at, args.order, r)
-        summary[r] = {"dominant_path": str(dominant.path), "share": float(dominant.share)}
-    cli.write_metadata(out, args, variables, [("", parameters)],
+        for label in labels:
+            suffix = f"_{cli.safe_name(label)}" if label else ""
+            tpa.plot_ranked(table, at, args.order, r,
+                            str(out / f"tpa_ranked_{name}{suffix}.png"), names, case=label)
+            if len(speeds) > 1:
+                tpa.plot_over_speed(table, args.order, r,
+                                    str(out / f"tpa_over_speed_{name}{suffix}.png"), names,
+                                    case=label)
+            ranked = tpa.ranked(table, at, args.order, r, case=label)
+            print(f"{r}, order {args.order:g} at {at:g} rpm ({args.order * at / 60:.1f} Hz)"
+                  f"{', case ' + repr(label) if label else ''}:")
+            shown = ranked[["amplitude", "phase_deg", "in_phase", "share"]].head(6).copy()
+            shown.insert(0, "path", [tpa.path_label(int(m), tpa.AXES.index(d) + 1, names)
+                                     for m, d in zip(ranked.mount[:6], ranked.direction[:6])])
+            print(shown.to_string(index=False, float_format=lambda v: f"{v:.4g}"))
+            dominant = tpa.dominant_path(table, at, args.order, r, case=label)
+            total = tpa.complex_values(table[(table.case == label) & (table.response == r)
+                                             & (table.order == args.order)
+                                             & np.isclose(table.rpm, at)
+                                             & (table.path == "sum")])[0]
+            summary.setdefault(r, {})[label] = {"dominant_path": str(dominant.path),
+                                                "share": float(dominant.share),
+                                                "dominant_amplitude": float(dominant.amplitude),
+                                                "total_amplitude": float(abs(total))}
+        if len(cases) > 1:
+            first = summary[r][labels[0]]["dominant_path"]
+            tpa.plot_cases(table, args.order, r, first, labels,
+                           str(out / f"tpa_cases_{name}.png"), names, at=at)
+            print(f"{r}, order {args.order:g} at {at:g} rpm, {first} and the total per case:")
+            for label in labels:
+                one = tpa.ranked(table, at, args.order, r, case=label).set_index("path")
+                print(f"  {label or 'model'}: {first} {one.amplitude[first]:.4g}, total "
+                      f"{summary[r][label]['total_amplitude']:.4g}")
+    cli.write_metadata(out, args, variables, cases,
                        {"tpa": {"speeds": speeds, "at": at, "order": args.order,
                                 "responses": responses, "revolutions": args.revolutions,
                                 "steps_per_revolution": args.steps_per_rev, **summary},
-                        "export": export.manifest})
+                        "export": exports[cases[0][0]].manifest})
     if "closure_max_relative_error" in summary:
         print(f"closure: the 12 paths add up to the simulated response within "
               f"{summary['closure_max_relative_error']:.2e} (every order above 1 % of the "
               "largest)")
-    print(f"{len(speeds)} points in {time.perf_counter() - started:.1f} s -> {out}")
+    print(f"{len(cases) * len(speeds)} points in {time.perf_counter() - started:.1f} s -> {out}")
     return 0
 
 
@@ -287,6 +327,12 @@ def cmd_ods(args) -> int:
             row.update({"simulated_displacement": abs(a / -w**2),
                         "relative_difference": abs(u - a / -w**2) / abs(a / -w**2)})
         rows.append(row)
+    for r in args.compare:
+        point, dof = body_point_of(r)
+        modes = ods.modal_contributions(shape, export, point, dof)
+        cli.save(modes, str(out / f"{stem}_modes_{cli.safe_name(r)}.csv"))
+        print(f"body modes carrying {r} (displacement, share in phase with the whole):")
+        print(modes.to_string(index=False, float_format=lambda v: f"{v:.4g}"))
     points = pd.DataFrame(rows)
     if len(points):
         cli.save(points, str(out / f"{stem}_points.csv"))
@@ -379,6 +425,9 @@ def add_parsers(sub) -> None:
     t.add_argument("--response", action="append",
                    help="acceleration to explain: steeringWheel.a[1..3], seat.a[1..3] or "
                         "<body point>.a[1..3] (repeatable; default steeringWheel.a[3])")
+    t.add_argument("--case", action="append", metavar="NAME[:NAME=VALUE,...]",
+                   help="a case with its own settings on top of --set (repeatable): each case "
+                        "is analysed and the first case's dominant path compared across them")
     window(t, 8, 72)
     t.set_defaults(func=cmd_tpa)
 

@@ -33,6 +33,9 @@ pub struct FullRecovery {
     /// Cells by VTK type name (`quad`, `triangle`, `line`, `tetra`, `hexahedron`, `wedge`,
     /// `tetra10`), each a list of node indices.
     pub cells: Vec<(&'static str, Vec<Vec<usize>>)>,
+    /// What each mode is (torsion, steering wheel vertical, …; [`crate::chassis::modal`]), where
+    /// the body's regions allow a description (empty otherwise).
+    pub descriptions: Vec<String>,
 }
 
 /// The cells of `mesh` grouped by type.
@@ -84,6 +87,8 @@ pub fn recover_all_nodes(
     let n_nodes = reduction.chassis.mesh.nodes.len();
     let m = body.n_modes();
     let mut shapes = vec![0.0; n_nodes * 6 * m];
+    let described = reduction.describe_modes().ok();
+    let mut descriptions = Vec::with_capacity(m);
     for (k, &w) in body.omega.iter().enumerate() {
         let hz = w / (2.0 * std::f64::consts::PI);
         let j = recomputed
@@ -123,6 +128,9 @@ pub fn recover_all_nodes(
                 diff.sqrt() / norm.sqrt().max(f64::MIN_POSITIVE)
             )));
         }
+        if let Some(d) = described.as_ref().and_then(|d| d.get(j)) {
+            descriptions.push(d.kind_label());
+        }
         // Node motion = T · (the mode over the equations).
         let (cp, ri, val) = (
             transformation.symbolic().col_ptr(),
@@ -145,6 +153,11 @@ pub fn recover_all_nodes(
         shapes,
         modes: m,
         cells: cells(mesh),
+        descriptions: if descriptions.len() == m {
+            descriptions
+        } else {
+            Vec::new()
+        },
     })
 }
 

@@ -192,7 +192,7 @@ fn write_full_recovery(
     write_json(
         folder,
         "mesh.json",
-        &json!({"nodes": full.nodes, "cells": cells}),
+        &json!({"nodes": full.nodes, "cells": cells, "mode_descriptions": full.descriptions}),
     )?;
     write_file(
         folder,
