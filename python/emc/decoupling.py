@@ -156,21 +156,21 @@ def plot(rows: pd.DataFrame, path: str, title: str = "", axis: dict | None = Non
     import matplotlib.pyplot as plt
 
     values = rows[[f"KE_{d} [%]" for d in DIRECTIONS]].to_numpy()
-    fig, ax = plt.subplots(figsize=(7.5, 0.55 * len(rows) + 2.2))
+    fig, ax = plt.subplots(figsize=(7.5, 0.5 * len(rows) + 1.9))
     image = ax.imshow(np.clip(values, 0, 100), cmap="Blues", vmin=0, vmax=100, aspect="auto")
     for (r, c), v in np.ndenumerate(values):
-        ax.text(c, r, f"{v:.0f}", ha="center", va="center", fontsize=9,
-                color="white" if v > 55 else "black")
+        ax.text(c, r, f"{v:.0f}" if abs(v) >= 0.5 else "0", ha="center", va="center",
+                fontsize=9, color="white" if v > 55 else "black")
     ax.set_xticks(range(6), ["x (lateral)", "y (axial)", "z (vertical)", "rx (pitch)",
                              "ry (roll)", "rz (yaw)"], fontsize=8)
     ax.set_yticks(range(len(rows)), [f"{f:.2f} Hz" for f in rows.frequency_hz], fontsize=9)
     ax.set_xlabel("kinetic energy at the powertrain's centre of mass [%]")
     fig.colorbar(image, ax=ax, shrink=0.8, label="%")
-    if axis is not None:
-        ax.text(0.0, -0.32 - 0.02 * len(rows), f"torque-roll axis vs the mounts' elastic axis: "
-                f"{axis['angle_deg']:.1f}° apart, elastic axis {1e3 * axis['offset_m']:.0f} mm "
-                "from the centre of mass", transform=ax.transAxes, fontsize=8)
     ax.set_title(title or "Decoupling table of the powertrain's rigid modes", fontsize=10)
-    fig.tight_layout()
+    if axis is not None:
+        fig.text(0.02, 0.02, f"torque-roll axis vs the mounts' elastic axis: "
+                 f"{axis['angle_deg']:.1f}° apart, elastic axis {1e3 * axis['offset_m']:.0f} mm "
+                 "from the centre of mass", fontsize=8)
+    fig.tight_layout(rect=(0, 0.05, 1, 1))
     fig.savefig(path, dpi=120)
     plt.close(fig)

@@ -12,16 +12,12 @@ use nalgebra::{Matrix3, Matrix6, Vector3, Vector6};
 use super::evaluate::Mode;
 use super::{CoupledModel, MountTarget};
 
-/// `[a]×`: the matrix of `a × ·`.
-pub(super) fn skew(a: &Vector3<f64>) -> Matrix3<f64> {
-    Matrix3::new(0.0, -a.z, a.y, a.z, 0.0, -a.x, -a.y, a.x, 0.0)
-}
-
 /// `T` with `v_ref = T v_at` for the twist `[velocity, ω]` of a rigid body taken at two points
 /// `r = ref − at` apart: `v_ref = v_at + ω × r`.
 pub(super) fn shift(r: &Vector3<f64>) -> Matrix6<f64> {
     let mut t = Matrix6::identity();
-    t.fixed_view_mut::<3, 3>(0, 3).copy_from(&(-skew(r)));
+    t.fixed_view_mut::<3, 3>(0, 3)
+        .copy_from(&(-r.cross_matrix()));
     t
 }
 
@@ -153,7 +149,7 @@ impl CoupledModel {
             g.fixed_view_mut::<3, 3>(0, 0)
                 .copy_from(&Matrix3::identity());
             g.fixed_view_mut::<3, 3>(0, 3)
-                .copy_from(&(-skew(&(bracket - cg))));
+                .copy_from(&(-(bracket - cg).cross_matrix()));
             stiffness += g.transpose() * k * g;
             mounts.push(MountStiffness {
                 index: i,
