@@ -6,6 +6,8 @@ Examples:
     emc sweep ... --scheduler tcp://10.0.0.5:8786        # a running Dask cluster
     emc runup --fmu dist/EngineMountChassis.fmu --rpm 800 2500 --duration 20 --out out/runup
     emc accuracy --set configFile=/path/my_car.json --out out/accuracy  # what accuracy costs
+    emc tpa --rpm 800 2500 --at 1100 --order 1.5 --out out/tpa   # which mount path carries it
+    emc frf / emc ods --rpm-point 1100 / emc decoupling --out ...  # transfer functions, shapes, mounts
 
 Every command runs scene 2 (the engine in the elastic body) unless --set scene=1. A case is
 --case NAME or --case NAME:name=value,name=value (repeatable; the common --set values apply to
@@ -820,6 +822,9 @@ def build_parser() -> argparse.ArgumentParser:
     from .accuracy import add_parser as add_accuracy
 
     add_accuracy(sub)
+    from .why import add_parsers as add_why
+
+    add_why(sub)
     return parser
 
 

@@ -19,16 +19,28 @@ def amplitude_spectrum(x: np.ndarray, dt: float) -> tuple[np.ndarray, np.ndarray
     return np.fft.rfftfreq(n, dt), amplitude
 
 
-def order_amplitudes(x: np.ndarray, revolutions: int, orders) -> dict[float, float]:
-    """Amplitude of each engine order in a window of exactly ``revolutions`` crank revolutions."""
-    x = np.asarray(x, dtype=float) - np.mean(x)
+def order_components(x: np.ndarray, revolutions: int, orders) -> np.ndarray:
+    """Complex amplitude ``X`` of each engine order in a window of exactly ``revolutions`` crank
+    revolutions, ``x(t) ≈ Re(X e^{iωt})`` with t from the first sample: (orders,) for one signal,
+    (orders, signals) for samples × signals."""
+    x = np.asarray(x, dtype=float)
+    x = x - np.mean(x, axis=0)
     n = len(x)
-    spectrum = np.fft.rfft(x)
-    result = {}
+    spectrum = np.fft.rfft(x, axis=0)
+    bins = []
     for order in orders:
         k = order * revolutions
         if abs(k - round(k)) > 1e-9:
             raise ValueError(f"order {order} does not fall on a bin of a {revolutions}-revolution window")
-        k = int(round(k))
-        result[float(order)] = 2.0 * abs(spectrum[k]) / n if 0 < k < len(spectrum) else float("nan")
-    return result
+        bins.append(int(round(k)))
+    out = np.full((len(bins),) + spectrum.shape[1:], np.nan + 0j)
+    for row, k in enumerate(bins):
+        if 0 < k < len(spectrum):
+            out[row] = 2.0 * spectrum[k] / n
+    return out
+
+
+def order_amplitudes(x: np.ndarray, revolutions: int, orders) -> dict[float, float]:
+    """Amplitude of each engine order in a window of exactly ``revolutions`` crank revolutions."""
+    amplitudes = np.abs(order_components(x, revolutions, orders))
+    return {float(order): float(a) for order, a in zip(orders, amplitudes)}

@@ -13,7 +13,9 @@ use crate::cosim::{
     self, BodyOption, BodyOptions, EffectSwitch, Input, Replaced, SceneKind, Settings,
     VehicleOverrides, VehicleSetting,
 };
-use crate::variables::{boolean, integer, real, string, Parameters, BOOLEANS, INTEGERS, REALS};
+use crate::variables::{
+    boolean, integer, real, string, Parameters, BOOLEANS, INTEGERS, REALS, STRINGS,
+};
 
 /// The Boolean parameter of an effect switch.
 fn effect_parameter(switch: EffectSwitch) -> u32 {
@@ -93,6 +95,20 @@ pub fn settings(
                 (true, "") => CacheSetting::Default,
                 (true, dir) => CacheSetting::Dir(PathBuf::from(dir)),
             },
+        },
+        export: match p.analysis_export_folder.trim() {
+            "" if p.analysis_full_recovery => {
+                return Err(format!(
+                    "{} = true needs {}: the folder to write the shapes to",
+                    BOOLEANS[boolean::ANALYSIS_FULL_RECOVERY as usize].name,
+                    STRINGS[string::ANALYSIS_EXPORT_FOLDER as usize].name
+                ))
+            }
+            "" => None,
+            folder => Some(cosim::ExportRequest {
+                folder: PathBuf::from(folder),
+                full_recovery: p.analysis_full_recovery,
+            }),
         },
     })
 }
