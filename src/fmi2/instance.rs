@@ -406,9 +406,13 @@ impl Instance {
         {
             self.ensure_simulation()?;
         }
+        let calculated = |i: &usize| causality(i) == Causality::CalculatedParameter;
+        if indices.iter().any(calculated) {
+            parameters::write_derived_parameters(&mut self.core.values)?;
+        }
         if indices
             .iter()
-            .any(|i| causality(i) == Causality::CalculatedParameter)
+            .any(|i| calculated(i) && !parameters::is_derived_parameter(T::table()[*i].vr))
         {
             self.ensure_natural_modes()?;
         }

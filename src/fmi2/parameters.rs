@@ -175,6 +175,19 @@ pub fn write_effective_parameters(values: &mut Values, runtime: &cosim::Runtime)
     }
 }
 
+/// The calculated parameters that follow from the parameters alone, written when one is read so
+/// that reading them builds no model: the chassis mode cut-off in use.
+pub fn write_derived_parameters(values: &mut Values) -> Result<(), String> {
+    let cutoff = settings(values, None, None)?.chassis.cutoff_hz();
+    values.reals.put(real::CHASSIS_MODE_CUTOFF_IN_USE, cutoff);
+    Ok(())
+}
+
+/// Whether the variable with value reference `vr` is one [`write_derived_parameters`] writes.
+pub fn is_derived_parameter(vr: u32) -> bool {
+    vr == REALS[real::CHASSIS_MODE_CUTOFF_IN_USE as usize].vr
+}
+
 /// The runtime's inputs from the Real input signals, from `time` on (SI units).
 pub fn inputs_from(tracks: &[InputTrack], time: f64) -> cosim::Inputs {
     inputs_by(|index, scale| {

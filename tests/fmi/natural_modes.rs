@@ -3,7 +3,7 @@
 //! Truth: the analytic frequencies of the decoupled rigid mount layout and the paper's Table 1.
 
 use crate::common::*;
-use engine_mount_chassis::fmi2::variables::{boolean, integer, real};
+use engine_mount_chassis::fmi2::variables::{boolean, integer, real, string};
 use engine_mount_chassis::paper::{TABLE1_RIGID, TABLE1_RING_CARRIER};
 
 const TWO_PI: f64 = 2.0 * std::f64::consts::PI;
@@ -157,4 +157,43 @@ fn a_stiffer_front_plate_raises_the_steering_wheel_modes_in_the_elastic_body() {
         pv > v * 1.005 && pl > l * 1.005,
         "steering wheel {v:.2} / {l:.2} Hz -> {pv:.2} / {pl:.2} Hz"
     );
+}
+
+#[test]
+fn the_chassis_cutoff_in_use_is_read_from_the_parameters_without_building_a_model() {
+    // Truth: the rule the parameters' descriptions state, 2500 rpm / 60 × order 4.5 × 1.2 =
+    // 225 Hz by default; an explicit chassis.modeCutoff is used as given. A configuration file
+    // that does not exist would fail any model build: the read must not need one.
+    let fmu = Fmu::load();
+    let cases: [(&[(u32, f64)], f64); 3] = [
+        (&[], 225.0),
+        (
+            &[
+                (real::SCENE_MAX_RPM, 4000.0),
+                (real::SCENE_MAX_ENGINE_ORDER, 3.0),
+            ],
+            240.0,
+        ),
+        (&[(real::CHASSIS_MODE_CUTOFF, 400.0)], 400.0),
+    ];
+    for (k, (parameters, want)) in cases.iter().enumerate() {
+        let s = fmu.instantiate(&format!("cutoff-{k}"));
+        assert_eq!(s.set_integer(&[integer::SCENE], &[2]), OK);
+        assert_eq!(
+            s.set_string(&[string::CONFIG_FILE], &["/nonexistent/vehicle.json"]),
+            OK
+        );
+        for (index, value) in parameters.iter() {
+            assert_eq!(s.set_real(&[*index], &[*value]), OK);
+        }
+        s.setup(0.0, None);
+        assert_eq!(s.enter_init(), OK);
+        let (status, cutoff) = s.get_real(&[real::CHASSIS_MODE_CUTOFF_IN_USE]);
+        assert_eq!(status, OK, "{:?}", s.logs());
+        assert!(
+            (cutoff[0] - want).abs() < 1e-9,
+            "case {k}: {} Hz",
+            cutoff[0]
+        );
+    }
 }
