@@ -11,7 +11,7 @@ use std::path::PathBuf;
 
 use super::input_track::InputTrack;
 use super::logger::{Level, Logger};
-use super::parameters;
+use super::parameters::{self, Calculated};
 use super::state::Phase;
 use super::values::{Num, Store, Typed, Values, VarType};
 use super::variables::{integer, real, Causality, LogCategory, Variability, Variable, REALS};
@@ -406,14 +406,19 @@ impl Instance {
         {
             self.ensure_simulation()?;
         }
-        let calculated = |i: &usize| causality(i) == Causality::CalculatedParameter;
-        if indices.iter().any(calculated) {
+        let needs = |what: Calculated| {
+            indices.iter().any(|i| {
+                causality(i) == Causality::CalculatedParameter
+                    && parameters::calculated(T::table()[*i].vr) == what
+            })
+        };
+        if needs(Calculated::FromParameters) {
             parameters::write_derived_parameters(&mut self.core.values)?;
         }
-        if indices
-            .iter()
-            .any(|i| calculated(i) && !parameters::is_derived_parameter(T::table()[*i].vr))
-        {
+        if needs(Calculated::FromModel) {
+            self.ensure_simulation()?;
+        }
+        if needs(Calculated::NaturalModes) {
             self.ensure_natural_modes()?;
         }
         let values = self.core.values.of::<T>().as_slice();

@@ -197,3 +197,54 @@ fn the_chassis_cutoff_in_use_is_read_from_the_parameters_without_building_a_mode
         );
     }
 }
+
+#[test]
+fn static_mount_deflections_carry_the_load_torque_as_the_mount_rates_say() {
+    // Truth: at the design position the preloads carry the weight, so without a load torque the
+    // static deflections are zero; a load torque T about the crank axis (y) turns the powertrain
+    // on the mounts, and for the small turn the static deflections answer like linear springs:
+    // doubling every mount's stiffness halves them, and T and −T give deflections of opposite
+    // sign and (nearly) equal size.
+    let fmu = Fmu::load();
+    let deflections = |torque: f64, scale: f64| -> Vec<f64> {
+        let s = fmu.instantiate(&format!("static-{torque}-{scale}"));
+        assert_eq!(s.set_integer(&[integer::SCENE], &[1]), OK);
+        assert_eq!(s.set_real(&[real::LOAD_TORQUE], &[torque]), OK);
+        for i in real::MOUNT_STIFFNESS_SCALE {
+            assert_eq!(s.set_real(&[i], &[scale]), OK);
+        }
+        s.setup(0.0, None);
+        assert_eq!(s.enter_init(), OK);
+        let vrs: Vec<u32> = real::MOUNT_STATIC_DEFLECTION
+            .iter()
+            .flatten()
+            .copied()
+            .collect();
+        let (status, d) = s.get_real(&vrs);
+        assert_eq!(status, OK, "{:?}", s.logs());
+        d
+    };
+    assert!(deflections(0.0, 1.0).iter().all(|d| d.abs() < 1e-6));
+    let soft = deflections(50.0, 1.0);
+    let stiff = deflections(50.0, 2.0);
+    let reverse = deflections(-50.0, 1.0);
+    let largest = soft.iter().fold(0.0_f64, |m, d| m.max(d.abs()));
+    assert!(largest > 1e-4 && largest < 3e-3, "{soft:?}");
+    for k in 0..soft.len() {
+        if soft[k].abs() < 0.05 * largest {
+            continue;
+        }
+        assert!(
+            (stiff[k] / soft[k] - 0.5).abs() < 0.02,
+            "{k}: {} vs {}",
+            stiff[k],
+            soft[k]
+        );
+        assert!(
+            (reverse[k] / soft[k] + 1.0).abs() < 0.02,
+            "{k}: {} vs {}",
+            reverse[k],
+            soft[k]
+        );
+    }
+}
