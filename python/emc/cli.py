@@ -46,6 +46,7 @@ DEFAULT_PARAMETERS = {"scene": 2}
 BOOLEAN_SPELLINGS = {"true": True, "1": True, "yes": True, "on": True,
                      "false": False, "0": False, "no": False, "off": False}
 HIGHEST_ORDER = 6.5  # what the analysis resolves (orders 0.5 … 6 and the band to 6.5)
+CUTOFF_IN_USE = "chassis.modeCutoffInUse"
 # Inputs and parameters each point's speed, load and start come from: set by the command's own
 # options, never by --set (a --set rpm would run every point at that speed, labelled otherwise).
 CONTROLLED = {"rpm": "--rpm", "loadTorque": "--load-torque", "initialization.periodic": "--start"}
@@ -136,12 +137,22 @@ def start_value(variables: dict, parameters: dict, name: str):
     return None if v is None or v.start is None else float(v.start)
 
 
+def cutoffs_in_use(fmu: str, cases: list[tuple[str, dict]]) -> list[float | None]:
+    """The chassis mode cut-off (Hz) each case's body keeps, as the FMU reports it
+    (``chassis.modeCutoffInUse``; None for an FMU without it)."""
+    with Runner(fmu) as runner:
+        if CUTOFF_IN_USE not in runner.vr:
+            return [None for _ in cases]
+        return [runner.initial_values(parameters, [CUTOFF_IN_USE])[0] for _, parameters in cases]
+
+
 def sampling_warnings(variables: dict, parameters: dict, rpm_from: float, rpm_to: float,
                       steps_per_revolution: int | None = None,
-                      step: float | None = None) -> list[str]:
+                      step: float | None = None, cutoff: float | None = None) -> list[str]:
     """What the chosen sampling and speeds cannot represent: aliasing and speeds beyond what the
     chassis model covers. A sweep samples ``steps_per_revolution`` times per revolution, a run-up
-    every ``step`` seconds."""
+    every ``step`` seconds; ``cutoff`` is the chassis mode cut-off in use (Hz,
+    :func:`cutoffs_in_use`)."""
     warnings = []
     scene = int(start_value(variables, parameters, "scene") or 1)
     if step is not None:
@@ -161,10 +172,9 @@ def sampling_warnings(variables: dict, parameters: dict, rpm_from: float, rpm_to
                         f"analysis reaches order {HIGHEST_ORDER:g} ({remedy})")
     max_rpm = start_value(variables, parameters, "scene.maxRpm")
     max_order = start_value(variables, parameters, "scene.maxEngineOrder")
-    cutoff = start_value(variables, parameters, "chassis.modeCutoff") or 0.0
-    if scene == 2 and max_rpm is not None and max_order is not None:
-        if cutoff <= 0.0:
-            cutoff = max_rpm / 60.0 * max_order * 1.2
+    automatic = (start_value(variables, parameters, "chassis.modeCutoff") or 0.0) <= 0.0
+    if scene == 2 and cutoff is not None and max_rpm is not None and max_order is not None:
+        if automatic:
             if rpm_to > max_rpm:
                 warnings.append(f"speeds up to {rpm_to:g} rpm exceed scene.maxRpm = {max_rpm:g}: "
                                 f"the automatic chassis cut-off ({cutoff:.0f} Hz) covers order "
@@ -434,7 +444,8 @@ def cmd_sweep(args) -> int:
     check_speeds(args.rpm, increasing=args.count > 1, highest=highest_speed(variables))
     signals = analysed_signals(args, variables, default_signals(variables))
     warn_cases([(label, sampling_warnings(variables, parameters, args.rpm[0], args.rpm[1],
-                                          args.steps_per_rev)) for label, parameters in cases])
+                                          args.steps_per_rev, cutoff=cutoff))
+                for (label, parameters), cutoff in zip(cases, cutoffs_in_use(args.fmu, cases))])
     reduction_notice(cases[0][1], variables)
     out = pathlib.Path(args.out)
     out.mkdir(parents=True, exist_ok=True)
@@ -488,7 +499,8 @@ def cmd_runup(args) -> int:
     signals = analysed_signals(args, variables, ["mount[1].F[3]"])
     periodic = args.start == "periodic" and "initialization.periodic" in variables
     warn_cases([(label, sampling_warnings(variables, parameters, args.rpm[0], args.rpm[1],
-                                          step=args.step)) for label, parameters in cases])
+                                          step=args.step, cutoff=cutoff))
+                for (label, parameters), cutoff in zip(cases, cutoffs_in_use(args.fmu, cases))])
     reduction_notice(cases[0][1], variables)
     out = pathlib.Path(args.out)
     out.mkdir(parents=True, exist_ok=True)
@@ -643,8 +655,9 @@ def run_study(args, cases: dict) -> int:
                 raise UsageError(f"this FMU lacks {key}, which case {name!r} needs")
     signals = analysed_signals(args, variables, STUDY_SIGNALS)
     study = [(name, case_parameters(common, params)) for name, params in cases.items()]
-    warn_cases([(label, sampling_warnings(variables, parameters, args.rpm[0], args.rpm[1], 72))
-                for label, parameters in study])
+    warn_cases([(label, sampling_warnings(variables, parameters, args.rpm[0], args.rpm[1], 72,
+                                          cutoff=cutoff))
+                for (label, parameters), cutoff in zip(study, cutoffs_in_use(args.fmu, study))])
     reduction_notice(study[0][1], variables)
     out = pathlib.Path(args.out)
     out.mkdir(parents=True, exist_ok=True)

@@ -53,6 +53,17 @@ def set_value(slave: FMU2Slave, kind: str, vr: int, value) -> None:
         slave.setString([vr], [str(value)])
 
 
+def mount_count(names: Iterable[str]) -> int:
+    """How many mounts an FMU has: the highest ``i`` of its variables ``mount[i].…`` (``names``:
+    the variable names of its model description)."""
+    found = [int(m.group(1)) for name in names if (m := re.match(r"mount\[(\d+)\]\.", name))]
+    return max(found, default=0)
+
+
+def variable_names(model_description) -> list[str]:
+    return [v.name for v in model_description.modelVariables]
+
+
 def logging_callbacks(sink: list) -> fmi2CallbackFunctions:
     """FMI callbacks whose logger appends "[status] category: message" lines to ``sink``."""
 
@@ -163,7 +174,9 @@ class Runner:
     def _set(self, name: str, value):
         set_value(self.slave, self.kind[name], self.vr[name], value)
 
-    def _start(self, start_values: dict):
+    def _start(self, start_values: dict, initialise: bool = True):
+        """Back to the instantiated state (reset), the start values set, initialisation mode
+        entered and, if ``initialise``, left."""
         if not self.fresh:
             self.slave.reset()
         self.fresh = False
@@ -171,7 +184,29 @@ class Runner:
         for name, value in start_values.items():
             self._set(name, value)
         self.slave.enterInitializationMode()
-        self.slave.exitInitializationMode()
+        if initialise:
+            self.slave.exitInitializationMode()
+
+    def get(self, names: Iterable[str]) -> list:
+        """The current values of the variables ``names``, each read with its type's getter."""
+        names = list(names)
+        getters = {"Real": self.slave.getReal, "Integer": self.slave.getInteger,
+                   "Boolean": self.slave.getBoolean, "String": self.slave.getString}
+        values = {}
+        for kind, getter in getters.items():
+            of_kind = [n for n in names if self.kind[n] == kind]
+            if of_kind:
+                values.update(zip(of_kind, getter([self.vr[n] for n in of_kind])))
+        return [values[n] for n in names]
+
+    def initial_values(self, start_values: dict, names: Iterable[str]) -> list:
+        """The values of ``names`` in initialisation mode for ``start_values``: calculated
+        parameters (outputs would build the model and give its static equilibrium)."""
+        try:
+            self._start(start_values, initialise=False)
+            return self.get(names)
+        except Exception as error:  # noqa: BLE001 - fmpy raises plain exceptions
+            raise self.failure("initialisation", error) from None
 
     def run_point(self, point: OperatingPoint, signals: list[str], case: str = "") -> dict:
         """Runs one point; returns the stationary window of ``signals`` sampled per step.
