@@ -831,8 +831,12 @@ def build_parser() -> argparse.ArgumentParser:
     r.set_defaults(func=cmd_bench_realtime)
 
     from .accuracy import add_parser as add_accuracy
+    from .doe import add_parser as add_doe
+    from .optimise import add_parser as add_optimise
 
     add_accuracy(sub)
+    add_doe(sub)
+    add_optimise(sub)
     return parser
 
 

@@ -50,7 +50,8 @@ import numpy as np
 from fmpy import extract, read_model_description
 from fmpy.fmi2 import FMU2Slave
 
-from .runner import logging_callbacks, mount_count, set_value, variable_names
+from .runner import (logging_callbacks, mount_count, release_logging, set_value,
+                     variable_names)
 from .spectra import ORDERS, order_amplitudes
 
 ALGORITHMS = ("jacobi", "gauss_seidel", "interface_jacobian")
@@ -115,6 +116,7 @@ class Fmu:
         except Exception:  # noqa: BLE001 - a failed run leaves the instance in an error state
             pass
         self.slave.freeInstance()
+        release_logging(self.callbacks)
         shutil.rmtree(self.unzipdir, ignore_errors=True)
 
 

@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import dataclasses
+import itertools
 import math
 import re
 import time
@@ -64,25 +65,49 @@ def variable_names(model_description) -> list[str]:
     return [v.name for v in model_description.modelVariables]
 
 
+# fmpy's logger proxy (which formats the FMU's printf-style messages) keeps ONE logger for the
+# whole process, the last one registered: each instance's own Python logger would receive every
+# instance's messages, and once it is freed the next message from any instance calls freed memory.
+# So one logger lives as long as the process and hands each message to the sink of the instance
+# it came from, named by the instance's component environment.
+_SINKS: dict[int, list] = {}
+_NEXT_SINK = itertools.count(1)
+
+
+def _dispatch(environment, _instance, status, category, message):
+    sink = _SINKS.get(environment or 0)
+    if sink is None:
+        return
+    label = STATUS_LABELS[status] if 0 <= status < len(STATUS_LABELS) else str(status)
+    sink.append(f"[{label}] {category.decode('utf-8', 'replace')}: "
+                f"{message.decode('utf-8', 'replace')}")
+
+
+_LOGGER = fmi2CallbackLoggerTYPE(_dispatch)
+
+
 def logging_callbacks(sink: list) -> fmi2CallbackFunctions:
-    """FMI callbacks whose logger appends "[status] category: message" lines to ``sink``."""
-
-    def logger(_env, _instance, status, category, message):
-        label = STATUS_LABELS[status] if 0 <= status < len(STATUS_LABELS) else str(status)
-        sink.append(f"[{label}] {category.decode('utf-8', 'replace')}: "
-                    f"{message.decode('utf-8', 'replace')}")
-
-    callbacks = fmi2CallbackFunctions()
-    callbacks.logger = fmi2CallbackLoggerTYPE(logger)
-    callbacks.allocateMemory = fmi2CallbackAllocateMemoryTYPE(calloc)
-    callbacks.freeMemory = fmi2CallbackFreeMemoryTYPE(free)
-    # The FMU formats its messages printf-style ("%s" and one argument): fmpy's proxy does that.
+    """FMI callbacks whose logger appends "[status] category: message" lines to ``sink`` (until
+    :func:`release_logging`)."""
     from ctypes import byref
 
     from fmpy.logging import addLoggerProxy
 
+    key = next(_NEXT_SINK)
+    _SINKS[key] = sink
+    callbacks = fmi2CallbackFunctions()
+    callbacks.logger = _LOGGER
+    callbacks.componentEnvironment = key
+    callbacks.allocateMemory = fmi2CallbackAllocateMemoryTYPE(calloc)
+    callbacks.freeMemory = fmi2CallbackFreeMemoryTYPE(free)
     addLoggerProxy(byref(callbacks))
     return callbacks
+
+
+def release_logging(callbacks: fmi2CallbackFunctions):
+    """Stops collecting the messages of the instance created with ``callbacks`` (after its
+    fmi2FreeInstance)."""
+    _SINKS.pop(callbacks.componentEnvironment or 0, None)
 
 
 @dataclasses.dataclass(frozen=True)
@@ -146,6 +171,7 @@ class Runner:
         except Exception:  # noqa: BLE001 - a failed point leaves the instance in an error state
             pass
         self.slave.freeInstance()
+        release_logging(self.callbacks)
         shutil.rmtree(self.unzipdir, ignore_errors=True)
 
     def warnings(self) -> list[str]:

@@ -125,3 +125,27 @@ def test_order_amplitudes_on_and_off_the_bins_recover_a_known_signal():
         np.testing.assert_allclose(a[1.5], [2.0, 4.0], atol=tol)
         np.testing.assert_allclose(a[3.0], [0.7, 1.4], atol=tol)
         assert max(np.max(a[o]) for o in ORDERS if o not in (1.5, 3.0)) < tol
+
+
+def test_instances_log_to_their_own_sink_and_outlive_each_other(fmu_path):
+    """fmpy's logger proxy keeps one logger per process: each instance's messages must still
+    reach its own log, and an instance closed first must not take the logger with it (a later
+    message of the other one called freed memory: a segmentation fault)."""
+    from emc.runner import PointFailed
+
+    broken = OperatingPoint(rpm=1500.0, revolutions=2,
+                            parameters=(("scene", 1), ("configFile", "/nonexistent/a.json")))
+    first = Runner(str(fmu_path), instance_name="first")
+    try:
+        second = Runner(str(fmu_path), instance_name="second")
+        with pytest.raises(PointFailed):
+            second.run_point(broken, ["mount[1].F[3]"])
+        assert any("/nonexistent/a.json" in line for line in second.log)
+        assert not first.log
+        second.close()
+        with pytest.raises(PointFailed) as failure:
+            first.run_point(broken, ["mount[1].F[3]"])
+        assert "/nonexistent/a.json" in failure.value.cause
+        assert any(line.startswith("[error]") for line in first.log)
+    finally:
+        first.close()
