@@ -121,7 +121,9 @@ def cmd_doe(args) -> int:
     from . import cli
 
     problem, variables, mounts = problem_from_args(args)
-    cli.check_range("--samples", args.samples, 2)
+    # RBD-FAST reads 10 harmonics of each variable's ordering of the sample: it needs more
+    # designs than 2 x 10.
+    cli.check_range("--samples", args.samples, 21 if args.method == "lhs" else 2)
     out = pathlib.Path(args.out)
     names = [v.name for v in problem.variables]
     salib = salib_problem(names, [(v.low, v.high) for v in problem.variables])

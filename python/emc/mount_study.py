@@ -5,10 +5,12 @@ Variables (each with bounds ``LOW:HIGH``):
 
 - ``mount[i].stiffnessScale``, ``mount[i].dampingScale``: the FMU's own inputs (a factor on the
   mount's force-deflection curve about its static operating point, and on its damping);
-- ``mount[i].rate[j]``: a factor on the stiffness of mount ``i``'s curve along its axis ``j``, and
-  ``mount[i].position[j]``: an offset (m) of its bracket along vehicle axis ``j``; both written
-  into a copy of the vehicle configuration (the FMU's own, or the ``configFile`` given), which the
-  worker that needs it writes to its temporary directory under its checksum.
+- ``mount[i].rate[j]``: a factor on the stiffness of mount ``i``'s curve along its axis ``j``,
+  written into a copy of the vehicle configuration (the FMU's own, or the ``configFile`` given),
+  which the worker that needs it writes to its temporary directory under its checksum.
+
+Mount positions are not variables: in the elastic body a mount's bracket must sit on its body
+node (within 1 mm), and the body's nodes are not parameters of the configuration.
 
 A design is evaluated by
 
@@ -50,11 +52,9 @@ from .runner import OperatingPoint, PointFailed, Runner
 from .sweep import analyse, speed_points
 
 # Default bounds of each kind of variable.
-DEFAULT_BOUNDS = {"stiffnessScale": (0.5, 2.0), "dampingScale": (0.5, 3.0), "rate": (0.5, 2.0),
-                  "position": (-0.02, 0.02)}
-BASELINE = {"stiffnessScale": 1.0, "dampingScale": 1.0, "rate": 1.0, "position": 0.0}
-VARIABLE = re.compile(r"^mount\[(\d+)\]\.(stiffnessScale|dampingScale|rate\[([123])\]|"
-                      r"position\[([123])\])$")
+DEFAULT_BOUNDS = {"stiffnessScale": (0.5, 2.0), "dampingScale": (0.5, 3.0), "rate": (0.5, 2.0)}
+BASELINE = {"stiffnessScale": 1.0, "dampingScale": 1.0, "rate": 1.0}
+VARIABLE = re.compile(r"^mount\[(\d+)\]\.(stiffnessScale|dampingScale|rate\[([123])\])$")
 OBJECTIVES = ("wheel-mean", "wheel-max", "weighted-mean")
 SIGNALS = WHEEL + SEAT
 STATIC_OUTPUTS = ([f"powertrain.r[{j}]" for j in (1, 2, 3)]
@@ -68,7 +68,8 @@ class StudyError(Exception):
 @dataclasses.dataclass(frozen=True)
 class Variable:
     """One design variable: an FMU input (``kind`` stiffnessScale or dampingScale) or a change of
-    the vehicle configuration (rate or position, along ``axis`` 1-3) of mount ``mount`` (1-based)."""
+    the vehicle configuration (a rate, along the mount's ``axis`` 1-3) of mount ``mount``
+    (1-based)."""
 
     name: str
     mount: int
@@ -83,7 +84,7 @@ class Variable:
 
     @property
     def in_configuration(self) -> bool:
-        return self.kind in ("rate", "position")
+        return self.kind == "rate"
 
 
 def parse_variable(text: str, mounts: int) -> Variable:
@@ -93,12 +94,12 @@ def parse_variable(text: str, mounts: int) -> Variable:
     match = VARIABLE.match(name)
     if not match:
         raise StudyError(f"--var {text}: not a design variable (mount[i].stiffnessScale, "
-                         "mount[i].dampingScale, mount[i].rate[j], mount[i].position[j])")
+                         "mount[i].dampingScale, mount[i].rate[j])")
     mount = int(match.group(1))
     if not 1 <= mount <= mounts:
         raise StudyError(f"--var {text}: the FMU has mounts 1 to {mounts}")
     kind = match.group(2).split("[")[0]
-    axis = match.group(3) or match.group(4)
+    axis = match.group(3)
     low, high = DEFAULT_BOUNDS[kind]
     if bounds:
         try:
@@ -107,7 +108,7 @@ def parse_variable(text: str, mounts: int) -> Variable:
             raise StudyError(f"--var {text}: bounds are LOW:HIGH") from None
     if not (math.isfinite(low) and math.isfinite(high) and low < high):
         raise StudyError(f"--var {text}: need finite bounds LOW < HIGH")
-    if kind != "position" and low < 0.0:
+    if low < 0.0:
         raise StudyError(f"--var {text}: a factor cannot be negative")
     if not low <= BASELINE[kind] <= high:
         raise StudyError(f"--var {text}: the bounds must contain the current design "
@@ -144,7 +145,7 @@ class Problem:
     seat_weight: float = 1.0
     limits: Limits = Limits()
     parameters: tuple = ()              # fixed FMU start values (name, value), e.g. configFile
-    base_configuration: str | None = None  # vehicle JSON the rate/position variables change
+    base_configuration: str | None = None  # vehicle JSON the rate variables change
 
     def settings(self) -> dict:
         """The study's settings as stored beside each evaluation."""
@@ -188,12 +189,8 @@ class Problem:
             config = json.loads(self.base_configuration)
         for v, value in zip(self.variables, x):
             if v.in_configuration:
-                mount = config["mounts"][v.mount - 1]
-                if v.kind == "rate":
-                    for knot in mount["curves"][v.axis - 1]["knots"]:
-                        knot["stiffness"] *= float(value)
-                else:
-                    mount["bracket"][v.axis - 1] += float(value)
+                for knot in config["mounts"][v.mount - 1]["curves"][v.axis - 1]["knots"]:
+                    knot["stiffness"] *= float(value)
             else:
                 values[v.name] = float(value)
         text = None if config is None else json.dumps(config, sort_keys=True)
@@ -270,8 +267,8 @@ def run(runner: Runner, item: Run, mounts: int):
 
 
 def base_configuration(fmu_path: str, parameters: dict) -> str:
-    """The vehicle configuration the rate and position variables change: ``configFile`` if set
-    (a complete configuration, not a patch), else the FMU's own."""
+    """The vehicle configuration the rate variables change: ``configFile`` if set (a complete
+    configuration, not a patch), else the FMU's own."""
     name = str(parameters.get("configFile") or "")
     if name and os.path.isabs(name):
         text = pathlib.Path(name).read_text()
@@ -280,7 +277,7 @@ def base_configuration(fmu_path: str, parameters: dict) -> str:
             text = z.read(f"resources/{name or 'vehicle.json'}").decode()
     config = json.loads(text)
     if "mounts" not in config or "extends" in config:
-        raise StudyError("rate and position variables need a complete vehicle configuration "
+        raise StudyError("rate variables need a complete vehicle configuration "
                          "with its mounts (not an \"extends\" patch)")
     return text
 
@@ -300,13 +297,17 @@ class Store:
             if stored != json.loads(json.dumps(self.header)):
                 raise StudyError(f"{self.path} holds the evaluations of another FMU or other "
                                  "settings: use another --out folder (or delete it)")
+            kept = lines[:1]
             for line in lines[1:]:
                 try:
                     record = json.loads(line)
                 except json.JSONDecodeError:
-                    break  # a line cut short by an interruption: evaluated again
+                    continue  # a line cut short by an interruption: that design runs again
+                kept.append(line)
                 self.records[record["key"]] = record
                 self.order.append(record["key"])
+            if len(kept) < len(lines) or not self.path.read_text().endswith("\n"):
+                self.path.write_text("".join(line + "\n" for line in kept))
         else:
             self.path.parent.mkdir(parents=True, exist_ok=True)
             self.path.write_text(json.dumps(self.header) + "\n")
@@ -382,8 +383,8 @@ def add_problem_options(p):
                    help="the packaged FMU (default dist/EngineMountChassis.fmu)")
     p.add_argument("--var", action="append", metavar="NAME[=LOW:HIGH]",
                    help="design variable (repeatable): mount[i].stiffnessScale (default bounds "
-                        "0.5:2), mount[i].dampingScale (0.5:3), mount[i].rate[j] (0.5:2), "
-                        "mount[i].position[j] (m, -0.02:0.02); default: every mount's "
+                        "0.5:2), mount[i].dampingScale (0.5:3), mount[i].rate[j] (0.5:2, "
+                        "mount i's curve along its axis j); default: every mount's "
                         "stiffnessScale and dampingScale")
     p.add_argument("--rpm", nargs=2, type=float, default=[800.0, 2000.0], metavar=("FROM", "TO"),
                    help="the speed band of the objective (default 800 2000)")

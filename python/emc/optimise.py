@@ -74,7 +74,7 @@ def minimise(problem: Problem, evaluator, start, evaluations: int = 60,
 
 def perturbations(problem: Problem, x) -> list[tuple[str, float, np.ndarray]]:
     """Design ``x`` with each variable changed by ±5 % alone (of its value; of its range for a
-    variable at 0, such as a position), kept inside the bounds: (variable, sign, design)."""
+    variable at 0), kept inside the bounds: (variable, sign, design)."""
     out = []
     for i, v in enumerate(problem.variables):
         for sign in (1.0, -1.0):
@@ -269,7 +269,7 @@ def best_of_study(folder: pathlib.Path, problem: Problem) -> np.ndarray:
 
 def add_parser(sub) -> None:
     """Registers ``emc optimise``."""
-    p = sub.add_parser("optimise", help="tune mount stiffness and damping (and rates, positions) "
+    p = sub.add_parser("optimise", help="tune mount stiffness and damping scales and rates "
                                         "for comfort over a speed band within travel limits")
     add_problem_options(p)
     p.add_argument("--evaluations", type=int, default=60,
