@@ -49,7 +49,7 @@ import pandas as pd
 
 from .comfort import SEAT, WHEEL, comfort_table
 from .runner import OperatingPoint, PointFailed, Runner
-from .sweep import analyse, speed_points
+from .sweep import analyse, speed_points, tables
 
 # Default bounds of each kind of variable.
 DEFAULT_BOUNDS = {"stiffnessScale": (0.5, 2.0), "dampingScale": (0.5, 3.0), "rate": (0.5, 2.0)}
@@ -211,7 +211,7 @@ class Problem:
     def assess(self, x, results: list, mounts: int) -> dict:
         """A design's record from the results of :meth:`evaluations`."""
         points, statics = results[:self.count], results[self.count:]
-        spectra = pd.DataFrame([row for rows, _ in points for row in rows[1]])
+        spectra = tables([analysis for analysis, _ in points])[1]
         comfort = comfort_table(spectra).sort_values("rpm")
         deflections = [v[len(STATIC_OUTPUTS):] for v in statics]
         static = {"deflection": float(np.max(np.abs(deflections))),

@@ -7,6 +7,7 @@ sweep gives exactly the numbers of a serial one.
 
 from __future__ import annotations
 
+import dataclasses
 import functools
 
 import numpy as np
@@ -22,29 +23,64 @@ def default_signals(runner: Runner) -> list[str]:
     return names
 
 
-def analyse(result: dict, case: str = "") -> tuple[list[dict], list[dict]]:
-    """Order amplitudes and spectrum rows of one point's stationary window."""
+@dataclasses.dataclass
+class Analysis:
+    """One point's stationary window analysed, in arrays (small to send back from a worker): the
+    order amplitudes (signals × :data:`ORDERS`) and the amplitude spectrum up to 6.5 orders
+    (signals × lines)."""
+
+    rpm: float
+    signals: list[str]
+    order_amplitude: np.ndarray
+    frequency: np.ndarray
+    amplitude: np.ndarray
+
+
+def analyse(result: dict) -> Analysis:
+    """Order amplitudes and spectrum of one point's stationary window, signal by signal."""
     point: OperatingPoint = result["point"]
-    order_rows, spectrum_rows = [], []
-    for j, signal in enumerate(result["signals"]):
+    orders, spectra = [], []
+    for j in range(len(result["signals"])):
         x = result["samples"][:, j]
-        amplitudes = order_amplitudes(x, point.revolutions, ORDERS)
-        for order, amplitude in amplitudes.items():
-            order_rows.append({"case": case, "rpm": point.rpm, "signal": signal, "order": order,
-                               "frequency": order * point.rpm / 60.0, "amplitude": amplitude})
+        orders.append(list(order_amplitudes(x, point.revolutions, ORDERS).values()))
         f, a = amplitude_spectrum(x, result["dt"])
         keep = f <= 6.5 * point.rpm / 60.0
-        for fi, ai in zip(f[keep], a[keep]):
-            spectrum_rows.append({"case": case, "rpm": point.rpm, "signal": signal,
-                                  "frequency": fi, "amplitude": ai})
-    return order_rows, spectrum_rows
+        spectra.append(a[keep])
+    return Analysis(point.rpm, list(result["signals"]), np.array(orders), f[keep],
+                    np.array(spectra))
+
+
+def tables(analyses: list[Analysis], case: str = "") -> tuple[pd.DataFrame, pd.DataFrame]:
+    """The order table (case, rpm, signal, order, frequency, amplitude) and the spectrum table
+    (case, rpm, signal, frequency, amplitude) of analysed points, sorted by case, signal, speed
+    and order or frequency."""
+    order_parts, spectrum_parts = [], []
+    orders = np.array(ORDERS)
+    for a in analyses:
+        n_signals, n_lines = len(a.signals), len(a.frequency)
+        order_parts.append(pd.DataFrame({
+            "case": case, "rpm": a.rpm, "signal": np.repeat(a.signals, len(orders)),
+            "order": np.tile(orders, n_signals), "frequency": np.tile(orders * a.rpm / 60.0,
+                                                                      n_signals),
+            "amplitude": a.order_amplitude.ravel()}))
+        spectrum_parts.append(pd.DataFrame({
+            "case": case, "rpm": a.rpm, "signal": np.repeat(a.signals, n_lines),
+            "frequency": np.tile(a.frequency, n_signals), "amplitude": a.amplitude.ravel()}))
+    sort = ["case", "signal", "rpm"]
+    order_table = pd.concat(order_parts, ignore_index=True) if order_parts else pd.DataFrame()
+    spectrum_table = (pd.concat(spectrum_parts, ignore_index=True) if spectrum_parts
+                      else pd.DataFrame())
+    if order_table.empty:
+        return order_table, spectrum_table
+    return (order_table.sort_values(sort + ["order"]).reset_index(drop=True),
+            spectrum_table.sort_values(sort + ["frequency"]).reset_index(drop=True))
 
 
 def sweep_point(runner: Runner, point: OperatingPoint, signals: list[str] | None,
-                case: str) -> tuple[tuple[list[dict], list[dict]], list[str]]:
-    """One point on ``runner``: its analysed rows and the FMU's warnings."""
+                case: str) -> tuple[Analysis, list[str]]:
+    """One point on ``runner``: its analysis and the FMU's warnings."""
     result = runner.run_point(point, signals or default_signals(runner), case)
-    return analyse(result, case), result["warnings"]
+    return analyse(result), result["warnings"]
 
 
 def run_sweep(fmu_path: str, points: list[OperatingPoint], signals: list[str] | None = None,
@@ -71,15 +107,10 @@ def run_sweep(fmu_path: str, points: list[OperatingPoint], signals: list[str] | 
     finally:
         if bar is not None:
             bar.close()
-    results = [rows for rows, _ in done]
     fmu_warnings = [w for _, point_warnings in done for w in point_warnings]
     if warnings is not None:
         warnings += fmu_warnings
-    orders = pd.DataFrame([row for r in results for row in r[0]])
-    spectra = pd.DataFrame([row for r in results for row in r[1]])
-    sort = ["case", "signal", "rpm"]
-    return (orders.sort_values(sort + ["order"]).reset_index(drop=True),
-            spectra.sort_values(sort + ["frequency"]).reset_index(drop=True))
+    return tables([analysis for analysis, _ in done], case)
 
 
 def speed_points(rpm_from: float, rpm_to: float, count: int, **kwargs) -> list[OperatingPoint]:
