@@ -1,5 +1,5 @@
 //! A body reduced elsewhere: Craig-Bampton matrices in Nastran `DMIG` form
-//! ([`crate::fe::nastran::read_dmig_file`]) → the [`ReducedChassis`] the coupled model gets, by
+//! ([`crate::nastran::read_dmig_file`]) → the [`ReducedChassis`] the coupled model gets, by
 //! the same orthogonalisation ([`orthogonalise`]) and damping table as the in-process reduction.
 //!
 //! The matrices: stiffness and mass (Nastran's `KAAX`, `MAAX`; symmetric, IFO 6) over the a-set
@@ -27,8 +27,8 @@ use super::damping::DampingTable;
 use super::error::CmsError;
 use super::reduce::{model, named_points, table_damping};
 use super::reduced::{RecoveryPoint, ReducedChassis};
-use super::spec::{ModeSelection, ReductionSpec};
-use crate::fe::nastran::{write_dmig_file, DmigDof, DmigFile, DmigMatrix};
+use super::spec::{DmigBodySource, ModeSelection, ReductionSpec};
+use crate::nastran::{write_dmig_file, DmigDof, DmigFile, DmigMatrix};
 
 /// What a body given as Craig-Bampton matrices needs to become a [`ReducedChassis`].
 #[derive(Debug, Clone, Copy)]
@@ -265,6 +265,37 @@ pub fn reduce_external(body: &ExternalBody<'_>) -> Result<ReducedChassis, CmsErr
         zeta: table_damping(&omega, body.damping),
         omega,
         points,
+    })
+}
+
+/// The reduced body of a spec whose body is given as DMIG matrices: the file read (its content
+/// must still be what the spec's checksum says: the cache key was made from it) and taken from
+/// there by [`reduce_external`] with the spec's interface, outputs, selection and damping.
+pub(crate) fn reduce_dmig_source(
+    spec: &ReductionSpec,
+    source: &DmigBodySource,
+) -> Result<ReducedChassis, CmsError> {
+    let options = crate::nastran::DeckOptions {
+        include_root: source.include_root.clone(),
+        ..Default::default()
+    };
+    let (file, sha256) = crate::nastran::read_dmig_file(&source.path, &options)?;
+    if sha256 != source.sha256 {
+        return Err(invalid(format!(
+            "DMIG file {} (or a file it includes) changed after its checksum was taken",
+            source.path.display()
+        )));
+    }
+    reduce_external(&ExternalBody {
+        file: &file,
+        stiffness: &source.stiffness,
+        mass: &source.mass,
+        recovery: source.recovery.as_deref(),
+        points: &source.points,
+        interface: &spec.interface,
+        outputs: &spec.outputs,
+        selection: spec.selection,
+        damping: &spec.damping,
     })
 }
 
