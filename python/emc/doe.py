@@ -135,7 +135,7 @@ def cmd_doe(args) -> int:
     from .distributed import progress_bar
 
     bar = progress_bar(len(X) + 1, "designs", not args.quiet, unit="design")
-    evaluator.progress = None if bar is None else bar.update
+    evaluator.progress = None if bar is None else (lambda record: bar.update(1))
     try:
         baseline = evaluator([problem.baseline()])[0]
         records = evaluator(list(X))

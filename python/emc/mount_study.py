@@ -371,7 +371,7 @@ class Evaluator:
                 self.store.put(x, record)
                 self.evaluated += 1
                 if self.progress is not None:
-                    self.progress(1)
+                    self.progress(record)
         return [self.store.get(x) for x in designs]
 
 

@@ -20,7 +20,9 @@ side by side (waterfalls, order cuts, comfort).
 from __future__ import annotations
 
 import json
+import math
 import pathlib
+import sys
 import time
 
 import numpy as np
@@ -183,6 +185,22 @@ def problem_signals() -> list[str]:
     return SIGNALS + ["mount[1].F[3]"]
 
 
+class Progress:
+    """One line per design the optimiser runs: its objective, whether it is within the limits,
+    the best so far."""
+
+    def __init__(self, stored: int):
+        self.count, self.best = stored, math.inf
+
+    def __call__(self, record: dict):
+        self.count += 1
+        if record["feasible"]:
+            self.best = min(self.best, record["objective"])
+        print(f"design {self.count}: objective {record['objective']:.4g} m/s²"
+              f"{'' if record['feasible'] else ' (beyond a limit)'}, best within the limits "
+              f"{self.best:.4g}, {record['seconds']:.1f} s", file=sys.stderr, flush=True)
+
+
 def cmd_optimise(args) -> int:
     from . import cli
 
@@ -195,6 +213,8 @@ def cmd_optimise(args) -> int:
     cli.reduction_notice({"scene": 2}, variables)
     started = time.perf_counter()
     store, evaluator, pool = open_study(args, problem, mounts)
+    if not args.quiet:
+        evaluator.progress = Progress(len(store.records))
     try:
         baseline = evaluator([problem.baseline()])[0]
         result = minimise(problem, evaluator, start, args.evaluations)

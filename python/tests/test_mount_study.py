@@ -118,7 +118,7 @@ def test_an_interrupted_study_continues_from_its_stored_evaluations(fmu_path, tm
                       rpm_from=1500.0, rpm_to=1500.0, count=1, revolutions=2)
     designs = [[0.5], [1.0], [1.5], [2.0], [2.5]]
 
-    def interrupt(_):
+    def interrupt(record):
         raise KeyboardInterrupt
 
     first = Evaluator(problem, fmu, Store(tmp_path, "sha", problem.settings()), 4,
