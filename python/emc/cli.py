@@ -417,14 +417,21 @@ def sweep_cases(args, cases: list[tuple[str, dict]], signals: list[str], out: pa
                 point_options: dict) -> tuple[pd.DataFrame, pd.DataFrame, list[str]]:
     """Every case's speed points (serial or on Dask), the FMU's warnings summarised, the order
     and spectrum tables of all cases written; returns (orders, spectra, FMU warnings)."""
+    from .distributed import FmuPool
+
     tables, fmu_warnings = [], []
-    for label, parameters in cases:
-        points = speed_points(args.rpm[0], args.rpm[1], args.count,
-                              parameters=tuple(parameters.items()), **point_options)
-        tables.append(run_sweep(args.fmu, points, signals=signals, case=label,
-                                parallel=not args.serial, scheduler=args.scheduler,
-                                workers=args.workers, progress=not args.quiet,
-                                warnings=fmu_warnings))
+    # One pool for every case: its workers start and load the FMU once.
+    pool = None if args.serial else FmuPool(args.fmu, args.workers, args.scheduler)
+    try:
+        for label, parameters in cases:
+            points = speed_points(args.rpm[0], args.rpm[1], args.count,
+                                  parameters=tuple(parameters.items()), **point_options)
+            tables.append(run_sweep(args.fmu, points, signals=signals, case=label,
+                                    parallel=not args.serial, progress=not args.quiet,
+                                    warnings=fmu_warnings, pool=pool))
+    finally:
+        if pool is not None:
+            pool.close()
     fmu_warnings_summary(fmu_warnings)
     orders = pd.concat([t[0] for t in tables], ignore_index=True)
     spectra = pd.concat([t[1] for t in tables], ignore_index=True)
