@@ -189,8 +189,9 @@ class Progress:
     """One line per design the optimiser runs: its objective, whether it is within the limits,
     the best so far."""
 
-    def __init__(self, stored: int):
-        self.count, self.best = stored, math.inf
+    def __init__(self, stored: list[dict]):
+        self.count = len(stored)
+        self.best = min((r["objective"] for r in stored if r["feasible"]), default=math.inf)
 
     def __call__(self, record: dict):
         self.count += 1
@@ -214,7 +215,7 @@ def cmd_optimise(args) -> int:
     started = time.perf_counter()
     store, evaluator, pool = open_study(args, problem, mounts)
     if not args.quiet:
-        evaluator.progress = Progress(len(store.records))
+        evaluator.progress = Progress(store.history())
     try:
         baseline = evaluator([problem.baseline()])[0]
         result = minimise(problem, evaluator, start, args.evaluations)
