@@ -116,13 +116,43 @@ def scaling_points(count: int, rpm_from: float = 800.0, rpm_to: float = 4000.0) 
                         parameters=(("scene", 2),))
 
 
-def _timed(run, repeat: int) -> tuple[list[float], object]:
-    times, result = [], None
+def _timed(run, repeat: int, cpu) -> tuple[list[float], list[float], object]:
+    """Wall times and CPU times (``cpu()`` before and after) of ``repeat`` runs, and the last
+    run's result."""
+    times, cpus, result = [], [], None
     for _ in range(repeat):
+        cpu_before = cpu()
         started = time.perf_counter()
         result = run()
         times.append(time.perf_counter() - started)
-    return times, result
+        cpus.append(cpu() - cpu_before)
+    return times, cpus, result
+
+
+def same_results(a: list, b: list) -> bool:
+    """Whether two lists of analysed points (with their warnings) are equal to the bit."""
+    def same(x, y):
+        return (x.rpm == y.rpm and x.signals == y.signals
+                and all(np.array_equal(getattr(x, f), getattr(y, f), equal_nan=True)
+                        for f in ("order_amplitude", "frequency", "amplitude")))
+
+    return len(a) == len(b) and all(same(x, y) and wx == wy for (x, wx), (y, wy) in zip(a, b))
+
+
+def _tree_cpu() -> float:
+    """CPU seconds used so far by this process and all its descendants alive (a local pool's
+    scheduler, nannies and workers)."""
+    import psutil
+
+    me = psutil.Process()
+    total = 0.0
+    for p in [me] + me.children(recursive=True):
+        try:
+            t = p.cpu_times()
+            total += t.user + t.system
+        except psutil.NoSuchProcess:
+            pass
+    return total
 
 
 def scaling_table(fmu_path: str, points: list, workers=(1, 2), repeat: int = 2,
@@ -130,8 +160,10 @@ def scaling_table(fmu_path: str, points: list, workers=(1, 2), repeat: int = 2,
     """Serial against Dask pools of each worker count, on warm instances: the serial loop runs
     on an instance that has already run a point; each pool is started and its workers' instances
     warmed (one point each, the reduced body read from the cache) before the timed runs. The
-    start and warm-up of each pool are reported beside. Every run's results are compared with
-    the serial ones to the bit."""
+    start and warm-up of each pool are reported beside, and the CPU time of each run: the serial
+    process's, or that of this process and all its children (scheduler, nannies, workers),
+    which load does not change. Every run's
+    results are compared with the serial ones to the bit."""
     from .distributed import FmuPool
     from .sweep import sweep_point
 
@@ -143,9 +175,10 @@ def scaling_table(fmu_path: str, points: list, workers=(1, 2), repeat: int = 2,
         first = time.perf_counter() - started
         print(f"first point (instance, body reduced or read from the cache): {first:.1f} s",
               file=out, flush=True)
-        times, serial = _timed(lambda: [evaluate(runner, p) for p in points], repeat)
+        times, cpus, serial = _timed(lambda: [evaluate(runner, p) for p in points], repeat,
+                                     time.process_time)
     rows.append({"workers": "serial", "start_s": 0.0, "warm_s": 0.0, "run_min_s": min(times),
-                 "run_max_s": max(times), "identical": True})
+                 "run_max_s": max(times), "cpu_s": min(cpus), "identical": True})
     print(f"serial: {min(times):.2f}-{max(times):.2f} s", file=out, flush=True)
     for w in workers:
         started = time.perf_counter()
@@ -154,10 +187,11 @@ def scaling_table(fmu_path: str, points: list, workers=(1, 2), repeat: int = 2,
             started = time.perf_counter()
             pool.warm(evaluate, points[0])
             warm = time.perf_counter() - started
-            times, results = _timed(lambda: pool.map(evaluate, points), repeat)
-        identical = results == serial
+            times, cpus, results = _timed(lambda: pool.map(evaluate, points), repeat,
+                                          _tree_cpu)
         rows.append({"workers": w, "start_s": start, "warm_s": warm, "run_min_s": min(times),
-                     "run_max_s": max(times), "identical": identical})
+                     "run_max_s": max(times), "cpu_s": min(cpus),
+                     "identical": same_results(results, serial)})
         print(f"{w} workers: start {start:.1f} s, warm-up {warm:.1f} s, "
               f"{min(times):.2f}-{max(times):.2f} s", file=out, flush=True)
     table = pd.DataFrame(rows)
@@ -165,6 +199,10 @@ def scaling_table(fmu_path: str, points: list, workers=(1, 2), repeat: int = 2,
     table["speedup"] = best_serial / table.run_min_s
     table["speedup_low"] = best_serial / table.run_max_s
     table["points_per_s"] = len(points) / table.run_min_s
+    # CPU of a run relative to the serial loop's: what the pool (scheduler, nannies, workers,
+    # this process) costs besides the simulations. On idle cores the speed-up approaches
+    # workers / cpu_ratio.
+    table["cpu_ratio"] = table.cpu_s / table.cpu_s.iloc[0]
     return table
 
 
@@ -188,7 +226,8 @@ def cmd_scaling(args) -> int:
     shown["speed-up vs serial"] = [f"{a:.2f}x ({b:.2f}x)" for a, b in
                                    zip(table.speedup, table.speedup_low)]
     print(shown[["workers", "start_s", "warm_s", "run s (min-max)", "speed-up vs serial",
-                 "points_per_s", "identical"]].to_string(
+                 "points_per_s", "cpu_s", "cpu_ratio",
+                 "identical"]].to_string(
         index=False, float_format=lambda v: f"{v:.2f}"))
     if args.csv:
         table.insert(0, "machine", machine_line())
