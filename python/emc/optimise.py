@@ -132,7 +132,7 @@ def plot_history(history: pd.DataFrame, baseline: float, path: str, title: str):
             label="feasible design")
     ax.plot(history.evaluation[~ok], history.objective[~ok], "x", ms=5, color="C3",
             label="beyond a limit")
-    best = history.objective.where(ok).cummin()
+    best = history.objective.where(ok).cummin().ffill()
     ax.step(history.evaluation, best, where="post", color="C2", lw=1.6,
             label="best feasible so far")
     ax.axhline(baseline, color="0.4", ls="--", lw=1.0, label="current design")
