@@ -36,7 +36,7 @@ from typing import Callable, Iterable
 import dask
 from distributed.diagnostics.plugin import WorkerPlugin
 
-from .runner import PointFailed, Runner, fmu_from_content
+from .runner import PointFailed, Runner, extracted, fmu_from_content
 
 # Local workers: Dask's nanny starts them with MALLOC_TRIM_THRESHOLD_=65536 so that they hand
 # memory back to the system; glibc then trims the FMU's short-lived allocations at every free, and
@@ -77,9 +77,11 @@ class FmuPlugin(WorkerPlugin):
         _FMU_FILES[self.sha256] = fmu_from_content(self.content, self.sha256)
 
     def teardown(self, worker):
-        runner = _RUNNERS.pop(self.sha256, None)
-        if runner is not None:
-            runner.close()
+        # The instance is dropped, not freed: a task may still be stepping it in the worker's
+        # thread (a study interrupted), and freeing it under that step corrupts the heap. The
+        # worker process ends next and takes it along; its files stay extracted for the next
+        # pool on this machine.
+        _RUNNERS.pop(self.sha256, None)
 
 
 def worker_runner(sha256: str) -> Runner:
@@ -89,7 +91,8 @@ def worker_runner(sha256: str) -> Runner:
         path = _FMU_FILES.get(sha256)
         if path is None:
             raise RuntimeError(f"the FMU {sha256[:12]}… never reached this worker")
-        runner = _RUNNERS[sha256] = Runner(path, instance_name=f"emc-worker-{os.getpid()}")
+        runner = _RUNNERS[sha256] = Runner(path, instance_name=f"emc-worker-{os.getpid()}",
+                                           unzipdir=extracted(path, sha256))
     return runner
 
 

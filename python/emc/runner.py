@@ -140,9 +140,12 @@ class OperatingPoint:
 class Runner:
     """One FMU instance; ``run_point`` resets it, so results never depend on earlier points."""
 
-    def __init__(self, fmu_path: str, instance_name: str = "emc"):
+    def __init__(self, fmu_path: str, instance_name: str = "emc", unzipdir: str | None = None):
+        """``unzipdir``: the FMU already extracted there (kept on close); else it is extracted
+        into a temporary directory of its own, removed on close."""
         self.md = read_model_description(fmu_path)
-        self.unzipdir = extract(fmu_path)
+        self.own_unzipdir = unzipdir is None
+        self.unzipdir = extract(fmu_path) if unzipdir is None else unzipdir
         self.vr = {v.name: v.valueReference for v in self.md.modelVariables}
         self.kind = {v.name: v.type for v in self.md.modelVariables}
         self.slave = FMU2Slave(
@@ -156,7 +159,8 @@ class Runner:
         try:
             self.slave.instantiate(callbacks=self.callbacks)
         except Exception as error:  # noqa: BLE001 - fmpy raises a bare Exception
-            shutil.rmtree(self.unzipdir, ignore_errors=True)
+            if self.own_unzipdir:
+                shutil.rmtree(self.unzipdir, ignore_errors=True)
             raise self.failure(f"instantiating {self.md.modelName}", error) from None
         # Errors and warnings always reach the logger; the model set-up events (scene, chassis
         # reduction or cache, periodic start) are cheap and tell what a failed point was doing.
@@ -172,7 +176,8 @@ class Runner:
             pass
         self.slave.freeInstance()
         release_logging(self.callbacks)
-        shutil.rmtree(self.unzipdir, ignore_errors=True)
+        if self.own_unzipdir:
+            shutil.rmtree(self.unzipdir, ignore_errors=True)
 
     def warnings(self) -> list[str]:
         """The FMU's warnings since the log was last cleared (a successful point may have some)."""
@@ -329,3 +334,19 @@ def fmu_from_content(content: bytes, sha256: str) -> str:
             out.write(content)
         os.replace(partial, path)
     return path
+
+
+def extracted(path: str, sha256: str) -> str:
+    """The FMU at ``path`` (with this checksum) extracted once per machine into the temporary
+    directory under its checksum; concurrent callers each extract into a directory of their own
+    and the first to rename it into place wins."""
+    import os
+
+    target = os.path.join(tempfile.gettempdir(), f"emc-fmu-{sha256}")
+    if not os.path.isdir(target):
+        partial = extract(path, tempfile.mkdtemp(prefix="emc-fmu-", suffix=".part"))
+        try:
+            os.rename(partial, target)
+        except OSError:  # another process was first
+            shutil.rmtree(partial, ignore_errors=True)
+    return target

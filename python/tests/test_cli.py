@@ -318,7 +318,7 @@ def test_fmu_content_is_written_once_under_its_checksum(fmu_path, tmp_path):
         results, failure = evaluate_batch(digest, evaluate, points)
     finally:
         plugin.teardown(worker=None)
-    assert failure is None and results[0][0][0], "orders of the point"
+    assert failure is None and results[0][0].order_amplitude.size, "orders of the point"
 
 
 def test_a_relative_fmu_works_on_workers_with_another_working_directory(fmu_path, tmp_path,
