@@ -12,9 +12,11 @@
 //! - [`cms`]: Craig-Bampton reduction of a body (procedural, deck, or reduced elsewhere).
 //! - [`model`]: engine multibody model, mounts, coupled system, outputs.
 //! - [`cosim`]: a scene with its integrator and inputs, stepped between communication points.
-//! - [`fmi2`]: the FMI 2.0 co-simulation C ABI (with [`fmi3`], the only `unsafe` code); its
-//!   [`fmi2::parameters`] is the one mapping between FMU variables and the typed settings.
-//! - [`fmi3`]: the FMI 3.0 co-simulation C ABI over the same instance.
+//! - [`fmu`]: the FMU runtime both ABIs share: instance, values, input signals, FMU states,
+//!   logging, stepping, the one guard of every exported function; its [`fmu::parameters`] is the
+//!   one mapping between FMU variables and the typed settings.
+//! - [`fmi2`], [`fmi3`]: the FMI 2.0 and 3.0 co-simulation C ABIs, the standards' signatures over
+//!   the runtime (with the runtime's guard and C-argument helpers, the only `unsafe` code).
 //! - [`variables`]: the variable table generated from `modelDescription/variables.json` (a leaf:
 //!   it imports nothing from the model), with [`variables::Parameters`], every parameter as one
 //!   typed structure.
@@ -29,6 +31,7 @@ pub mod eigen;
 pub mod fe;
 pub mod fmi2;
 pub mod fmi3;
+pub mod fmu;
 pub mod model;
 pub mod nastran;
 pub mod ode;

@@ -62,6 +62,7 @@
 mod cache;
 mod craig_bampton;
 mod damping;
+mod dmig_export;
 mod error;
 mod external;
 mod hash;
@@ -78,8 +79,9 @@ pub use craig_bampton::{
     craig_bampton, craig_bampton_basis, orthogonalise, CraigBampton, CraigBamptonBasis,
 };
 pub use damping::{DampingBand, DampingTable};
+pub use dmig_export::{dmig_of_reduction, DmigBody};
 pub use error::CmsError;
-pub use external::{dmig_of_reduction, reduce_external, DmigBody, ExternalBody};
+pub use external::{reduce_external, ExternalBody};
 pub use hash::sha256_hex;
 pub use reduce::{reduce, reduce_detailed, reduce_with_notes, Reduction};
 pub use reduced::{RecoveryPoint, ReducedChassis};

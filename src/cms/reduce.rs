@@ -3,7 +3,7 @@
 //! the output points).
 
 use super::craig_bampton::{craig_bampton, CraigBampton};
-use super::damping::DampingTable;
+use super::damping::table_damping;
 use super::error::CmsError;
 use super::external::reduce_dmig_source;
 use super::reduced::{RecoveryPoint, ReducedChassis};
@@ -188,14 +188,6 @@ pub(crate) fn named_points(
         }
     }
     Ok(named)
-}
-
-/// The damping ratio of each mode by the table: shared by every body, reduced here or elsewhere.
-pub(crate) fn table_damping(omega: &[f64], damping: &DampingTable) -> Vec<f64> {
-    omega
-        .iter()
-        .map(|w| damping.zeta(w / (2.0 * std::f64::consts::PI)))
-        .collect()
 }
 
 /// The reduction of `spec` with the full model and full mode shapes kept.
