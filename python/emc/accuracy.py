@@ -38,7 +38,8 @@ from .spectra import order_amplitudes
 
 DEFAULT_TOLERANCES = (1e-3, 1e-4, 1e-5, 1e-6, 1e-7, 1e-8, 1e-9)
 REFERENCE_TOLERANCE = 1e-11
-MAIN_ORDERS = (1.5, 2.0, 3.0)
+# The orders whose amplitudes the work-precision table compares by default (--order).
+COMPARED_ORDERS = (1.5, 2.0, 3.0)
 
 
 @dataclasses.dataclass(frozen=True)
@@ -139,7 +140,7 @@ def order_error(samples: np.ndarray, reference: np.ndarray, scenario: Scenario,
 
 def work_precision(fmu: str, cases: list[tuple[str, dict]], scenarios: list[Scenario],
                    signals: list[str], tolerances=DEFAULT_TOLERANCES,
-                   reference_tolerance: float = REFERENCE_TOLERANCE, orders=MAIN_ORDERS,
+                   reference_tolerance: float = REFERENCE_TOLERANCE, orders=COMPARED_ORDERS,
                    progress=None, repeat: int = 1) -> pd.DataFrame:
     """The work-precision table: one row per case, scenario and tolerance. With ``repeat`` > 1
     each run is repeated and the least CPU and wall time are kept (the runs are identical; the
@@ -336,7 +337,7 @@ def cmd_accuracy(args) -> int:
     signals = list(dict.fromkeys(args.signal or []))
     cli.check_outputs("--signal", signals, variables)
     signals = signals or default_accuracy_signals(variables)
-    orders = tuple(args.order or MAIN_ORDERS)
+    orders = tuple(args.order or COMPARED_ORDERS)
     tolerances = sorted(set(args.rtol), reverse=True)
     cli.reduction_notice(cases[0][1], variables)
     out = pathlib.Path(args.out)
