@@ -18,7 +18,7 @@ for p in attrs click cloudpickle fsspec locket Jinja2 MarkupSafe msgpack packagi
          PyYAML sortedcontainers tblib toolz tornado zict; do
   "${pip[@]}" -d "$dir" "$p==$(version "$p")"
 done
-for p in numpy pandas lxml python-dateutil six tzdata; do
+for p in numpy pandas lxml python-dateutil tzdata; do
   "${pip[@]}" -d "$dir/fallback" "$p==$(version "$p")"
 done
 du -sh "$dir"
