@@ -345,6 +345,18 @@ class Evaluator:
         if self.runner is not None:
             self.runner.close()
 
+    def run_all(self, items: list, progress=None) -> list:
+        """The results of FMU runs (:class:`Run`), on the pool or here, in order."""
+        evaluate = functools.partial(run, mounts=self.mounts)
+        if self.pool is not None:
+            return self.pool.map(evaluate, items, progress)
+        results = []
+        for item in items:
+            results.append(evaluate(self.runner, item))
+            if progress is not None:
+                progress(1)
+        return results
+
     def __call__(self, designs, chunk: int | None = None) -> list[dict]:
         """The records of ``designs`` (rows of the variables' values), stored ones read, the
         others run ``chunk`` designs at a time (stored after each chunk)."""
@@ -354,15 +366,11 @@ class Evaluator:
         by_key = {Store.key(x): x for x in designs}
         workers = self.pool.workers if self.pool is not None else 1
         chunk = chunk or max(1, 2 * workers)
-        evaluate = functools.partial(run, mounts=self.mounts)
         for start in range(0, len(missing), chunk):
             todo = [by_key[k] for k in missing[start:start + chunk]]
             items = [item for x in todo for item in self.problem.evaluations(x)]
             began = time.perf_counter()
-            if self.pool is not None:
-                results = self.pool.map(evaluate, items)
-            else:
-                results = [evaluate(self.runner, item) for item in items]
+            results = self.run_all(items)
             seconds = (time.perf_counter() - began) / len(todo)
             per = len(items) // len(todo)
             for k, x in enumerate(todo):

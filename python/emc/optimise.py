@@ -146,24 +146,26 @@ def plot_history(history: pd.DataFrame, baseline: float, path: str, title: str):
     plt.close(fig)
 
 
-def compare(args, problem: Problem, designs: dict, out: pathlib.Path, pool, units: dict):
-    """Sweeps each design of ``designs`` (label → x) over the band and draws them side by side:
-    waterfalls and order cuts of the steering wheel's vertical acceleration, comfort."""
+def compare(problem: Problem, evaluator, designs: dict, out: pathlib.Path, units: dict,
+            progress: bool = True):
+    """Sweeps each design of ``designs`` (label → x) over the band on the study's pool (a
+    configuration a design needs travels with its runs) and draws them side by side: waterfalls
+    and order cuts of the steering wheel's vertical and lateral acceleration, comfort."""
     from . import plots
     from .comfort import comfort_table
-    from .mount_study import configuration_file
-    from .sweep import run_sweep, save, speed_points
+    from .distributed import progress_bar
+    from .sweep import save, tables
 
     orders, spectra = [], []
     for label, x in designs.items():
-        values, config = problem.start_values(x)
-        if config is not None:
-            values += (("configFile", configuration_file(config)),)
-        points = speed_points(problem.rpm_from, problem.rpm_to, problem.count,
-                              revolutions=problem.revolutions, periodic=True,
-                              parameters=(("scene", 2),) + values)
-        o, s = run_sweep(args.fmu, points, problem_signals(), case=label, parallel=not args.serial,
-                         progress=not args.quiet, pool=pool)
+        points = problem.evaluations(x)[:problem.count]
+        bar = progress_bar(len(points), label, progress, unit="point")
+        try:
+            done = evaluator.run_all(points, None if bar is None else bar.update)
+        finally:
+            if bar is not None:
+                bar.close()
+        o, s = tables([analysis for analysis, _ in done], label)
         orders.append(o)
         spectra.append(s)
     orders, spectra = pd.concat(orders, ignore_index=True), pd.concat(spectra, ignore_index=True)
@@ -177,12 +179,6 @@ def compare(args, problem: Problem, designs: dict, out: pathlib.Path, pool, unit
     save(exposure, str(out / "comfort.csv"))
     plots.comfort(exposure, str(out / "comfort.png"), cases=labels)
     return exposure
-
-
-def problem_signals() -> list[str]:
-    from .mount_study import SIGNALS
-
-    return SIGNALS + ["mount[1].F[3]"]
 
 
 class Progress:
@@ -229,7 +225,7 @@ def cmd_optimise(args) -> int:
                      f"{problem.objective} over {problem.rpm_from:g}-{problem.rpm_to:g} rpm "
                      f"({problem.count} points), COBYQA: {result['message']}")
         designs = {"current design": problem.baseline(), "optimum": np.array(best["x"])}
-        compare(args, problem, designs, out, pool, cli.units_of(variables))
+        compare(problem, evaluator, designs, out, cli.units_of(variables), not args.quiet)
     finally:
         evaluator.close()
         if pool is not None:

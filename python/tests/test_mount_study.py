@@ -144,3 +144,26 @@ def test_an_interrupted_study_continues_from_its_stored_evaluations(fmu_path, tm
     # Another FMU (checksum) or other settings in the same folder: refused, not mixed.
     with pytest.raises(StudyError, match="another FMU or other settings"):
         Store(tmp_path, "other", problem.settings())
+
+
+def test_the_commands_write_their_tables_and_plots(fmu_path, tmp_path, capsys):
+    """emc doe and emc optimise end to end on a tiny problem (a rate variable: its vehicle
+    configuration travels to the workers with the runs), the optimiser starting from the DOE."""
+    from emc.cli import main
+
+    tiny = ["--fmu", str(fmu_path), "--var", "mount[1].rate[3]", "--rpm", "1500", "2000",
+            "--count", "2", "--revolutions", "2", "--quiet"]
+    assert main(["doe", *tiny, "--method", "lhs", "--samples", "21", "--serial",
+                 "--out", str(tmp_path / "doe")]) == 0
+    for name in ("designs.csv", "sensitivity.csv", "sensitivity.png", "scatter.png", "doe.json",
+                 "metadata.json"):
+        assert (tmp_path / "doe" / name).exists(), name
+    assert main(["optimise", *tiny, "--evaluations", "4", "--workers", "2",
+                 "--start-from", str(tmp_path / "doe"), "--out", str(tmp_path / "opt")]) == 0
+    for name in ("history.csv", "history.png", "local_check.csv", "optimum.json", "comfort.png",
+                 "waterfall_steeringWheel.a3.png", "order_cuts_steeringWheel.a3.png"):
+        assert (tmp_path / "opt" / name).exists(), name
+    out = capsys.readouterr().out
+    assert "objective (wheel-mean, m/s²): current design" in out
+    report = json.loads((tmp_path / "opt" / "optimum.json").read_text())
+    assert report["best"]["feasible"] and report["best"]["objective"] <= report["baseline"]["objective"]
