@@ -46,7 +46,7 @@ from .runner import PointFailed, Runner, extracted, fmu_from_content
 # periodic housekeeping (an event-loop tick every 20 ms, system and memory monitors every
 # 0.5 s and 0.1 s, work stealing every 0.1 s) cost the caller 4 % and each worker 2 % of a core
 # while a study runs; at 1-5 s they cost a tenth of that (2 workers, 48 scene-2 points: all
-# processes together 7 % above the serial loop's CPU time instead of 22 %).
+# processes together within 1-4 % of the serial loop's CPU time instead of 22 % above it).
 WORKER_CONFIG = {
     "distributed.nanny.pre-spawn-environ": {
         "MALLOC_TRIM_THRESHOLD_": 1 << 28, "MALLOC_TOP_PAD_": 1 << 26,
