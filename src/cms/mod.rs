@@ -73,7 +73,7 @@ pub use cache::{
 pub use craig_bampton::{
     craig_bampton, craig_bampton_basis, orthogonalise, CraigBampton, CraigBamptonBasis,
 };
-pub use damping::{DampingBand, DampingTable};
+pub use damping::{BodyDamping, DampingTable, DampingUnit, DEFAULT_BODY_DAMPING_RATIO};
 pub use error::CmsError;
 pub use external::{dmig_of_reduction, reduce_external, DmigBody, ExternalBody};
 pub use hash::sha256_hex;

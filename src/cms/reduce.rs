@@ -182,7 +182,7 @@ pub(crate) fn named_points(
 pub(crate) fn table_damping(omega: &[f64], damping: &DampingTable) -> Vec<f64> {
     omega
         .iter()
-        .map(|w| damping.zeta(w / (2.0 * std::f64::consts::PI)))
+        .map(|w| damping.ratio(w / (2.0 * std::f64::consts::PI)))
         .collect()
 }
 
