@@ -78,13 +78,14 @@ fn symmetric<'f>(file: &'f DmigFile, name: &str) -> Result<&'f DmigMatrix, CmsEr
     Ok(m)
 }
 
-/// The kept modal coordinates, ascending id: the Rayleigh frequency of each selects it.
+/// The kept modal coordinates, ascending id, and the highest Rayleigh frequency among them (Hz,
+/// 0 if none is kept): the Rayleigh frequency of each selects it.
 fn select_modal(
     k: &DmigMatrix,
     m: &DmigMatrix,
     modal: &[DmigDof],
     selection: ModeSelection,
-) -> Result<Vec<DmigDof>, CmsError> {
+) -> Result<(Vec<DmigDof>, f64), CmsError> {
     let mut hz = Vec::with_capacity(modal.len());
     for &q in modal {
         let (kq, mq) = (k.get(q, q), m.get(q, q));
@@ -99,7 +100,7 @@ fn select_modal(
         }
         hz.push(((kq / mq).sqrt() / (2.0 * std::f64::consts::PI), q));
     }
-    let mut kept: Vec<DmigDof> = match selection {
+    let kept: Vec<(f64, DmigDof)> = match selection {
         ModeSelection::Count(n) => {
             if n > modal.len() {
                 return Err(invalid(format!(
@@ -109,12 +110,14 @@ fn select_modal(
                 )));
             }
             hz.sort_by(|a, b| a.0.total_cmp(&b.0));
-            hz.iter().take(n).map(|&(_, q)| q).collect()
+            hz.into_iter().take(n).collect()
         }
-        ModeSelection::CutoffHz(f) => hz.iter().filter(|(h, _)| *h < f).map(|&(_, q)| q).collect(),
+        ModeSelection::CutoffHz(f) => hz.into_iter().filter(|(h, _)| *h < f).collect(),
     };
+    let top = kept.iter().map(|&(h, _)| h).fold(0.0, f64::max);
+    let mut kept: Vec<DmigDof> = kept.into_iter().map(|(_, q)| q).collect();
     kept.sort_unstable();
-    Ok(kept)
+    Ok((kept, top))
 }
 
 /// The body given by Craig-Bampton matrices, reduced to its modes like our own reduction.
@@ -149,7 +152,7 @@ pub fn reduce_external(body: &ExternalBody<'_>) -> Result<ReducedChassis, CmsErr
 
     // Coordinates: the kept modal ones, then the mounts' boundary DOFs in mount order (the
     // order of our own reduction's constraint modes), then any other boundary DOF.
-    let mut coords = select_modal(k, m, &modal, body.selection)?;
+    let (mut coords, cutoff_hz) = select_modal(k, m, &modal, body.selection)?;
     let mut interface_dofs = Vec::new();
     for name in body.interface {
         let g = grid_of(name, "mount body node")?;
@@ -265,6 +268,7 @@ pub fn reduce_external(body: &ExternalBody<'_>) -> Result<ReducedChassis, CmsErr
         zeta: table_damping(&omega, body.damping),
         omega,
         points,
+        cutoff_hz: Some(cutoff_hz),
     })
 }
 

@@ -211,6 +211,7 @@ pub fn reduce_detailed(spec: &ReductionSpec) -> Result<Reduction, CmsError> {
         omega: modes.omega.clone(),
         zeta,
         points,
+        cutoff_hz: Some(modes.fixed_interface_hz.iter().copied().fold(0.0, f64::max)),
     };
     Ok(Reduction {
         chassis: model.chassis,

@@ -25,6 +25,11 @@ pub struct ReducedChassis {
     pub zeta: Vec<f64>,
     /// Interface (mount) nodes first, then output points.
     pub points: Vec<RecoveryPoint>,
+    /// The modes above this frequency (Hz) are the interface modes of the reduction, whose
+    /// frequencies follow from the constraint modes, not from the structure: the highest
+    /// fixed-interface mode kept (0 if none was). `None`: not known (modal data from a file).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub cutoff_hz: Option<f64>,
 }
 
 impl ReducedChassis {
@@ -39,6 +44,7 @@ impl ReducedChassis {
             omega: Vec::new(),
             zeta: Vec::new(),
             points: Vec::new(),
+            cutoff_hz: None,
         }
     }
 
@@ -63,6 +69,7 @@ impl ReducedChassis {
                     ..p.clone()
                 })
                 .collect(),
+            cutoff_hz: self.cutoff_hz,
         }
     }
 }

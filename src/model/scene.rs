@@ -3,7 +3,8 @@
 //! scene needs (scene 2, Table 1 middle column).
 
 use crate::cms::{
-    reduce_cached_with_notes, reduce_external, BulkDeckBody, CacheOutcome, CacheSetting,
+    reduce_cached_with_notes, reduce_external, BodyDamping, BulkDeckBody, CacheOutcome,
+    CacheSetting,
     ExternalBody, InterfaceDofs, ModeSelection, ReducedChassis, ReductionSpec,
 };
 use crate::fe::chassis_config::ChassisConfig;
@@ -81,7 +82,8 @@ pub struct BodyOptions {
     /// All six DOFs of the mount nodes as interface (rotational constraint modes, kHz), instead
     /// of the translations (the mounts transmit forces only).
     pub interface_rotations: bool,
-    /// Factor on every modal damping ratio (1 = the ADAMS table; 0 = undamped).
+    /// Factor on the body's physical modal damping, its table and per-mode overrides (1 = as
+    /// configured; 0 = undamped); the numerical damping of the interface modes stays.
     pub modal_damping_scale: f64,
     /// Procedural body only: the transverse stiffening bar between the front girders.
     pub stiffening_bar: bool,
@@ -93,7 +95,8 @@ pub struct BodyOptions {
 
 impl Default for BodyOptions {
     /// The paper's question: engine orders up to 4.5 at up to 2500 rpm (an automatic cut-off of
-    /// 225 Hz), translational interface, the ADAMS damping table, the body as designed, cached.
+    /// 225 Hz), translational interface, the body's damping as configured, the body as designed,
+    /// cached.
     fn default() -> Self {
         BodyOptions {
             mode_cutoff_hz: 0.0,
@@ -318,11 +321,12 @@ pub fn reduction_spec(
 ) -> Result<(ReductionSpec, String), SceneError> {
     options.validate()?;
     let (chassis, deck) = match &vehicle.body {
-        BodyConfig::Procedural { chassis } => (chassis.as_ref().clone(), None),
+        BodyConfig::Procedural { chassis, .. } => (chassis.as_ref().clone(), None),
         BodyConfig::Nastran {
             path,
             points,
             include_root,
+            ..
         } => {
             options.procedural_only("a bulk data deck")?;
             // Streaming over the deck and its INCLUDEs: the key follows every file's content
@@ -366,6 +370,45 @@ pub fn reduction_spec(
         ..ReductionSpec::default()
     };
     Ok((spec, origin))
+}
+
+/// Sets the modal damping of `body` from the vehicle's body damping (or the default; a reduced
+/// body read from a file keeps its own ratios unless the configuration gives a damping), the
+/// physical part scaled by `scale`; returns what was applied, for the log.
+fn apply_damping(
+    body: &mut ReducedChassis,
+    vehicle: &VehicleConfig,
+    scale: f64,
+) -> Result<String, SceneError> {
+    let given = vehicle.body.damping();
+    if given.is_none() {
+        if let BodyConfig::Reduced { .. } = vehicle.body {
+            for z in &mut body.zeta {
+                *z *= scale;
+            }
+            return Ok(format!("the file's modal damping x{scale}"));
+        }
+    }
+    let (damping, origin) = match given {
+        Some(d) => (d.clone(), "modal damping of the vehicle configuration"),
+        None => (BodyDamping::default(), "default modal damping"),
+    };
+    let hz: Vec<f64> = body
+        .omega
+        .iter()
+        .map(|w| w / (2.0 * std::f64::consts::PI))
+        .collect();
+    body.zeta = damping
+        .ratios(&hz, body.cutoff_hz, scale)
+        .map_err(|e| SceneError::Model(format!("body.damping: {e}")))?;
+    let interface = match body.cutoff_hz {
+        Some(c) => {
+            let above = hz.iter().filter(|f| **f > c).count();
+            format!("; {above} interface modes above {c:.1} Hz damped numerically")
+        }
+        None => String::new(),
+    };
+    Ok(format!("{origin} x{scale}{interface}"))
 }
 
 /// The reduced body the scene asks for, from the cache or freshly reduced (timed for the log).
@@ -417,6 +460,7 @@ pub fn body(
             recovery,
             points,
             include_root,
+            ..
         } => {
             options.procedural_only("given as Craig-Bampton matrices (DMIG)")?;
             if options.interface_rotations {
@@ -456,7 +500,7 @@ pub fn body(
                 ),
             )
         }
-        BodyConfig::Reduced { path } => {
+        BodyConfig::Reduced { path, .. } => {
             options.procedural_only("a reduced model from a file")?;
             let text = crate::text_file::read_limited(path, crate::text_file::DATA_LIMIT)
                 .map_err(|e| format!("reduced body: {e}"))?;
@@ -469,14 +513,14 @@ pub fn body(
     let mut body = if flexible {
         body
     } else {
-        body.keep_below(RIGID_BODY_HZ)
+        // The rigid-body modes on the suspension are the body's physical modes here.
+        let mut rigid = body.keep_below(RIGID_BODY_HZ);
+        rigid.cutoff_hz = rigid.cutoff_hz.map(|_| RIGID_BODY_HZ);
+        rigid
     };
-    for z in &mut body.zeta {
-        *z *= options.modal_damping_scale;
-    }
+    let damping_origin = apply_damping(&mut body, vehicle, options.modal_damping_scale)?;
     let note = format!(
-        "{origin}, modal damping x{}: {} modes, {:.1}..{:.1} Hz, in {seconds:.2} s",
-        options.modal_damping_scale,
+        "{origin}, {damping_origin}: {} modes, {:.1}..{:.1} Hz, in {seconds:.2} s",
         body.n_modes(),
         body.omega.first().copied().unwrap_or(0.0) / (2.0 * std::f64::consts::PI),
         body.omega.last().copied().unwrap_or(0.0) / (2.0 * std::f64::consts::PI),

@@ -18,6 +18,7 @@ use super::mount::{MountConfig, MountCurve};
 use super::powertrain::config::EngineConfig;
 use super::powertrain::defaults::{POWERTRAIN_CG, POWERTRAIN_MASS};
 use super::validate::{err, positive, ConfigError};
+use crate::cms::BodyDamping;
 use crate::fe::chassis::{SEAT_RAIL, STEERING_WHEEL};
 use crate::fe::chassis_config::ChassisConfig;
 
@@ -31,6 +32,9 @@ pub enum BodyConfig {
     Procedural {
         /// The chassis's geometry, sections, materials, trim and suspension.
         chassis: Box<ChassisConfig>,
+        /// Modal damping of the body (`None`: [`BodyDamping::default`]).
+        #[serde(default, skip_serializing_if = "Option::is_none")]
+        damping: Option<BodyDamping>,
     },
     /// A user's body from a Nastran bulk data deck ([`crate::fe::nastran`]), reduced by
     /// Craig-Bampton like the procedural one; `points` names the GRID ids the mounts
@@ -47,6 +51,10 @@ pub enum BodyConfig {
         /// configuration file's folder).
         #[serde(default, skip_serializing_if = "Option::is_none")]
         include_root: Option<PathBuf>,
+        /// Modal damping of the body (`None`: the deck's own `TABDMP1` named by `SDAMPING` in
+        /// its case control, else [`BodyDamping::default`]).
+        #[serde(default, skip_serializing_if = "Option::is_none")]
+        damping: Option<BodyDamping>,
     },
     /// A body reduced elsewhere: Craig-Bampton matrices in Nastran `DMIG` form
     /// ([`crate::fe::nastran::read_dmig_file`], [`crate::cms::reduce_external`]), reduced to its
@@ -71,6 +79,9 @@ pub enum BodyConfig {
         /// configuration file's folder).
         #[serde(default, skip_serializing_if = "Option::is_none")]
         include_root: Option<PathBuf>,
+        /// Modal damping of the body (`None`: [`BodyDamping::default`]).
+        #[serde(default, skip_serializing_if = "Option::is_none")]
+        damping: Option<BodyDamping>,
     },
     /// Modal data of an already reduced body: the JSON of a [`crate::cms::ReducedChassis`]
     /// (frequencies, damping ratios, named points with their mode-shape rows). A relative path is
@@ -78,7 +89,23 @@ pub enum BodyConfig {
     Reduced {
         /// The JSON file of the reduced body.
         path: PathBuf,
+        /// Modal damping of the body in place of the file's ratios (`None`: the file's).
+        #[serde(default, skip_serializing_if = "Option::is_none")]
+        damping: Option<BodyDamping>,
     },
+}
+
+impl BodyConfig {
+    /// The body's modal damping as the configuration gives it (`None`: the body's own, or the
+    /// default; see each kind).
+    pub fn damping(&self) -> Option<&BodyDamping> {
+        match self {
+            BodyConfig::Procedural { damping, .. }
+            | BodyConfig::Nastran { damping, .. }
+            | BodyConfig::Dmig { damping, .. }
+            | BodyConfig::Reduced { damping, .. } => damping.as_ref(),
+        }
+    }
 }
 
 /// A deck named by a configuration file must lie in `root` (checked on the resolved paths, so
@@ -184,6 +211,7 @@ impl Default for VehicleConfig {
             mounts: default_mounts(POWERTRAIN_MASS * gravity),
             body: BodyConfig::Procedural {
                 chassis: Box::default(),
+                damping: None,
             },
             outputs: vec![STEERING_WHEEL.to_string(), SEAT_RAIL.to_string()],
             effects: Effects::default(),
@@ -251,7 +279,7 @@ impl VehicleConfig {
             .map_err(|e| err("file", e))?;
         let mut config = Self::from_json(&text)?;
         let dir = path.parent().unwrap_or(std::path::Path::new(""));
-        if let BodyConfig::Reduced { path: body }
+        if let BodyConfig::Reduced { path: body, .. }
         | BodyConfig::Nastran { path: body, .. }
         | BodyConfig::Dmig { path: body, .. } = &mut config.body
         {
@@ -313,6 +341,13 @@ impl VehicleConfig {
             }
         }
         self.validate_body_points()?;
+        if let Some(damping) = self.body.damping() {
+            damping.check().map_err(|e| {
+                let (field, message) = e.split_once(": ").unwrap_or(("", e.as_str()));
+                let field = field.split_whitespace().next().unwrap_or(field);
+                err(format!("body.damping.{field}"), message.to_string())
+            })?;
+        }
         if let Some(i) = self.outputs.iter().position(|o| o.trim().is_empty()) {
             return Err(err(
                 format!("outputs[{i}]"),
