@@ -37,16 +37,19 @@ BOUNDS = ("low", "nominal", "high")
 
 # The default band. The body: 5 % of critical nominal, 3–7 % (Adams & Askenazi's range for metal
 # structures with joints) as modalDampingScale 0.6–1.4. The mounts: a loss factor of 0.15 at
-# 10 Hz nominal, 0.10–0.20 (rubber engine mounts) as dampingScale 2/3–4/3.
+# 10 Hz nominal, 0.10–0.20 (rubber engine mounts) as dampingScale 2/3–4/3 — paired the other way
+# round: above the powertrain's own modes on its mounts a mount's damping transmits force to the
+# body, so the least damped body with the most damped mounts gives the highest levels at the
+# body's resonances (and the other pair the lowest).
 BODY_SCALE = (0.6, 1.4)
-MOUNT_SCALE = (2.0 / 3.0, 4.0 / 3.0)
+MOUNT_SCALE = (4.0 / 3.0, 2.0 / 3.0)
 MOUNTS = 4
 
 
 @dataclasses.dataclass(frozen=True)
 class Band:
     """The FMU start values of each bound, applied on top of a case's own settings. ``low`` is
-    the bound with less damping (higher levels at a resonance)."""
+    the bound with the least damped body (the higher levels at its resonances)."""
 
     low: dict
     high: dict
@@ -73,7 +76,8 @@ class Band:
                 mounts: tuple[float, float] | None = MOUNT_SCALE,
                 mount_count: int = MOUNTS) -> "Band":
         """The body's modal damping (``chassis.modalDampingScale``) and the mounts' damping
-        (``mount[i].dampingScale``) at the scales ``(low, high)``; ``None`` leaves one nominal."""
+        (``mount[i].dampingScale``) at the scales ``(at the low bound, at the high bound)``, each
+        pair enclosing 1 (the nominal); ``None`` leaves one nominal."""
         if body is None and mounts is None:
             raise ValueError("a damping band needs the body's or the mounts' bounds")
         low, high, parts = {}, {}, []
@@ -84,9 +88,10 @@ class Band:
             if pair is None:
                 continue
             a, b = (float(v) for v in pair)
-            if not (np.isfinite(a) and np.isfinite(b) and 0.0 <= a <= 1.0 <= b):
-                raise ValueError(f"{what} bounds must satisfy 0 <= low <= 1 <= high "
-                                 f"(scales of the nominal), got {a:g} {b:g}")
+            if not (np.isfinite(a) and np.isfinite(b) and min(a, b) >= 0.0
+                    and min(a, b) <= 1.0 <= max(a, b)):
+                raise ValueError(f"{what} bounds must be >= 0 and enclose 1 (scales of the "
+                                 f"nominal), got {a:g} {b:g}")
             low.update({n: a for n in names})
             high.update({n: b for n in names})
             parts.append(f"{what} x{a:.3g}..x{b:.3g}")
@@ -265,13 +270,14 @@ def add_options(parser):
     parser.add_argument("--band", action="store_true",
                         help="run at two damping bounds beside the nominal and draw the band: "
                              f"body modal damping x{BODY_SCALE[0]:g}..x{BODY_SCALE[1]:g} "
-                             f"(5 %% nominal: 3-7 %%), mount damping x{MOUNT_SCALE[0]:.3g}.."
-                             f"x{MOUNT_SCALE[1]:.3g} (loss factor 0.15: 0.10-0.20)")
+                             f"(5 %% nominal: 3-7 %%) with mount damping x{MOUNT_SCALE[0]:.3g}.."
+                             f"x{MOUNT_SCALE[1]:.3g} (loss factor 0.15: 0.20-0.10)")
     parser.add_argument("--band-body", nargs=2, type=float, metavar=("LOW", "HIGH"),
-                        help="the band's chassis.modalDampingScale bounds (implies --band)")
+                        help="the band's chassis.modalDampingScale at the low and the high bound "
+                             "(implies --band)")
     parser.add_argument("--band-mounts", nargs=2, type=float, metavar=("LOW", "HIGH"),
-                        help="the band's mount[i].dampingScale bounds, every mount (implies "
-                             "--band; 1 1 leaves the mounts nominal)")
+                        help="the band's mount[i].dampingScale at the low and the high bound, "
+                             "every mount (implies --band; 1 1 leaves the mounts nominal)")
 
 
 def from_options(args, variables: dict) -> Band | None:
