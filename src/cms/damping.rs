@@ -14,8 +14,6 @@
 //! to a flexible body given no damping) stays available as [`DampingTable::adams`] and
 //! [`BodyDamping::adams`].
 
-use std::collections::BTreeMap;
-
 use serde::{Deserialize, Serialize};
 
 use super::error::CmsError;
@@ -216,12 +214,13 @@ impl DampingTable {
 pub struct BodyDamping {
     /// Physical: damping of each mode by its natural frequency.
     pub table: DampingTable,
-    /// Physical: damping ratio (fraction of critical) of single modes by number (1 = the lowest
-    /// mode of the reduced body), in place of the table's.
-    #[serde(default, skip_serializing_if = "BTreeMap::is_empty")]
-    pub modes: BTreeMap<usize, f64>,
+    /// Physical: (mode number, damping ratio) of single modes, 1 being the lowest mode of the
+    /// reduced body, the ratio a fraction of critical, in place of the table's.
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub modes: Vec<(usize, f64)>,
     /// Numerical: the least damping of the modes above the fixed-interface cut-off (the
-    /// interface modes), by frequency.
+    /// interface modes), by frequency (default: 10 % below 1 kHz, 100 % above).
+    #[serde(default = "interface_mode_damping")]
     pub above_cutoff: DampingTable,
 }
 
@@ -245,7 +244,7 @@ impl Default for BodyDamping {
     fn default() -> Self {
         Self {
             table: DampingTable::uniform(DEFAULT_BODY_DAMPING_RATIO),
-            modes: BTreeMap::new(),
+            modes: Vec::new(),
             above_cutoff: interface_mode_damping(),
         }
     }
@@ -257,7 +256,7 @@ impl BodyDamping {
     pub fn adams() -> Self {
         Self {
             table: DampingTable::adams(),
-            modes: BTreeMap::new(),
+            modes: Vec::new(),
             above_cutoff: interface_mode_damping(),
         }
     }
@@ -276,13 +275,18 @@ impl BodyDamping {
         self.above_cutoff
             .check()
             .map_err(|e| format!("above_cutoff: {e}"))?;
-        for (&mode, &zeta) in &self.modes {
+        for (i, &(mode, zeta)) in self.modes.iter().enumerate() {
             if mode == 0 {
-                return Err("modes: mode 0 does not exist (modes are numbered from 1)".into());
+                return Err(format!(
+                    "modes[{i}]: mode 0 does not exist (modes are numbered from 1)"
+                ));
+            }
+            if self.modes[..i].iter().any(|&(m, _)| m == mode) {
+                return Err(format!("modes[{i}]: mode {mode} is given twice"));
             }
             if !(zeta.is_finite() && zeta >= 0.0) {
                 return Err(format!(
-                    "modes.{mode}: damping ratio {zeta} must be finite and >= 0"
+                    "modes[{i}]: damping ratio {zeta} of mode {mode} must be finite and >= 0"
                 ));
             }
         }
@@ -303,16 +307,16 @@ impl BodyDamping {
             return Err(format!("scale {scale} must be finite and >= 0"));
         }
         let n = frequencies_hz.len();
-        if let Some((&mode, _)) = self.modes.range(n + 1..).next() {
+        if let Some((i, &(mode, _))) = self.modes.iter().enumerate().find(|(_, m)| m.0 > n) {
             return Err(format!(
-                "modes.{mode}: the body has {n} modes (numbered 1 to {n})"
+                "modes[{i}]: mode {mode}, but the body has {n} modes (numbered 1 to {n})"
             ));
         }
         Ok(frequencies_hz
             .iter()
             .enumerate()
             .map(|(k, &f)| {
-                if let Some(&zeta) = self.modes.get(&(k + 1)) {
+                if let Some(&(_, zeta)) = self.modes.iter().find(|m| m.0 == k + 1) {
                     return scale * zeta;
                 }
                 let physical = scale * self.table.ratio(f);
@@ -433,8 +437,7 @@ mod tests {
         assert_eq!(d.ratios(&hz, None, 1.0).unwrap(), vec![0.05; 5]);
         // An override is final, and scaled.
         let mut o = d.clone();
-        o.modes.insert(2, 0.02);
-        o.modes.insert(5, 0.0);
+        o.modes = vec![(2, 0.02), (5, 0.0)];
         let z = o.ratios(&hz, Some(225.0), 2.0).unwrap();
         assert_eq!(z, vec![0.10, 0.04, 0.10, 0.10, 0.0]);
         // The ADAMS preset reproduces the old table on the interface modes too.
@@ -445,15 +448,18 @@ mod tests {
     #[test]
     fn bad_body_damping_is_named() {
         let mut d = BodyDamping::default();
-        d.modes.insert(7, 0.03);
+        d.modes = vec![(1, 0.01), (7, 0.03)];
         let e = d.ratios(&[10.0; 5], None, 1.0).unwrap_err();
-        assert!(e.contains("modes.7") && e.contains("5 modes"), "{e}");
-        d.modes.clear();
-        d.modes.insert(0, 0.03);
+        assert!(
+            e.contains("modes[1]: mode 7") && e.contains("5 modes"),
+            "{e}"
+        );
+        d.modes = vec![(0, 0.03)];
         assert!(d.check().unwrap_err().contains("mode 0"));
-        d.modes.clear();
-        d.modes.insert(3, -1.0);
-        assert!(d.check().unwrap_err().contains("modes.3"));
+        d.modes = vec![(3, -1.0)];
+        assert!(d.check().unwrap_err().contains("modes[0]"));
+        d.modes = vec![(3, 0.01), (3, 0.02)];
+        assert!(d.check().unwrap_err().contains("given twice"));
         let mut d = BodyDamping::default();
         d.above_cutoff.points.clear();
         assert!(d.check().unwrap_err().starts_with("above_cutoff"));
@@ -470,11 +476,11 @@ mod tests {
         let back: BodyDamping = serde_json::from_str(&text).unwrap();
         assert_eq!(back, d);
         let parsed: BodyDamping = serde_json::from_str(
-            r#"{"table": {"type": "g", "points": [[0, 0.06]]}, "modes": {"7": 0.02},
+            r#"{"table": {"type": "g", "points": [[0, 0.06]]}, "modes": [[7, 0.02]],
                 "above_cutoff": {"type": "crit", "points": [[0, 1.0]]}}"#,
         )
         .unwrap();
-        assert_eq!(parsed.modes.get(&7), Some(&0.02));
+        assert_eq!(parsed.modes, vec![(7, 0.02)]);
         assert!((parsed.table.ratio(40.0) - 0.03).abs() < 1e-15);
     }
 }

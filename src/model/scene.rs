@@ -4,8 +4,7 @@
 
 use crate::cms::{
     reduce_cached_with_notes, reduce_external, BodyDamping, BulkDeckBody, CacheOutcome,
-    CacheSetting,
-    ExternalBody, InterfaceDofs, ModeSelection, ReducedChassis, ReductionSpec,
+    CacheSetting, ExternalBody, InterfaceDofs, ModeSelection, ReducedChassis, ReductionSpec,
 };
 use crate::fe::chassis_config::ChassisConfig;
 
@@ -386,12 +385,12 @@ fn apply_damping(
             for z in &mut body.zeta {
                 *z *= scale;
             }
-            return Ok(format!("the file's modal damping x{scale}"));
+            return Ok(format!("modal damping x{scale} (the file's ratios)"));
         }
     }
     let (damping, origin) = match given {
-        Some(d) => (d.clone(), "modal damping of the vehicle configuration"),
-        None => (BodyDamping::default(), "default modal damping"),
+        Some(d) => (d.clone(), "the vehicle configuration's"),
+        None => (BodyDamping::default(), "the default"),
     };
     let hz: Vec<f64> = body
         .omega
@@ -408,7 +407,7 @@ fn apply_damping(
         }
         None => String::new(),
     };
-    Ok(format!("{origin} x{scale}{interface}"))
+    Ok(format!("modal damping x{scale} ({origin}){interface}"))
 }
 
 /// The reduced body the scene asks for, from the cache or freshly reduced (timed for the log).

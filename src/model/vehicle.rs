@@ -202,7 +202,8 @@ pub fn default_mounts(weight: f64) -> Vec<MountConfig> {
 
 impl Default for VehicleConfig {
     /// The paper's vehicle: the Steyr M13 inline-3 on four mounts in the procedural FIAT Brava
-    /// body, steering wheel and seat rail as outputs.
+    /// body with the default modal damping ([`BodyDamping::default`]), steering wheel and seat
+    /// rail as outputs.
     fn default() -> Self {
         let gravity = 9.81;
         Self {
@@ -211,7 +212,7 @@ impl Default for VehicleConfig {
             mounts: default_mounts(POWERTRAIN_MASS * gravity),
             body: BodyConfig::Procedural {
                 chassis: Box::default(),
-                damping: None,
+                damping: Some(BodyDamping::default()),
             },
             outputs: vec![STEERING_WHEEL.to_string(), SEAT_RAIL.to_string()],
             effects: Effects::default(),
@@ -344,7 +345,6 @@ impl VehicleConfig {
         if let Some(damping) = self.body.damping() {
             damping.check().map_err(|e| {
                 let (field, message) = e.split_once(": ").unwrap_or(("", e.as_str()));
-                let field = field.split_whitespace().next().unwrap_or(field);
                 err(format!("body.damping.{field}"), message.to_string())
             })?;
         }
@@ -358,7 +358,8 @@ impl VehicleConfig {
     }
 
     /// Every named point of a bulk-deck body must be a node the vehicle uses (a mount's body
-    /// node or an output): a misspelt name would otherwise be ignored.
+    /// node or an output): a misspelt name would otherwise be ignored; and no two active mounts
+    /// may attach to one GRID.
     fn validate_body_points(&self) -> Result<(), ConfigError> {
         let (BodyConfig::Nastran { points, .. } | BodyConfig::Dmig { points, .. }) = &self.body
         else {
@@ -371,16 +372,38 @@ impl VehicleConfig {
                     .iter()
                     .any(|m| m.body_node.as_deref() == Some(name))
         };
-        match points.keys().find(|name| !used(name)) {
-            Some(name) => Err(err(
+        if let Some(name) = points.keys().find(|name| !used(name)) {
+            return Err(err(
                 format!("body.points.{name}"),
                 format!(
                     "body point '{name}' is neither a mount's body_node nor an output ({})",
                     self.outputs.join(", ")
                 ),
-            )),
-            None => Ok(()),
+            ));
         }
+        // Two mounts on one grid would make the interface singular far downstream.
+        let mut seen: Vec<(u32, usize)> = Vec::new();
+        for (i, m) in self.mounts.iter().enumerate().filter(|(_, m)| m.active) {
+            let Some(grid) = m.body_node.as_ref().and_then(|n| points.get(n)) else {
+                continue;
+            };
+            if let Some(&(_, j)) = seen.iter().find(|(g, _)| g == grid) {
+                let other = &self.mounts[j];
+                return Err(err(
+                    format!("mounts[{i}].body_node"),
+                    format!(
+                        "mounts '{}' and '{}' both attach to GRID {grid} (body points '{}' and \
+                         '{}'): each mount needs its own grid",
+                        other.name,
+                        m.name,
+                        other.body_node.as_deref().unwrap_or(""),
+                        m.body_node.as_deref().unwrap_or("")
+                    ),
+                ));
+            }
+            seen.push((*grid, i));
+        }
+        Ok(())
     }
 
     /// The body nodes the active mounts attach to, in mount order (the body's interface).
