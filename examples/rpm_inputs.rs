@@ -10,9 +10,9 @@ use std::path::PathBuf;
 use std::time::Instant;
 
 use engine_mount_chassis::cosim::FmuKind;
-use engine_mount_chassis::fmi2::instance::{Instance, Outcome, Status};
-use engine_mount_chassis::fmi2::logger::Logger;
 use engine_mount_chassis::fmi2::variables::{integer, real};
+use engine_mount_chassis::fmu::instance::{Instance, Outcome, Status};
+use engine_mount_chassis::fmu::logger::Logger;
 
 struct Run {
     cpu: f64,
@@ -25,7 +25,8 @@ struct Run {
 fn run(scene: i32, seconds: f64, h: f64, derivatives: bool) -> Result<Run, String> {
     let resources = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("resources");
     let logger = Logger::new(None, std::ptr::null_mut(), "rpm", false);
-    let mut fmu = Instance::new("rpm", FmuKind::Engine, logger, Some(resources));
+    let abi = &engine_mount_chassis::fmi2::abi::ABI;
+    let mut fmu = Instance::new("rpm", FmuKind::Engine, abi, logger, Some(resources));
     let ok = |s: Outcome, what: &str| match s {
         Ok(Status::Ok | Status::Warning) => Ok(()),
         Ok(other) => Err(format!("{what}: {other:?}")),

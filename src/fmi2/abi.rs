@@ -1,197 +1,46 @@
-//! The exported FMI 2.0 functions. Every entry point that takes an instance passes one guard,
-//! `entry`: the instance pointer is checked, panics are caught (a panic must never unwind into
-//! the C caller), the call is checked against the state machine ([`super::state`]), and a
-//! refusal is logged once, naming the function. Inside, C arguments become slices (`array`,
-//! `array_mut`, null pointers refused), value references become typed positions through the
-//! one table ([`super::values::indices`]), and the instance does the rest. This file, the
-//! logger's callback and [`crate::fmi3::abi`] (which reuses the slice helpers here) are the only
-//! places with `unsafe` in the crate: every block says why it is sound.
+//! The exported FMI 2.0 functions: the standard's signatures over the runtime ([`crate::fmu`]).
+//! Every entry point that takes an instance passes the runtime's one guard
+//! ([`crate::fmu::guard::Abi::entry`]) with its state mask ([`super::state`]); inside, C arguments
+//! become Rust values ([`crate::fmu::c_args`]), value references become typed positions
+//! ([`super::values`]), and the runtime does the rest.
 
 #![allow(non_snake_case)]
 #![allow(clippy::not_unsafe_ptr_arg_deref)] // the C ABI hands us raw pointers by design
 
-use std::ffi::{c_char, CStr, CString};
-use std::panic::{catch_unwind, AssertUnwindSafe};
+use std::ffi::c_char;
 
 use fmi_sys::fmi2::*;
 
-use super::fmu_states::FmuStates;
-use super::instance::{Instance, Outcome, Status};
-use super::logger::{Level, Logger};
-use super::snapshot;
-use super::state::{self, Mask, Phase};
+use super::state;
 use super::uri::resource_path;
-use super::values::{indices, Typed};
-use super::variables::{
-    string, LogCategory, BODY_GUID, BODY_MODEL_IDENTIFIER, GUID, MODEL_IDENTIFIER, STRINGS,
-};
+use super::values::{indices, slots};
 use crate::cosim::FmuKind;
+use crate::fmu::c_args::{array, array_mut, place, string_value, texts};
+use crate::fmu::guard::{self, Abi, FunctionNames, Request};
+use crate::fmu::instance::{Outcome, Status};
+use crate::fmu::logger::Logger;
+use crate::fmu::state::Phase;
+use crate::fmu::values::Typed;
 
-/// Marks a live instance allocated by `fmi2Instantiate`; cleared when freed, so a stale or
-/// foreign pointer is recognised with high probability instead of being used.
-const LIVE: u64 = 0x454d_4346_4d55_0001;
-
-struct Handle {
-    live: u64,
-    instance: Instance,
-    /// Strings returned by fmi2GetString stay valid until the next call on this instance.
-    returned_strings: Vec<CString>,
-    /// The FMU states this instance handed out (fmi2GetFMUstate, fmi2DeSerializeFMUstate) and
-    /// that are not freed yet: they belong to it and are freed with it.
-    states: FmuStates,
-}
-
-fn status(s: Status) -> fmi2Status {
-    match s {
-        Status::Ok => fmi2Status_fmi2OK,
-        Status::Warning => fmi2Status_fmi2Warning,
-        Status::Discard => fmi2Status_fmi2Discard,
-        Status::Error => fmi2Status_fmi2Error,
-        Status::Fatal => fmi2Status_fmi2Fatal,
-    }
-}
-
-/// The guard of every entry point with an instance: runs `body` on the instance behind `c` if
-/// `function` may be called in its phase (`mask`). A null or stale pointer gives fmi2Error, a
-/// refusal is logged as "`function`: reason" with fmi2Error, a panic gives fmi2Fatal (the
-/// instance is then unusable), and in the fatal phase only fmi2FreeInstance is allowed.
-fn entry(
-    c: fmi2Component,
-    function: &'static str,
-    mask: Mask,
-    body: impl FnOnce(&mut Handle) -> Outcome,
-) -> fmi2Status {
-    if c.is_null() {
-        return fmi2Status_fmi2Error;
-    }
-    let ptr = c as *mut Handle;
-    // SAFETY: a non-null fmi2Component is, per FMI 2.0, the pointer fmi2Instantiate returned and
-    // fmi2FreeInstance has not been called on it; the caller must not use one instance from two
-    // threads at once (FMI 2.0 §2.1.4), so this is the only live reference.
-    let handle = unsafe { &mut *ptr };
-    if handle.live != LIVE {
-        return fmi2Status_fmi2Error;
-    }
-    let result = catch_unwind(AssertUnwindSafe(|| {
-        let inst = &handle.instance;
-        inst.logger.log(Level::Info, LogCategory::Calls, function);
-        let phase = inst.phase();
-        if phase == Phase::Fatal {
-            inst.logger.log(
-                Level::Fatal,
-                LogCategory::StatusError,
-                &format!("{function}: the instance is in a fatal state; only fmi2FreeInstance is allowed"),
-            );
-            return Status::Fatal;
-        }
-        if !mask.allows(phase) {
-            inst.log_error(&format!("{function} is not allowed in phase {phase:?}"));
-            return Status::Error;
-        }
-        match body(handle) {
-            Ok(s) => s,
-            Err(message) => {
-                handle.instance.log_error(&format!("{function}: {message}"));
-                Status::Error
-            }
-        }
-    }));
-    match result {
-        Ok(s) => status(s),
-        Err(panic) => {
-            let what = panic
-                .downcast_ref::<&str>()
-                .map(|s| s.to_string())
-                .or_else(|| panic.downcast_ref::<String>().cloned())
-                .unwrap_or_else(|| "unknown panic".to_owned());
-            let _ = catch_unwind(AssertUnwindSafe(|| {
-                handle.instance.core.phase = Phase::Fatal;
-                handle.instance.logger.log(
-                    Level::Fatal,
-                    LogCategory::StatusError,
-                    &format!("{function}: internal error (bug), the instance is unusable: {what}"),
-                );
-            }));
-            fmi2Status_fmi2Fatal
-        }
-    }
-}
-
-/// A slice from the C array `name` of `n` elements; a null pointer with `n > 0` is refused.
-///
-/// # Safety
-/// `ptr` must be null or point to `n` initialised elements that stay valid and unaliased for `'a`.
-pub(crate) unsafe fn array<'a, T>(ptr: *const T, n: usize, name: &str) -> Result<&'a [T], String> {
-    if n == 0 {
-        Ok(&[])
-    } else if ptr.is_null() {
-        Err(format!("argument {name} is NULL"))
-    } else {
-        // SAFETY: guaranteed by the caller's contract above.
-        Ok(unsafe { std::slice::from_raw_parts(ptr, n) })
-    }
-}
-
-/// As [`array`], for writing.
-///
-/// # Safety
-/// As [`array`], and the elements must be writable.
-pub(crate) unsafe fn array_mut<'a, T>(
-    ptr: *mut T,
-    n: usize,
-    name: &str,
-) -> Result<&'a mut [T], String> {
-    if n == 0 {
-        Ok(&mut [])
-    } else if ptr.is_null() {
-        Err(format!("argument {name} is NULL"))
-    } else {
-        // SAFETY: guaranteed by the caller's contract above.
-        Ok(unsafe { std::slice::from_raw_parts_mut(ptr, n) })
-    }
-}
-
-/// The single writable element behind `ptr`; a null pointer is refused.
-///
-/// # Safety
-/// `ptr` must be null or point to a writable `T` valid for `'a`.
-pub(crate) unsafe fn place<'a, T>(ptr: *mut T, name: &str) -> Result<&'a mut T, String> {
-    // SAFETY: guaranteed by the caller's contract above.
-    unsafe { ptr.as_mut() }.ok_or_else(|| format!("argument {name} is NULL"))
-}
-
-/// A Rust string from a C string; `None` for null or invalid UTF-8.
-///
-/// # Safety
-/// `ptr` is null or a NUL-terminated string valid for the call.
-pub(crate) unsafe fn text(ptr: fmi2String) -> Option<String> {
-    if ptr.is_null() {
-        return None;
-    }
-    // SAFETY: non-null and NUL-terminated by the caller's contract.
-    unsafe { CStr::from_ptr(ptr) }
-        .to_str()
-        .ok()
-        .map(str::to_owned)
-}
-
-/// Strings from the C array `name` of `n` C strings; null or non-UTF-8 entries are refused.
-///
-/// # Safety
-/// As [`array`], each entry null or a NUL-terminated string valid for the call.
-pub(crate) unsafe fn texts(
-    ptr: *const fmi2String,
-    n: usize,
-    name: &str,
-) -> Result<Vec<String>, String> {
-    // SAFETY: the caller's contract.
-    let raw = unsafe { array(ptr, n, name) }?;
-    raw.iter()
-        // SAFETY: each entry is null or NUL-terminated, by the caller's contract.
-        .map(|p| unsafe { text(*p) })
-        .collect::<Option<Vec<_>>>()
-        .ok_or_else(|| format!("an entry of {name} is NULL or not UTF-8"))
-}
+/// FMI 2.0 as the runtime sees it.
+pub static ABI: Abi = Abi {
+    // Marks a live instance of fmi2Instantiate.
+    live: 0x454d_4346_4d55_0001,
+    kinds: &[FmuKind::Engine, FmuKind::Body],
+    token: "GUID",
+    resources: "resource location",
+    errors_enter_error_state: false,
+    phase_name: Phase::name,
+    error_state_hint: "",
+    names: FunctionNames {
+        instantiate: "fmi2Instantiate",
+        free_instance: "fmi2FreeInstance",
+        setup_experiment: "fmi2SetupExperiment",
+        exit_initialization: "fmi2ExitInitializationMode",
+        do_step: "fmi2DoStep",
+        set_fmu_state: "fmi2SetFMUstate",
+    },
+};
 
 // ----- inquiry ---------------------------------------------------------------------------------
 
@@ -212,10 +61,10 @@ const _: fmi2GetVersionTYPE = Some(fmi2GetVersion);
 // ----- creation and destruction ----------------------------------------------------------------
 
 /// Creates an instance and returns its handle, or null after logging why through the master's
-/// logger: a missing `instanceName`, a `fmuType` other than co-simulation, a GUID that is not
-/// this FMU's, or a resource location that is not a directory. The model itself is built only in
-/// [`fmi2ExitInitializationMode`], or earlier when an output or a calculated parameter is read
-/// in initialisation mode.
+/// logger: a missing `instanceName`, a `fmuType` other than co-simulation, a GUID that is neither
+/// of this library's FMUs', or a resource location that is not a directory. The model itself is
+/// built only in [`fmi2ExitInitializationMode`], or earlier when an output or a calculated
+/// parameter is read in initialisation mode.
 #[no_mangle]
 pub extern "C" fn fmi2Instantiate(
     instanceName: fmi2String,
@@ -226,72 +75,30 @@ pub extern "C" fn fmi2Instantiate(
     _visible: fmi2Boolean,
     loggingOn: fmi2Boolean,
 ) -> fmi2Component {
-    let result = catch_unwind(AssertUnwindSafe(|| {
-        let (callback, environment) = if functions.is_null() {
-            (None, std::ptr::null_mut())
-        } else {
-            // SAFETY: non-null; FMI 2.0 requires it to point to a callback struct that stays
-            // valid for the instance's lifetime. We copy the two fields we use.
-            let f = unsafe { &*functions };
-            (f.logger, f.componentEnvironment)
-        };
-        // SAFETY: FMI strings are NUL-terminated or null.
-        let (name, guid, resources) = unsafe {
-            (
-                text(instanceName).unwrap_or_default(),
-                text(fmuGUID).unwrap_or_default(),
-                text(fmuResourceLocation),
-            )
-        };
-        let logger = Logger::new(callback, environment, &name, loggingOn != 0);
-        let refuse = |logger: &Logger, message: &str| {
-            let message = format!("fmi2Instantiate: {message}");
-            logger.log(Level::Error, LogCategory::StatusError, &message);
-            std::ptr::null_mut()
-        };
-        if name.is_empty() {
-            return refuse(&logger, "instanceName is missing");
-        }
-        if fmuType != fmi2Type_fmi2CoSimulation {
-            return refuse(
-                &logger,
-                "this FMU supports co-simulation only (fmuType must be fmi2CoSimulation)",
-            );
-        }
-        let kind = if guid == GUID {
-            FmuKind::Engine
-        } else if guid == BODY_GUID {
-            FmuKind::Body
-        } else {
-            return refuse(
-                &logger,
-                &format!(
-                    "GUID \"{guid}\" matches neither {MODEL_IDENTIFIER} ({GUID}) nor {BODY_MODEL_IDENTIFIER} ({BODY_GUID}), the FMUs of this library"
-                ),
-            );
-        };
-        let resource_dir = match resource_dir(resources.as_deref()) {
-            Ok(dir) => dir,
-            Err(m) => return refuse(&logger, &m),
-        };
-        if resource_dir.is_none() {
-            let config = STRINGS[string::CONFIG_FILE as usize].name;
-            logger.log(
-                Level::Warning,
-                LogCategory::StatusWarning,
-                &format!("fmi2Instantiate: no resource location given; the built-in vehicle is used unless {config} names an absolute path"),
-            );
-        }
-        let handle = Box::new(Handle {
-            live: LIVE,
-            instance: Instance::new(&name, kind, logger, resource_dir),
-            returned_strings: Vec::new(),
-            states: FmuStates::default(),
-        });
-        Box::into_raw(handle) as fmi2Component
-    }));
-    result.unwrap_or(std::ptr::null_mut())
+    let (callback, environment) = if functions.is_null() {
+        (None, std::ptr::null_mut())
+    } else {
+        // SAFETY: non-null; FMI 2.0 requires it to point to a callback struct that stays valid
+        // for the instance's lifetime. We copy the two fields we use.
+        let f = unsafe { &*functions };
+        (f.logger, f.componentEnvironment)
+    };
+    let request = Request {
+        name: instanceName,
+        token: fmuGUID,
+        resources: fmuResourceLocation,
+        resource_dir,
+    };
+    let refusal = (fmuType != fmi2Type_fmi2CoSimulation)
+        .then_some("this FMU supports co-simulation only (fmuType must be fmi2CoSimulation)");
+    guard::instantiate(
+        &ABI,
+        request,
+        |name| Logger::new(callback, environment, name, loggingOn != 0),
+        refusal,
+    )
 }
+const _: fmi2InstantiateTYPE = Some(fmi2Instantiate);
 
 /// The resource directory a resource location URI names (`None`: no location given).
 fn resource_dir(uri: Option<&str>) -> Result<Option<std::path::PathBuf>, String> {
@@ -307,25 +114,12 @@ fn resource_dir(uri: Option<&str>) -> Result<Option<std::path::PathBuf>, String>
     }
     Ok(Some(path))
 }
-const _: fmi2InstantiateTYPE = Some(fmi2Instantiate);
 
 /// Frees the instance and every FMU state it handed out. A null or already freed handle is
 /// ignored; allowed in every phase, including after a fatal error.
 #[no_mangle]
 pub extern "C" fn fmi2FreeInstance(c: fmi2Component) {
-    if c.is_null() {
-        return;
-    }
-    let ptr = c as *mut Handle;
-    // SAFETY: c came from fmi2Instantiate (Box::into_raw) and is freed at most once by contract;
-    // the live marker catches the common double free before we take ownership back.
-    unsafe {
-        if (*ptr).live != LIVE {
-            return;
-        }
-        (*ptr).live = 0;
-        drop(Box::from_raw(ptr));
-    }
+    guard::free(c, &ABI)
 }
 const _: fmi2FreeInstanceTYPE = Some(fmi2FreeInstance);
 
@@ -339,7 +133,7 @@ pub extern "C" fn fmi2SetDebugLogging(
     nCategories: usize,
     categories: *const fmi2String,
 ) -> fmi2Status {
-    entry(c, "fmi2SetDebugLogging", state::SET_DEBUG_LOGGING, |h| {
+    ABI.entry(c, "fmi2SetDebugLogging", state::SET_DEBUG_LOGGING, |h| {
         // SAFETY: FMI passes an array of nCategories C strings.
         let names = unsafe { texts(categories, nCategories, "categories") }?;
         h.instance
@@ -364,7 +158,7 @@ pub extern "C" fn fmi2SetupExperiment(
     stopTimeDefined: fmi2Boolean,
     stopTime: fmi2Real,
 ) -> fmi2Status {
-    entry(c, "fmi2SetupExperiment", state::SETUP_EXPERIMENT, |h| {
+    ABI.entry(c, "fmi2SetupExperiment", state::SETUP_EXPERIMENT, |h| {
         h.instance.setup_experiment(
             startTime,
             (stopTimeDefined != 0).then_some(stopTime),
@@ -378,7 +172,7 @@ const _: fmi2SetupExperimentTYPE = Some(fmi2SetupExperiment);
 /// read (they are then those of the static equilibrium).
 #[no_mangle]
 pub extern "C" fn fmi2EnterInitializationMode(c: fmi2Component) -> fmi2Status {
-    entry(
+    ABI.entry(
         c,
         "fmi2EnterInitializationMode",
         state::ENTER_INITIALIZATION,
@@ -393,7 +187,7 @@ const _: fmi2EnterInitializationModeTYPE = Some(fmi2EnterInitializationMode);
 /// fmi2Error and the reason logged.
 #[no_mangle]
 pub extern "C" fn fmi2ExitInitializationMode(c: fmi2Component) -> fmi2Status {
-    entry(
+    ABI.entry(
         c,
         "fmi2ExitInitializationMode",
         state::EXIT_INITIALIZATION,
@@ -405,7 +199,7 @@ const _: fmi2ExitInitializationModeTYPE = Some(fmi2ExitInitializationMode);
 /// Ends the simulation: afterwards values can still be read, but no step taken.
 #[no_mangle]
 pub extern "C" fn fmi2Terminate(c: fmi2Component) -> fmi2Status {
-    entry(c, "fmi2Terminate", state::TERMINATE, |h| {
+    ABI.entry(c, "fmi2Terminate", state::TERMINATE, |h| {
         h.instance.terminate()
     })
 }
@@ -415,7 +209,7 @@ const _: fmi2TerminateTYPE = Some(fmi2Terminate);
 /// experiment. FMU states handed out stay valid.
 #[no_mangle]
 pub extern "C" fn fmi2Reset(c: fmi2Component) -> fmi2Status {
-    entry(c, "fmi2Reset", state::RESET, |h| h.instance.reset())
+    ABI.entry(c, "fmi2Reset", state::RESET, |h| h.instance.reset())
 }
 const _: fmi2ResetTYPE = Some(fmi2Reset);
 
@@ -430,14 +224,10 @@ fn get_values<T: Typed, C>(
     value: *mut C,
     convert: impl Fn(T) -> C,
 ) -> fmi2Status {
-    entry(c, function, state::GET_VALUES, |h| {
+    ABI.entry(c, function, state::GET_VALUES, |h| {
         // SAFETY: FMI passes arrays of nvr value references and nvr values.
         let (vrs, out) = unsafe { (array(vr, nvr, "vr")?, array_mut(value, nvr, "value")?) };
-        let read = h.instance.get::<T>(&indices::<T>(vrs)?)?;
-        for (o, x) in out.iter_mut().zip(read) {
-            *o = convert(x);
-        }
-        Ok(Status::Ok)
+        h.read::<T, C>(&slots::<T>(vrs)?, out, convert, |_| None)
     })
 }
 
@@ -450,7 +240,7 @@ fn set_values<T: Typed, C: Copy>(
     value: *const C,
     convert: impl Fn(u32, C) -> Result<T, String>,
 ) -> fmi2Status {
-    entry(c, function, state::SET_VALUES, |h| {
+    ABI.entry(c, function, state::SET_VALUES, |h| {
         // SAFETY: FMI passes arrays of nvr value references and nvr values.
         let (vrs, given) = unsafe { (array(vr, nvr, "vr")?, array(value, nvr, "value")?) };
         let values = vrs
@@ -458,7 +248,7 @@ fn set_values<T: Typed, C: Copy>(
             .zip(given)
             .map(|(vr, x)| convert(*vr, *x))
             .collect::<Result<Vec<T>, String>>()?;
-        h.instance.set::<T>(&indices::<T>(vrs)?, &values)
+        h.write(&slots::<T>(vrs)?, &values)
     })
 }
 
@@ -523,18 +313,10 @@ pub extern "C" fn fmi2GetString(
     nvr: usize,
     value: *mut fmi2String,
 ) -> fmi2Status {
-    entry(c, "fmi2GetString", state::GET_VALUES, |h| {
+    ABI.entry(c, "fmi2GetString", state::GET_VALUES, |h| {
         // SAFETY: FMI passes arrays of nvr value references and nvr string slots.
         let (vrs, out) = unsafe { (array(vr, nvr, "vr")?, array_mut(value, nvr, "value")?) };
-        let read = h.instance.get::<String>(&indices::<String>(vrs)?)?;
-        h.returned_strings = read
-            .iter()
-            .map(|t| CString::new(t.replace('\0', "")).unwrap_or_default())
-            .collect();
-        for (o, t) in out.iter_mut().zip(&h.returned_strings) {
-            *o = t.as_ptr();
-        }
-        Ok(Status::Ok)
+        h.read_strings(&slots::<String>(vrs)?, out)
     })
 }
 const _: fmi2GetStringTYPE = Some(fmi2GetString);
@@ -592,7 +374,7 @@ pub extern "C" fn fmi2SetString(
 ) -> fmi2Status {
     set_values::<String, _>(c, "fmi2SetString", vr, nvr, value, |_, p| {
         // SAFETY: each entry of an FMI string array is null or NUL-terminated.
-        unsafe { text(p) }.ok_or_else(|| "a value is NULL or not UTF-8".to_owned())
+        unsafe { string_value(p) }
     })
 }
 const _: fmi2SetStringTYPE = Some(fmi2SetString);
@@ -603,11 +385,9 @@ const _: fmi2SetStringTYPE = Some(fmi2SetString);
 /// into a new FMU state, or into the given one if `*FMUstate` is a state of this instance.
 #[no_mangle]
 pub extern "C" fn fmi2GetFMUstate(c: fmi2Component, FMUstate: *mut fmi2FMUstate) -> fmi2Status {
-    entry(c, "fmi2GetFMUstate", state::FMU_STATE, |h| {
+    ABI.entry(c, "fmi2GetFMUstate", state::FMU_STATE, |h| {
         // SAFETY: FMUstate points to a writable fmi2FMUstate slot (FMI 2.0 §2.1.8).
-        let slot = unsafe { place(FMUstate, "FMUstate") }?;
-        let core = h.instance.core.clone();
-        h.states.store(slot, core)
+        unsafe { h.get_fmu_state(FMUstate) }
     })
 }
 const _: fmi2GetFMUstateTYPE = Some(fmi2GetFMUstate);
@@ -616,11 +396,8 @@ const _: fmi2GetFMUstateTYPE = Some(fmi2GetFMUstate);
 /// parameters than the model this instance has built (it would silently change the model).
 #[no_mangle]
 pub extern "C" fn fmi2SetFMUstate(c: fmi2Component, FMUstate: fmi2FMUstate) -> fmi2Status {
-    entry(c, "fmi2SetFMUstate", state::FMU_STATE, |h| {
-        let core = h.states.core(FMUstate)?;
-        h.instance.check_state_fits(core)?;
-        h.instance.core = core.clone();
-        Ok(Status::Ok)
+    ABI.entry(c, "fmi2SetFMUstate", state::FMU_STATE, |h| {
+        h.set_fmu_state(FMUstate)
     })
 }
 const _: fmi2SetFMUstateTYPE = Some(fmi2SetFMUstate);
@@ -629,12 +406,9 @@ const _: fmi2SetFMUstateTYPE = Some(fmi2SetFMUstate);
 /// foreign pointer refused.
 #[no_mangle]
 pub extern "C" fn fmi2FreeFMUstate(c: fmi2Component, FMUstate: *mut fmi2FMUstate) -> fmi2Status {
-    entry(c, "fmi2FreeFMUstate", state::FMU_STATE, |h| {
-        // SAFETY: FMUstate is null or points to a slot holding null or a state we handed out.
-        let Some(slot) = (unsafe { FMUstate.as_mut() }) else {
-            return Ok(Status::Ok);
-        };
-        h.states.free(slot)
+    ABI.entry(c, "fmi2FreeFMUstate", state::FMU_STATE, |h| {
+        // SAFETY: FMUstate is null or points to a slot holding null or a state.
+        unsafe { h.free_fmu_state(FMUstate) }
     })
 }
 const _: fmi2FreeFMUstateTYPE = Some(fmi2FreeFMUstate);
@@ -646,12 +420,9 @@ pub extern "C" fn fmi2SerializedFMUstateSize(
     FMUstate: fmi2FMUstate,
     size: *mut usize,
 ) -> fmi2Status {
-    entry(c, "fmi2SerializedFMUstateSize", state::FMU_STATE, |h| {
-        let bytes = h.states.serialized(FMUstate, h.instance.guid())?;
-        // SAFETY: size points to a writable usize.
-        let size = unsafe { place(size, "size") }?;
-        *size = bytes.len();
-        Ok(Status::Ok)
+    ABI.entry(c, "fmi2SerializedFMUstateSize", state::FMU_STATE, |h| {
+        // SAFETY: size points to a writable size_t.
+        unsafe { h.serialized_fmu_state_size(FMUstate, size) }
     })
 }
 const _: fmi2SerializedFMUstateSizeTYPE = Some(fmi2SerializedFMUstateSize);
@@ -665,11 +436,9 @@ pub extern "C" fn fmi2SerializeFMUstate(
     serializedState: *mut fmi2Byte,
     size: usize,
 ) -> fmi2Status {
-    entry(c, "fmi2SerializeFMUstate", state::FMU_STATE, |h| {
-        // SAFETY: the caller provides a writable buffer of `size` bytes.
-        let out = unsafe { array_mut(serializedState as *mut u8, size, "serializedState") }?;
-        h.states.serialize_into(FMUstate, h.instance.guid(), out)?;
-        Ok(Status::Ok)
+    ABI.entry(c, "fmi2SerializeFMUstate", state::FMU_STATE, |h| {
+        // SAFETY: the master provides a writable buffer of `size` bytes.
+        unsafe { h.serialize_fmu_state(FMUstate, serializedState as *mut u8, size) }
     })
 }
 const _: fmi2SerializeFMUstateTYPE = Some(fmi2SerializeFMUstate);
@@ -684,19 +453,9 @@ pub extern "C" fn fmi2DeSerializeFMUstate(
     size: usize,
     FMUstate: *mut fmi2FMUstate,
 ) -> fmi2Status {
-    entry(c, "fmi2DeSerializeFMUstate", state::FMU_STATE, |h| {
-        // SAFETY: the caller provides `size` readable bytes and a writable state slot.
-        let (bytes, slot) = unsafe {
-            (
-                array(serializedState as *const u8, size, "serializedState")?,
-                place(FMUstate, "FMUstate")?,
-            )
-        };
-        let inst = &h.instance;
-        let core = snapshot::deserialize(bytes, inst.guid(), |core, dynamic| {
-            inst.restore_simulation(core, dynamic)
-        })?;
-        h.states.store(slot, core)
+    ABI.entry(c, "fmi2DeSerializeFMUstate", state::FMU_STATE, |h| {
+        // SAFETY: the master provides `size` readable bytes and a writable state slot.
+        unsafe { h.deserialize_fmu_state(serializedState as *const u8, size, FMUstate) }
     })
 }
 const _: fmi2DeSerializeFMUstateTYPE = Some(fmi2DeSerializeFMUstate);
@@ -715,7 +474,7 @@ pub extern "C" fn fmi2GetDirectionalDerivative(
     dvKnown: *const fmi2Real,
     dvUnknown: *mut fmi2Real,
 ) -> fmi2Status {
-    entry(
+    ABI.entry(
         c,
         "fmi2GetDirectionalDerivative",
         state::DIRECTIONAL_DERIVATIVE,
@@ -755,7 +514,7 @@ pub extern "C" fn fmi2SetRealInputDerivatives(
     order: *const fmi2Integer,
     value: *const fmi2Real,
 ) -> fmi2Status {
-    entry(
+    ABI.entry(
         c,
         "fmi2SetRealInputDerivatives",
         state::SET_INPUT_DERIVATIVES,
@@ -785,7 +544,7 @@ pub extern "C" fn fmi2GetRealOutputDerivatives(
     _order: *const fmi2Integer,
     _value: *mut fmi2Real,
 ) -> fmi2Status {
-    entry(
+    ABI.entry(
         c,
         "fmi2GetRealOutputDerivatives",
         state::GET_OUTPUT_DERIVATIVES,
@@ -805,7 +564,7 @@ pub extern "C" fn fmi2DoStep(
     communicationStepSize: fmi2Real,
     _noSetFMUStatePriorToCurrentPoint: fmi2Boolean,
 ) -> fmi2Status {
-    entry(c, "fmi2DoStep", state::DO_STEP, |h| {
+    ABI.entry(c, "fmi2DoStep", state::DO_STEP, |h| {
         h.instance
             .do_step(currentCommunicationPoint, communicationStepSize)
     })
@@ -816,7 +575,7 @@ const _: fmi2DoStepTYPE = Some(fmi2DoStep);
 /// progress.
 #[no_mangle]
 pub extern "C" fn fmi2CancelStep(c: fmi2Component) -> fmi2Status {
-    entry(c, "fmi2CancelStep", state::CANCEL_STEP, |_| {
+    ABI.entry(c, "fmi2CancelStep", state::CANCEL_STEP, |_| {
         Err("no step is in progress (fmi2DoStep always completes synchronously)".into())
     })
 }
@@ -834,7 +593,7 @@ pub extern "C" fn fmi2GetStatus(
     _s: fmi2StatusKind,
     _value: *mut fmi2Status,
 ) -> fmi2Status {
-    entry(c, "fmi2GetStatus", state::GET_STATUS, |_| {
+    ABI.entry(c, "fmi2GetStatus", state::GET_STATUS, |_| {
         Err("no asynchronous step status exists (canRunAsynchronuously=false)".into())
     })
 }
@@ -848,7 +607,7 @@ pub extern "C" fn fmi2GetRealStatus(
     s: fmi2StatusKind,
     value: *mut fmi2Real,
 ) -> fmi2Status {
-    entry(c, "fmi2GetRealStatus", state::GET_STATUS, |h| {
+    ABI.entry(c, "fmi2GetRealStatus", state::GET_STATUS, |h| {
         if s != fmi2StatusKind_fmi2LastSuccessfulTime {
             return no_status(s, "Real");
         }
@@ -866,7 +625,7 @@ pub extern "C" fn fmi2GetIntegerStatus(
     s: fmi2StatusKind,
     _value: *mut fmi2Integer,
 ) -> fmi2Status {
-    entry(c, "fmi2GetIntegerStatus", state::GET_STATUS, |_| {
+    ABI.entry(c, "fmi2GetIntegerStatus", state::GET_STATUS, |_| {
         no_status(s, "Integer")
     })
 }
@@ -880,7 +639,7 @@ pub extern "C" fn fmi2GetBooleanStatus(
     s: fmi2StatusKind,
     value: *mut fmi2Boolean,
 ) -> fmi2Status {
-    entry(c, "fmi2GetBooleanStatus", state::GET_STATUS, |h| {
+    ABI.entry(c, "fmi2GetBooleanStatus", state::GET_STATUS, |h| {
         if s != fmi2StatusKind_fmi2Terminated {
             return no_status(s, "Boolean");
         }
@@ -899,7 +658,7 @@ pub extern "C" fn fmi2GetStringStatus(
     s: fmi2StatusKind,
     _value: *mut fmi2String,
 ) -> fmi2Status {
-    entry(c, "fmi2GetStringStatus", state::GET_STATUS, |_| {
+    ABI.entry(c, "fmi2GetStringStatus", state::GET_STATUS, |_| {
         no_status(s, "String")
     })
 }

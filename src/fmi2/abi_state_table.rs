@@ -8,7 +8,9 @@ use std::ffi::CString;
 use std::sync::{Mutex, OnceLock};
 
 use super::*;
-use crate::fmi2::variables::{boolean, integer, real, string, BOOLEANS, INTEGERS, REALS, STRINGS};
+use crate::fmu::guard::Handle;
+use crate::variables::GUID;
+use crate::variables::{boolean, integer, real, string, BOOLEANS, INTEGERS, REALS, STRINGS};
 
 /// Log lines per instance name, from fmi-sys' logger through the `log` crate.
 struct Capture(Mutex<HashMap<String, Vec<String>>>);

@@ -1,53 +1,7 @@
 //! The FMI 2.0 co-simulation state machine as a per-function mask (like the Modelica
 //! Reference-FMUs): every entry point states the phases in which it may be called.
 
-/// Where an instance is in the co-simulation state machine.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, serde::Serialize, serde::Deserialize)]
-pub enum Phase {
-    /// After fmi2Instantiate or fmi2Reset: parameters may be set, the experiment set up.
-    Instantiated,
-    /// Between fmi2EnterInitializationMode and fmi2ExitInitializationMode.
-    InitializationMode,
-    /// The model is built and the last step (if any) succeeded: fmi2DoStep may be called.
-    StepComplete,
-    /// A step was discarded: values can be read, the simulation cannot continue.
-    StepFailed,
-    /// After fmi2Terminate.
-    Terminated,
-    /// Output evaluation failed after a step: values can be read, nothing else done.
-    Error,
-    /// A panic (a bug) made the instance unusable; only fmi2FreeInstance is allowed.
-    Fatal,
-}
-
-impl Phase {
-    fn bit(self) -> u16 {
-        1 << (self as u16)
-    }
-}
-
-/// A set of phases.
-#[derive(Debug, Clone, Copy)]
-pub struct Mask(u16);
-
-impl Mask {
-    const fn of(phases: &[Phase]) -> Mask {
-        let mut bits = 0u16;
-        let mut i = 0;
-        while i < phases.len() {
-            bits |= 1 << (phases[i] as u16);
-            i += 1;
-        }
-        Mask(bits)
-    }
-
-    /// Whether `phase` is in the set.
-    pub fn allows(self, phase: Phase) -> bool {
-        self.0 & phase.bit() != 0
-    }
-}
-
-use Phase::*;
+use crate::fmu::state::{Mask, Phase::*, READABLE};
 
 // The masks of the co-simulation state machine (FMI 2.0 §4.2.4, Table 4.2.4; the same as the
 // Modelica Reference-FMUs'). `stepInProgress` and `stepCanceled` never occur here: fmi2DoStep
@@ -77,16 +31,10 @@ pub const EXIT_INITIALIZATION: Mask = Mask::of(&[InitializationMode]);
 /// fmi2Terminate: after initialisation, also after a failed step.
 pub const TERMINATE: Mask = Mask::of(&[StepComplete, StepFailed]);
 /// fmi2GetReal/Integer/Boolean/String.
-pub const GET_VALUES: Mask = Mask::of(&[
-    InitializationMode,
-    StepComplete,
-    StepFailed,
-    Terminated,
-    Error,
-]);
+pub const GET_VALUES: Mask = READABLE;
 /// fmi2SetReal/Integer/Boolean/String (co-simulation: no event or continuous-time mode).
 pub const SET_VALUES: Mask = Mask::of(&[Instantiated, InitializationMode, StepComplete]);
-/// fmi2GetDirectionalDerivative (always refused in the body): where values can be read.
+/// fmi2GetDirectionalDerivative: where values can be read.
 pub const DIRECTIONAL_DERIVATIVE: Mask = GET_VALUES;
 /// fmi2SetRealInputDerivatives: wherever inputs may be set.
 pub const SET_INPUT_DERIVATIVES: Mask = Mask::of(&[Instantiated, InitializationMode, StepComplete]);

@@ -1,147 +1,51 @@
-//! The exported FMI 3.0 functions. As in [`crate::fmi2::abi`], every entry point with an
-//! instance passes one guard, `entry`: the instance pointer is checked, panics are caught (none
-//! may unwind into the C caller), the call is checked against the 3.0 state machine
-//! ([`super::state`]), a refusal is logged once naming the function, and every fmi3Error puts
-//! the instance into the error state. Inside, value references are resolved to the 2.0 table
-//! ([`super::values`]) and the shared [`Instance`] does the work: the model, the stepping and the
-//! FMU states are the 2.0 layer's.
+//! The exported FMI 3.0 functions: the standard's signatures over the runtime ([`crate::fmu`]),
+//! the same one the FMI 2.0 ABI uses. Every entry point with an instance passes the runtime's
+//! one guard ([`crate::fmu::guard::Abi::entry`]) with its 3.0 state mask ([`super::state`]); every
+//! fmi3Error leads to the error state. Inside, C arguments become Rust values
+//! ([`crate::fmu::c_args`]), value references (arrays among them) are resolved to the variable
+//! table ([`super::values`]), and the runtime does the work.
 
 #![allow(non_snake_case)]
 #![allow(clippy::not_unsafe_ptr_arg_deref)] // the C ABI hands us raw pointers by design
 #![allow(clippy::too_many_arguments)] // the signatures are the standard's
 
-use std::ffi::{c_char, CString};
+use std::ffi::c_char;
 use std::panic::{catch_unwind, AssertUnwindSafe};
 use std::path::PathBuf;
 
 use fmi_sys::fmi3::*;
 
-use super::state::{self, Mask, Phase};
-use super::values::{resolve, unknown, Slot};
-use crate::fmi2::abi::{array, array_mut, place, text, texts};
-use crate::fmi2::fmu_states::FmuStates;
-use crate::fmi2::instance::{Instance, Outcome, Status};
-use crate::fmi2::logger::{Level, Logger};
-use crate::fmi2::snapshot;
-use crate::fmi2::state::Phase as Phase2;
-use crate::fmi2::values::Typed;
+use super::state;
+use super::values::{resolve, unknown};
+use crate::cosim::FmuKind;
+use crate::fmu::c_args::{array, array_mut, place, string_value, text, texts};
+use crate::fmu::guard::{self, Abi, FunctionNames, Request};
+use crate::fmu::instance::{Outcome, Status};
+use crate::fmu::logger::{Level, Logger};
+use crate::fmu::state::Phase;
+use crate::fmu::values::{Slot, Typed};
 use crate::variables::fmi3::{MODES_SIZE, MODES_SIZE_MAX};
-use crate::variables::{string, LogCategory, GUID, STRINGS};
+use crate::variables::LogCategory;
 
-/// Marks a live instance allocated by `fmi3InstantiateCoSimulation` (another value than the 2.0
-/// layer's, so an instance of one standard is never used through the other).
-const LIVE: u64 = 0x454d_4346_4d55_0003;
-
-struct Handle {
-    live: u64,
-    instance: Instance,
-    /// In configuration mode (the 2.0 phase underneath stays `Instantiated`).
-    configuration: bool,
-    /// A call returned fmi3Error: the error state until an FMU state is restored or the instance
-    /// is reset.
-    error: bool,
-    /// The structural parameter `modes.size`: the length of the natural-mode arrays.
-    modes_size: u64,
-    /// Strings returned by fmi3GetString stay valid until the next call on this instance.
-    returned_strings: Vec<CString>,
-    /// The FMU states this instance handed out and has not freed, recognised by address.
-    states: FmuStates,
-}
-
-impl Handle {
-    fn phase(&self) -> Phase {
-        Phase::of(self.instance.phase(), self.configuration, self.error)
-    }
-}
-
-fn status(s: Status) -> fmi3Status {
-    match s {
-        Status::Ok => fmi3Status_fmi3OK,
-        Status::Warning => fmi3Status_fmi3Warning,
-        Status::Discard => fmi3Status_fmi3Discard,
-        Status::Error => fmi3Status_fmi3Error,
-        Status::Fatal => fmi3Status_fmi3Fatal,
-    }
-}
-
-/// The guard of every entry point with an instance: runs `body` on the instance behind
-/// `instance` if `function` may be called in its phase (`mask`). A null or stale pointer gives
-/// fmi3Error; a refusal is logged as "`function`: reason" and gives fmi3Error and the error
-/// state; a panic gives fmi3Fatal (the instance is then unusable); in the fatal state only
-/// fmi3FreeInstance is allowed.
-fn entry(
-    instance: fmi3Instance,
-    function: &'static str,
-    mask: Mask,
-    body: impl FnOnce(&mut Handle) -> Outcome,
-) -> fmi3Status {
-    if instance.is_null() {
-        return fmi3Status_fmi3Error;
-    }
-    let ptr = instance as *mut Handle;
-    // SAFETY: a non-null fmi3Instance is, per FMI 3.0, the pointer fmi3InstantiateCoSimulation
-    // returned and fmi3FreeInstance has not been called on it; one instance must not be used from
-    // two threads at once (FMI 3.0 §2.2.2), so this is the only live reference.
-    let handle = unsafe { &mut *ptr };
-    if handle.live != LIVE {
-        return fmi3Status_fmi3Error;
-    }
-    let result = catch_unwind(AssertUnwindSafe(|| {
-        let inst = &handle.instance;
-        inst.logger.log(Level::Info, LogCategory::Calls, function);
-        let phase = handle.phase();
-        if phase == Phase::Fatal {
-            inst.logger.log(
-                Level::Fatal,
-                LogCategory::StatusError,
-                &format!("{function}: the instance is in a fatal state; only fmi3FreeInstance is allowed"),
-            );
-            return Status::Fatal;
-        }
-        if !mask.allows(phase) {
-            let hint = if phase == Phase::Error {
-                " (after fmi3Error: fmi3SetFMUState, fmi3Reset or fmi3FreeInstance)"
-            } else {
-                ""
-            };
-            inst.log_error(&format!(
-                "{function} is not allowed in phase {phase:?}{hint}"
-            ));
-            return Status::Error;
-        }
-        match body(handle) {
-            Ok(s) => s,
-            Err(message) => {
-                handle.instance.log_error(&format!("{function}: {message}"));
-                Status::Error
-            }
-        }
-    }));
-    match result {
-        Ok(s) => {
-            if s == Status::Error {
-                handle.error = true;
-            }
-            status(s)
-        }
-        Err(panic) => {
-            let what = panic
-                .downcast_ref::<&str>()
-                .map(|s| s.to_string())
-                .or_else(|| panic.downcast_ref::<String>().cloned())
-                .unwrap_or_else(|| "unknown panic".to_owned());
-            let _ = catch_unwind(AssertUnwindSafe(|| {
-                handle.instance.core.phase = Phase2::Fatal;
-                handle.instance.logger.log(
-                    Level::Fatal,
-                    LogCategory::StatusError,
-                    &format!("{function}: internal error (bug), the instance is unusable: {what}"),
-                );
-            }));
-            fmi3Status_fmi3Fatal
-        }
-    }
-}
+/// FMI 3.0 as the runtime sees it.
+pub static ABI: Abi = Abi {
+    // Marks a live instance of fmi3InstantiateCoSimulation (another value than FMI 2.0's).
+    live: 0x454d_4346_4d55_0003,
+    kinds: &[FmuKind::Engine],
+    token: "instantiation token",
+    resources: "resource path",
+    errors_enter_error_state: true,
+    phase_name: state::name,
+    error_state_hint: " (after fmi3Error: fmi3SetFMUState, fmi3Reset or fmi3FreeInstance)",
+    names: FunctionNames {
+        instantiate: "fmi3InstantiateCoSimulation",
+        free_instance: "fmi3FreeInstance",
+        setup_experiment: "fmi3EnterInitializationMode",
+        exit_initialization: "fmi3ExitInitializationMode",
+        do_step: "fmi3DoStep",
+        set_fmu_state: "fmi3SetFMUState",
+    },
+};
 
 // ----- inquiry, creation and destruction -------------------------------------------------------
 
@@ -172,69 +76,36 @@ pub extern "C" fn fmi3InstantiateCoSimulation(
     logMessage: fmi3LogMessageCallback,
     _intermediateUpdate: fmi3IntermediateUpdateCallback,
 ) -> fmi3Instance {
-    let result = catch_unwind(AssertUnwindSafe(|| {
-        // SAFETY: FMI strings are NUL-terminated or null.
-        let (name, token, resources) = unsafe {
-            (
-                text(instanceName).unwrap_or_default(),
-                text(instantiationToken).unwrap_or_default(),
-                text(resourcePath),
-            )
-        };
-        let logger = Logger::new_fmi3(logMessage, instanceEnvironment, &name, loggingOn);
-        let refuse = |logger: &Logger, message: &str| {
-            let message = format!("fmi3InstantiateCoSimulation: {message}");
-            logger.log(Level::Error, LogCategory::StatusError, &message);
-            std::ptr::null_mut()
-        };
-        if name.is_empty() {
-            return refuse(&logger, "instanceName is missing");
-        }
-        if token != GUID {
-            return refuse(
-                &logger,
-                &format!("instantiation token \"{token}\" does not match this FMU's {GUID}"),
-            );
-        }
-        if eventModeUsed {
-            return refuse(
-                &logger,
-                "eventModeUsed: this FMU has no event mode (hasEventMode=false)",
-            );
-        }
-        if nRequiredIntermediateVariables > 0 {
-            return refuse(
-                &logger,
-                "required intermediate variables: this FMU provides no intermediate update",
-            );
-        }
-        let resource_dir = match resources.filter(|r| !r.is_empty()) {
-            None => {
-                let config = STRINGS[string::CONFIG_FILE as usize].name;
-                logger.log(
-                    Level::Warning,
-                    LogCategory::StatusWarning,
-                    &format!("fmi3InstantiateCoSimulation: no resource path given; the built-in vehicle is used unless {config} names an absolute path"),
-                );
-                None
-            }
-            Some(r) if PathBuf::from(&r).is_dir() => Some(PathBuf::from(r)),
-            Some(r) => return refuse(&logger, &format!("resource path {r} is not a directory")),
-        };
-        let handle = Box::new(Handle {
-            live: LIVE,
-            instance: Instance::new(&name, crate::cosim::FmuKind::Engine, logger, resource_dir),
-            configuration: false,
-            error: false,
-            modes_size: MODES_SIZE_MAX,
-            returned_strings: Vec::new(),
-            states: FmuStates::default(),
-        });
-        Box::into_raw(handle) as fmi3Instance
-    }));
-    result.unwrap_or(std::ptr::null_mut())
+    let request = Request {
+        name: instanceName,
+        token: instantiationToken,
+        resources: resourcePath,
+        resource_dir,
+    };
+    let refusal = if eventModeUsed {
+        Some("eventModeUsed: this FMU has no event mode (hasEventMode=false)")
+    } else if nRequiredIntermediateVariables > 0 {
+        Some("required intermediate variables: this FMU provides no intermediate update")
+    } else {
+        None
+    };
+    guard::instantiate(
+        &ABI,
+        request,
+        |name| Logger::new_fmi3(logMessage, instanceEnvironment, name, loggingOn),
+        refusal,
+    )
 }
 const _: fmi3InstantiateCoSimulationTYPE = Some(fmi3InstantiateCoSimulation);
+
+/// The resource directory a resource path names (`None`: none or an empty one given).
+fn resource_dir(path: Option<&str>) -> Result<Option<PathBuf>, String> {
+    match path.filter(|r| !r.is_empty()) {
+        None => Ok(None),
+        Some(r) if PathBuf::from(r).is_dir() => Ok(Some(PathBuf::from(r))),
+        Some(r) => Err(format!("resource path {r} is not a directory")),
+    }
+}
 
 /// Logs through `logMessage` that `interface` is not supported and returns null.
 fn refuse_interface(
@@ -302,19 +173,7 @@ const _: fmi3InstantiateScheduledExecutionTYPE = Some(fmi3InstantiateScheduledEx
 /// ignored. Allowed in every state, the fatal one included.
 #[no_mangle]
 pub extern "C" fn fmi3FreeInstance(instance: fmi3Instance) {
-    if instance.is_null() {
-        return;
-    }
-    let ptr = instance as *mut Handle;
-    // SAFETY: instance came from fmi3InstantiateCoSimulation (Box::into_raw) and is freed at most
-    // once by contract; the live marker catches the common double free before ownership returns.
-    unsafe {
-        if (*ptr).live != LIVE {
-            return;
-        }
-        (*ptr).live = 0;
-        drop(Box::from_raw(ptr));
-    }
+    guard::free(instance, &ABI)
 }
 const _: fmi3FreeInstanceTYPE = Some(fmi3FreeInstance);
 
@@ -326,7 +185,7 @@ pub extern "C" fn fmi3SetDebugLogging(
     nCategories: usize,
     categories: *const fmi3String,
 ) -> fmi3Status {
-    entry(instance, "fmi3SetDebugLogging", state::ANY, |h| {
+    ABI.entry(instance, "fmi3SetDebugLogging", state::ANY, |h| {
         // SAFETY: FMI passes an array of nCategories C strings.
         let names = unsafe { texts(categories, nCategories, "categories") }?;
         h.instance.logger.set_debug_logging(loggingOn, &names)?;
@@ -340,14 +199,11 @@ const _: fmi3SetDebugLoggingTYPE = Some(fmi3SetDebugLogging);
 /// Enters configuration mode, where the structural parameter `modes.size` may be set.
 #[no_mangle]
 pub extern "C" fn fmi3EnterConfigurationMode(instance: fmi3Instance) -> fmi3Status {
-    entry(
+    ABI.entry(
         instance,
         "fmi3EnterConfigurationMode",
         state::ENTER_FROM_INSTANTIATED,
-        |h| {
-            h.configuration = true;
-            Ok(Status::Ok)
-        },
+        |h| h.instance.configuration_mode(true),
     )
 }
 const _: fmi3EnterConfigurationModeTYPE = Some(fmi3EnterConfigurationMode);
@@ -355,14 +211,11 @@ const _: fmi3EnterConfigurationModeTYPE = Some(fmi3EnterConfigurationMode);
 /// Leaves configuration mode for the instantiated state.
 #[no_mangle]
 pub extern "C" fn fmi3ExitConfigurationMode(instance: fmi3Instance) -> fmi3Status {
-    entry(
+    ABI.entry(
         instance,
         "fmi3ExitConfigurationMode",
         state::EXIT_CONFIGURATION,
-        |h| {
-            h.configuration = false;
-            Ok(Status::Ok)
-        },
+        |h| h.instance.configuration_mode(false),
     )
 }
 const _: fmi3ExitConfigurationModeTYPE = Some(fmi3ExitConfigurationMode);
@@ -379,7 +232,7 @@ pub extern "C" fn fmi3EnterInitializationMode(
     stopTimeDefined: fmi3Boolean,
     stopTime: fmi3Float64,
 ) -> fmi3Status {
-    entry(
+    ABI.entry(
         instance,
         "fmi3EnterInitializationMode",
         state::ENTER_FROM_INSTANTIATED,
@@ -399,7 +252,7 @@ const _: fmi3EnterInitializationModeTYPE = Some(fmi3EnterInitializationMode);
 /// mode there is no event mode to pass through.
 #[no_mangle]
 pub extern "C" fn fmi3ExitInitializationMode(instance: fmi3Instance) -> fmi3Status {
-    entry(
+    ABI.entry(
         instance,
         "fmi3ExitInitializationMode",
         state::EXIT_INITIALIZATION,
@@ -411,7 +264,7 @@ const _: fmi3ExitInitializationModeTYPE = Some(fmi3ExitInitializationMode);
 /// Always refused: the FMU has no event mode (hasEventMode=false).
 #[no_mangle]
 pub extern "C" fn fmi3EnterEventMode(instance: fmi3Instance) -> fmi3Status {
-    entry(instance, "fmi3EnterEventMode", state::UNSUPPORTED, |_| {
+    ABI.entry(instance, "fmi3EnterEventMode", state::UNSUPPORTED, |_| {
         Err("this FMU has no event mode (hasEventMode=false)".into())
     })
 }
@@ -420,7 +273,7 @@ const _: fmi3EnterEventModeTYPE = Some(fmi3EnterEventMode);
 /// Always refused: step mode is entered by fmi3ExitInitializationMode, event mode does not exist.
 #[no_mangle]
 pub extern "C" fn fmi3EnterStepMode(instance: fmi3Instance) -> fmi3Status {
-    entry(instance, "fmi3EnterStepMode", state::UNSUPPORTED, |_| {
+    ABI.entry(instance, "fmi3EnterStepMode", state::UNSUPPORTED, |_| {
         Err("this FMU has no event mode to leave (hasEventMode=false)".into())
     })
 }
@@ -429,7 +282,7 @@ const _: fmi3EnterStepModeTYPE = Some(fmi3EnterStepMode);
 /// Ends the simulation: values can still be read, no step taken.
 #[no_mangle]
 pub extern "C" fn fmi3Terminate(instance: fmi3Instance) -> fmi3Status {
-    entry(instance, "fmi3Terminate", state::TERMINATE, |h| {
+    ABI.entry(instance, "fmi3Terminate", state::TERMINATE, |h| {
         h.instance.terminate()
     })
 }
@@ -439,12 +292,7 @@ const _: fmi3TerminateTYPE = Some(fmi3Terminate);
 /// handed out stay valid.
 #[no_mangle]
 pub extern "C" fn fmi3Reset(instance: fmi3Instance) -> fmi3Status {
-    entry(instance, "fmi3Reset", state::ANY, |h| {
-        h.configuration = false;
-        h.error = false;
-        h.modes_size = MODES_SIZE_MAX;
-        h.instance.reset()
-    })
+    ABI.entry(instance, "fmi3Reset", state::ANY, |h| h.instance.reset())
 }
 const _: fmi3ResetTYPE = Some(fmi3Reset);
 
@@ -461,27 +309,11 @@ fn get_values<T: Typed, C>(
     convert: impl Fn(T) -> C,
     time: impl Fn(f64) -> Option<C>,
 ) -> fmi3Status {
-    entry(instance, function, state::GET_VALUES, |h| {
-        before_initialization(h)?;
+    ABI.entry(instance, function, state::GET_VALUES, |h| {
         // SAFETY: FMI passes nvr value references and room for nValues values.
         let (vrs, out) = unsafe { (array(vr, nvr, "vr")?, array_mut(value, n_values, "values")?) };
-        let slots = resolve::<T>(vrs, h.modes_size, n_values)?;
-        let elements: Vec<usize> = slots
-            .iter()
-            .filter_map(|s| match s {
-                Slot::Element(i) => Some(*i),
-                Slot::Time => None,
-            })
-            .collect();
-        let mut read = h.instance.get::<T>(&elements)?.into_iter();
-        let now = h.instance.core.time;
-        for (o, s) in out.iter_mut().zip(&slots) {
-            *o = match s {
-                Slot::Element(_) => convert(read.next().ok_or("value count")?),
-                Slot::Time => time(now).ok_or("time")?,
-            };
-        }
-        Ok(Status::Ok)
+        let slots = resolve::<T>(vrs, h.instance.modes_size, n_values)?;
+        h.read(&slots, out, convert, time)
     })
 }
 
@@ -496,34 +328,16 @@ fn set_values<T: Typed, C: Copy>(
     n_values: usize,
     convert: impl Fn(C) -> Result<T, String>,
 ) -> fmi3Status {
-    entry(instance, function, state::SET_VALUES, |h| {
+    ABI.entry(instance, function, state::SET_VALUES, |h| {
         // SAFETY: FMI passes nvr value references and nValues values.
         let (vrs, given) = unsafe { (array(vr, nvr, "vr")?, array(value, n_values, "values")?) };
-        let slots = resolve::<T>(vrs, h.modes_size, n_values)?;
-        let mut elements = Vec::with_capacity(slots.len());
-        for s in slots {
-            match s {
-                Slot::Element(i) => elements.push(i),
-                Slot::Time => {
-                    return Err("time is the independent variable and cannot be set".into())
-                }
-            }
-        }
+        let slots = resolve::<T>(vrs, h.instance.modes_size, n_values)?;
         let values = given
             .iter()
             .map(|x| convert(*x))
             .collect::<Result<Vec<T>, String>>()?;
-        h.instance.set::<T>(&elements, &values)
+        h.write(&slots, &values)
     })
-}
-
-/// Refuses reading in the error state entered before initialisation: a calculated parameter
-/// read there would build the model as a side effect of a diagnostic read.
-fn before_initialization(h: &Handle) -> Result<(), String> {
-    if h.instance.phase() == Phase2::Instantiated {
-        return Err("nothing to read before initialisation".into());
-    }
-    Ok(())
 }
 
 /// A C `bool` read as its byte: a value other than 0 or 1 is refused instead of being undefined
@@ -615,8 +429,7 @@ pub extern "C" fn fmi3GetString(
     values: *mut fmi3String,
     nValues: usize,
 ) -> fmi3Status {
-    entry(instance, "fmi3GetString", state::GET_VALUES, |h| {
-        before_initialization(h)?;
+    ABI.entry(instance, "fmi3GetString", state::GET_VALUES, |h| {
         // SAFETY: FMI passes nValueReferences value references and nValues string slots.
         let (vrs, out) = unsafe {
             (
@@ -624,23 +437,8 @@ pub extern "C" fn fmi3GetString(
                 array_mut(values, nValues, "values")?,
             )
         };
-        let slots = resolve::<String>(vrs, h.modes_size, nValues)?;
-        let elements: Vec<usize> = slots
-            .iter()
-            .filter_map(|s| match s {
-                Slot::Element(i) => Some(*i),
-                Slot::Time => None,
-            })
-            .collect();
-        let read = h.instance.get::<String>(&elements)?;
-        h.returned_strings = read
-            .iter()
-            .map(|t| CString::new(t.replace('\0', "")).unwrap_or_default())
-            .collect();
-        for (o, t) in out.iter_mut().zip(&h.returned_strings) {
-            *o = t.as_ptr();
-        }
-        Ok(Status::Ok)
+        let slots = resolve::<String>(vrs, h.instance.modes_size, nValues)?;
+        h.read_strings(&slots, out)
     })
 }
 const _: fmi3GetStringTYPE = Some(fmi3GetString);
@@ -654,7 +452,7 @@ pub extern "C" fn fmi3GetUInt64(
     values: *mut fmi3UInt64,
     nValues: usize,
 ) -> fmi3Status {
-    entry(instance, "fmi3GetUInt64", state::GET_STRUCTURAL, |h| {
+    ABI.entry(instance, "fmi3GetUInt64", state::GET_STRUCTURAL, |h| {
         // SAFETY: FMI passes nValueReferences value references and room for nValues values.
         let (vrs, out) = unsafe {
             (
@@ -663,7 +461,7 @@ pub extern "C" fn fmi3GetUInt64(
             )
         };
         structural(vrs, nValues)?;
-        out.iter_mut().for_each(|o| *o = h.modes_size);
+        out.iter_mut().for_each(|o| *o = h.instance.modes_size);
         Ok(Status::Ok)
     })
 }
@@ -679,7 +477,7 @@ pub extern "C" fn fmi3SetUInt64(
     values: *const fmi3UInt64,
     nValues: usize,
 ) -> fmi3Status {
-    entry(instance, "fmi3SetUInt64", state::SET_STRUCTURAL, |h| {
+    ABI.entry(instance, "fmi3SetUInt64", state::SET_STRUCTURAL, |h| {
         // SAFETY: FMI passes nValueReferences value references and nValues values.
         let (vrs, given) = unsafe {
             (
@@ -694,7 +492,7 @@ pub extern "C" fn fmi3SetUInt64(
             ));
         }
         if let Some(last) = given.last() {
-            h.modes_size = *last;
+            h.instance.modes_size = *last;
         }
         Ok(Status::Ok)
     })
@@ -799,7 +597,7 @@ pub extern "C" fn fmi3SetString(
         nValues,
         |p| {
             // SAFETY: each entry of an FMI string array is null or NUL-terminated.
-            unsafe { text(p) }.ok_or_else(|| "a value is NULL or not UTF-8".to_owned())
+            unsafe { string_value(p) }
         },
     )
 }
@@ -818,7 +616,7 @@ macro_rules! no_such_type {
             _values: *mut $c,
             _nValues: usize,
         ) -> fmi3Status {
-            entry(instance, stringify!($get), state::GET_VALUES, |_| {
+            ABI.entry(instance, stringify!($get), state::GET_VALUES, |_| {
                 none_of_type(valueReferences, nValueReferences, $name)
             })
         }
@@ -833,7 +631,7 @@ macro_rules! no_such_type {
             _values: *const $c,
             _nValues: usize,
         ) -> fmi3Status {
-            entry(instance, stringify!($set), state::SET_VALUES, |_| {
+            ABI.entry(instance, stringify!($set), state::SET_VALUES, |_| {
                 none_of_type(valueReferences, nValueReferences, $name)
             })
         }
@@ -918,7 +716,7 @@ pub extern "C" fn fmi3GetBinary(
     _values: *mut fmi3Binary,
     _nValues: usize,
 ) -> fmi3Status {
-    entry(instance, "fmi3GetBinary", state::GET_VALUES, |_| {
+    ABI.entry(instance, "fmi3GetBinary", state::GET_VALUES, |_| {
         none_of_type(valueReferences, nValueReferences, "Binary")
     })
 }
@@ -934,7 +732,7 @@ pub extern "C" fn fmi3SetBinary(
     _values: *const fmi3Binary,
     _nValues: usize,
 ) -> fmi3Status {
-    entry(instance, "fmi3SetBinary", state::SET_VALUES, |_| {
+    ABI.entry(instance, "fmi3SetBinary", state::SET_VALUES, |_| {
         none_of_type(valueReferences, nValueReferences, "Binary")
     })
 }
@@ -948,7 +746,7 @@ pub extern "C" fn fmi3GetClock(
     nValueReferences: usize,
     _values: *mut fmi3Clock,
 ) -> fmi3Status {
-    entry(instance, "fmi3GetClock", state::GET_VALUES, |_| {
+    ABI.entry(instance, "fmi3GetClock", state::GET_VALUES, |_| {
         none_of_type(valueReferences, nValueReferences, "Clock")
     })
 }
@@ -962,7 +760,7 @@ pub extern "C" fn fmi3SetClock(
     nValueReferences: usize,
     _values: *const fmi3Clock,
 ) -> fmi3Status {
-    entry(instance, "fmi3SetClock", state::SET_VALUES, |_| {
+    ABI.entry(instance, "fmi3SetClock", state::SET_VALUES, |_| {
         none_of_type(valueReferences, nValueReferences, "Clock")
     })
 }
@@ -978,7 +776,7 @@ macro_rules! refused {
         #[no_mangle]
         pub extern "C" fn $name(instance: fmi3Instance, $($arg: $argty),*) -> fmi3Status {
             $(let _ = $arg;)*
-            entry(instance, stringify!($name), state::UNSUPPORTED, |_| Err($reason.into()))
+            ABI.entry(instance, stringify!($name), state::UNSUPPORTED, |_| Err($reason.into()))
         }
         const _: $ty = Some($name);
     };
@@ -1050,7 +848,7 @@ pub extern "C" fn fmi3GetOutputDerivatives(
     values: *mut fmi3Float64,
     nValues: usize,
 ) -> fmi3Status {
-    entry(
+    ABI.entry(
         instance,
         "fmi3GetOutputDerivatives",
         state::GET_OUTPUT_DERIVATIVES,
@@ -1070,7 +868,7 @@ pub extern "C" fn fmi3GetOutputDerivatives(
                 ));
             }
             let mut elements = Vec::with_capacity(nValues);
-            for s in resolve::<f64>(vrs, h.modes_size, nValues)? {
+            for s in resolve::<f64>(vrs, h.instance.modes_size, nValues)? {
                 match s {
                     Slot::Element(i) => elements.push(i),
                     Slot::Time => return Err("time is not an output".into()),
@@ -1133,11 +931,9 @@ pub extern "C" fn fmi3GetFMUState(
     instance: fmi3Instance,
     FMUState: *mut fmi3FMUState,
 ) -> fmi3Status {
-    entry(instance, "fmi3GetFMUState", state::GET_FMU_STATE, |h| {
+    ABI.entry(instance, "fmi3GetFMUState", state::GET_FMU_STATE, |h| {
         // SAFETY: FMUState points to a writable fmi3FMUState slot (FMI 3.0 §2.3.6.5).
-        let slot = unsafe { place(FMUState, "FMUState") }?;
-        let core = h.instance.core.clone();
-        h.states.store(slot, core)
+        unsafe { h.get_fmu_state(FMUState) }
     })
 }
 const _: fmi3GetFMUStateTYPE = Some(fmi3GetFMUState);
@@ -1146,13 +942,8 @@ const _: fmi3GetFMUStateTYPE = Some(fmi3GetFMUState);
 /// taken with other parameters than the model this instance has built.
 #[no_mangle]
 pub extern "C" fn fmi3SetFMUState(instance: fmi3Instance, FMUState: fmi3FMUState) -> fmi3Status {
-    entry(instance, "fmi3SetFMUState", state::ANY, |h| {
-        let core = h.states.core(FMUState)?;
-        h.instance.check_state_fits(core)?;
-        h.instance.core = core.clone();
-        h.error = false;
-        h.configuration = false;
-        Ok(Status::Ok)
+    ABI.entry(instance, "fmi3SetFMUState", state::ANY, |h| {
+        h.set_fmu_state(FMUState)
     })
 }
 const _: fmi3SetFMUStateTYPE = Some(fmi3SetFMUState);
@@ -1164,12 +955,9 @@ pub extern "C" fn fmi3FreeFMUState(
     instance: fmi3Instance,
     FMUState: *mut fmi3FMUState,
 ) -> fmi3Status {
-    entry(instance, "fmi3FreeFMUState", state::ANY, |h| {
-        // SAFETY: FMUState is null or points to a slot holding null or a state we handed out.
-        let Some(slot) = (unsafe { FMUState.as_mut() }) else {
-            return Ok(Status::Ok);
-        };
-        h.states.free(slot)
+    ABI.entry(instance, "fmi3FreeFMUState", state::ANY, |h| {
+        // SAFETY: FMUState is null or points to a slot holding null or a state.
+        unsafe { h.free_fmu_state(FMUState) }
     })
 }
 const _: fmi3FreeFMUStateTYPE = Some(fmi3FreeFMUState);
@@ -1181,12 +969,9 @@ pub extern "C" fn fmi3SerializedFMUStateSize(
     FMUState: fmi3FMUState,
     size: *mut usize,
 ) -> fmi3Status {
-    entry(instance, "fmi3SerializedFMUStateSize", state::ANY, |h| {
-        let bytes = h.states.serialized(FMUState, h.instance.guid())?;
-        // SAFETY: size points to a writable usize.
-        let size = unsafe { place(size, "size") }?;
-        *size = bytes.len();
-        Ok(Status::Ok)
+    ABI.entry(instance, "fmi3SerializedFMUStateSize", state::ANY, |h| {
+        // SAFETY: size points to a writable size_t.
+        unsafe { h.serialized_fmu_state_size(FMUState, size) }
     })
 }
 const _: fmi3SerializedFMUStateSizeTYPE = Some(fmi3SerializedFMUStateSize);
@@ -1201,11 +986,9 @@ pub extern "C" fn fmi3SerializeFMUState(
     serializedState: *mut fmi3Byte,
     size: usize,
 ) -> fmi3Status {
-    entry(instance, "fmi3SerializeFMUState", state::ANY, |h| {
-        // SAFETY: the caller provides a writable buffer of `size` bytes.
-        let out = unsafe { array_mut(serializedState, size, "serializedState") }?;
-        h.states.serialize_into(FMUState, h.instance.guid(), out)?;
-        Ok(Status::Ok)
+    ABI.entry(instance, "fmi3SerializeFMUState", state::ANY, |h| {
+        // SAFETY: the master provides a writable buffer of `size` bytes.
+        unsafe { h.serialize_fmu_state(FMUState, serializedState, size) }
     })
 }
 const _: fmi3SerializeFMUStateTYPE = Some(fmi3SerializeFMUState);
@@ -1220,19 +1003,9 @@ pub extern "C" fn fmi3DeserializeFMUState(
     size: usize,
     FMUState: *mut fmi3FMUState,
 ) -> fmi3Status {
-    entry(instance, "fmi3DeserializeFMUState", state::ANY, |h| {
-        // SAFETY: the caller provides `size` readable bytes and a writable state slot.
-        let (bytes, slot) = unsafe {
-            (
-                array(serializedState, size, "serializedState")?,
-                place(FMUState, "FMUState")?,
-            )
-        };
-        let inst = &h.instance;
-        let core = snapshot::deserialize(bytes, inst.guid(), |core, dynamic| {
-            inst.restore_simulation(core, dynamic)
-        })?;
-        h.states.store(slot, core)
+    ABI.entry(instance, "fmi3DeserializeFMUState", state::ANY, |h| {
+        // SAFETY: the master provides `size` readable bytes and a writable state slot.
+        unsafe { h.deserialize_fmu_state(serializedState, size, FMUState) }
     })
 }
 const _: fmi3DeserializeFMUStateTYPE = Some(fmi3DeserializeFMUState);
@@ -1255,7 +1028,7 @@ pub extern "C" fn fmi3DoStep(
     earlyReturn: *mut fmi3Boolean,
     lastSuccessfulTime: *mut fmi3Float64,
 ) -> fmi3Status {
-    entry(instance, "fmi3DoStep", state::DO_STEP, |h| {
+    ABI.entry(instance, "fmi3DoStep", state::DO_STEP, |h| {
         // SAFETY: FMI 3.0 passes four writable out-arguments.
         let (event, terminate, early, last) = unsafe {
             (
@@ -1267,7 +1040,7 @@ pub extern "C" fn fmi3DoStep(
         };
         *event = false;
         *early = false;
-        if h.instance.core.phase == Phase2::StepFailed {
+        if h.instance.core.phase == Phase::StepFailed {
             *terminate = true;
             *last = h.instance.last_successful_time();
             return Err("an earlier step failed (terminateSimulation); call fmi3Terminate or restore an FMU state".into());

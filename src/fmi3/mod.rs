@@ -1,12 +1,13 @@
-//! The FMI 3.0 co-simulation layer: a second C ABI over the same instance as FMI 2.0.
+//! The FMI 3.0 co-simulation C ABI: the standard's signatures over the same runtime
+//! ([`crate::fmu`]) as FMI 2.0's, and nothing else.
 //!
-//! - [`abi`]: the exported `fmi3*` functions, each behind one guard (instance pointer, state
-//!   machine, panics) like [`crate::fmi2::abi`], delegating to [`crate::fmi2::instance::Instance`]:
-//!   the model, its stepping, its variable stores and its FMU states are the 2.0 layer's.
+//! - [`abi`]: the exported `fmi3*` functions, each behind the runtime's guard with its state
+//!   mask, delegating to the runtime: the model, its stepping, its variable stores and its FMU
+//!   states are shared with FMI 2.0.
 //! - [`state`]: the FMI 3.0 co-simulation state machine (no event mode, no intermediate update)
-//!   with its error and fatal states.
+//!   as a mask per function over the runtime's one phase type.
 //! - [`values`]: 3.0 value references (arrays such as `mount.F`) resolved to the elements of the
-//!   2.0 variable table.
+//!   variable table.
 //!
 //! `build.rs` (`build/fmi3_description.rs`) writes the 3.0 model description and
 //! `terminalsAndIcons.xml` from the same variable table.

@@ -1,19 +1,10 @@
-//! FMI 3.0 value references resolved to the 2.0 variable table: an array variable (`mount.F`,
-//! `mode.frequency`, …) stands for its elements, row-major, each a variable of the 2.0 table,
-//! so the 3.0 layer reads and writes the same stores as the 2.0 one.
+//! FMI 3.0 value references resolved to the runtime's variable table: an array variable
+//! (`mount.F`, `mode.frequency`, …) stands for its elements, row-major, each a scalar variable
+//! of the table (the 2.0 variables), so both ABIs read and write the same stores.
 
-use crate::fmi2::values::VarType;
+use crate::fmu::values::{Slot, VarType};
 use crate::variables::fmi3::{MODES_SIZE, TIME, VARIABLES};
 use crate::variables::ArrayVariable;
-
-/// Where one value of a 3.0 get or set call goes.
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
-pub enum Slot {
-    /// The variable of the 2.0 table at this index among its type.
-    Element(usize),
-    /// The independent variable `time`.
-    Time,
-}
 
 /// The 3.0 variable with value reference `vr`, if it has 2.0 elements.
 pub fn variable(vr: u32) -> Option<&'static ArrayVariable> {

@@ -8,12 +8,12 @@ use std::path::{Path, PathBuf};
 
 use super::input_track::InputTrack;
 use super::values::Values;
-use super::variables::{boolean, integer, real, string, Parameters, BOOLEANS, INTEGERS, REALS};
 use crate::cms::CacheSetting;
 use crate::cosim::{
     self, BodyOption, BodyOptions, EffectSwitch, Input, Replaced, SceneKind, Settings,
     VehicleOverrides, VehicleSetting,
 };
+use crate::variables::{boolean, integer, real, string, Parameters, BOOLEANS, INTEGERS, REALS};
 
 /// The Boolean parameter of an effect switch.
 fn effect_parameter(switch: EffectSwitch) -> u32 {
@@ -121,14 +121,20 @@ pub fn config_file(
             "the FMU's resources {} have no {} ({} is empty)",
             r.display(),
             cosim::DEFAULT_CONFIG_NAME,
-            super::variables::STRINGS[string::CONFIG_FILE as usize].name
+            crate::variables::STRINGS[string::CONFIG_FILE as usize].name
         ));
     }
     Ok(Some(path))
 }
 
-/// Where the tolerances come from, for the log.
-pub fn tolerance_note(values: &Values, settings: &Settings, experiment: Option<f64>) -> String {
+/// Where the tolerances come from, for the log; `setup` names the function that set up the
+/// experiment.
+pub fn tolerance_note(
+    values: &Values,
+    settings: &Settings,
+    experiment: Option<f64>,
+    setup: &str,
+) -> String {
     let name = REALS[real::SOLVER_REL_TOL as usize].name;
     let absolute = REALS[real::SOLVER_ABS_TOL as usize].name;
     let absolute = if settings.abs_tol > 0.0 {
@@ -137,9 +143,9 @@ pub fn tolerance_note(values: &Values, settings: &Settings, experiment: Option<f
         format!("; {absolute} = 0: the absolute tolerance follows the relative one")
     };
     let relative = match (experiment, values.reals.set_by_master(real::SOLVER_REL_TOL)) {
-        (Some(t), false) => format!("relative tolerance {t} from fmi2SetupExperiment"),
+        (Some(t), false) => format!("relative tolerance {t} from {setup}"),
         (Some(t), true) => format!(
-            "relative tolerance {} from {name} (set explicitly; fmi2SetupExperiment's {t} not used)",
+            "relative tolerance {} from {name} (set explicitly; {setup}'s {t} not used)",
             settings.rel_tol
         ),
         (None, _) => format!("relative tolerance {} ({name})", settings.rel_tol),

@@ -1,43 +1,64 @@
 //! One FMU instance: its state ([`Core`]), its life cycle, and reading and writing variables.
 //! Stepping is in [`super::step`].
 //!
-//! Everything here is safe Rust, and the calls arrive checked: [`super::abi`] has already
-//! verified the instance pointer, the state mask and the arguments, and mapped the value
-//! references to typed positions. A method returns `Err(message)` to refuse a call; the ABI logs
-//! it once, naming the function. A refused call leaves the instance exactly as it was: values
+//! Everything here is safe Rust, and the calls arrive checked: the guard
+//! ([`super::guard::Abi::entry`]) has already verified the instance pointer and the state mask, and
+//! the ABI the arguments, and mapped the value references to typed positions. A method returns
+//! `Err(message)` to refuse a call; the guard logs it once, naming the function. A refused call leaves the instance exactly as it was: values
 //! are checked as a whole before any is applied.
 
 use std::path::PathBuf;
 
+use super::guard::{self, Abi};
 use super::input_track::InputTrack;
 use super::logger::{Level, Logger};
 use super::parameters;
 use super::state::Phase;
 use super::values::{Num, Store, Typed, Values, VarType};
-use super::variables::{integer, real, Causality, LogCategory, Variability, Variable, REALS};
 use crate::cosim::{self, FmuKind, Runtime};
+use crate::variables::fmi3::MODES_SIZE_MAX;
+use crate::variables::{integer, real, Causality, LogCategory, Variability, Variable, REALS};
 
-/// Result of an FMI call, mapped to `fmi2Status` by the ABI layer.
+/// Result of an FMI call. Both standards number their statuses alike (fmi2OK = fmi3OK = 0, …,
+/// Fatal = 4, checked at compile time): an ABI returns `status as u32`.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, PartialOrd, Ord)]
+#[repr(u32)]
 pub enum Status {
-    /// fmi2OK.
-    Ok,
-    /// fmi2Warning: the call did its work, with something logged the master should know
-    /// (e.g. an input ramp bent onto its bound).
-    Warning,
-    /// fmi2Discard: the step could not be completed; the FMU stopped at the last successful time.
-    Discard,
-    /// fmi2Error: the call was refused (changing nothing), or the outputs could not be evaluated
+    /// OK.
+    Ok = 0,
+    /// Warning: the call did its work, with something logged the master should know (e.g. an
+    /// input ramp bent onto its bound).
+    Warning = 1,
+    /// Discard: the step could not be completed; the FMU stopped at the last successful time.
+    Discard = 2,
+    /// Error: the call was refused (changing nothing), or the outputs could not be evaluated
     /// after a step.
-    Error,
-    /// fmi2Fatal: the instance is unusable.
-    Fatal,
+    Error = 3,
+    /// Fatal: the instance is unusable.
+    Fatal = 4,
 }
 
-/// What a call on an instance gives: a status, or the reason it was refused (`fmi2Error`).
+// The statuses are numbered as both standards number theirs.
+const _: () = {
+    use fmi_sys::{fmi2::*, fmi3::*};
+    assert!(
+        Status::Ok as u32 == fmi2Status_fmi2OK
+            && Status::Warning as u32 == fmi2Status_fmi2Warning
+            && Status::Discard as u32 == fmi2Status_fmi2Discard
+            && Status::Error as u32 == fmi2Status_fmi2Error
+            && Status::Fatal as u32 == fmi2Status_fmi2Fatal
+            && Status::Ok as u32 == fmi3Status_fmi3OK
+            && Status::Warning as u32 == fmi3Status_fmi3Warning
+            && Status::Discard as u32 == fmi3Status_fmi3Discard
+            && Status::Error as u32 == fmi3Status_fmi3Error
+            && Status::Fatal as u32 == fmi3Status_fmi3Fatal
+    );
+};
+
+/// What a call on an instance gives: a status, or the reason it was refused (an error).
 pub type Outcome = Result<Status, String>;
 
-/// Everything an FMU state (`fmi2GetFMUstate`) captures.
+/// Everything an FMU state captures.
 #[derive(Clone)]
 pub struct Core {
     /// Where the instance is in the co-simulation state machine.
@@ -46,15 +67,16 @@ pub struct Core {
     pub values: Values,
     /// The signal of each Real input (indexed like the Reals; unused for non-inputs).
     pub inputs: Vec<InputTrack>,
-    /// Start time of `fmi2SetupExperiment` in s (0 if it was not called).
+    /// Start time of the experiment in s (0 if none was set up).
     pub start_time: f64,
-    /// Stop time of `fmi2SetupExperiment` in s, if defined: no step may pass it.
+    /// Stop time of the experiment in s, if defined: no step may pass it.
     pub stop_time: Option<f64>,
-    /// The tolerance of `fmi2SetupExperiment`, if the master defined one.
+    /// The experiment's tolerance, if the master defined one.
     pub experiment_tolerance: Option<f64>,
     /// The FMU's current time in s: the last communication point reached.
     pub time: f64,
-    /// Set when a step failed: `fmi2GetBooleanStatus(fmi2Terminated)` reports it.
+    /// Set when a step failed: `fmi2GetBooleanStatus(fmi2Terminated)` and fmi3DoStep's
+    /// `terminateSimulation` report it.
     pub terminated: bool,
     /// The built model with its integrator; `None` before initialisation ends and after a
     /// parameter change in initialisation mode (rebuilt when next needed).
@@ -122,16 +144,20 @@ impl Core {
 
 /// One instance of the FMU.
 pub struct Instance {
-    /// The `instanceName` of fmi2Instantiate.
+    /// The `instanceName` it was instantiated with.
     pub name: String,
     /// Which of the library's FMUs this instance is (from the GUID it was instantiated with).
     pub kind: FmuKind,
+    /// The standard it was instantiated through (function names for messages).
+    pub abi: &'static Abi,
+    /// FMI 3.0's structural parameter `modes.size`: how many natural modes the mode arrays
+    /// have (FMI 2.0: always all slots).
+    pub modes_size: u64,
     /// The master's logger callback with the enabled categories.
     pub logger: Logger,
-    /// The FMU's `resources` directory, from `fmuResourceLocation`; relative `configFile`
-    /// paths are resolved against it.
+    /// The FMU's `resources` directory; relative `configFile` paths are resolved against it.
     pub resource_dir: Option<PathBuf>,
-    /// Everything an FMU state captures; replaced as a whole by fmi2SetFMUstate.
+    /// Everything an FMU state captures; replaced as a whole when one is restored.
     pub core: Core,
 }
 
@@ -140,12 +166,15 @@ impl Instance {
     pub fn new(
         name: &str,
         kind: FmuKind,
+        abi: &'static Abi,
         logger: Logger,
         resource_dir: Option<PathBuf>,
     ) -> Instance {
         Instance {
             name: name.to_owned(),
             kind,
+            abi,
+            modes_size: MODES_SIZE_MAX,
             logger,
             resource_dir,
             core: Core::fresh(),
@@ -154,17 +183,14 @@ impl Instance {
 
     /// The GUID of this instance's FMU.
     pub fn guid(&self) -> &'static str {
-        match self.kind {
-            FmuKind::Engine => super::variables::GUID,
-            FmuKind::Body => super::variables::BODY_GUID,
-        }
+        guard::guid(self.kind)
     }
 
     /// The bit of this instance's FMU in [`Variable::fmus`].
     fn fmu_bit(&self) -> u8 {
         match self.kind {
-            FmuKind::Engine => super::variables::ENGINE_FMU,
-            FmuKind::Body => super::variables::BODY_FMU,
+            FmuKind::Engine => crate::variables::ENGINE_FMU,
+            FmuKind::Body => crate::variables::BODY_FMU,
         }
     }
 
@@ -179,10 +205,7 @@ impl Instance {
                     "value reference {} ({}) is not a variable of {}",
                     v.vr,
                     v.name,
-                    match self.kind {
-                        FmuKind::Engine => super::variables::MODEL_IDENTIFIER,
-                        FmuKind::Body => super::variables::BODY_MODEL_IDENTIFIER,
-                    }
+                    guard::model_identifier(self.kind)
                 ))
             }
             None => Ok(()),
@@ -213,13 +236,25 @@ impl Instance {
 
     // ----- life cycle ------------------------------------------------------------------------
 
-    /// `fmi2Reset`: back to the freshly instantiated state with start values.
+    /// Reset: back to the freshly instantiated state with start values.
     pub fn reset(&mut self) -> Outcome {
         self.core = Core::fresh();
+        self.modes_size = MODES_SIZE_MAX;
         Ok(Status::Ok)
     }
 
-    /// `fmi2SetupExperiment`. A defined tolerance becomes the integrator's relative tolerance
+    /// FMI 3.0's configuration mode, entered (`true`) or left.
+    pub fn configuration_mode(&mut self, enter: bool) -> Outcome {
+        self.core.phase = if enter {
+            Phase::ConfigurationMode
+        } else {
+            Phase::Instantiated
+        };
+        Ok(Status::Ok)
+    }
+
+    /// Sets up the experiment (fmi2SetupExperiment; FMI 3.0 as part of entering
+    /// initialisation). A defined tolerance becomes the integrator's relative tolerance
     /// unless the master set `solver.relTol` itself (which then wins); either way it is logged.
     pub fn setup_experiment(
         &mut self,
@@ -259,13 +294,13 @@ impl Instance {
         Ok(Status::Ok)
     }
 
-    /// `fmi2EnterInitializationMode`.
+    /// Enters initialisation mode.
     pub fn enter_initialization(&mut self) -> Outcome {
         self.core.phase = Phase::InitializationMode;
         Ok(Status::Ok)
     }
 
-    /// `fmi2ExitInitializationMode`: builds the model and its initial state; refused, with the
+    /// Exits initialisation mode: builds the model and its initial state; refused, with the
     /// reason, if the parameters or the configuration do not give a valid model.
     pub fn exit_initialization(&mut self) -> Outcome {
         self.ensure_simulation()?;
@@ -273,7 +308,7 @@ impl Instance {
         Ok(Status::Ok)
     }
 
-    /// `fmi2Terminate`.
+    /// Terminates.
     pub fn terminate(&mut self) -> Outcome {
         self.core.phase = Phase::Terminated;
         Ok(Status::Ok)
@@ -319,6 +354,7 @@ impl Instance {
             &self.core.values,
             &settings,
             self.core.experiment_tolerance,
+            self.abi.names.setup_experiment,
         ));
         let what = match self.kind {
             FmuKind::Engine => format!("scene {}", settings.scene.number()),
@@ -395,11 +431,15 @@ impl Instance {
 
     // ----- get and set -------------------------------------------------------------------------
 
-    /// `fmi2GetXXX` for the variables at `indices`. Outputs asked for in initialisation mode are
-    /// the static equilibrium's; calculated parameters (the natural modes) are computed when
-    /// first asked for.
+    /// Reads the variables at `indices`. Outputs asked for in initialisation mode are the
+    /// static equilibrium's; calculated parameters (the natural modes) are computed when first
+    /// asked for. In the error state entered before the model was built nothing is read: a
+    /// natural mode would build the model as a side effect of a diagnostic read.
     pub fn get<T: Typed>(&mut self, indices: &[usize]) -> Result<Vec<T>, String> {
         self.check_members::<T>(indices)?;
+        if self.core.phase == Phase::Error && self.core.simulation.is_none() {
+            return Err("nothing to read before initialisation".into());
+        }
         let causality = |i: &usize| T::table()[*i].causality;
         if self.core.phase == Phase::InitializationMode
             && indices.iter().any(|i| causality(i) == Causality::Output)
@@ -416,7 +456,7 @@ impl Instance {
         Ok(indices.iter().map(|&i| values[i].clone()).collect())
     }
 
-    /// `fmi2SetXXX` for the variables at `indices`: all checked before any is applied.
+    /// Sets the variables at `indices`: all checked before any is applied.
     pub fn set<T: Typed>(&mut self, indices: &[usize], values: &[T]) -> Outcome {
         self.check_members::<T>(indices)?;
         let phase = self.core.phase;
@@ -467,7 +507,7 @@ impl Instance {
         Ok(())
     }
 
-    /// `fmi2GetDirectionalDerivative`: `Σ_k ∂unknown/∂known_k · seed_k` for Real outputs with
+    /// Directional derivatives: `Σ_k ∂unknown/∂known_k · seed_k` for Real outputs with
     /// respect to Real inputs at the current communication point, the state held — the same
     /// instantaneous dependence the model structure declares (non-zero only through the
     /// interface inputs). Exact: from the mounts' tangent stiffness and damping and the
@@ -502,10 +542,10 @@ impl Instance {
             return Err(format!("seed {} is not finite", Num(*s)));
         }
         if self.core.phase != Phase::StepComplete {
-            return Err(
-                "directional derivatives are provided between steps, after fmi2ExitInitializationMode"
-                    .into(),
-            );
+            return Err(format!(
+                "directional derivatives are provided between steps, after {}",
+                self.abi.names.exit_initialization
+            ));
         }
         let mut increments = vec![0.0; REALS.len()];
         for (&k, &s) in knowns.iter().zip(seeds) {
@@ -540,7 +580,7 @@ impl Instance {
         Ok(())
     }
 
-    /// `fmi2SetRealInputDerivatives` for the Reals at `indices`.
+    /// First time derivatives of the Real inputs at `indices` (fmi2SetRealInputDerivatives).
     pub fn set_real_input_derivatives(
         &mut self,
         indices: &[usize],
@@ -575,7 +615,7 @@ impl Instance {
 
     // ----- FMU states --------------------------------------------------------------------------
 
-    /// Whether `core` (from `fmi2SetFMUstate`) can become this instance's state: its values are
+    /// Whether `core` (of a restored FMU state) can become this instance's state: its values are
     /// admissible and, once this instance has built its model, it was taken with the same
     /// parameters (a state of another scene or configuration would silently change the model).
     pub fn check_state_fits(&self, core: &Core) -> Result<(), String> {
@@ -594,7 +634,7 @@ impl Instance {
         }
     }
 
-    /// `fmi2LastSuccessfulTime` in s: the time reached, also after a discarded step.
+    /// The last successful time in s: the time reached, also after a discarded step.
     pub fn last_successful_time(&self) -> f64 {
         self.core.time
     }
@@ -645,7 +685,13 @@ mod tests {
     fn deserialized_state_continues_bit_for_bit() {
         let logger = Logger::new(None, std::ptr::null_mut(), "t", false);
         let resources = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("resources");
-        let mut inst = Instance::new("t", FmuKind::Engine, logger, Some(resources));
+        let mut inst = Instance::new(
+            "t",
+            FmuKind::Engine,
+            &crate::fmi2::abi::ABI,
+            logger,
+            Some(resources),
+        );
         assert_eq!(inst.setup_experiment(0.0, None, None), Ok(Status::Ok));
         inst.enter_initialization().unwrap();
         assert_eq!(inst.exit_initialization(), Ok(Status::Ok));
@@ -654,7 +700,7 @@ mod tests {
             assert_eq!(inst.do_step(t, 1e-3), Ok(Status::Ok));
             t += 1e-3;
         }
-        let bytes = super::super::snapshot::serialize(&inst.core, inst.guid());
+        let bytes = crate::fmu::snapshot::serialize(&inst.core, inst.guid());
         let saved = inst.core.clone();
         let mut reference = Vec::new();
         let mut tt = t;
@@ -670,7 +716,7 @@ mod tests {
             tt += 1e-3;
             assert_eq!(&inst.core.values.reals, r, "in-memory");
         }
-        let core = super::super::snapshot::deserialize(&bytes, inst.guid(), |c, d| {
+        let core = crate::fmu::snapshot::deserialize(&bytes, inst.guid(), |c, d| {
             inst.restore_simulation(c, d)
         })
         .unwrap();

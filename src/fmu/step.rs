@@ -1,12 +1,13 @@
-//! `fmi2DoStep`: check the step, commit the inputs for it, advance the simulation, report.
+//! A communication step (fmi2DoStep, fmi3DoStep): check the step, commit the inputs for it,
+//! advance the simulation, report.
 
 use super::instance::{Instance, Outcome, Status};
 use super::logger::Level;
 use super::parameters;
 use super::state::Phase;
 use super::values::Num;
-use super::variables::{integer, Causality, LogCategory, Variability, REALS};
 use crate::cosim;
+use crate::variables::{integer, Causality, LogCategory, Variability, REALS};
 
 /// Relative tolerance on communication points: masters compute them as `t0 + n h`.
 const TIME_JITTER: f64 = 1e-9;
@@ -28,7 +29,7 @@ fn same_time(a: f64, b: f64) -> bool {
 }
 
 impl Instance {
-    /// `fmi2DoStep` from `current` over `step`.
+    /// A communication step from `current` over `step`.
     pub fn do_step(&mut self, current: f64, step: f64) -> Outcome {
         let target = self.validate_step(current, step)?;
         let clipped = self.commit_step_inputs(target - current)?;
@@ -50,9 +51,10 @@ impl Instance {
         if !same_time(current, self.core.time) {
             return Err(format!(
                 "communication point {} s does not match the FMU time {} s \
-                 (use fmi2SetFMUstate to go back in time)",
+                 (use {} to go back in time)",
                 Num(current),
-                Num(self.core.time)
+                Num(self.core.time),
+                self.abi.names.set_fmu_state
             ));
         }
         let target = on_grid(current + step);
@@ -146,7 +148,7 @@ impl Instance {
     }
 
     /// A step the integrator could not complete: it kept its last successful step, which is
-    /// reported, and the run stops there (`fmi2Discard`, then `fmi2GetBooleanStatus` says
+    /// reported, and the run stops there (a discard; the instance then reports itself
     /// terminated).
     fn fail_step(&mut self, current: f64, target: f64, failure: cosim::StepFailure) -> Status {
         if let Some(simulation) = self.core.simulation.as_mut() {
@@ -160,7 +162,8 @@ impl Instance {
         self.core.phase = Phase::StepFailed;
         self.core.terminated = true;
         self.log_error(&format!(
-            "fmi2DoStep from {current} s to {target} s failed at {reached} s: {}",
+            "{} from {current} s to {target} s failed at {reached} s: {}",
+            self.abi.names.do_step,
             parameters::message(&failure.error)
         ));
         Status::Discard

@@ -34,7 +34,7 @@ struct SavedCore {
     simulation: Option<RuntimeState>,
 }
 
-/// Serializes a state captured by `fmi2GetFMUstate`.
+/// Serializes a captured FMU state.
 pub fn serialize(core: &Core, guid: &str) -> Vec<u8> {
     let saved = SavedCore {
         guid: guid.to_string(),

@@ -10,7 +10,7 @@ use std::ffi::c_void;
 use super::instance::{Core, Outcome, Status};
 use super::snapshot;
 
-/// One FMU state: everything `fmi2GetFMUstate` captured.
+/// One FMU state: everything getting the FMU state captured.
 struct Saved {
     core: Core,
 }

@@ -8,7 +8,7 @@ use fmi_sys::fmi2::{
 use fmi_sys::fmi3::fmi3LogMessageCallback;
 use std::ffi::CString;
 
-use super::variables::{LogCategory, LOG_CATEGORIES};
+use crate::variables::{LogCategory, LOG_CATEGORIES};
 
 /// How serious a message is; maps to the status passed to the callback.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]

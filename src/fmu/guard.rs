@@ -1,0 +1,441 @@
+//! What every exported function of either ABI goes through: the instance's handle (a live
+//! marker of its standard, the instance, the strings and FMU states it handed out), the one
+//! guard [`Abi::entry`] (instance pointer, liveness, state mask, panics), instantiation and freeing,
+//! and the work both standards share behind their own signatures: reading and writing values
+//! at resolved positions, and the FMU-state functions.
+//!
+//! Each ABI describes itself once, as an [`Abi`]: its live marker, how it names its phases and
+//! functions, and whether every refusal leads to the error state (FMI 3.0) or leaves the phase
+//! as it was (FMI 2.0).
+
+use std::ffi::{c_char, c_void, CString};
+use std::panic::{catch_unwind, AssertUnwindSafe};
+use std::path::PathBuf;
+
+use super::c_args::{array, array_mut, place, text};
+use super::fmu_states::FmuStates;
+use super::instance::{Instance, Outcome, Status};
+use super::logger::{Level, Logger};
+use super::snapshot;
+use super::state::{Mask, Phase};
+use super::values::{Slot, Typed};
+use crate::cosim::FmuKind;
+use crate::variables::{
+    string, LogCategory, BODY_GUID, BODY_MODEL_IDENTIFIER, GUID, MODEL_IDENTIFIER, STRINGS,
+};
+
+/// The names of an ABI's functions that the runtime's messages mention.
+#[derive(Debug)]
+pub struct FunctionNames {
+    /// Instantiation (`fmi2Instantiate`, `fmi3InstantiateCoSimulation`).
+    pub instantiate: &'static str,
+    /// Freeing an instance.
+    pub free_instance: &'static str,
+    /// Where the experiment's tolerance comes from (`fmi2SetupExperiment`,
+    /// `fmi3EnterInitializationMode`).
+    pub setup_experiment: &'static str,
+    /// Leaving initialisation mode.
+    pub exit_initialization: &'static str,
+    /// A communication step.
+    pub do_step: &'static str,
+    /// Restoring an FMU state.
+    pub set_fmu_state: &'static str,
+}
+
+/// What the runtime needs to know of the standard an instance was created through.
+#[derive(Debug)]
+pub struct Abi {
+    /// Marks a live instance of this standard; another value than the other standard's, so an
+    /// instance of one standard is never used through the other.
+    pub live: u64,
+    /// The FMUs this ABI instantiates.
+    pub kinds: &'static [FmuKind],
+    /// Its word for the instantiation token (`GUID`, `instantiation token`).
+    pub token: &'static str,
+    /// Its word for the resources argument (`resource location`, `resource path`).
+    pub resources: &'static str,
+    /// FMI 3.0: every call answered with an error leads to [`Phase::Error`]; FMI 2.0 leaves
+    /// the phase of a refused call as it was.
+    pub errors_enter_error_state: bool,
+    /// How the standard names the phases, for messages.
+    pub phase_name: fn(Phase) -> &'static str,
+    /// What to do in the error state, said when a call is refused there.
+    pub error_state_hint: &'static str,
+    /// Function names for messages.
+    pub names: FunctionNames,
+}
+
+/// An instance as the master holds it: the pointer both ABIs hand out.
+pub struct Handle {
+    live: u64,
+    /// The instance.
+    pub instance: Instance,
+    /// Strings returned by a string getter stay valid until the next such call on this instance.
+    returned_strings: Vec<CString>,
+    /// The FMU states this instance handed out and has not freed: they belong to it and are
+    /// freed with it.
+    states: FmuStates,
+}
+
+impl Abi {
+    /// [`entry`] for this standard, with the status as the standard's C status (fmi2Status and
+    /// fmi3Status number the statuses as [`Status`]).
+    pub fn entry(
+        &self,
+        ptr: *mut c_void,
+        function: &'static str,
+        mask: Mask,
+        body: impl FnOnce(&mut Handle) -> Outcome,
+    ) -> u32 {
+        entry(ptr, self, function, mask, body) as u32
+    }
+}
+
+/// The guard of every entry point with an instance: runs `body` on the instance behind `ptr`
+/// if `function` may be called in its phase (`mask`). A null or stale pointer, or one of the
+/// other standard, gives an error; a refusal is logged as "`function`: reason" and gives an
+/// error (and, for FMI 3.0, the error state); a panic gives a fatal status (the instance is then
+/// unusable); in the fatal phase only freeing the instance is allowed.
+fn entry(
+    ptr: *mut c_void,
+    abi: &Abi,
+    function: &'static str,
+    mask: Mask,
+    body: impl FnOnce(&mut Handle) -> Outcome,
+) -> Status {
+    if ptr.is_null() {
+        return Status::Error;
+    }
+    let ptr = ptr as *mut Handle;
+    // SAFETY: a non-null instance pointer is, per FMI 2.0 and 3.0, the pointer instantiation
+    // returned, not freed since; the caller must not use one instance from two threads at once
+    // (FMI 2.0 §2.1.4, FMI 3.0 §2.2.2), so this is the only live reference.
+    let handle = unsafe { &mut *ptr };
+    if handle.live != abi.live {
+        return Status::Error;
+    }
+    let result = catch_unwind(AssertUnwindSafe(|| {
+        let inst = &handle.instance;
+        inst.logger.log(Level::Info, LogCategory::Calls, function);
+        let phase = inst.phase();
+        if phase == Phase::Fatal {
+            inst.logger.log(
+                Level::Fatal,
+                LogCategory::StatusError,
+                &format!(
+                    "{function}: the instance is in a fatal state; only {} is allowed",
+                    abi.names.free_instance
+                ),
+            );
+            return Status::Fatal;
+        }
+        if !mask.allows(phase) {
+            let hint = if phase == Phase::Error {
+                abi.error_state_hint
+            } else {
+                ""
+            };
+            inst.log_error(&format!(
+                "{function} is not allowed in phase {}{hint}",
+                (abi.phase_name)(phase)
+            ));
+            return Status::Error;
+        }
+        match body(handle) {
+            Ok(s) => s,
+            Err(message) => {
+                handle.instance.log_error(&format!("{function}: {message}"));
+                Status::Error
+            }
+        }
+    }));
+    match result {
+        Ok(s) => {
+            if s == Status::Error && abi.errors_enter_error_state {
+                handle.instance.core.phase = Phase::Error;
+            }
+            s
+        }
+        Err(panic) => {
+            let what = panic
+                .downcast_ref::<&str>()
+                .map(|s| s.to_string())
+                .or_else(|| panic.downcast_ref::<String>().cloned())
+                .unwrap_or_else(|| "unknown panic".to_owned());
+            let _ = catch_unwind(AssertUnwindSafe(|| {
+                handle.instance.core.phase = Phase::Fatal;
+                handle.instance.logger.log(
+                    Level::Fatal,
+                    LogCategory::StatusError,
+                    &format!("{function}: internal error (bug), the instance is unusable: {what}"),
+                );
+            }));
+            Status::Fatal
+        }
+    }
+}
+
+/// What a master passed to instantiate, read by the ABI.
+pub struct Request {
+    /// `instanceName`.
+    pub name: *const c_char,
+    /// The GUID or instantiation token.
+    pub token: *const c_char,
+    /// The resource location or path as given (null: none).
+    pub resources: *const c_char,
+    /// How the ABI turns the resources argument into a directory (`None`: none given).
+    pub resource_dir: fn(Option<&str>) -> Result<Option<PathBuf>, String>,
+}
+
+/// Creates an instance and returns its handle, or null after logging why through the logger
+/// `logger` makes for the instance's name: a missing `instanceName`, `refusal` (the ABI's own
+/// reason, such as an interface it does not provide), a token that is none of this ABI's FMUs,
+/// or resources that are not a directory. The model itself is built only when initialisation
+/// ends, or earlier when an output or a calculated parameter is read in initialisation mode.
+pub fn instantiate(
+    abi: &'static Abi,
+    request: Request,
+    logger: impl FnOnce(&str) -> Logger,
+    refusal: Option<&str>,
+) -> *mut c_void {
+    let result = catch_unwind(AssertUnwindSafe(|| {
+        // SAFETY: FMI strings are NUL-terminated or null.
+        let (name, token, resources) = unsafe {
+            (
+                text(request.name).unwrap_or_default(),
+                text(request.token).unwrap_or_default(),
+                text(request.resources),
+            )
+        };
+        let logger = logger(&name);
+        let refuse = |message: &str| {
+            let message = format!("{}: {message}", abi.names.instantiate);
+            logger.log(Level::Error, LogCategory::StatusError, &message);
+            std::ptr::null_mut()
+        };
+        if name.is_empty() {
+            return refuse("instanceName is missing");
+        }
+        if let Some(reason) = refusal {
+            return refuse(reason);
+        }
+        let Some(&kind) = abi.kinds.iter().find(|k| guid(**k) == token) else {
+            let fmus: Vec<String> = abi
+                .kinds
+                .iter()
+                .map(|k| format!("{} ({})", model_identifier(*k), guid(*k)))
+                .collect();
+            return refuse(&format!(
+                "{} \"{token}\" does not match {}, the FMUs of this library",
+                abi.token,
+                fmus.join(" or ")
+            ));
+        };
+        let resource_dir = match (request.resource_dir)(resources.as_deref()) {
+            Ok(dir) => dir,
+            Err(m) => return refuse(&m),
+        };
+        if resource_dir.is_none() {
+            let config = STRINGS[string::CONFIG_FILE as usize].name;
+            logger.log(
+                Level::Warning,
+                LogCategory::StatusWarning,
+                &format!(
+                    "{}: no {} given; the built-in vehicle is used unless {config} names an absolute path",
+                    abi.names.instantiate, abi.resources
+                ),
+            );
+        }
+        let handle = Box::new(Handle {
+            live: abi.live,
+            instance: Instance::new(&name, kind, abi, logger, resource_dir),
+            returned_strings: Vec::new(),
+            states: FmuStates::default(),
+        });
+        Box::into_raw(handle) as *mut c_void
+    }));
+    result.unwrap_or(std::ptr::null_mut())
+}
+
+/// The GUID (FMI 3.0: instantiation token) of an FMU of this library.
+pub fn guid(kind: FmuKind) -> &'static str {
+    match kind {
+        FmuKind::Engine => GUID,
+        FmuKind::Body => BODY_GUID,
+    }
+}
+
+/// The `modelIdentifier` of an FMU of this library.
+pub fn model_identifier(kind: FmuKind) -> &'static str {
+    match kind {
+        FmuKind::Engine => MODEL_IDENTIFIER,
+        FmuKind::Body => BODY_MODEL_IDENTIFIER,
+    }
+}
+
+/// Frees the instance behind `ptr` and every FMU state it handed out. A null or already freed
+/// pointer, or one of the other standard, is ignored; allowed in every phase.
+pub fn free(ptr: *mut c_void, abi: &Abi) {
+    if ptr.is_null() {
+        return;
+    }
+    let ptr = ptr as *mut Handle;
+    // SAFETY: ptr came from `instantiate` (Box::into_raw) and is freed at most once by contract;
+    // the live marker catches the common double free, and a pointer of the other standard,
+    // before we take ownership back.
+    unsafe {
+        if (*ptr).live != abi.live {
+            return;
+        }
+        (*ptr).live = 0;
+        drop(Box::from_raw(ptr));
+    }
+}
+
+impl Handle {
+    /// Reads the values of type `T` at `slots` into `out` through `convert` (`time` gives the
+    /// independent variable's value, where the standard has one).
+    pub fn read<T: Typed, C>(
+        &mut self,
+        slots: &[Slot],
+        out: &mut [C],
+        convert: impl Fn(T) -> C,
+        time: impl Fn(f64) -> Option<C>,
+    ) -> Outcome {
+        let elements: Vec<usize> = slots.iter().filter_map(Slot::element).collect();
+        let mut read = self.instance.get::<T>(&elements)?.into_iter();
+        let now = self.instance.core.time;
+        for (o, s) in out.iter_mut().zip(slots) {
+            *o = match s {
+                Slot::Element(_) => convert(read.next().ok_or("value count")?),
+                Slot::Time => time(now).ok_or("time has no value of this type")?,
+            };
+        }
+        Ok(Status::Ok)
+    }
+
+    /// Reads String variables into `out`: the pointers stay valid until the next call of this
+    /// function on this instance or until it is freed.
+    pub fn read_strings(&mut self, slots: &[Slot], out: &mut [*const c_char]) -> Outcome {
+        let elements: Vec<usize> = slots.iter().filter_map(Slot::element).collect();
+        let read = self.instance.get::<String>(&elements)?;
+        self.returned_strings = read
+            .iter()
+            .map(|t| CString::new(t.replace('\0', "")).unwrap_or_default())
+            .collect();
+        for (o, t) in out.iter_mut().zip(&self.returned_strings) {
+            *o = t.as_ptr();
+        }
+        Ok(Status::Ok)
+    }
+
+    /// Sets the variables of type `T` at `slots` to `values`, all checked before any is
+    /// applied; the independent variable is refused.
+    pub fn write<T: Typed>(&mut self, slots: &[Slot], values: &[T]) -> Outcome {
+        let mut elements = Vec::with_capacity(slots.len());
+        for s in slots {
+            match s {
+                Slot::Element(i) => elements.push(*i),
+                Slot::Time => {
+                    return Err("time is the independent variable and cannot be set".into())
+                }
+            }
+        }
+        self.instance.set::<T>(&elements, values)
+    }
+
+    /// Copies the instance's complete state into a new FMU state, or into the one in `*slot` if
+    /// it is a state of this instance.
+    ///
+    /// # Safety
+    /// `slot` is null or points to the master's writable FMU-state slot.
+    pub unsafe fn get_fmu_state(&mut self, slot: *mut *mut c_void) -> Outcome {
+        // SAFETY: the caller's contract.
+        let slot = unsafe { place(slot, "FMUstate") }?;
+        let core = self.instance.core.clone();
+        self.states.store(slot, core)
+    }
+
+    /// Restores a state this instance handed out; refused if it was taken with other parameters
+    /// than the model this instance has built (it would silently change the model).
+    pub fn set_fmu_state(&mut self, state: *mut c_void) -> Outcome {
+        let core = self.states.core(state)?;
+        self.instance.check_state_fits(core)?;
+        self.instance.core = core.clone();
+        Ok(Status::Ok)
+    }
+
+    /// Frees an FMU state of this instance and sets `*slot` to null; a null slot or state is
+    /// ignored, a foreign state refused.
+    ///
+    /// # Safety
+    /// `slot` is null or points to a writable slot holding null or a state.
+    pub unsafe fn free_fmu_state(&mut self, slot: *mut *mut c_void) -> Outcome {
+        // SAFETY: the caller's contract.
+        let Some(slot) = (unsafe { slot.as_mut() }) else {
+            return Ok(Status::Ok);
+        };
+        self.states.free(slot)
+    }
+
+    /// Writes the number of bytes [`Handle::serialize_fmu_state`] needs for `state` to `*size`.
+    ///
+    /// # Safety
+    /// `size` is null or points to a writable `usize`.
+    pub unsafe fn serialized_fmu_state_size(
+        &mut self,
+        state: *mut c_void,
+        size: *mut usize,
+    ) -> Outcome {
+        let bytes = self.states.serialized(state, self.instance.guid())?;
+        // SAFETY: the caller's contract.
+        *unsafe { place(size, "size") }? = bytes.len();
+        Ok(Status::Ok)
+    }
+
+    /// Serialises an FMU state of this instance into the master's buffer of `size` bytes, which
+    /// must be exactly the serialized size.
+    ///
+    /// # Safety
+    /// `buffer` is null or points to `size` writable bytes.
+    pub unsafe fn serialize_fmu_state(
+        &mut self,
+        state: *mut c_void,
+        buffer: *mut u8,
+        size: usize,
+    ) -> Outcome {
+        // SAFETY: the caller's contract.
+        let out = unsafe { array_mut(buffer, size, "serializedState") }?;
+        self.states
+            .serialize_into(state, self.instance.guid(), out)?;
+        Ok(Status::Ok)
+    }
+
+    /// Creates an FMU state from `size` bytes of a serialized one (possibly of another process,
+    /// of either standard's FMU of the same model) into `*slot`; bytes of another model,
+    /// malformed or with inadmissible values are refused. The model is rebuilt from the state's
+    /// own parameters.
+    ///
+    /// # Safety
+    /// `bytes` is null or points to `size` readable bytes; `slot` is null or points to a
+    /// writable FMU-state slot.
+    pub unsafe fn deserialize_fmu_state(
+        &mut self,
+        bytes: *const u8,
+        size: usize,
+        slot: *mut *mut c_void,
+    ) -> Outcome {
+        // SAFETY: the caller's contract.
+        let (bytes, slot) = unsafe {
+            (
+                array(bytes, size, "serializedState")?,
+                place(slot, "FMUstate")?,
+            )
+        };
+        let inst = &self.instance;
+        let core = snapshot::deserialize(bytes, inst.guid(), |core, dynamic| {
+            inst.restore_simulation(core, dynamic)
+        })?;
+        self.states.store(slot, core)
+    }
+}
