@@ -280,6 +280,7 @@ mod tests {
                 shape: vec![[1.0; 6], [2.0; 6]],
             }],
             cutoff_hz: None,
+            own_damping: None,
         }
     }
 

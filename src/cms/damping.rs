@@ -60,6 +60,35 @@ impl DampingUnit {
     }
 }
 
+/// What is wrong with a [`DampingTable`]: the point (0-based, if one is at fault) and why.
+#[derive(Debug, Clone, PartialEq)]
+pub struct TableError {
+    /// The offending point.
+    pub point: Option<usize>,
+    /// What is wrong with it.
+    pub message: String,
+}
+
+impl std::fmt::Display for TableError {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        match self.point {
+            Some(i) => write!(f, "point {i}: {}", self.message),
+            None => f.write_str(&self.message),
+        }
+    }
+}
+
+/// The damping a body brings with it (a deck's `TABDMP1` named by `SDAMPING`), applied unless
+/// the vehicle configuration gives the body a damping.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct OwnDamping {
+    /// Where it comes from, for the log (`TABDMP1 12 at line 40 of body.bdf`).
+    pub source: String,
+    /// The table.
+    pub table: DampingTable,
+}
+
 /// Damping against natural frequency, as Nastran's `TABDMP1`: pairs (frequency in Hz, value in
 /// [`DampingUnit`]), linear interpolation of the values between the points, the end values held
 /// outside the table. Two points at the same frequency make a step; exactly at the step the mean
@@ -120,33 +149,45 @@ impl DampingTable {
         }
     }
 
-    /// Checks the table; the message names the offending point (0-based) and its value.
+    /// Checks the table; the error names the offending point (0-based) and its value.
     /// At least one point; frequencies finite, >= 0 and ascending, at most two equal ones in a
     /// row (a step); values finite and >= 0 (`Q`: > 0).
-    pub fn check(&self) -> Result<(), String> {
+    pub fn check(&self) -> Result<(), TableError> {
         let unit = self.unit.nastran();
+        let at = |i: usize, message: String| {
+            Err(TableError {
+                point: Some(i),
+                message,
+            })
+        };
         if self.points.is_empty() {
-            return Err("the table has no point (at least one frequency and value)".into());
+            return Err(TableError {
+                point: None,
+                message: "the table has no point (at least one frequency and value)".into(),
+            });
         }
         for (i, &[f, v]) in self.points.iter().enumerate() {
             if !(f.is_finite() && f >= 0.0) {
-                return Err(format!(
-                    "point {i}: frequency {f} Hz must be finite and >= 0"
-                ));
+                return at(i, format!("frequency {f} Hz must be finite and >= 0"));
             }
             if i > 0 {
                 let before = self.points[i - 1][0];
                 if f < before {
-                    return Err(format!(
-                        "point {i}: frequency {f} Hz is below the one before it ({before} Hz); \
-                         frequencies must increase (two equal ones make a step)"
-                    ));
+                    return at(
+                        i,
+                        format!(
+                            "frequency {f} Hz is below the one before it ({before} Hz); \
+                             frequencies must increase (two equal ones make a step)"
+                        ),
+                    );
                 }
                 if i > 1 && f == before && f == self.points[i - 2][0] {
-                    return Err(format!(
-                        "point {i}: a third value at {f} Hz; a step takes two points at one \
-                         frequency"
-                    ));
+                    return at(
+                        i,
+                        format!(
+                            "a third value at {f} Hz; a step takes two points at one frequency"
+                        ),
+                    );
                 }
             }
             let bad = match self.unit {
@@ -159,9 +200,7 @@ impl DampingTable {
                 } else {
                     "finite and >= 0"
                 };
-                return Err(format!(
-                    "point {i}: {unit} value {v} at {f} Hz must be {need}"
-                ));
+                return at(i, format!("{unit} value {v} at {f} Hz must be {need}"));
             }
         }
         Ok(())
@@ -396,7 +435,7 @@ mod tests {
 
     #[test]
     fn bad_tables_are_named() {
-        let e = |t: DampingTable| t.check().unwrap_err();
+        let e = |t: DampingTable| t.check().unwrap_err().to_string();
         assert!(e(table(DampingUnit::Crit, &[])).contains("no point"));
         let m = e(table(DampingUnit::Crit, &[[10.0, 0.01], [5.0, 0.02]]));
         assert!(m.contains("point 1") && m.contains("increase"), "{m}");

@@ -326,6 +326,7 @@ pub fn reduce_external(body: &ExternalBody<'_>) -> Result<ReducedChassis, CmsErr
         omega,
         points,
         cutoff_hz: Some(cutoff_hz),
+        own_damping: None,
     })
 }
 

@@ -122,6 +122,7 @@ mod tests {
                 shape: vec![[0.0, 0.0, 0.5, 0.0, 0.0, 0.0]],
             }],
             cutoff_hz: None,
+            own_damping: None,
         }
     }
 

@@ -286,6 +286,7 @@ mod tests {
                 shape: vec![[0.0, 0.0, 1.0, 0.0, 0.0, 0.0]],
             }],
             cutoff_hz: None,
+            own_damping: None,
         };
         BodyAlone {
             body,

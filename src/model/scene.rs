@@ -408,9 +408,10 @@ fn file_digest(
     crate::nastran::deck_digest(path, &options)
 }
 
-/// Sets the modal damping of `body` from the vehicle's body damping (or the default; a reduced
-/// body read from a file keeps its own ratios unless the configuration gives a damping), the
-/// physical part scaled by `scale`; returns what was applied, for the log.
+/// Sets the modal damping of `body`: the vehicle configuration's body damping, else the body's
+/// own (a deck's `TABDMP1` named by `SDAMPING`; a reduced body read from a file keeps its
+/// ratios), else the default; the physical part scaled by `scale`. Returns what was applied,
+/// for the log.
 fn apply_damping(
     body: &mut ReducedChassis,
     vehicle: &VehicleConfig,
@@ -425,9 +426,13 @@ fn apply_damping(
             return Ok(format!("modal damping x{scale} (the file's ratios)"));
         }
     }
-    let (damping, origin) = match given {
-        Some(d) => (d.clone(), "the vehicle configuration's"),
-        None => (BodyDamping::default(), "the default"),
+    let (damping, origin) = match (given, &body.own_damping) {
+        (Some(d), _) => (d.clone(), "the vehicle configuration's".to_owned()),
+        (None, Some(own)) => (
+            BodyDamping::from_table(own.table.clone()),
+            format!("the body's {}", own.source),
+        ),
+        (None, None) => (BodyDamping::default(), "the default".to_owned()),
     };
     let hz: Vec<f64> = body
         .omega

@@ -3,6 +3,7 @@
 mod bulk_deck;
 mod cache;
 mod damping;
+mod deck_damping;
 mod deck_diagnostics;
 mod dmig;
 mod reduction;

@@ -51,6 +51,7 @@ fn rigid_chassis(cfg: &VehicleConfig, mass: f64, hz: [f64; 3]) -> ReducedChassis
         zeta: vec![0.0; 3],
         points,
         cutoff_hz: None,
+        own_damping: None,
     }
 }
 

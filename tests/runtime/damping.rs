@@ -43,6 +43,7 @@ fn single_mode_body(hz: f64) -> ReducedChassis {
         zeta: vec![0.0],
         points,
         cutoff_hz: None,
+        own_damping: None,
     }
 }
 
