@@ -494,8 +494,10 @@ mod tests {
 
     #[test]
     fn bad_body_damping_is_named() {
-        let mut d = BodyDamping::default();
-        d.modes = vec![(1, 0.01), (7, 0.03)];
+        let mut d = BodyDamping {
+            modes: vec![(1, 0.01), (7, 0.03)],
+            ..BodyDamping::default()
+        };
         let e = d.ratios(&[10.0; 5], None, 1.0).unwrap_err();
         assert!(
             e.contains("modes[1]: mode 7") && e.contains("5 modes"),

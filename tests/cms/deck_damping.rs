@@ -12,8 +12,7 @@ use engine_mount_chassis::cms::{
 };
 use engine_mount_chassis::nastran::{deck_digest, DeckOptions};
 
-#[path = "../common/plate_deck.rs"]
-mod plate_deck;
+use crate::plate_deck;
 
 /// The held plate with a case control section (`control`) and `extra` bulk cards, written to a
 /// fresh folder, as a reduction spec keeping every fixed-interface mode below 1 kHz.

@@ -11,9 +11,7 @@ use engine_mount_chassis::cms::{
 };
 use engine_mount_chassis::nastran::{deck_digest, DeckOptions};
 
-#[path = "../common/plate_deck.rs"]
-mod plate_deck;
-use plate_deck::plate;
+use crate::plate_deck::{self, plate};
 
 /// The plate held by 1e5 N/m springs at its corners.
 fn corner_springs() -> String {

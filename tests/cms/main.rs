@@ -1,5 +1,8 @@
 //! Integration tests of the Craig-Bampton reduction and its cache (`src/cms`).
 
+#[path = "../common/plate_deck.rs"]
+mod plate_deck;
+
 mod bulk_deck;
 mod cache;
 mod damping;
