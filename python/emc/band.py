@@ -191,27 +191,16 @@ def order_cuts_figure(orders: pd.DataFrame, signal: str, unit: str | None = None
     data = orders[orders.signal == signal]
     if data.empty:
         raise ValueError(f"no order amplitudes for {signal}")
-    columns = min(3, len(cut_orders))
-    rows = -(-len(cut_orders) // columns)
-    fig, axes = plots.plt.subplots(rows, columns, figsize=(4.3 * columns, 3.3 * rows + 1.0),
-                                   sharex=True, sharey=True, squeeze=False,
-                                   layout="constrained")
+    fig, axes = plots.order_panels(len(cut_orders), extra_height=1.0)
     cases = _cases(data)
-    for k, ax in enumerate(axes.flat):
-        if k >= len(cut_orders):
-            ax.set_visible(False)
-            continue
-        order = cut_orders[k]
+    ylabel = f"amplitude (peak) [{plots.level_reference(unit)[2]}]"
+    for k, (ax, order) in enumerate(zip(axes.flat, cut_orders)):
         for j, case in enumerate(cases):
             d = data[(data.case.fillna("") == case) & np.isclose(data.order, order)]
             x, low, nominal, high = _curves(d, "rpm", "amplitude")
             draw_band(ax, x, low, nominal, high, label=plots.case_label(case), color=f"C{j}",
                       lw=1.4, marker="o", ms=3)
-        plots._cut_axes(ax, data.amplitude)
-        ax.set_title(f"order {order:g}", fontsize=10)
-        if k % columns == 0:
-            ax.set_ylabel(f"amplitude (peak) [{plots.level_reference(unit)[2]}]")
-        ax.tick_params(labelbottom=True)
+        plots.order_panel_axes(ax, k, order, axes.shape[1], ylabel, data.amplitude)
     handles, labels = axes.flat[0].get_legend_handles_labels()
     fig.legend(handles, [f"{lab}: nominal, band shaded" for lab in labels],
                loc="outside lower center", ncol=min(len(cases), 3), fontsize=9, frameon=False)

@@ -3,44 +3,26 @@
 //! bad damping input is refused naming the card, its id and the deck line. (The independent
 //! check, a deck written by pyNastran through the body FMU, is `python/tests/test_bulk_deck.py`.)
 
-use std::collections::BTreeMap;
 use std::path::PathBuf;
 
 use engine_mount_chassis::cms::{
-    reduce_cached_with_notes, reduce_with_notes, BodySource, BulkDeckBody, CacheOutcome,
-    CacheSetting, InterfaceDofs, ModeSelection, ReductionSpec,
+    reduce_cached_with_notes, reduce_with_notes, CacheOutcome, CacheSetting, ModeSelection,
+    ReductionSpec,
 };
-use engine_mount_chassis::nastran::{deck_digest, DeckOptions};
 
 use crate::plate_deck;
 
 /// The held plate with a case control section (`control`) and `extra` bulk cards, written to a
 /// fresh folder, as a reduction spec keeping every fixed-interface mode below 1 kHz.
 fn deck_spec(name: &str, control: &str, extra: &str) -> (ReductionSpec, PathBuf) {
-    let dir = std::env::temp_dir().join(format!("emc-deck-damping-{name}-{}", std::process::id()));
-    let _ = std::fs::remove_dir_all(&dir);
-    std::fs::create_dir_all(&dir).unwrap();
-    let path = dir.join("plate.bdf");
     let bulk = plate_deck::plate(&format!("{}{extra}", plate_deck::corner_springs(1e5)), 0.0);
-    std::fs::write(&path, format!("SOL 103\nCEND\n{control}{bulk}")).unwrap();
-    let points: BTreeMap<String, u32> = [("mount_a", 1011), ("mount_b", 1015), ("mount_c", 1021)]
-        .into_iter()
-        .map(|(n, g)| (n.to_string(), g))
-        .collect();
-    let spec = ReductionSpec {
-        body: BodySource::Deck(BulkDeckBody {
-            sha256: deck_digest(&path, &DeckOptions::default()).unwrap(),
-            path,
-            points: points.clone(),
-            include_root: None,
-        }),
-        interface: points.keys().cloned().collect(),
-        interface_dofs: InterfaceDofs::Translations,
-        selection: ModeSelection::CutoffHz(1000.0),
-        outputs: Vec::new(),
-        ..ReductionSpec::default()
-    };
-    (spec, dir)
+    let mounts = [("mount_a", 1011), ("mount_b", 1015), ("mount_c", 1021)];
+    crate::deck_diagnostics::deck_spec(
+        &format!("deck-damping-{name}"),
+        &format!("SOL 103\nCEND\n{control}{bulk}"),
+        &mounts,
+        ModeSelection::CutoffHz(1000.0),
+    )
 }
 
 /// The table of the test written out by hand: G 0.04 up to 50 Hz, a step to G 0.08 there, G

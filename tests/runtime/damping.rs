@@ -134,21 +134,7 @@ fn inputs(rpm: f64) -> Inputs {
 /// The largest steering-wheel acceleration over 0.4 s at 1500 rpm; every output finite.
 fn wheel_peak(settings: &Settings) -> f64 {
     let mut sim = Simulation::new(settings, 0.0, &inputs(1500.0)).expect("scene 2");
-    let mut peak: f64 = 0.0;
-    for k in 1..=400 {
-        sim.advance_to(k as f64 * 1e-3).expect("step");
-        let o = sim.outputs().unwrap();
-        for a in o.steering_wheel_acceleration {
-            assert!(a.is_finite());
-            peak = peak.max(a.abs());
-        }
-        assert!(o
-            .mount_force
-            .iter()
-            .flatten()
-            .all(|f| f.is_finite() && f.abs() < 5.0 * 180.0 * 9.81));
-    }
-    peak
+    crate::hard_cases::wheel_peak(&mut sim, 400)
 }
 
 #[test]
