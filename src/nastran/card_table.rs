@@ -21,7 +21,7 @@ pub struct CardSupport {
 }
 
 /// Every bulk data card the reader accepts, by row of the user guide's table.
-pub const CARD_TABLE: [CardSupport; 24] = [
+pub const CARD_TABLE: [CardSupport; 25] = [
     CardSupport {
         cards: &["GRID"],
         read_as: "a node (six DOFs, in its CD system)",
@@ -159,6 +159,12 @@ pub const CARD_TABLE: [CardSupport; 24] = [
         read_as: "WTMASS scales every mass; the output and bookkeeping parameters below are ignored",
         fields: "WTMASS",
         refused: "any other parameter (COUPMASS, K6ROT, …: they may change K or M)",
+    },
+    CardSupport {
+        cards: &["TABDMP1"],
+        read_as: "modal damping against frequency: the table the case control's SDAMPING names damps the reduced body",
+        fields: "TID, TYPE (G, CRIT, Q), FLAT (blank or 1: end values held), pairs f, g up to ENDT (SKIP pairs left out)",
+        refused: "FLAT = 0 (linear extrapolation); other TYPEs",
     },
     CardSupport {
         cards: &["EIGRL", "EIGR"],

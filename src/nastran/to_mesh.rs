@@ -8,6 +8,7 @@ use nalgebra::{Matrix3, Vector3};
 use super::card_table;
 use super::cards::{self, Orientation, Reader, ScalarValue, SystemKind};
 use super::lexer::{CardSink, Loc, RawCard, Value};
+use super::reader::DeckInfo;
 use super::solid_cards;
 use super::NastranBody;
 use crate::fe::error::FeError;
@@ -55,6 +56,7 @@ struct Cards {
     solids: BTreeMap<u32, solid_cards::SolidElement>,
     solid_properties: BTreeMap<u32, solid_cards::Psolid>,
     supports: Vec<(cards::Support, Loc)>,
+    damping_tables: BTreeMap<u32, cards::DampingTableCard>,
     element_lines: BTreeMap<u32, (Loc, &'static str)>,
     mass_scale: f64,
 }
@@ -234,6 +236,10 @@ impl Cards {
                     insert_unique(&mut c.solid_properties, "PSOLID", p.id, &line, p)?;
                 }
                 "PARAM" => c.param(&r)?,
+                "TABDMP1" => {
+                    let t = cards::tabdmp1(&r)?;
+                    insert_unique(&mut c.damping_tables, "TABDMP1", t.id, &line, t)?;
+                }
                 // Eigenvalue extraction requests: the caller chooses the modes.
                 "EIGRL" | "EIGR" => {}
                 // A listed card without an arm: the table test names it.
@@ -486,8 +492,10 @@ impl CardSink for Collector {
     }
 }
 
-/// Builds the body from the cards read and the SPC set the case control selects.
-pub(crate) fn build(cards: Collector, spc_selection: Option<u32>) -> Result<NastranBody, FeError> {
+/// Builds the body from the cards read and the SPC set and the damping table the case control
+/// selects.
+pub(crate) fn build(cards: Collector, info: &DeckInfo) -> Result<NastranBody, FeError> {
+    let spc_selection = info.spc_selection;
     let mut c = cards.0;
     let systems = Systems::new(&c.systems)?;
     let mut body = NastranBody {
@@ -498,7 +506,25 @@ pub(crate) fn build(cards: Collector, spc_selection: Option<u32>) -> Result<Nast
         element_cards: BTreeMap::new(),
         unused_grids: Vec::new(),
         notes: Vec::new(),
+        damping: None,
     };
+    if let Some((id, at)) = &info.sdamping {
+        let table = c.damping_tables.remove(id).ok_or_else(|| {
+            let tables: Vec<String> = c.damping_tables.keys().map(u32::to_string).collect();
+            mesh_error(
+                at,
+                format!(
+                    "SDAMPING = {id} names no TABDMP1 (the deck's TABDMP1 ids: {})",
+                    if tables.is_empty() {
+                        "none".to_string()
+                    } else {
+                        tables.join(", ")
+                    }
+                ),
+            )
+        })?;
+        body.damping = Some(table);
+    }
     for (&id, g) in &c.grids {
         let x = Vector3::from(g.x);
         let p = match g.cp {
