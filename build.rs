@@ -126,6 +126,7 @@ fn main() {
     println!("cargo:rerun-if-changed={}", table_path.display());
     println!("cargo:rerun-if-changed=build.rs");
     println!("cargo:rerun-if-changed=build/fmi3_description.rs");
+    write_algorithm_sources(&manifest, &out);
 
     let text = std::fs::read_to_string(&table_path)
         .unwrap_or_else(|e| fail(&format!("cannot read {}: {e}", table_path.display())));
@@ -979,4 +980,41 @@ fn documentation(scalars: &[Scalar], fmu: &Fmu) -> String {
     }
     h.push_str("</table>\n</body></html>\n");
     h
+}
+
+/// The folders whose code turns a body description into a reduced body (elements, decks, the
+/// procedural chassis, eigensolvers, the reduction), concatenated in path order into
+/// `algorithm_sources.txt`: `cms::cache` hashes it into every cache key, so a reduction computed
+/// by other code is never served, and a new file in these folders is covered without a list to
+/// keep up to date.
+fn write_algorithm_sources(manifest: &Path, out: &Path) {
+    fn collect(dir: &Path, files: &mut Vec<PathBuf>) {
+        let entries = std::fs::read_dir(dir)
+            .unwrap_or_else(|e| fail(&format!("cannot list {}: {e}", dir.display())));
+        for entry in entries {
+            let path = entry
+                .unwrap_or_else(|e| fail(&format!("cannot list {}: {e}", dir.display())))
+                .path();
+            if path.is_dir() {
+                collect(&path, files);
+            } else if path.extension().is_some_and(|x| x == "rs") {
+                files.push(path);
+            }
+        }
+    }
+    let mut files = Vec::new();
+    for room in ["fe", "nastran", "chassis", "eigen", "cms"] {
+        let dir = manifest.join("src").join(room);
+        println!("cargo:rerun-if-changed={}", dir.display());
+        collect(&dir, &mut files);
+    }
+    files.sort();
+    let mut text = String::new();
+    for path in &files {
+        let rel = path.strip_prefix(manifest).unwrap_or(path);
+        text += &format!("// {}\n", rel.display());
+        text += &std::fs::read_to_string(path)
+            .unwrap_or_else(|e| fail(&format!("cannot read {}: {e}", path.display())));
+    }
+    write(&out.join("algorithm_sources.txt"), &text);
 }

@@ -10,12 +10,12 @@
 
 use std::time::Instant;
 
+use engine_mount_chassis::chassis::{config::ChassisConfig, Chassis};
 use engine_mount_chassis::cms::{
     reduce_cached, reduce_detailed, CacheSetting, ModeSelection, ReductionSpec,
 };
+use engine_mount_chassis::eigen::lowest_modes;
 use engine_mount_chassis::fe::assembly::assemble;
-use engine_mount_chassis::fe::chassis::Chassis;
-use engine_mount_chassis::fe::eigen::lowest_modes;
 
 /// Peak resident set size of this process (VmHWM) in MB, if /proc is readable.
 fn peak_rss_mb() -> Option<f64> {
@@ -30,7 +30,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
 
     // The default reduction first, so that the peak memory below belongs to it and the FE model.
     let t0 = Instant::now();
-    let chassis = Chassis::build(&spec.chassis)?;
+    let chassis = Chassis::build(&ChassisConfig::default())?;
     let asm = assemble(&chassis.mesh)?;
     let t_fe = t0.elapsed().as_secs_f64();
     let n_dof = asm.dofs.n_free();

@@ -7,12 +7,12 @@
 
 use std::time::Instant;
 
+use engine_mount_chassis::chassis::config::ChassisConfig;
+use engine_mount_chassis::chassis::modal::describe;
+use engine_mount_chassis::chassis::Chassis;
+use engine_mount_chassis::eigen::lowest_modes;
 use engine_mount_chassis::fe::assembly::assemble;
-use engine_mount_chassis::fe::chassis::Chassis;
-use engine_mount_chassis::fe::chassis_config::ChassisConfig;
 use engine_mount_chassis::fe::checks::{check_assembled, check_mesh, CheckLimits};
-use engine_mount_chassis::fe::eigen::lowest_modes;
-use engine_mount_chassis::fe::modal::describe;
 
 fn status_kib(field: &str) -> Option<u64> {
     let text = std::fs::read_to_string("/proc/self/status").ok()?;

@@ -9,12 +9,12 @@
 //! print(numpy.sort(numpy.sqrt(abs(lam)) / (2 * numpy.pi)))
 //! ```
 
+use engine_mount_chassis::chassis::config::ChassisConfig;
+use engine_mount_chassis::chassis::modal::describe;
+use engine_mount_chassis::chassis::Chassis;
+use engine_mount_chassis::eigen::lowest_modes;
 use engine_mount_chassis::fe::assembly::{assemble, translational_mass};
-use engine_mount_chassis::fe::chassis::Chassis;
-use engine_mount_chassis::fe::chassis_config::ChassisConfig;
-use engine_mount_chassis::fe::eigen::lowest_modes;
 use engine_mount_chassis::fe::export::write_all;
-use engine_mount_chassis::fe::modal::describe;
 
 fn main() -> Result<(), Box<dyn std::error::Error>> {
     let args: Vec<String> = std::env::args().skip(1).collect();

@@ -7,15 +7,15 @@
 //! 44–48 Hz coupled).
 //!
 //! `cargo run --release --example fe_tune [config.json]` prints the tuned parameters; copy them
-//! into the defaults in `src/fe/chassis_config.rs` or a JSON description. Fixed-point iteration:
+//! into the defaults in `src/chassis/config.rs` or a JSON description. Fixed-point iteration:
 //! each frequency scales with the square root of its own stiffness knob (body stiffness scale,
 //! column iy, column iz); the floor trim absorbs the mass error.
 
+use engine_mount_chassis::chassis::config::{ChassisConfig, SectionSpec};
+use engine_mount_chassis::chassis::modal::{describe, steering_wheel_pair, ModeKind};
+use engine_mount_chassis::chassis::Chassis;
+use engine_mount_chassis::eigen::lowest_modes;
 use engine_mount_chassis::fe::assembly::{assemble, translational_mass};
-use engine_mount_chassis::fe::chassis::Chassis;
-use engine_mount_chassis::fe::chassis_config::{ChassisConfig, SectionSpec};
-use engine_mount_chassis::fe::eigen::lowest_modes;
-use engine_mount_chassis::fe::modal::{describe, steering_wheel_pair, ModeKind};
 
 const TORSION: f64 = 44.5;
 const WHEEL_VERTICAL: f64 = 31.5;

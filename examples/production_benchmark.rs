@@ -3,9 +3,9 @@
 //! `cargo run --release --example production_benchmark -- modes`
 //!   (a) The fixed-interface eigenproblem of the default body (4 mounts × 3 translations held)
 //!   for cut-offs of 225 Hz, 500 Hz, 1 kHz and 2 kHz: the single-shift Lanczos solver
-//!   (`fe::eigen::lowest_modes`, given the exact mode count from a Sturm count, so without the
+//!   (`eigen::lowest_modes`, given the exact mode count from a Sturm count, so without the
 //!   retries the reduction used to need) against spectrum slicing
-//!   (`fe::eigen_slicing::sliced_modes`), time and largest frequency difference.
+//!   (`eigen::slicing::sliced_modes`), time and largest frequency difference.
 //!
 //! `cargo run --release --example production_benchmark -- sizes [refinements…] [--modes N]`
 //!   (b) For each refinement r (default 1 2 4 8: grid spacing / r, about 15 k, 60 k, 240 k and
@@ -32,16 +32,16 @@ use std::path::{Path, PathBuf};
 use std::process::Command;
 use std::time::Instant;
 
+use engine_mount_chassis::chassis::config::ChassisConfig;
+use engine_mount_chassis::chassis::{region, Chassis, MountLayout};
 use engine_mount_chassis::cms::{InterfaceDofs, Partition};
+use engine_mount_chassis::eigen::lowest_modes;
+use engine_mount_chassis::eigen::slicing::{eigenvalue_count, sliced_modes, SliceStop};
 use engine_mount_chassis::fe::assembly::{assemble, SparseMat};
-use engine_mount_chassis::fe::chassis::{region, Chassis, MountLayout};
-use engine_mount_chassis::fe::chassis_config::ChassisConfig;
-use engine_mount_chassis::fe::eigen::lowest_modes;
-use engine_mount_chassis::fe::eigen_slicing::{eigenvalue_count, sliced_modes, SliceStop};
 use engine_mount_chassis::fe::mesh::{Material, Mesh};
-use engine_mount_chassis::fe::nastran::{read_bulk_deck_with, write_bulk_deck, DeckOptions};
 use engine_mount_chassis::fe::shell::ShellSection;
 use engine_mount_chassis::model::{BodyConfig, VehicleConfig};
+use engine_mount_chassis::nastran::{read_bulk_deck_with, write_bulk_deck, DeckOptions};
 
 use fmu_host::{boolean, integer, real, string};
 use nalgebra::Vector3;

@@ -5,7 +5,7 @@
 //!
 //! `cargo run --release --example read_dmig -- <file>`
 
-use engine_mount_chassis::fe::nastran::{read_dmig_file, DeckOptions};
+use engine_mount_chassis::nastran::{read_dmig_file, DeckOptions};
 
 fn main() -> Result<(), Box<dyn std::error::Error>> {
     let path = std::env::args().nth(1).ok_or("usage: read_dmig <file>")?;

@@ -4,7 +4,12 @@
 //! FMI layer. Each concern lives in its own module:
 //!
 //! - [`ode`]: the Gear/BDF integrator, generic over [`ode::OdeProblem`]; knows nothing of engines.
-//! - [`fe`]: finite elements, assembly and the procedural chassis.
+//! - [`fe`]: general finite elements (beams, shells, solids, masses, springs, links) and sparse
+//!   assembly.
+//! - [`chassis`]: the product's procedural car body (the paper's phenomenological chassis).
+//! - [`nastran`]: a user's body from a Nastran bulk data deck (read, write, DMIG).
+//! - [`eigen`]: eigensolvers for the sparse pencil (shift-invert Lanczos, spectrum slicing).
+//! - [`cms`]: Craig-Bampton reduction of a body (procedural, deck, or reduced elsewhere).
 //! - [`model`]: engine multibody model, mounts, coupled system, outputs.
 //! - [`cosim`]: a scene with its integrator and inputs, stepped between communication points.
 //! - [`fmu`]: the FMU runtime both ABIs share: instance, values, input signals, FMU states,
@@ -19,13 +24,16 @@
 #![deny(rustdoc::broken_intra_doc_links)]
 #![deny(missing_docs)]
 
+pub mod chassis;
 pub mod cms;
 pub mod cosim;
+pub mod eigen;
 pub mod fe;
 pub mod fmi2;
 pub mod fmi3;
 pub mod fmu;
 pub mod model;
+pub mod nastran;
 pub mod ode;
 pub mod paper;
 pub mod saved_state;

@@ -98,40 +98,16 @@ fn checksum(reduced: &ReducedChassis, notes: &[String]) -> Result<String, String
     Ok(sha256_hex(json.as_bytes()))
 }
 
-/// The source of every file whose code turns a spec into a reduction (FE generator, elements,
-/// assembly, eigen solver, reduction). Hashing it into the key means an edited generator or
-/// solver can never be served a reduction computed by the old code, even without a bump of
-/// [`FORMAT_VERSION`]. A new file that affects the result must be added here.
-const ALGORITHM_SOURCES: [&str; 23] = [
-    include_str!("../fe/assembly.rs"),
-    include_str!("../fe/beam.rs"),
-    include_str!("../fe/chassis.rs"),
-    include_str!("../fe/chassis_config.rs"),
-    include_str!("../fe/checks.rs"),
-    include_str!("../fe/dof.rs"),
-    include_str!("../fe/eigen.rs"),
-    include_str!("../fe/mass.rs"),
-    include_str!("../fe/mesh.rs"),
-    include_str!("../fe/links.rs"),
-    include_str!("../fe/nastran/cards.rs"),
-    include_str!("../fe/nastran/lexer.rs"),
-    include_str!("../fe/nastran/to_mesh.rs"),
-    include_str!("../fe/shell3.rs"),
-    include_str!("../fe/shell.rs"),
-    include_str!("../fe/spring.rs"),
-    include_str!("craig_bampton.rs"),
-    include_str!("damping.rs"),
-    include_str!("reduce.rs"),
-    include_str!("reduced.rs"),
-    include_str!("sparse_ops.rs"),
-    include_str!("spec.rs"),
-    include_str!("cache.rs"),
-];
+/// The source of every file whose code turns a spec into a reduction (elements, decks, the
+/// procedural chassis, eigensolvers, reduction), gathered by `build.rs` from their folders.
+/// Hashing it into the key means an edited generator or solver can never be served a reduction
+/// computed by the old code, even without a bump of [`FORMAT_VERSION`].
+const ALGORITHM_SOURCES: &str = include_str!(concat!(env!("OUT_DIR"), "/algorithm_sources.txt"));
 
 /// Fingerprint of [`ALGORITHM_SOURCES`], computed once per process.
 fn algorithm_fingerprint() -> &'static str {
     static FINGERPRINT: OnceLock<String> = OnceLock::new();
-    FINGERPRINT.get_or_init(|| sha256_hex(ALGORITHM_SOURCES.concat().as_bytes()))
+    FINGERPRINT.get_or_init(|| sha256_hex(ALGORITHM_SOURCES.as_bytes()))
 }
 
 /// The full cache key of `spec`: the format version, the fingerprint of the code and every

@@ -16,10 +16,10 @@ use faer::{Accum, Mat, Side};
 use super::error::CmsError;
 use super::sparse_ops::Partition;
 use super::spec::ModeSelection;
+use crate::eigen::block_product::BlockProduct;
+use crate::eigen::slicing::{eigenvalue_count, prefer_slicing, sliced_modes, SliceStop};
+use crate::eigen::{check_pencil, lowest_modes, Modes};
 use crate::fe::assembly::SparseMat;
-use crate::fe::block_product::BlockProduct;
-use crate::fe::eigen::{check_pencil, lowest_modes, Modes};
-use crate::fe::eigen_slicing::{eigenvalue_count, prefer_slicing, sliced_modes, SliceStop};
 use crate::fe::FeError;
 
 /// The orthogonalised Craig-Bampton modes of a structure, in the full DOF space.

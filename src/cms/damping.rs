@@ -103,6 +103,14 @@ impl DampingTable {
     }
 }
 
+/// The damping ratio of each mode by the table: shared by every body, reduced here or elsewhere.
+pub(crate) fn table_damping(omega: &[f64], damping: &DampingTable) -> Vec<f64> {
+    omega
+        .iter()
+        .map(|w| damping.zeta(w / (2.0 * std::f64::consts::PI)))
+        .collect()
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

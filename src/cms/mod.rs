@@ -6,16 +6,20 @@
 //! as `η̈_k + 2 ζ_k ω_k η̇_k + ω_k² η_k = Σ_p φ_{p,k} · F_p`, with `F_p` the force (and moment)
 //! acting on recovery point `p` and `φ_{p,k}` that point's 6-DOF motion in mode `k`.
 //!
+//! The body is one of three ([`BodySource`]): the procedural chassis ([`crate::chassis`]), a
+//! bulk data deck ([`crate::nastran`]), or Craig-Bampton matrices reduced elsewhere (DMIG).
+//!
 //! Pipeline: [`ReductionSpec`] → [`reduce`] (builds and assembles the body, interface = the
 //! translational, or all six, DOFs of the layout's mount nodes) → [`craig_bampton()`] (constraint
-//! modes by sparse Cholesky, fixed-interface modes by the FE module's shift-invert Lanczos, with
-//! spectrum slicing for many modes or large bodies ([`crate::fe::eigen_slicing`]),
+//! modes by sparse Cholesky, fixed-interface modes by [`crate::eigen`]'s shift-invert Lanczos, with
+//! spectrum slicing for many modes or large bodies ([`crate::eigen::slicing`]),
 //! orthogonalisation) → [`ReducedChassis`] with the rows of the recovery points only.
 //! [`reduce_cached`] keeps the result in the user's cache directory.
 //!
-//! A body reduced in another solver comes as Craig-Bampton matrices (Nastran `DMIG`):
-//! [`reduce_external`] takes it from there the same way ([`orthogonalise`], the damping table),
-//! and [`dmig_of_reduction`] writes our own reduction in that form.
+//! A body reduced in another solver comes as Craig-Bampton matrices (Nastran `DMIG`,
+//! [`BodySource::Dmig`]): [`reduce_external`] takes it from there the same way
+//! ([`orthogonalise`], the damping table), and [`dmig_of_reduction`] writes our own reduction
+//! in that form.
 //!
 //! Recovery points, in order: the layout's mount nodes (`mount_front_left`, `mount_front_right`,
 //! `mount_rear_left`, `mount_rear_right`, minus the one the three-mount layout removes), then the
@@ -58,6 +62,7 @@
 mod cache;
 mod craig_bampton;
 mod damping;
+mod dmig_export;
 mod error;
 mod external;
 mod hash;
@@ -74,11 +79,14 @@ pub use craig_bampton::{
     craig_bampton, craig_bampton_basis, orthogonalise, CraigBampton, CraigBamptonBasis,
 };
 pub use damping::{DampingBand, DampingTable};
+pub use dmig_export::{dmig_of_reduction, DmigBody};
 pub use error::CmsError;
-pub use external::{dmig_of_reduction, reduce_external, DmigBody, ExternalBody};
+pub use external::{reduce_external, ExternalBody};
 pub use hash::sha256_hex;
 pub use reduce::{reduce, reduce_detailed, reduce_with_notes, Reduction};
 pub use reduced::{RecoveryPoint, ReducedChassis};
 pub use sparse_ops::Partition;
-pub use spec::{BulkDeckBody, InterfaceDofs, ModeSelection, ReductionSpec};
+pub use spec::{
+    BodySource, BulkDeckBody, DmigBodySource, InterfaceDofs, ModeSelection, ReductionSpec,
+};
 pub use transfer::{PointDof, Response};

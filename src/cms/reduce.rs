@@ -3,19 +3,19 @@
 //! the output points).
 
 use super::craig_bampton::{craig_bampton, CraigBampton};
-use super::damping::DampingTable;
+use super::damping::table_damping;
 use super::error::CmsError;
+use super::external::reduce_dmig_source;
 use super::reduced::{RecoveryPoint, ReducedChassis};
-use super::spec::BulkDeckBody;
-use super::spec::ReductionSpec;
+use super::spec::{BodySource, BulkDeckBody, ReductionSpec};
+use crate::chassis::config::ChassisConfig;
+use crate::chassis::modal::{describe, ModeDescription};
+use crate::chassis::Chassis;
+use crate::eigen::Modes;
 use crate::fe::assembly::{assemble, mat_vec, Assembled, SparseMat};
-use crate::fe::chassis::Chassis;
-use crate::fe::chassis_config::ChassisConfig;
 use crate::fe::checks::{check_mesh_named, CheckLimits, MeshIndices, Naming, DOF_NAMES};
 use crate::fe::dof::{DofMap, DOF_PER_NODE};
-use crate::fe::eigen::Modes;
-use crate::fe::modal::{describe, ModeDescription};
-use crate::fe::nastran::DeckNames;
+use crate::nastran::DeckNames;
 
 /// A reduction together with the full model it came from, for verification and tools. The
 /// coupled model needs only [`Reduction::reduced`]; use [`reduce`] to drop the rest.
@@ -50,12 +50,17 @@ impl Reduction {
 
 /// The reduced chassis described by `spec` (only recovery rows are kept).
 pub fn reduce(spec: &ReductionSpec) -> Result<ReducedChassis, CmsError> {
-    Ok(reduce_detailed(spec)?.reduced)
+    Ok(reduce_with_notes(spec)?.0)
 }
 
 /// The reduced chassis described by `spec` and the notes on its body for the log
-/// ([`Reduction::notes`]).
+/// ([`Reduction::notes`]). A body given as DMIG matrices is taken from its file
+/// ([`crate::cms::reduce_external`]); the others are built and reduced here.
 pub fn reduce_with_notes(spec: &ReductionSpec) -> Result<(ReducedChassis, Vec<String>), CmsError> {
+    if let BodySource::Dmig(source) = &spec.body {
+        spec.validate()?;
+        return Ok((reduce_dmig_source(spec, source)?, Vec::new()));
+    }
     let r = reduce_detailed(spec)?;
     Ok((r.reduced, r.notes))
 }
@@ -70,16 +75,23 @@ pub(crate) struct Model {
     pub notes: Vec<String>,
 }
 
-/// Builds and assembles the body `spec` describes.
+/// Builds and assembles the body `spec` describes (procedural or deck; a DMIG body has no FE
+/// model).
 pub(crate) fn model(spec: &ReductionSpec) -> Result<Model, CmsError> {
     spec.validate()?;
-    let (chassis, names, notes) = match &spec.deck {
-        None => (
-            Chassis::build(&spec.chassis)?,
+    let (chassis, names, notes) = match &spec.body {
+        BodySource::Procedural(config) => (
+            Chassis::build(config)?,
             BodyNames::Mesh(MeshIndices),
             Vec::new(),
         ),
-        Some(deck) => deck_body(deck)?,
+        BodySource::Deck(deck) => deck_body(deck)?,
+        BodySource::Dmig(_) => {
+            return Err(CmsError::InvalidInput(format!(
+                "{} is reduced already: it has no FE model to build",
+                spec.body.describe()
+            )))
+        }
     };
     let assembled = assemble(&chassis.mesh)?;
     let mounts = spec
@@ -178,14 +190,6 @@ pub(crate) fn named_points(
     Ok(named)
 }
 
-/// The damping ratio of each mode by the table: shared by every body, reduced here or elsewhere.
-pub(crate) fn table_damping(omega: &[f64], damping: &DampingTable) -> Vec<f64> {
-    omega
-        .iter()
-        .map(|w| damping.zeta(w / (2.0 * std::f64::consts::PI)))
-        .collect()
-}
-
 /// The reduction of `spec` with the full model and full mode shapes kept.
 pub fn reduce_detailed(spec: &ReductionSpec) -> Result<Reduction, CmsError> {
     let model = model(spec)?;
@@ -226,11 +230,11 @@ pub fn reduce_detailed(spec: &ReductionSpec) -> Result<Reduction, CmsError> {
 /// as in Nastran), with its names and the notes for the log; the content must still be what
 /// the spec's checksum says (the cache key was made from it).
 fn deck_body(deck: &BulkDeckBody) -> Result<(Chassis, BodyNames, Vec<String>), CmsError> {
-    let options = crate::fe::nastran::DeckOptions {
+    let options = crate::nastran::DeckOptions {
         include_root: deck.include_root.clone(),
         ..Default::default()
     };
-    let (mut body, sha256) = crate::fe::nastran::read_bulk_deck_with(&deck.path, &options)
+    let (mut body, sha256) = crate::nastran::read_bulk_deck_with(&deck.path, &options)
         .map_err(|e| CmsError::InvalidInput(format!("bulk data deck: {e}")))?;
     if sha256 != deck.sha256 {
         return Err(CmsError::InvalidInput(format!(

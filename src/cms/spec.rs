@@ -5,8 +5,8 @@ use serde::{Deserialize, Serialize};
 
 use super::damping::DampingTable;
 use super::error::CmsError;
-use crate::fe::chassis::{MOUNT_NAMES, SEAT_RAIL, STEERING_WHEEL};
-use crate::fe::chassis_config::ChassisConfig;
+use crate::chassis::config::ChassisConfig;
+use crate::chassis::{MOUNT_NAMES, SEAT_RAIL, STEERING_WHEEL};
 
 /// Which DOFs of each mount node form the Craig-Bampton interface.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
@@ -39,7 +39,7 @@ pub enum ModeSelection {
     CutoffHz(f64),
 }
 
-/// A body from a Nastran bulk data deck ([`crate::fe::nastran`]): the file, the SHA-256 of its
+/// A body from a Nastran bulk data deck ([`crate::nastran`]): the file, the SHA-256 of its
 /// content (so the cache key changes with the content), and the GRID ids of the named points
 /// (mounts, outputs).
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
@@ -48,7 +48,7 @@ pub struct BulkDeckBody {
     /// The deck's file.
     pub path: std::path::PathBuf,
     /// SHA-256 (hex) of its content and of its INCLUDE files
-    /// ([`crate::fe::nastran::deck_digest`]).
+    /// ([`crate::nastran::deck_digest`]).
     pub sha256: String,
     /// GRID id of every named point.
     pub points: std::collections::BTreeMap<String, u32>,
@@ -57,15 +57,60 @@ pub struct BulkDeckBody {
     pub include_root: Option<std::path::PathBuf>,
 }
 
+/// A body reduced in another solver: Craig-Bampton matrices in Nastran `DMIG` form
+/// ([`crate::nastran::read_dmig_file`]), the SHA-256 of the file, the matrices' names and the
+/// GRID ids of the named points. [`crate::cms::reduce_external`] takes it from there.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct DmigBodySource {
+    /// The DMIG (punch) file.
+    pub path: std::path::PathBuf,
+    /// SHA-256 (hex) of its content and of its INCLUDE files.
+    pub sha256: String,
+    /// Name of the stiffness matrix (Nastran writes `KAAX`).
+    pub stiffness: String,
+    /// Name of the mass matrix (Nastran writes `MAAX`).
+    pub mass: String,
+    /// Name of the recovery matrix of the output points, if any.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub recovery: Option<String>,
+    /// GRID id of every named point.
+    pub points: std::collections::BTreeMap<String, u32>,
+    /// The folder the file's INCLUDE files are confined to (`None`: the file's folder).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub include_root: Option<std::path::PathBuf>,
+}
+
+/// Which body a reduction reduces.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum BodySource {
+    /// The product's procedural chassis ([`crate::chassis`]), reduced here.
+    Procedural(Box<ChassisConfig>),
+    /// A user's body from a bulk data deck ([`crate::nastran`]), reduced here.
+    Deck(BulkDeckBody),
+    /// A body reduced elsewhere (Craig-Bampton matrices), orthogonalised and damped here.
+    Dmig(DmigBodySource),
+}
+
+impl BodySource {
+    /// What the body is, for messages: `procedural chassis`, `bulk data deck <path>`,
+    /// `DMIG body <path>`.
+    pub fn describe(&self) -> String {
+        match self {
+            BodySource::Procedural(_) => "procedural chassis".to_owned(),
+            BodySource::Deck(d) => format!("bulk data deck {}", d.path.display()),
+            BodySource::Dmig(d) => format!("DMIG body {}", d.path.display()),
+        }
+    }
+}
+
 /// Everything the reduction depends on.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct ReductionSpec {
-    /// The body description (the procedural chassis), unless `deck` is given.
-    pub chassis: ChassisConfig,
-    /// A user's body from a bulk data deck instead of the procedural chassis.
-    #[serde(default, skip_serializing_if = "Option::is_none")]
-    pub deck: Option<BulkDeckBody>,
+    /// The body to reduce.
+    pub body: BodySource,
     /// Named body nodes the engine mounts attach to: they form the interface, in this order.
     pub interface: Vec<String>,
     /// Interface DOFs per mount node.
@@ -79,7 +124,7 @@ pub struct ReductionSpec {
     /// the coupling it adds between modes. Off by default (ADAMS' table only).
     #[serde(default)]
     pub discrete_dampers: bool,
-    /// Named FE nodes recovered after the mount nodes (see [`crate::fe::chassis`] for names).
+    /// Named FE nodes recovered after the mount nodes (see [`crate::chassis`] for names).
     pub outputs: Vec<String>,
 }
 
@@ -88,8 +133,7 @@ impl Default for ReductionSpec {
     /// fixed-interface modes, ADAMS damping, steering wheel and seat rail recovered.
     fn default() -> Self {
         Self {
-            chassis: ChassisConfig::default(),
-            deck: None,
+            body: BodySource::Procedural(Box::default()),
             interface: MOUNT_NAMES.iter().map(|n| format!("mount_{n}")).collect(),
             interface_dofs: InterfaceDofs::Translations,
             selection: ModeSelection::Count(40),
@@ -111,6 +155,22 @@ impl ReductionSpec {
             }
         }
         self.damping.validate()?;
+        if let BodySource::Dmig(d) = &self.body {
+            if self.interface_dofs == InterfaceDofs::All {
+                return Err(CmsError::InvalidInput(format!(
+                    "interface_dofs = all does not apply to the DMIG body {}: its interface is \
+                     the file's boundary set",
+                    d.path.display()
+                )));
+            }
+            if self.discrete_dampers {
+                return Err(CmsError::InvalidInput(format!(
+                    "discrete_dampers does not apply to the DMIG body {}: it has no FE damping \
+                     matrix",
+                    d.path.display()
+                )));
+            }
+        }
         if self.interface.is_empty() {
             return Err(CmsError::InvalidInput(
                 "interface: no node; the mounts must attach somewhere".into(),
@@ -161,7 +221,10 @@ mod tests {
             selection: ModeSelection::Count(17),
             ..ReductionSpec::default()
         };
-        spec.chassis.body_stiffness_scale = 0.1 + 0.2;
+        spec.body = BodySource::Procedural(Box::new(ChassisConfig {
+            body_stiffness_scale: 0.1 + 0.2,
+            ..ChassisConfig::default()
+        }));
         let text = spec.canonical_json().unwrap();
         let back = ReductionSpec::from_json(&text).unwrap();
         assert_eq!(back, spec);

@@ -1,7 +1,7 @@
 //! Mesh checks: degenerate or warped elements, unconnected nodes, DOFs without mass or stiffness.
 //! Every problem found is named and all are reported together. Names come from a [`Naming`]:
 //! [`MeshIndices`] names the mesh's own indices (`node 14`, `shell 3`), a body read from a
-//! Nastran deck names its GRID and element ids ([`crate::fe::nastran::DeckNames`]).
+//! Nastran deck names its GRID and element ids ([`crate::nastran::DeckNames`]).
 //!
 //! Connectivity rule: a node is *connected* when any element, point mass, scalar spring or
 //! damper, bush or rigid/interpolation link references it; it is *held* when an element with

@@ -12,8 +12,7 @@ use nalgebra::Matrix3;
 use super::error::FeError;
 use super::links::LinkEquation;
 
-/// Degrees of freedom per node (three translations, three rotations).
-pub const DOF_PER_NODE: usize = 6;
+pub use super::mesh::DOF_PER_NODE;
 
 /// Global numbering of the free DOFs. Constrained and dependent DOFs have no equation index;
 /// a dependent DOF is a fixed linear combination of equations ([`DofMap::motion_row`]).

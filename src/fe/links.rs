@@ -16,8 +16,8 @@
 
 use nalgebra::{Matrix3, Matrix6, SMatrix, Vector3};
 
-use super::dof::DOF_PER_NODE;
 use super::error::FeError;
+use super::mesh::DOF_PER_NODE;
 use super::mesh::{InterpolationLink, Mesh, RigidLink};
 use super::nodal_frames;
 

@@ -5,32 +5,10 @@ use std::collections::BTreeMap;
 use nalgebra::{Matrix3, Vector3};
 use serde::{Deserialize, Serialize};
 
-use super::shell::ShellSection;
+pub use super::section::{Material, ShellSection};
 
-/// Linear elastic isotropic material.
-#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
-pub struct Material {
-    /// Young's modulus (Pa).
-    pub youngs_modulus: f64,
-    /// Poisson's ratio (-).
-    pub poisson_ratio: f64,
-    /// Density (kg/m³).
-    pub density: f64,
-}
-
-impl Material {
-    /// Structural steel.
-    pub const STEEL: Material = Material {
-        youngs_modulus: 210.0e9,
-        poisson_ratio: 0.3,
-        density: 7850.0,
-    };
-
-    /// Shear modulus G = E / (2 (1 + ν)).
-    pub fn shear_modulus(&self) -> f64 {
-        self.youngs_modulus / (2.0 * (1.0 + self.poisson_ratio))
-    }
-}
+/// Degrees of freedom per node (three translations, three rotations).
+pub const DOF_PER_NODE: usize = 6;
 
 /// Beam cross-section. `iy` resists bending in the local x-z plane, `iz` in the local x-y plane.
 ///

@@ -13,8 +13,8 @@ use std::collections::BTreeMap;
 
 use nalgebra::{Matrix3, Matrix6, SMatrix};
 
-use super::dof::DOF_PER_NODE;
 use super::error::FeError;
+use super::mesh::DOF_PER_NODE;
 
 /// Checks that every frame is a rotation (orthonormal, right-handed) of an existing node.
 pub fn validate(frames: &BTreeMap<usize, Matrix3<f64>>, n_nodes: usize) -> Result<(), FeError> {

@@ -3,10 +3,9 @@
 //! scene needs (scene 2, Table 1 middle column).
 
 use crate::cms::{
-    reduce_cached_with_notes, reduce_external, BulkDeckBody, CacheOutcome, CacheSetting,
-    ExternalBody, InterfaceDofs, ModeSelection, ReducedChassis, ReductionSpec,
+    reduce_cached_with_notes, BodySource, BulkDeckBody, CacheOutcome, CacheSetting, DmigBodySource,
+    InterfaceDofs, ModeSelection, ReducedChassis, ReductionSpec,
 };
-use crate::fe::chassis_config::ChassisConfig;
 
 use super::body_alone::BodyAlone;
 use super::coupled::CoupledModel;
@@ -319,15 +318,21 @@ pub fn build_body_alone(
     Ok((model, note))
 }
 
-/// What the procedural body's reduction depends on for this vehicle and these options, and a
-/// description of the mode selection for the log.
+/// What the reduction of the vehicle's body depends on for these options (procedural chassis,
+/// bulk data deck, or Craig-Bampton matrices reduced elsewhere), and a description of the mode
+/// selection for the log.
 pub fn reduction_spec(
     vehicle: &VehicleConfig,
     options: &BodyOptions,
 ) -> Result<(ReductionSpec, String), SceneError> {
     options.validate()?;
-    let (chassis, deck) = match &vehicle.body {
-        BodyConfig::Procedural { chassis } => (chassis.as_ref().clone(), None),
+    let body = match &vehicle.body {
+        BodyConfig::Procedural { chassis } => {
+            let mut chassis = chassis.clone();
+            chassis.options.stiffening_bar |= options.stiffening_bar;
+            chassis.options.stiff_front_plate |= options.stiff_front_plate;
+            BodySource::Procedural(chassis)
+        }
         BodyConfig::Nastran {
             path,
             points,
@@ -336,88 +341,14 @@ pub fn reduction_spec(
             options.procedural_only("a bulk data deck")?;
             // Streaming over the deck and its INCLUDEs: the key follows every file's content
             // without holding any of them in memory.
-            let deck_options = crate::fe::nastran::DeckOptions {
-                include_root: include_root.clone(),
-                ..Default::default()
-            };
-            let sha256 = crate::fe::nastran::deck_digest(path, &deck_options)
-                .map_err(|e| format!("bulk data deck: {e}"))?;
-            let deck = BulkDeckBody {
+            let sha256 =
+                file_digest(path, include_root).map_err(|e| format!("bulk data deck: {e}"))?;
+            BodySource::Deck(BulkDeckBody {
                 path: path.clone(),
                 sha256,
                 points: points.clone(),
                 include_root: include_root.clone(),
-            };
-            (ChassisConfig::default(), Some(deck))
-        }
-        BodyConfig::Reduced { .. } | BodyConfig::Dmig { .. } => {
-            return Err(SceneError::Model(
-                "the vehicle's body is already reduced".into(),
-            ));
-        }
-    };
-    let interface = vehicle.interface_nodes().map_err(|e| e.to_string())?;
-    let (selection, origin) = mode_selection(vehicle, options);
-    let mut chassis = chassis;
-    chassis.options.stiffening_bar |= options.stiffening_bar;
-    chassis.options.stiff_front_plate |= options.stiff_front_plate;
-    let spec = ReductionSpec {
-        chassis,
-        deck,
-        interface,
-        interface_dofs: if options.interface_rotations {
-            InterfaceDofs::All
-        } else {
-            InterfaceDofs::Translations
-        },
-        selection,
-        outputs: vehicle.outputs.clone(),
-        ..ReductionSpec::default()
-    };
-    Ok((spec, origin))
-}
-
-/// The reduced body the scene asks for, from the cache or freshly reduced (timed for the log).
-pub fn body(
-    vehicle: &VehicleConfig,
-    options: &BodyOptions,
-) -> Result<(ReducedChassis, String), SceneError> {
-    options.validate()?;
-    let flexible = vehicle.effects.chassis_flexibility;
-    let started = std::time::Instant::now();
-    let (body, origin) = match &vehicle.body {
-        BodyConfig::Procedural { .. } | BodyConfig::Nastran { .. } => {
-            let (spec, origin) = reduction_spec(vehicle, options)?;
-            let (body, outcome, notes) = reduce_cached_with_notes(&spec, &options.cache)
-                .map_err(|e| format!("chassis reduction: {e}"))?;
-            let source = match outcome {
-                CacheOutcome::Hit(path) => format!("read from cache {}", path.display()),
-                CacheOutcome::Stored(path) => format!("reduced and cached at {}", path.display()),
-                CacheOutcome::Replaced { path, reason } => format!(
-                    "reduced and cached at {} (old entry: {reason})",
-                    path.display()
-                ),
-                CacheOutcome::NotStored { reason } => format!("reduced (not cached: {reason})"),
-                CacheOutcome::Disabled => "reduced (caching disabled)".to_owned(),
-            };
-            let what = match &spec.deck {
-                Some(deck) => format!(
-                    "bulk data deck {} (Craig-Bampton, {origin})",
-                    deck.path.display()
-                ),
-                None => {
-                    let on = |b: bool| if b { "on" } else { "off" };
-                    let o = &spec.chassis.options;
-                    format!(
-                        "procedural chassis (Craig-Bampton, {origin}, stiffening bar {}, stiffer front plate {})",
-                        on(o.stiffening_bar),
-                        on(o.stiff_front_plate)
-                    )
-                }
-            };
-            // The deck's notes (dropped grids, element-shape warnings) go to the log with it.
-            let notes: String = notes.iter().map(|n| format!("; {n}")).collect();
-            (body, format!("{what}, {source}{notes}"))
+            })
         }
         BodyConfig::Dmig {
             path,
@@ -436,34 +367,102 @@ pub fn body(
                      file's boundary set",
                 ));
             }
-            let (selection, origin) = mode_selection(vehicle, options);
-            let read_options = crate::fe::nastran::DeckOptions {
+            let sha256 = file_digest(path, include_root).map_err(|e| format!("DMIG body: {e}"))?;
+            BodySource::Dmig(DmigBodySource {
+                path: path.clone(),
+                sha256,
+                stiffness: stiffness.clone(),
+                mass: mass.clone(),
+                recovery: recovery.clone(),
+                points: points.clone(),
                 include_root: include_root.clone(),
-                ..Default::default()
-            };
-            let (file, _) = crate::fe::nastran::read_dmig_file(path, &read_options)
-                .map_err(|e| format!("DMIG body: {e}"))?;
-            let interface = vehicle.interface_nodes().map_err(|e| e.to_string())?;
-            let damping = ReductionSpec::default().damping;
-            let body = reduce_external(&ExternalBody {
-                file: &file,
-                stiffness,
-                mass,
-                recovery: recovery.as_deref(),
-                points,
-                interface: &interface,
-                outputs: &vehicle.outputs,
-                selection,
-                damping: &damping,
             })
-            .map_err(|e| format!("DMIG body {}: {e}", path.display()))?;
-            (
-                body,
-                format!(
-                    "DMIG body {} (Craig-Bampton matrices {stiffness}, {mass}; {origin})",
+        }
+        BodyConfig::Reduced { .. } => {
+            return Err(SceneError::Model(
+                "the vehicle's body is already reduced".into(),
+            ));
+        }
+    };
+    let interface = vehicle.interface_nodes().map_err(|e| e.to_string())?;
+    let (selection, origin) = mode_selection(vehicle, options);
+    let spec = ReductionSpec {
+        body,
+        interface,
+        interface_dofs: if options.interface_rotations {
+            InterfaceDofs::All
+        } else {
+            InterfaceDofs::Translations
+        },
+        selection,
+        outputs: vehicle.outputs.clone(),
+        ..ReductionSpec::default()
+    };
+    Ok((spec, origin))
+}
+
+/// SHA-256 of a bulk data or DMIG file and the files it includes.
+fn file_digest(
+    path: &std::path::Path,
+    include_root: &Option<std::path::PathBuf>,
+) -> Result<String, crate::fe::FeError> {
+    let options = crate::nastran::DeckOptions {
+        include_root: include_root.clone(),
+        ..Default::default()
+    };
+    crate::nastran::deck_digest(path, &options)
+}
+
+/// The reduced body the scene asks for, from the cache or freshly reduced (timed for the log).
+pub fn body(
+    vehicle: &VehicleConfig,
+    options: &BodyOptions,
+) -> Result<(ReducedChassis, String), SceneError> {
+    options.validate()?;
+    let flexible = vehicle.effects.chassis_flexibility;
+    let started = std::time::Instant::now();
+    let (body, origin) = match &vehicle.body {
+        BodyConfig::Procedural { .. } | BodyConfig::Nastran { .. } | BodyConfig::Dmig { .. } => {
+            let (spec, origin) = reduction_spec(vehicle, options)?;
+            let (body, outcome, notes) =
+                reduce_cached_with_notes(&spec, &options.cache).map_err(|e| match &spec.body {
+                    BodySource::Dmig(d) => format!("DMIG body {}: {e}", d.path.display()),
+                    _ => format!("chassis reduction: {e}"),
+                })?;
+            let source = match outcome {
+                CacheOutcome::Hit(path) => format!("read from cache {}", path.display()),
+                CacheOutcome::Stored(path) => format!("reduced and cached at {}", path.display()),
+                CacheOutcome::Replaced { path, reason } => format!(
+                    "reduced and cached at {} (old entry: {reason})",
                     path.display()
                 ),
-            )
+                CacheOutcome::NotStored { reason } => format!("reduced (not cached: {reason})"),
+                CacheOutcome::Disabled => "reduced (caching disabled)".to_owned(),
+            };
+            let what = match &spec.body {
+                BodySource::Procedural(chassis) => {
+                    let on = |b: bool| if b { "on" } else { "off" };
+                    format!(
+                        "procedural chassis (Craig-Bampton, {origin}, stiffening bar {}, stiffer \
+                         front plate {})",
+                        on(chassis.options.stiffening_bar),
+                        on(chassis.options.stiff_front_plate)
+                    )
+                }
+                BodySource::Deck(deck) => format!(
+                    "bulk data deck {} (Craig-Bampton, {origin})",
+                    deck.path.display()
+                ),
+                BodySource::Dmig(d) => format!(
+                    "DMIG body {} (Craig-Bampton matrices {}, {}; {origin})",
+                    d.path.display(),
+                    d.stiffness,
+                    d.mass
+                ),
+            };
+            // The deck's notes (dropped grids, element-shape warnings) go to the log with it.
+            let notes: String = notes.iter().map(|n| format!("; {n}")).collect();
+            (body, format!("{what}, {source}{notes}"))
         }
         BodyConfig::Reduced { path } => {
             options.procedural_only("a reduced model from a file")?;

@@ -18,21 +18,21 @@ use super::mount::{MountConfig, MountCurve};
 use super::powertrain::config::EngineConfig;
 use super::powertrain::defaults::{POWERTRAIN_CG, POWERTRAIN_MASS};
 use super::validate::{err, positive, ConfigError};
-use crate::fe::chassis::{SEAT_RAIL, STEERING_WHEEL};
-use crate::fe::chassis_config::ChassisConfig;
+use crate::chassis::config::ChassisConfig;
+use crate::chassis::{SEAT_RAIL, STEERING_WHEEL};
 
 /// Where the elastic body comes from (used when the scene has a body).
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 #[serde(tag = "kind", rename_all = "snake_case", deny_unknown_fields)]
 pub enum BodyConfig {
-    /// The procedural car body ([`crate::fe::chassis`]): its mount nodes are `mount_front_left`,
+    /// The procedural car body ([`crate::chassis`]): its mount nodes are `mount_front_left`,
     /// `mount_front_right`, `mount_rear_left`, `mount_rear_right`; other named nodes include
     /// `steering_wheel` and `seat_rail`.
     Procedural {
         /// The chassis's geometry, sections, materials, trim and suspension.
         chassis: Box<ChassisConfig>,
     },
-    /// A user's body from a Nastran bulk data deck ([`crate::fe::nastran`]), reduced by
+    /// A user's body from a Nastran bulk data deck ([`crate::nastran`]), reduced by
     /// Craig-Bampton like the procedural one; `points` names the GRID ids the mounts
     /// (`body_node`) and the outputs refer to. A relative path is taken from the configuration
     /// file's folder. Read from a file, the configuration confines the deck to its own folder
@@ -49,7 +49,7 @@ pub enum BodyConfig {
         include_root: Option<PathBuf>,
     },
     /// A body reduced elsewhere: Craig-Bampton matrices in Nastran `DMIG` form
-    /// ([`crate::fe::nastran::read_dmig_file`], [`crate::cms::reduce_external`]), reduced to its
+    /// ([`crate::nastran::read_dmig_file`], [`crate::cms::reduce_external`]), reduced to its
     /// modes with the damping table like the other bodies. `points` names the GRID ids of the
     /// mount body nodes (boundary grids of `stiffness`) and of the outputs (boundary grids or
     /// rows of `recovery`). A relative path is taken from the configuration file's folder, and

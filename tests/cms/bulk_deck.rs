@@ -5,12 +5,12 @@
 use std::collections::BTreeMap;
 use std::path::Path;
 
+use engine_mount_chassis::chassis::config::ChassisConfig;
+use engine_mount_chassis::chassis::Chassis;
 use engine_mount_chassis::cms::CacheSetting;
-use engine_mount_chassis::fe::chassis::Chassis;
-use engine_mount_chassis::fe::chassis_config::ChassisConfig;
-use engine_mount_chassis::fe::nastran::write_bulk_deck;
 use engine_mount_chassis::model::scene::{build, BodyOptions, SceneKind};
 use engine_mount_chassis::model::{BodyConfig, VehicleConfig};
+use engine_mount_chassis::nastran::write_bulk_deck;
 
 fn modes(vehicle: &VehicleConfig) -> Vec<f64> {
     let options = BodyOptions {

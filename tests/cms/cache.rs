@@ -4,8 +4,10 @@
 
 use std::path::{Path, PathBuf};
 
+use engine_mount_chassis::chassis::config::ChassisConfig;
 use engine_mount_chassis::cms::{
-    reduce, reduce_cached, CacheOutcome, CacheSetting, DampingTable, ModeSelection, ReductionSpec,
+    reduce, reduce_cached, BodySource, CacheOutcome, CacheSetting, DampingTable, ModeSelection,
+    ReductionSpec,
 };
 
 /// A cheap reduction (constraint modes only) keeps these tests fast; the cache does not care.
@@ -52,7 +54,10 @@ fn any_changed_input_misses_the_cache() {
     let base_path = stored_path(&first).to_path_buf();
 
     let mut stiffer = spec();
-    stiffer.chassis.body_stiffness_scale *= 1.0 + 1e-12;
+    stiffer.body = BodySource::Procedural(Box::new(ChassisConfig {
+        body_stiffness_scale: ChassisConfig::default().body_stiffness_scale * (1.0 + 1e-12),
+        ..ChassisConfig::default()
+    }));
     let mut damped = spec();
     damped.damping = DampingTable::uniform(0.02);
     let mut outputs = spec();

@@ -6,10 +6,10 @@ use std::collections::BTreeMap;
 use std::path::PathBuf;
 
 use engine_mount_chassis::cms::{
-    reduce_cached_with_notes, reduce_with_notes, BulkDeckBody, CacheOutcome, CacheSetting,
-    InterfaceDofs, ModeSelection, ReductionSpec,
+    reduce_cached_with_notes, reduce_with_notes, BodySource, BulkDeckBody, CacheOutcome,
+    CacheSetting, InterfaceDofs, ModeSelection, ReductionSpec,
 };
-use engine_mount_chassis::fe::nastran::{deck_digest, DeckOptions};
+use engine_mount_chassis::nastran::{deck_digest, DeckOptions};
 
 #[path = "../common/plate_deck.rs"]
 mod plate_deck;
@@ -38,7 +38,7 @@ fn spec(name: &str, deck: &str, third_mount: u32) -> (ReductionSpec, PathBuf) {
     .map(|(n, g)| (n.to_string(), g))
     .collect();
     let spec = ReductionSpec {
-        deck: Some(BulkDeckBody {
+        body: BodySource::Deck(BulkDeckBody {
             sha256: deck_digest(&path, &DeckOptions::default()).unwrap(),
             path,
             points: points.clone(),

@@ -12,9 +12,9 @@ use engine_mount_chassis::cms::{
     dmig_of_reduction, reduce_external, CacheSetting, DampingTable, ExternalBody, ModeSelection,
     ReducedChassis,
 };
-use engine_mount_chassis::fe::nastran::{parse_dmig_str, read_dmig_file, DeckOptions};
 use engine_mount_chassis::model::scene::{body, reduction_spec, BodyOptions};
 use engine_mount_chassis::model::VehicleConfig;
+use engine_mount_chassis::nastran::{parse_dmig_str, read_dmig_file, DeckOptions};
 
 fn temp_dir(tag: &str) -> PathBuf {
     let dir = std::env::temp_dir().join(format!("emc-dmig-{tag}-{}", std::process::id()));
@@ -171,7 +171,7 @@ fn chain_frequencies() -> Vec<f64> {
 }
 
 fn chains_body(
-    file: &engine_mount_chassis::fe::nastran::DmigFile,
+    file: &engine_mount_chassis::nastran::DmigFile,
     selection: ModeSelection,
 ) -> ReducedChassis {
     let points = BTreeMap::from([("tip".to_string(), 1)]);

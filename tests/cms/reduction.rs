@@ -4,13 +4,13 @@
 
 use std::sync::OnceLock;
 
+use engine_mount_chassis::chassis::config::ChassisConfig;
+use engine_mount_chassis::chassis::{Chassis, MountLayout};
 use engine_mount_chassis::cms::{
     reduce, reduce_detailed, InterfaceDofs, ModeSelection, ReducedChassis, Reduction, ReductionSpec,
 };
+use engine_mount_chassis::eigen::lowest_modes;
 use engine_mount_chassis::fe::assembly::{mat_vec, SparseMat};
-use engine_mount_chassis::fe::chassis::{Chassis, MountLayout};
-use engine_mount_chassis::fe::chassis_config::ChassisConfig;
-use engine_mount_chassis::fe::eigen::lowest_modes;
 use faer::linalg::solvers::Solve;
 use faer::{Mat, Side};
 

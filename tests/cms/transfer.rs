@@ -8,7 +8,7 @@ use engine_mount_chassis::cms::{
     reduce_detailed, DampingTable, ModeSelection, PointDof, ReducedChassis, Reduction,
     ReductionSpec, Response,
 };
-use engine_mount_chassis::fe::eigen::lowest_modes;
+use engine_mount_chassis::eigen::lowest_modes;
 use faer::c64;
 use faer::linalg::solvers::Solve;
 use faer::sparse::linalg::solvers::{Lu, SymbolicLu};

@@ -5,9 +5,9 @@
 use std::f64::consts::PI;
 use std::fmt::Write;
 
+use engine_mount_chassis::eigen::lowest_modes;
 use engine_mount_chassis::fe::assembly::{assemble, Assembled};
-use engine_mount_chassis::fe::eigen::lowest_modes;
-use engine_mount_chassis::fe::nastran::{parse_str, write_bulk_deck, NastranBody};
+use engine_mount_chassis::nastran::{parse_str, write_bulk_deck, NastranBody};
 use nalgebra::{DMatrix, DVector, Matrix3, Vector3};
 
 // The steel section of every beam test (also `beam_shear`).
@@ -604,8 +604,10 @@ fn bad_offset_codes_pin_flags_and_displacement_systems_are_refused_naming_card_a
 
 #[test]
 fn a_reduced_body_with_mount_grids_in_displacement_systems_reports_the_same_basic_motion() {
-    use engine_mount_chassis::cms::{reduce, BulkDeckBody, ModeSelection, ReductionSpec};
-    use engine_mount_chassis::fe::nastran::{deck_digest, DeckOptions};
+    use engine_mount_chassis::cms::{
+        reduce, BodySource, BulkDeckBody, ModeSelection, ReductionSpec,
+    };
+    use engine_mount_chassis::nastran::{deck_digest, DeckOptions};
     let dir = std::env::temp_dir().join(format!("emc-beam-cards-cd-{}", std::process::id()));
     std::fs::create_dir_all(&dir).unwrap();
     let reduced = |cd: Cd| {
@@ -615,7 +617,7 @@ fn a_reduced_body_with_mount_grids_in_displacement_systems_reports_the_same_basi
             .map(|(n, g)| (n.to_string(), g))
             .into();
         let spec = ReductionSpec {
-            deck: Some(BulkDeckBody {
+            body: BodySource::Deck(BulkDeckBody {
                 sha256: deck_digest(&path, &DeckOptions::default()).unwrap(),
                 path,
                 points,

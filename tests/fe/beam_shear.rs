@@ -7,9 +7,9 @@
 use std::f64::consts::PI;
 use std::fmt::Write;
 
+use engine_mount_chassis::eigen::lowest_modes;
 use engine_mount_chassis::fe::assembly::assemble;
-use engine_mount_chassis::fe::eigen::lowest_modes;
-use engine_mount_chassis::fe::nastran::{parse_str, write_bulk_deck, NastranBody};
+use engine_mount_chassis::nastran::{parse_str, write_bulk_deck, NastranBody};
 use nalgebra::{DMatrix, DVector};
 
 // The steel section of `beam_cards` (A = 3e-4 m², I1 = 4e-8 m⁴, I2 = 1e-8 m⁴): with the short

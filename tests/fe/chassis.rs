@@ -2,14 +2,16 @@
 //! Table 1): 1000 kg, first global torsion 43 Hz, steering wheel 31.5 Hz vertical / ~32 Hz
 //! lateral; structural options of paper §7.1 move the frequencies in the right direction.
 
-use engine_mount_chassis::fe::assembly::{assemble, translational_mass, Assembled};
-use engine_mount_chassis::fe::chassis::{
+use engine_mount_chassis::chassis::config::ChassisConfig;
+use engine_mount_chassis::chassis::modal::{
+    describe, steering_wheel_pair, ModeDescription, ModeKind,
+};
+use engine_mount_chassis::chassis::{
     Chassis, MountLayout, SEAT_RAIL, STEERING_WHEEL, WHEEL_CENTRES,
 };
-use engine_mount_chassis::fe::chassis_config::ChassisConfig;
+use engine_mount_chassis::eigen::{lowest_modes, Modes};
+use engine_mount_chassis::fe::assembly::{assemble, translational_mass, Assembled};
 use engine_mount_chassis::fe::checks::{check_assembled, check_mesh, CheckLimits};
-use engine_mount_chassis::fe::eigen::{lowest_modes, Modes};
-use engine_mount_chassis::fe::modal::{describe, steering_wheel_pair, ModeDescription, ModeKind};
 use faer::linalg::solvers::Solve;
 use faer::{Mat, Side};
 

@@ -4,9 +4,9 @@
 use std::f64::consts::PI;
 use std::fmt::Write;
 
+use engine_mount_chassis::eigen::lowest_modes;
 use engine_mount_chassis::fe::assembly::{assemble, Assembled};
-use engine_mount_chassis::fe::eigen::lowest_modes;
-use engine_mount_chassis::fe::nastran::{parse_str, NastranBody};
+use engine_mount_chassis::nastran::{parse_str, NastranBody};
 use nalgebra::{DMatrix, Matrix3, Vector3};
 
 fn error_of(deck: &str) -> String {

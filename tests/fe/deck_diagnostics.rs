@@ -3,7 +3,7 @@
 //! while invalid ones are refused, and springs and bushes hold their grids.
 
 use engine_mount_chassis::fe::checks::{check_mesh, check_mesh_named, CheckLimits};
-use engine_mount_chassis::fe::nastran::{parse_str, DeckNames, NastranBody};
+use engine_mount_chassis::nastran::{parse_str, DeckNames, NastranBody};
 
 #[path = "../common/plate_deck.rs"]
 mod plate_deck;

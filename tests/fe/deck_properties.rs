@@ -3,9 +3,7 @@
 
 use std::fmt::Write;
 
-use engine_mount_chassis::fe::nastran::{
-    lex, parse_reader, parse_str, write_bulk_deck, DeckLimits,
-};
+use engine_mount_chassis::nastran::{lex, parse_reader, parse_str, write_bulk_deck, DeckLimits};
 use proptest::prelude::*;
 
 /// Pieces that bulk data is made of, so random decks reach deep into the lexer and the card

@@ -6,7 +6,7 @@ use std::io::Read;
 use std::path::{Path, PathBuf};
 
 use engine_mount_chassis::cms::sha256_hex;
-use engine_mount_chassis::fe::nastran::{
+use engine_mount_chassis::nastran::{
     deck_digest, lex_reader_peak_line_bytes, parse_reader, parse_str, read_bulk_deck,
     read_bulk_deck_with, DeckLimits, DeckOptions,
 };

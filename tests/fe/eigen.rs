@@ -1,8 +1,8 @@
 //! The sparse shift-invert block Lanczos solver against a second method: a dense generalized
 //! symmetric eigen solve with nalgebra (Cholesky of M, symmetric eigen of L⁻¹ K L⁻ᵀ).
 
+use engine_mount_chassis::eigen::lowest_modes;
 use engine_mount_chassis::fe::assembly::{assemble, mat_vec, Assembled};
-use engine_mount_chassis::fe::eigen::lowest_modes;
 use engine_mount_chassis::fe::mesh::{
     Beam, BeamSection, GroundSpring, Material, Mesh, PointMass, Shell,
 };

@@ -1,16 +1,16 @@
-//! Spectrum slicing (`fe::eigen_slicing`) against the single-shift Lanczos solver on the default
+//! Spectrum slicing (`eigen::slicing`) against the single-shift Lanczos solver on the default
 //! body's fixed-interface problem, and against closed forms: uniform chains, repeated so that
 //! every eigenvalue has a multiplicity above the Lanczos block width and clusters straddle
 //! slice boundaries.
 
+use engine_mount_chassis::chassis::config::ChassisConfig;
+use engine_mount_chassis::chassis::{Chassis, MountLayout};
 use engine_mount_chassis::cms::Partition;
-use engine_mount_chassis::fe::assembly::{assemble, SparseMat};
-use engine_mount_chassis::fe::chassis::{Chassis, MountLayout};
-use engine_mount_chassis::fe::chassis_config::ChassisConfig;
-use engine_mount_chassis::fe::eigen::{lowest_modes, Modes};
-use engine_mount_chassis::fe::eigen_slicing::{
+use engine_mount_chassis::eigen::slicing::{
     eigenvalue_count, lowest_modes_auto, modes_in_interval, sliced_modes, SliceStop, SLICE_MODES,
 };
+use engine_mount_chassis::eigen::{lowest_modes, Modes};
+use engine_mount_chassis::fe::assembly::{assemble, SparseMat};
 use faer::sparse::{SparseColMat, Triplet};
 use faer::Mat;
 

@@ -3,8 +3,8 @@
 
 use std::f64::consts::PI;
 
+use engine_mount_chassis::eigen::{lowest_modes, Modes};
 use engine_mount_chassis::fe::assembly::{assemble, Assembled};
-use engine_mount_chassis::fe::eigen::{lowest_modes, Modes};
 use engine_mount_chassis::fe::mesh::{Beam, BeamSection, Material, Mesh, Shell};
 use faer::prelude::Solve;
 use faer::Mat;

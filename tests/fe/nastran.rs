@@ -7,11 +7,11 @@ use std::f64::consts::PI;
 use std::fmt::Write;
 use std::path::{Path, PathBuf};
 
+use engine_mount_chassis::chassis::config::ChassisConfig;
+use engine_mount_chassis::chassis::Chassis;
+use engine_mount_chassis::eigen::{lowest_modes, Modes};
 use engine_mount_chassis::fe::assembly::{assemble, mat_vec, Assembled};
-use engine_mount_chassis::fe::chassis::Chassis;
-use engine_mount_chassis::fe::chassis_config::ChassisConfig;
-use engine_mount_chassis::fe::eigen::{lowest_modes, Modes};
-use engine_mount_chassis::fe::nastran::{parse_str, read_bulk_deck, write_bulk_deck, NastranBody};
+use engine_mount_chassis::nastran::{parse_str, read_bulk_deck, write_bulk_deck, NastranBody};
 use nalgebra::{DMatrix, Matrix3, Vector3};
 
 fn data(name: &str) -> PathBuf {

@@ -6,10 +6,10 @@
 use std::f64::consts::PI;
 use std::fmt::Write;
 
+use engine_mount_chassis::eigen::lowest_modes;
 use engine_mount_chassis::fe::assembly::assemble;
-use engine_mount_chassis::fe::eigen::lowest_modes;
 use engine_mount_chassis::fe::mesh::{Material, Mesh, Shell};
-use engine_mount_chassis::fe::nastran::{parse_str, write_bulk_deck, NastranBody};
+use engine_mount_chassis::nastran::{parse_str, write_bulk_deck, NastranBody};
 use faer::prelude::Solve;
 use faer::Mat;
 use nalgebra::Vector3;

@@ -6,12 +6,12 @@
 use std::f64::consts::PI;
 use std::fmt::Write;
 
+use engine_mount_chassis::eigen::{lowest_modes, Modes};
 use engine_mount_chassis::fe::assembly::{assemble, translational_mass, Assembled};
 use engine_mount_chassis::fe::checks::{check_assembled, check_mesh, CheckLimits};
-use engine_mount_chassis::fe::eigen::{lowest_modes, Modes};
 use engine_mount_chassis::fe::mesh::{Material, Mesh, Solid};
-use engine_mount_chassis::fe::nastran::{parse_str, write_bulk_deck};
 use engine_mount_chassis::fe::solid::{self, SolidKind};
+use engine_mount_chassis::nastran::{parse_str, write_bulk_deck};
 use faer::linalg::solvers::Solve;
 use faer::{Mat, Side};
 use nalgebra::{Matrix3, Vector3, Vector6};

@@ -1,8 +1,8 @@
 //! Paper §6.2 / Table 1 middle column with the real chassis: the coupled modes of the engine in
 //! the elastic body against the engine on rigid ground (left column).
 
+use engine_mount_chassis::chassis::modal::{steering_wheel_pair, ModeKind as ChassisMode};
 use engine_mount_chassis::cms::reduce_detailed;
-use engine_mount_chassis::fe::modal::{steering_wheel_pair, ModeKind as ChassisMode};
 use engine_mount_chassis::model::scene::{reduction_spec, BodyOptions};
 use engine_mount_chassis::model::{CoupledModel, Direction, Mode, ModeKind, VehicleConfig};
 

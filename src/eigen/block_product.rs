@@ -10,7 +10,7 @@
 use faer::reborrow::ReborrowMut;
 use faer::{MatMut, MatRef};
 
-use super::assembly::SparseMat;
+use crate::fe::assembly::SparseMat;
 
 /// Vectors carried through one pass over the sparse matrix.
 const WIDTH: usize = 8;

@@ -22,8 +22,8 @@ use faer::sparse::linalg::solvers::Llt;
 use faer::sparse::{SparseColMat, Triplet};
 use faer::{Mat, Side};
 
-use super::assembly::{mat_vec, SparseMat};
-use super::error::FeError;
+use crate::fe::assembly::{mat_vec, SparseMat};
+use crate::fe::error::FeError;
 
 /// Eigenpairs of (K, M), ascending.
 #[derive(Debug, Clone)]
@@ -79,7 +79,7 @@ fn norm2(v: &[f64]) -> f64 {
 }
 
 /// Deterministic pseudo-random start vectors (xorshift), so results are reproducible; shared
-/// with [`super::eigen_slicing`].
+/// with [`super::slicing`].
 pub(super) struct Xorshift(pub(super) u64);
 
 impl Xorshift {
@@ -155,7 +155,7 @@ impl Basis<'_> {
 }
 
 /// Checks a pencil (K, M) before any solve: both square, of equal size, every entry finite.
-/// Shared by the eigensolvers here and in [`super::eigen_slicing`] and by the Craig-Bampton
+/// Shared by the eigensolvers here and in [`super::slicing`] and by the Craig-Bampton
 /// reduction.
 pub fn check_pencil(k: &SparseMat, m: &SparseMat) -> Result<(), FeError> {
     let n = k.nrows();

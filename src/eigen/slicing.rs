@@ -1,7 +1,7 @@
 //! Many eigenpairs of (K, M) by spectrum slicing: shift-invert block Lanczos at several shifts,
 //! each slice's completeness proved by Sturm counts.
 //!
-//! [`super::eigen::lowest_modes`] runs one Lanczos process at one shift and keeps every Krylov
+//! [`super::shift_invert::lowest_modes`] runs one Lanczos process at one shift and keeps every Krylov
 //! vector; its basis grows to several times the number of modes asked for, so its
 //! reorthogonalisation costs O(n·m²) and its Rayleigh-Ritz steps O(m³) for m modes, and its
 //! memory is 2·n·6m numbers. Above a few hundred modes that is what limits the reduction.
@@ -51,9 +51,9 @@ use faer::sparse::linalg::matmul::sparse_dense_matmul;
 use faer::sparse::{SparseColMat, SymbolicSparseColMat, Triplet};
 use faer::{Accum, Conj, Mat, MatMut, MatRef, Par, Side};
 
-use super::assembly::SparseMat;
-use super::eigen::{check_pencil, lowest_modes, Modes, Xorshift};
-use super::error::FeError;
+use super::shift_invert::{check_pencil, lowest_modes, Modes, Xorshift};
+use crate::fe::assembly::SparseMat;
+use crate::fe::error::FeError;
 
 /// Mode count from which [`prefer_slicing`] picks spectrum slicing. Measured on the
 /// 15,300-DOF default body (docs, evidence "Production size"): 80 modes take 1.1 s either way,

@@ -11,8 +11,8 @@ use std::sync::Arc;
 use sha2::{Digest, Sha256};
 
 use super::lexer::{
-    case_control_spc, is_begin_bulk, lex_error, shown, split_line, strip_comment, CardSink, Field,
-    Loc, RawCard,
+    case_control_spc, is_begin_bulk, lex_error, shown, split_line, strip_comment, CardSink, Deck,
+    Field, Loc, RawCard,
 };
 use crate::fe::error::FeError;
 
@@ -827,4 +827,14 @@ impl CardSink for Discard {
     }
 
     fn reset(&mut self) {}
+}
+/// Splits `text` into cards (an in-memory deck: `INCLUDE` is refused, there is no folder to
+/// resolve it against).
+pub fn lex(text: &str) -> Result<Deck, FeError> {
+    let mut cards: Vec<RawCard> = Vec::new();
+    let info = read_text(text, &DeckLimits::default(), &mut cards)?;
+    Ok(Deck {
+        cards,
+        spc_selection: info.spc_selection,
+    })
 }

@@ -178,9 +178,8 @@ impl<'m> Deck<'m> {
     }
 
     fn header(&mut self) {
-        self.out.push_str(
-            "$ Nastran bulk data written by engine_mount_chassis (fe::nastran), SI units\n",
-        );
+        self.out
+            .push_str("$ Nastran bulk data written by engine_mount_chassis (nastran), SI units\n");
         for (name, node) in &self.mesh.named_nodes {
             let _ = writeln!(self.out, "$ named node {name} = GRID {}", node + 1);
         }
@@ -577,7 +576,7 @@ fn placement(
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::fe::nastran::parse_real;
+    use crate::nastran::parse_real;
 
     #[test]
     fn reals_fit_16_columns_and_read_back() {

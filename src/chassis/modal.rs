@@ -6,12 +6,12 @@ use std::collections::BTreeMap;
 
 use nalgebra::{Matrix6, Vector3, Vector6};
 
-use super::assembly::{mat_vec, Assembled};
-use super::chassis::{region, STEERING_WHEEL};
-use super::dof::Expansion;
-use super::eigen::Modes;
-use super::error::FeError;
-use super::mesh::Mesh;
+use super::body::{region, STEERING_WHEEL};
+use crate::eigen::Modes;
+use crate::fe::assembly::{mat_vec, Assembled};
+use crate::fe::dof::Expansion;
+use crate::fe::error::FeError;
+use crate::fe::mesh::Mesh;
 
 /// What a mode is.
 #[derive(Debug, Clone, PartialEq)]

@@ -1192,7 +1192,7 @@ mod tests {
     fn the_supported_card_table_is_the_dispatch() {
         for card in SUPPORTED_CARDS {
             let mut collector = Collector::new();
-            let raw = crate::fe::nastran::lex(&format!("{card},1\n"))
+            let raw = crate::nastran::lex(&format!("{card},1\n"))
                 .unwrap()
                 .cards
                 .remove(0);
@@ -1203,10 +1203,7 @@ mod tests {
                 );
             }
         }
-        let raw = crate::fe::nastran::lex("CTRIA6,1\n")
-            .unwrap()
-            .cards
-            .remove(0);
+        let raw = crate::nastran::lex("CTRIA6,1\n").unwrap().cards.remove(0);
         let err = Collector::new().card(raw).err().unwrap().to_string();
         assert!(err.contains(&SUPPORTED_CARDS.join(", ")), "{err}");
     }

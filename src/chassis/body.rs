@@ -14,10 +14,10 @@ use std::collections::{BTreeMap, HashMap};
 
 use nalgebra::{Matrix3, Vector3};
 
-use super::chassis_config::{ChassisConfig, Geometry, SectionSpec, Sections, Thicknesses, Trim};
-use super::checks::{check_mesh, CheckLimits};
-use super::error::FeError;
-use super::mesh::{Beam, BeamSection, GroundSpring, Material, Mesh, PointMass, Shell};
+use super::config::{ChassisConfig, Geometry, SectionSpec, Sections, Thicknesses, Trim};
+use crate::fe::checks::{check_mesh, CheckLimits};
+use crate::fe::error::FeError;
+use crate::fe::mesh::{Beam, BeamSection, GroundSpring, Material, Mesh, PointMass, Shell};
 
 /// Engine-mount layout: the original four mounts or the paper's improved three-mount vehicle.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]

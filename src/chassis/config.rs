@@ -12,8 +12,8 @@
 
 use serde::{Deserialize, Serialize};
 
-use super::error::FeError;
-use super::mesh::{BeamSection, Material};
+use crate::fe::error::FeError;
+use crate::fe::mesh::{BeamSection, Material};
 
 /// A beam cross-section given by its shape.
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
@@ -565,7 +565,7 @@ impl ChassisConfig {
 
 impl ChassisConfig {
     /// Checks what serde cannot: sizes positive, positions on the grid and in order, the mount
-    /// name known. [`crate::fe::chassis::Chassis::build`] calls it first, so an error names the
+    /// name known. [`crate::chassis::Chassis::build`] calls it first, so an error names the
     /// field rather than a degenerate element.
     pub fn validate(&self) -> Result<(), FeError> {
         let g = &self.geometry;
@@ -585,7 +585,7 @@ impl ChassisConfig {
             ("suspension.tyre_rate", self.suspension.tyre_rate),
         ];
         for (name, v) in positive {
-            super::error::require_positive(name, v)?;
+            crate::fe::error::require_positive(name, v)?;
         }
         g.validate_grid(&[
             ("mounts.front_x", self.mounts.front_x),

@@ -145,13 +145,13 @@ use std::collections::BTreeMap;
 use std::path::Path;
 
 pub use dmig::{parse_dmig_str, read_dmig_file, write_dmig_file, DmigDof, DmigFile, DmigMatrix};
-pub use lexer::{classify, lex, parse_real, Deck, Field, Loc, RawCard, Value};
+pub use lexer::{classify, parse_real, Deck, Field, Loc, RawCard, Value};
 pub use names::DeckNames;
-pub use reader::{DeckLimits, DeckOptions};
+pub use reader::{lex, DeckLimits, DeckOptions};
 pub use writer::write_bulk_deck;
 
-use super::error::FeError;
-use super::mesh::Mesh;
+use crate::fe::error::FeError;
+use crate::fe::mesh::Mesh;
 
 /// Nastran ids of the mesh entities, in mesh order (`beams[i]` is the CBAR/CBEAM id of
 /// `mesh.beams[i]`, …). A CONM2/CONM1 with an offset appears in `masses` and in `rigid_links`.
@@ -217,7 +217,7 @@ impl NastranBody {
     }
 
     /// Adds `name → GRID ids` node sets to `mesh.regions` (mode descriptions need the regions
-    /// of [`crate::fe::chassis::region`], which a bulk data file does not carry).
+    /// of [`crate::chassis::region`], which a bulk data file does not carry).
     pub fn name_regions(&mut self, regions: &BTreeMap<String, Vec<u32>>) -> Result<(), FeError> {
         for (name, grids) in regions {
             let nodes = grids

@@ -344,20 +344,10 @@ pub(super) fn case_control_spc(line: &str, loc: &Loc) -> Result<Option<u32>, FeE
     })
 }
 
-/// Splits `text` into cards (an in-memory deck: `INCLUDE` is refused, there is no folder to
-/// resolve it against).
-pub fn lex(text: &str) -> Result<Deck, FeError> {
-    let mut cards: Vec<RawCard> = Vec::new();
-    let info = super::reader::read_text(text, &super::reader::DeckLimits::default(), &mut cards)?;
-    Ok(Deck {
-        cards,
-        spc_selection: info.spc_selection,
-    })
-}
-
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::nastran::lex;
 
     #[test]
     fn nastran_reals_in_all_their_forms() {
