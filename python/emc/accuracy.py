@@ -34,10 +34,12 @@ import numpy as np
 import pandas as pd
 
 from .runner import Runner
+from .spectra import order_amplitudes
 
 DEFAULT_TOLERANCES = (1e-3, 1e-4, 1e-5, 1e-6, 1e-7, 1e-8, 1e-9)
 REFERENCE_TOLERANCE = 1e-11
-MAIN_ORDERS = (1.5, 2.0, 3.0)
+# The orders whose amplitudes the work-precision table compares by default (--order).
+COMPARED_ORDERS = (1.5, 2.0, 3.0)
 
 
 @dataclasses.dataclass(frozen=True)
@@ -123,38 +125,22 @@ def relative_l2(samples: np.ndarray, reference: np.ndarray) -> float:
     return math.sqrt(float(np.sum((samples - reference) ** 2)) / spread)
 
 
-def order_amplitudes(samples: np.ndarray, rpm: float, step: float, orders) -> np.ndarray:
-    """Amplitudes (orders × columns) on the longest window of whole working cycles (two
-    revolutions) at the end of the samples."""
-    revolutions = len(samples) * step * rpm / 60.0
-    cycles = int(revolutions // 2)
-    if cycles < 1:
-        return np.full((len(orders), samples.shape[1]), math.nan)
-    n = int(round(cycles * 2 * 60.0 / rpm / step))
-    window = samples[-n:] - samples[-n:].mean(axis=0)
-    t = np.arange(n) * step
-    out = []
-    for order in orders:
-        w = 2 * math.pi * order * rpm / 60.0
-        phasor = np.exp(-1j * w * t) @ window
-        out.append(2 * np.abs(phasor) / n)
-    return np.array(out)
-
-
 def order_error(samples: np.ndarray, reference: np.ndarray, scenario: Scenario,
                 orders) -> float:
     if not scenario.stationary:
         return math.nan
-    a = order_amplitudes(samples, scenario.rpm_from, scenario.step, orders)
-    b = order_amplitudes(reference, scenario.rpm_from, scenario.step, orders)
-    errors = [np.linalg.norm(x - y) / np.linalg.norm(y) for x, y in zip(a, b)
-              if np.linalg.norm(y) > 0.0]
+    # The longest window of whole working cycles at the end of the samples.
+    per_revolution = 60.0 / scenario.rpm_from / scenario.step
+    a = order_amplitudes(samples, None, orders, per_revolution)
+    b = order_amplitudes(reference, None, orders, per_revolution)
+    errors = [np.linalg.norm(a[o] - b[o]) / np.linalg.norm(b[o]) for o in b
+              if np.linalg.norm(b[o]) > 0.0]
     return float(max(errors)) if errors else math.nan
 
 
 def work_precision(fmu: str, cases: list[tuple[str, dict]], scenarios: list[Scenario],
                    signals: list[str], tolerances=DEFAULT_TOLERANCES,
-                   reference_tolerance: float = REFERENCE_TOLERANCE, orders=MAIN_ORDERS,
+                   reference_tolerance: float = REFERENCE_TOLERANCE, orders=COMPARED_ORDERS,
                    progress=None, repeat: int = 1) -> pd.DataFrame:
     """The work-precision table: one row per case, scenario and tolerance. With ``repeat`` > 1
     each run is repeated and the least CPU and wall time are kept (the runs are identical; the
@@ -351,7 +337,7 @@ def cmd_accuracy(args) -> int:
     signals = list(dict.fromkeys(args.signal or []))
     cli.check_outputs("--signal", signals, variables)
     signals = signals or default_accuracy_signals(variables)
-    orders = tuple(args.order or MAIN_ORDERS)
+    orders = tuple(args.order or COMPARED_ORDERS)
     tolerances = sorted(set(args.rtol), reverse=True)
     cli.reduction_notice(cases[0][1], variables)
     out = pathlib.Path(args.out)

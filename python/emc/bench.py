@@ -1,6 +1,9 @@
-"""What each effect costs: CPU time per simulated second for each scene and effect set.
+"""Benchmarks that print a table: what each effect costs, the FMU's speed through fmpy, and how
+a study scales on Dask.
 
-Each case runs a constant-speed point (fade-in, then a fixed simulated time) in this process
+    python -m emc.bench scaling --fmu dist/EngineMountChassis.fmu --points 192 --workers 1 4 16
+
+What each effect costs (``effects_table``): each case runs a constant-speed point (fade-in, then a fixed simulated time) in this process
 through fmpy; the CPU time covers the stepping only (not the instantiation, which may reduce the
 chassis), including fmpy's per-step call overhead. The integrator counters come from the FMU's
 ``solver.*`` outputs.
@@ -8,6 +11,12 @@ chassis), including fmpy's per-step call overhead. The integrator counters come 
 
 from __future__ import annotations
 
+import argparse
+import datetime
+import functools
+import os
+import platform
+import sys
 import time
 
 import numpy as np
@@ -95,3 +104,155 @@ def realtime_table(fmu_path: str, rpm: float = 2000.0, seconds: float = 1.0, rep
                          "us per doStep+getReal": 1e6 / max(factors) * step,
                          "integrator steps per s": steps / t})
     return pd.DataFrame(rows)
+
+
+def scaling_points(count: int, rpm_from: float = 800.0, rpm_to: float = 4000.0) -> list:
+    """The points of the scaling benchmark: what ``emc sweep`` runs by default (scene 2, periodic
+    start, 8 revolutions, 72 steps per revolution), ``count`` speeds from ``rpm_from`` to
+    ``rpm_to``."""
+    from .sweep import speed_points
+
+    return speed_points(rpm_from, rpm_to, count, revolutions=8, periodic=True,
+                        parameters=(("scene", 2),))
+
+
+def _timed(run, repeat: int, cpu) -> tuple[list[float], list[float], object]:
+    """Wall times and CPU times (``cpu()`` before and after) of ``repeat`` runs, and the last
+    run's result."""
+    times, cpus, result = [], [], None
+    for _ in range(repeat):
+        cpu_before = cpu()
+        started = time.perf_counter()
+        result = run()
+        times.append(time.perf_counter() - started)
+        cpus.append(cpu() - cpu_before)
+    return times, cpus, result
+
+
+def same_results(a: list, b: list) -> bool:
+    """Whether two lists of analysed points (with their warnings) are equal to the bit."""
+    def same(x, y):
+        return (x.rpm == y.rpm and x.signals == y.signals
+                and all(np.array_equal(getattr(x, f), getattr(y, f), equal_nan=True)
+                        for f in ("order_amplitude", "frequency", "amplitude")))
+
+    return len(a) == len(b) and all(same(x, y) and wx == wy for (x, wx), (y, wy) in zip(a, b))
+
+
+def _tree_cpu() -> float:
+    """CPU seconds used so far by this process and all its descendants alive (a local pool's
+    scheduler, nannies and workers)."""
+    import psutil
+
+    me = psutil.Process()
+    total = 0.0
+    for p in [me] + me.children(recursive=True):
+        try:
+            t = p.cpu_times()
+            total += t.user + t.system
+        except psutil.NoSuchProcess:
+            pass
+    return total
+
+
+def scaling_table(fmu_path: str, points: list, workers=(1, 2), repeat: int = 2,
+                  out=sys.stdout) -> pd.DataFrame:
+    """Serial against Dask pools of each worker count, on warm instances: the serial loop runs
+    on an instance that has already run a point; each pool is started and its workers' instances
+    warmed (one point each, the reduced body read from the cache) before the timed runs. The
+    start and warm-up of each pool are reported beside, and the CPU time of each run: the serial
+    process's, or that of this process and all its children (scheduler, nannies, workers),
+    which load does not change. Every run's
+    results are compared with the serial ones to the bit."""
+    from .distributed import FmuPool
+    from .sweep import sweep_point
+
+    evaluate = functools.partial(sweep_point, signals=None, case="")
+    rows = []
+    with Runner(fmu_path) as runner:
+        started = time.perf_counter()
+        evaluate(runner, points[0])  # reduces the body into the cache if it is not there yet
+        first = time.perf_counter() - started
+        print(f"first point (instance, body reduced or read from the cache): {first:.1f} s",
+              file=out, flush=True)
+        times, cpus, serial = _timed(lambda: [evaluate(runner, p) for p in points], repeat,
+                                     time.process_time)
+    rows.append({"workers": "serial", "start_s": 0.0, "warm_s": 0.0, "run_min_s": min(times),
+                 "run_max_s": max(times), "cpu_s": min(cpus), "identical": True})
+    print(f"serial: {min(times):.2f}-{max(times):.2f} s", file=out, flush=True)
+    for w in workers:
+        started = time.perf_counter()
+        with FmuPool(fmu_path, workers=w) as pool:
+            start = time.perf_counter() - started
+            started = time.perf_counter()
+            pool.warm(evaluate, points[0])
+            warm = time.perf_counter() - started
+            times, cpus, results = _timed(lambda: pool.map(evaluate, points), repeat,
+                                          _tree_cpu)
+        rows.append({"workers": w, "start_s": start, "warm_s": warm, "run_min_s": min(times),
+                     "run_max_s": max(times), "cpu_s": min(cpus),
+                     "identical": same_results(results, serial)})
+        print(f"{w} workers: start {start:.1f} s, warm-up {warm:.1f} s, "
+              f"{min(times):.2f}-{max(times):.2f} s", file=out, flush=True)
+    table = pd.DataFrame(rows)
+    best_serial = table.run_min_s.iloc[0]
+    table["speedup"] = best_serial / table.run_min_s
+    table["speedup_low"] = best_serial / table.run_max_s
+    table["points_per_s"] = len(points) / table.run_min_s
+    # CPU of a run relative to the serial loop's: what the pool (scheduler, nannies, workers,
+    # this process) costs besides the simulations. On idle cores the speed-up approaches
+    # workers / cpu_ratio.
+    table["cpu_ratio"] = table.cpu_s / table.cpu_s.iloc[0]
+    return table
+
+
+def machine_line() -> str:
+    load = os.getloadavg()
+    return (f"{platform.node()}: {os.cpu_count()} logical CPUs, Python {platform.python_version()}, "
+            f"load average {load[0]:.2f} / {load[1]:.2f} / {load[2]:.2f} (1 / 5 / 15 min), "
+            f"{datetime.datetime.now().astimezone().isoformat(timespec='seconds')}")
+
+
+def cmd_scaling(args) -> int:
+    points = scaling_points(args.points, *args.rpm)
+    print(machine_line(), flush=True)
+    print(f"{len(points)} points, {args.rpm[0]:g}-{args.rpm[1]:g} rpm, scene 2, periodic start, "
+          f"8 revolutions at 72 steps each; {args.repeat} timed runs per row", flush=True)
+    table = scaling_table(args.fmu, points, args.workers, args.repeat)
+    load = os.getloadavg()
+    print(f"load average after: {load[0]:.2f} / {load[1]:.2f} / {load[2]:.2f}")
+    shown = table.copy()
+    shown["run s (min-max)"] = [f"{a:.2f}-{b:.2f}" for a, b in zip(table.run_min_s, table.run_max_s)]
+    shown["speed-up vs serial"] = [f"{a:.2f}x ({b:.2f}x)" for a, b in
+                                   zip(table.speedup, table.speedup_low)]
+    print(shown[["workers", "start_s", "warm_s", "run s (min-max)", "speed-up vs serial",
+                 "points_per_s", "cpu_s", "cpu_ratio",
+                 "identical"]].to_string(
+        index=False, float_format=lambda v: f"{v:.2f}"))
+    if args.csv:
+        table.insert(0, "machine", machine_line())
+        table.insert(1, "points", len(points))
+        table.to_csv(args.csv, index=False)
+        print(f"-> {args.csv}")
+    return 0 if table.identical.all() else 1
+
+
+def main(argv: list[str] | None = None) -> int:
+    parser = argparse.ArgumentParser(prog="python -m emc.bench", description=__doc__,
+                                     formatter_class=argparse.RawDescriptionHelpFormatter)
+    sub = parser.add_subparsers(dest="command", required=True)
+    s = sub.add_parser("scaling", help="a sweep serial and on Dask pools of several worker counts "
+                                       "(warm instances), with speed-ups and a bit-for-bit check")
+    s.add_argument("--fmu", default="dist/EngineMountChassis.fmu")
+    s.add_argument("--points", type=int, default=48, help="speed points (default 48)")
+    s.add_argument("--rpm", type=float, nargs=2, default=[800.0, 4000.0], metavar=("FROM", "TO"))
+    s.add_argument("--workers", type=int, nargs="+", default=[2], help="worker counts (default 2)")
+    s.add_argument("--repeat", type=int, default=2, help="timed runs per row (default 2)")
+    s.add_argument("--csv", help="also write the table here")
+    s.set_defaults(func=cmd_scaling)
+    args = parser.parse_args(argv)
+    return args.func(args)
+
+
+if __name__ == "__main__":
+    sys.exit(main())

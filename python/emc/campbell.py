@@ -11,51 +11,27 @@ from __future__ import annotations
 
 import numpy as np
 import pandas as pd
-from fmpy import extract, read_model_description
-from fmpy.fmi2 import FMU2Slave
 
-import shutil
+from .runner import Runner
+from .spectra import MAIN_ORDERS, ORDERS
 
-ORDERS = tuple(k / 2 for k in range(1, 13))  # 0.5 … 6.0
-MAIN_ORDERS = (1.0, 1.5, 2.0, 3.0, 4.5)
 # Body modes damped at most this much are resonant enough to mark their crossings.
 LIGHT_DAMPING = 0.02
 
 
 def natural_modes(fmu_path: str, parameters: dict | None = None, case: str = "") -> pd.DataFrame:
     """The FMU's natural modes for ``parameters`` (start values), one row per mode."""
-    md = read_model_description(fmu_path)
-    variables = {v.name: v for v in md.modelVariables}
-    if "modes.count" not in variables:
-        raise RuntimeError(f"{fmu_path} reports no natural modes (no modes.count variable)")
-    unzipdir = extract(fmu_path)
-    slave = FMU2Slave(guid=md.guid, unzipDirectory=unzipdir,
-                      modelIdentifier=md.coSimulation.modelIdentifier, instanceName="campbell")
-    try:
-        slave.instantiate()
-        slave.setupExperiment(startTime=0.0)
-        for name, value in (parameters or {}).items():
-            v = variables[name]
-            setter = {"Real": slave.setReal, "Integer": slave.setInteger,
-                      "Boolean": slave.setBoolean, "String": slave.setString}[v.type]
-            convert = {"Real": float, "Integer": int, "Boolean": bool, "String": str}[v.type]
-            setter([v.valueReference], [convert(value)])
-        slave.enterInitializationMode()
-        count = slave.getInteger([variables["modes.count"].valueReference])[0]
+    with Runner(fmu_path, instance_name="campbell") as runner:
+        if "modes.count" not in runner.vr:
+            raise RuntimeError(f"{fmu_path} reports no natural modes (no modes.count variable)")
+        count = runner.initial_values(parameters or {}, ["modes.count"])[0]
 
         def column(field: str) -> list[float]:
-            vrs = [variables[f"mode[{k}].{field}"].valueReference for k in range(1, count + 1)]
-            return list(slave.getReal(vrs)) if vrs else []
+            return runner.get([f"mode[{k}].{field}" for k in range(1, count + 1)])
 
-        table = pd.DataFrame({"case": case, "mode": np.arange(1, count + 1),
-                              "frequency": column("frequency"), "damping": column("damping"),
-                              "powertrain_share": column("powertrainShare")})
-        slave.exitInitializationMode()
-        slave.terminate()
-    finally:
-        slave.freeInstance()
-        shutil.rmtree(unzipdir, ignore_errors=True)
-    return table
+        return pd.DataFrame({"case": case, "mode": np.arange(1, count + 1),
+                             "frequency": column("frequency"), "damping": column("damping"),
+                             "powertrain_share": column("powertrainShare")})
 
 
 def crossings(modes: pd.DataFrame, rpm_from: float, rpm_to: float,

@@ -6,6 +6,8 @@ Examples:
     emc sweep ... --scheduler tcp://10.0.0.5:8786        # a running Dask cluster
     emc runup --fmu dist/EngineMountChassis.fmu --rpm 800 2500 --duration 20 --out out/runup
     emc accuracy --set configFile=/path/my_car.json --out out/accuracy  # what accuracy costs
+    emc tpa --rpm 800 2500 --at 1100 --order 1.5 --out out/tpa   # which mount path carries it
+    emc frf / emc ods --rpm-point 1100 / emc decoupling --out ...  # transfer functions, shapes, mounts
 
 Every command runs scene 2 (the engine in the elastic body) unless --set scene=1. A case is
 --case NAME or --case NAME:name=value,name=value (repeatable; the common --set values apply to
@@ -46,6 +48,7 @@ DEFAULT_PARAMETERS = {"scene": 2}
 BOOLEAN_SPELLINGS = {"true": True, "1": True, "yes": True, "on": True,
                      "false": False, "0": False, "no": False, "off": False}
 HIGHEST_ORDER = 6.5  # what the analysis resolves (orders 0.5 … 6 and the band to 6.5)
+CUTOFF_IN_USE = "chassis.modeCutoffInUse"
 # Inputs and parameters each point's speed, load and start come from: set by the command's own
 # options, never by --set (a --set rpm would run every point at that speed, labelled otherwise).
 CONTROLLED = {"rpm": "--rpm", "loadTorque": "--load-torque", "initialization.periodic": "--start"}
@@ -136,12 +139,22 @@ def start_value(variables: dict, parameters: dict, name: str):
     return None if v is None or v.start is None else float(v.start)
 
 
+def cutoffs_in_use(fmu: str, cases: list[tuple[str, dict]]) -> list[float | None]:
+    """The chassis mode cut-off (Hz) each case's body keeps, as the FMU reports it
+    (``chassis.modeCutoffInUse``; None for an FMU without it)."""
+    with Runner(fmu) as runner:
+        if CUTOFF_IN_USE not in runner.vr:
+            return [None for _ in cases]
+        return [runner.initial_values(parameters, [CUTOFF_IN_USE])[0] for _, parameters in cases]
+
+
 def sampling_warnings(variables: dict, parameters: dict, rpm_from: float, rpm_to: float,
                       steps_per_revolution: int | None = None,
-                      step: float | None = None) -> list[str]:
+                      step: float | None = None, cutoff: float | None = None) -> list[str]:
     """What the chosen sampling and speeds cannot represent: aliasing and speeds beyond what the
     chassis model covers. A sweep samples ``steps_per_revolution`` times per revolution, a run-up
-    every ``step`` seconds."""
+    every ``step`` seconds; ``cutoff`` is the chassis mode cut-off in use (Hz,
+    :func:`cutoffs_in_use`)."""
     warnings = []
     scene = int(start_value(variables, parameters, "scene") or 1)
     if step is not None:
@@ -161,10 +174,9 @@ def sampling_warnings(variables: dict, parameters: dict, rpm_from: float, rpm_to
                         f"analysis reaches order {HIGHEST_ORDER:g} ({remedy})")
     max_rpm = start_value(variables, parameters, "scene.maxRpm")
     max_order = start_value(variables, parameters, "scene.maxEngineOrder")
-    cutoff = start_value(variables, parameters, "chassis.modeCutoff") or 0.0
-    if scene == 2 and max_rpm is not None and max_order is not None:
-        if cutoff <= 0.0:
-            cutoff = max_rpm / 60.0 * max_order * 1.2
+    automatic = (start_value(variables, parameters, "chassis.modeCutoff") or 0.0) <= 0.0
+    if scene == 2 and cutoff is not None and max_rpm is not None and max_order is not None:
+        if automatic:
             if rpm_to > max_rpm:
                 warnings.append(f"speeds up to {rpm_to:g} rpm exceed scene.maxRpm = {max_rpm:g}: "
                                 f"the automatic chassis cut-off ({cutoff:.0f} Hz) covers order "
@@ -407,14 +419,21 @@ def sweep_cases(args, cases: list[tuple[str, dict]], signals: list[str], out: pa
                 point_options: dict) -> tuple[pd.DataFrame, pd.DataFrame, list[str]]:
     """Every case's speed points (serial or on Dask), the FMU's warnings summarised, the order
     and spectrum tables of all cases written; returns (orders, spectra, FMU warnings)."""
+    from .distributed import FmuPool
+
     tables, fmu_warnings = [], []
-    for label, parameters in cases:
-        points = speed_points(args.rpm[0], args.rpm[1], args.count,
-                              parameters=tuple(parameters.items()), **point_options)
-        tables.append(run_sweep(args.fmu, points, signals=signals, case=label,
-                                parallel=not args.serial, scheduler=args.scheduler,
-                                workers=args.workers, progress=not args.quiet,
-                                warnings=fmu_warnings))
+    # One pool for every case: its workers start and load the FMU once.
+    pool = None if args.serial else FmuPool(args.fmu, args.workers, args.scheduler)
+    try:
+        for label, parameters in cases:
+            points = speed_points(args.rpm[0], args.rpm[1], args.count,
+                                  parameters=tuple(parameters.items()), **point_options)
+            tables.append(run_sweep(args.fmu, points, signals=signals, case=label,
+                                    parallel=not args.serial, progress=not args.quiet,
+                                    warnings=fmu_warnings, pool=pool))
+    finally:
+        if pool is not None:
+            pool.close()
     fmu_warnings_summary(fmu_warnings)
     orders = pd.concat([t[0] for t in tables], ignore_index=True)
     spectra = pd.concat([t[1] for t in tables], ignore_index=True)
@@ -434,7 +453,8 @@ def cmd_sweep(args) -> int:
     check_speeds(args.rpm, increasing=args.count > 1, highest=highest_speed(variables))
     signals = analysed_signals(args, variables, default_signals(variables))
     warn_cases([(label, sampling_warnings(variables, parameters, args.rpm[0], args.rpm[1],
-                                          args.steps_per_rev)) for label, parameters in cases])
+                                          args.steps_per_rev, cutoff=cutoff))
+                for (label, parameters), cutoff in zip(cases, cutoffs_in_use(args.fmu, cases))])
     reduction_notice(cases[0][1], variables)
     out = pathlib.Path(args.out)
     out.mkdir(parents=True, exist_ok=True)
@@ -488,7 +508,8 @@ def cmd_runup(args) -> int:
     signals = analysed_signals(args, variables, ["mount[1].F[3]"])
     periodic = args.start == "periodic" and "initialization.periodic" in variables
     warn_cases([(label, sampling_warnings(variables, parameters, args.rpm[0], args.rpm[1],
-                                          step=args.step)) for label, parameters in cases])
+                                          step=args.step, cutoff=cutoff))
+                for (label, parameters), cutoff in zip(cases, cutoffs_in_use(args.fmu, cases))])
     reduction_notice(cases[0][1], variables)
     out = pathlib.Path(args.out)
     out.mkdir(parents=True, exist_ok=True)
@@ -643,8 +664,9 @@ def run_study(args, cases: dict) -> int:
                 raise UsageError(f"this FMU lacks {key}, which case {name!r} needs")
     signals = analysed_signals(args, variables, STUDY_SIGNALS)
     study = [(name, case_parameters(common, params)) for name, params in cases.items()]
-    warn_cases([(label, sampling_warnings(variables, parameters, args.rpm[0], args.rpm[1], 72))
-                for label, parameters in study])
+    warn_cases([(label, sampling_warnings(variables, parameters, args.rpm[0], args.rpm[1], 72,
+                                          cutoff=cutoff))
+                for (label, parameters), cutoff in zip(study, cutoffs_in_use(args.fmu, study))])
     reduction_notice(study[0][1], variables)
     out = pathlib.Path(args.out)
     out.mkdir(parents=True, exist_ok=True)
@@ -818,8 +840,15 @@ def build_parser() -> argparse.ArgumentParser:
     r.set_defaults(func=cmd_bench_realtime)
 
     from .accuracy import add_parser as add_accuracy
+    from .doe import add_parser as add_doe
+    from .optimise import add_parser as add_optimise
 
     add_accuracy(sub)
+    add_doe(sub)
+    add_optimise(sub)
+    from .why import add_parsers as add_why
+
+    add_why(sub)
     return parser
 
 

@@ -50,19 +50,29 @@ import numpy as np
 from fmpy import extract, read_model_description
 from fmpy.fmi2 import FMU2Slave
 
-from .runner import logging_callbacks, set_value
+from .runner import (logging_callbacks, mount_count, release_logging, set_value,
+                     variable_names)
+from .spectra import ORDERS, order_amplitudes
 
 ALGORITHMS = ("jacobi", "gauss_seidel", "interface_jacobian")
-MOUNTS, AXES = 4, 3
-FORCES = [f"mount[{i}].F[{j}]" for i in range(1, MOUNTS + 1) for j in range(1, AXES + 1)]
-BODY_R = [f"mount[{i}].r[{j}]" for i in range(1, MOUNTS + 1) for j in range(1, AXES + 1)]
-BODY_V = [f"mount[{i}].v[{j}]" for i in range(1, MOUNTS + 1) for j in range(1, AXES + 1)]
-BODY_A = [f"mount[{i}].a[{j}]" for i in range(1, MOUNTS + 1) for j in range(1, AXES + 1)]
-ENGINE_R = [f"mount[{i}].body.r[{j}]" for i in range(1, MOUNTS + 1) for j in range(1, AXES + 1)]
-ENGINE_V = [f"mount[{i}].body.v[{j}]" for i in range(1, MOUNTS + 1) for j in range(1, AXES + 1)]
+AXES = 3
 COMFORT = [f"steeringWheel.a[{j}]" for j in range(1, AXES + 1)]
-SIGNALS = FORCES + COMFORT
-ORDERS = np.arange(1, 13) * 0.5
+
+
+def per_mount(pattern: str, mounts: int) -> list[str]:
+    """``pattern`` (with ``{i}`` the mount, ``{j}`` the axis) for every mount and axis."""
+    return [pattern.format(i=i, j=j) for i in range(1, mounts + 1) for j in range(1, AXES + 1)]
+
+
+def forces(mounts: int) -> list[str]:
+    return per_mount("mount[{i}].F[{j}]", mounts)
+
+
+def signals(mounts: int) -> list[str]:
+    """What a run records: the mount forces and the steering-wheel acceleration."""
+    return forces(mounts) + COMFORT
+
+
 # A mount force beyond this (N) is no longer a car: the coupling has diverged.
 FORCE_LIMIT = 1e6
 
@@ -106,6 +116,7 @@ class Fmu:
         except Exception:  # noqa: BLE001 - a failed run leaves the instance in an error state
             pass
         self.slave.freeInstance()
+        release_logging(self.callbacks)
         shutil.rmtree(self.unzipdir, ignore_errors=True)
 
 
@@ -180,9 +191,18 @@ class CoupledPair:
                            **(engine_parameters or {})})
         self.body.start(cache)
         e, b = self.engine, self.body
-        self.vr = dict(F=e.refs(FORCES), Fb=b.refs(FORCES), r=b.refs(BODY_R), v=b.refs(BODY_V),
-                       a=b.refs(BODY_A), re=e.refs(ENGINE_R), ve=e.refs(ENGINE_V),
-                       sw=b.refs(COMFORT))
+        mounts = mount_count(variable_names(e.md))
+        self.names = dict(F=forces(mounts), r=per_mount("mount[{i}].r[{j}]", mounts),
+                          v=per_mount("mount[{i}].v[{j}]", mounts),
+                          a=per_mount("mount[{i}].a[{j}]", mounts),
+                          re=per_mount("mount[{i}].body.r[{j}]", mounts),
+                          ve=per_mount("mount[{i}].body.v[{j}]", mounts))
+        self.signals = signals(mounts)
+        names = self.names
+        self.vr = dict(F=e.refs(names["F"]), Fb=b.refs(names["F"]), r=b.refs(names["r"]),
+                       v=b.refs(names["v"]), a=b.refs(names["a"]), re=e.refs(names["re"]),
+                       ve=e.refs(names["ve"]), sw=b.refs(COMFORT))
+        self.n = len(names["F"])
         e.slave.enterInitializationMode()
         b.slave.enterInitializationMode()
         self.init_change = []
@@ -200,9 +220,9 @@ class CoupledPair:
         b.slave.exitInitializationMode()
         self.F = np.array(e.slave.getReal(self.vr["F"]))
         b.slave.setReal(self.vr["Fb"], list(self.F))
-        self.k_groups = dependency_groups(e, FORCES, ENGINE_R)
-        self.c_groups = dependency_groups(e, FORCES, ENGINE_V)
-        self.a_groups = dependency_groups(b, BODY_A, FORCES)
+        self.k_groups = dependency_groups(e, names["F"], names["re"])
+        self.c_groups = dependency_groups(e, names["F"], names["ve"])
+        self.a_groups = dependency_groups(b, names["a"], names["F"])
 
     def close(self):
         self.engine.close()
@@ -218,42 +238,43 @@ class CoupledPair:
 
     def mount_stiffness(self) -> tuple[np.ndarray, np.ndarray]:
         """K = ∂F/∂r and C = ∂F/∂v of the engine (force on the body w.r.t. the body's motion)."""
-        return (jacobian(self.engine, FORCES, ENGINE_R, *self.k_groups),
-                jacobian(self.engine, FORCES, ENGINE_V, *self.c_groups))
+        names = self.names
+        return (jacobian(self.engine, names["F"], names["re"], *self.k_groups),
+                jacobian(self.engine, names["F"], names["ve"], *self.c_groups))
 
     def interface_compliance(self) -> np.ndarray:
         """A = ∂a/∂F of the body: mount-point accelerations per mount force (inverse interface
         mass)."""
-        return jacobian(self.body, BODY_A, FORCES, *self.a_groups)
+        return jacobian(self.body, self.names["a"], self.names["F"], *self.a_groups)
 
     def body_response(self, t: float, H: float, probe: float = 1000.0,
                       ramp: bool = True) -> tuple[np.ndarray, np.ndarray]:
         """S_r, S_v: the change of the body's mount displacement and velocity at t+H per unit
         force increment ΔF ramped in over [t, t+H] (``ramp=False``: applied at t and held),
         measured with the body's state saved and restored (exact: the body is linear)."""
-        b, vr = self.body, self.vr
+        b, vr, n = self.body, self.vr, self.n
         state = b.slave.getFMUstate()
         base = self.F.copy()
 
         def probe_step(slopes):
             b.slave.setFMUstate(state)
             b.slave.setReal(vr["Fb"], list(base if ramp else base + slopes * H))
-            slopes = slopes if ramp else np.zeros(12)
-            b.slave.setRealInputDerivatives(vr["Fb"], [1] * 12, list(slopes))
+            slopes = slopes if ramp else np.zeros(n)
+            b.slave.setRealInputDerivatives(vr["Fb"], [1] * n, list(slopes))
             b.slave.doStep(t, H)
             return np.array(b.slave.getReal(vr["r"])), np.array(b.slave.getReal(vr["v"]))
 
-        r0, v0 = probe_step(np.zeros(12))
-        S_r, S_v = np.zeros((12, 12)), np.zeros((12, 12))
-        for k in range(12):
-            slopes = np.zeros(12)
+        r0, v0 = probe_step(np.zeros(n))
+        S_r, S_v = np.zeros((n, n)), np.zeros((n, n))
+        for k in range(n):
+            slopes = np.zeros(n)
             slopes[k] = probe / H
             r, v = probe_step(slopes)
             S_r[:, k], S_v[:, k] = (r - r0) / probe, (v - v0) / probe
         b.slave.setFMUstate(state)
         b.slave.freeFMUstate(state)
         b.slave.setReal(vr["Fb"], list(base))
-        b.slave.setRealInputDerivatives(vr["Fb"], [1] * 12, [0.0] * 12)
+        b.slave.setRealInputDerivatives(vr["Fb"], [1] * n, [0.0] * n)
         return S_r, S_v
 
     # ----- stepping ----------------------------------------------------------------------------
@@ -294,17 +315,17 @@ class CoupledPair:
         if m < 1 or abs(m * h_out - H) > 1e-9 * H:
             raise ValueError(f"the coupling step {H} s is not a whole multiple of the sampling {h_out} s")
         n_steps = int(round(self.t_end / H))
-        e, b, vr = self.engine, self.body, self.vr
-        samples = np.full((n_steps * m, len(SIGNALS)), np.nan)
-        zeros12 = [0.0] * 12
-        ones12 = [1] * 12
+        e, b, vr, nf = self.engine, self.body, self.vr, self.n
+        samples = np.full((n_steps * m, len(self.signals)), np.nan)
+        zeros = [0.0] * nf
+        ones = [1] * nf
         r = np.array(b.slave.getReal(vr["r"]))
         v = np.array(b.slave.getReal(vr["v"]))
         if algorithm == "interface_jacobian":
             S_r, S_v = self.body_response(0.0, H)
             refresh = max(1, int(round(jacobian_every / H)))
-            dF = np.zeros(12)
-            I = np.eye(12)
+            dF = np.zeros(nf)
+            I = np.eye(nf)
         row = 0
         t_reached = 0.0
         status = "ok"
@@ -315,29 +336,29 @@ class CoupledPair:
                 base = row
 
                 def rec_engine(k):
-                    samples[base + k, :12] = e.slave.getReal(vr["F"])
+                    samples[base + k, :nf] = e.slave.getReal(vr["F"])
 
                 def rec_body(k):
-                    samples[base + k, 12:] = b.slave.getReal(vr["sw"])
+                    samples[base + k, nf:] = b.slave.getReal(vr["sw"])
 
                 if algorithm == "jacobi":
-                    e.slave.setRealInputDerivatives(vr["re"], ones12, zeros12)
-                    e.slave.setRealInputDerivatives(vr["ve"], ones12, zeros12)
-                    b.slave.setRealInputDerivatives(vr["Fb"], ones12, zeros12)
+                    e.slave.setRealInputDerivatives(vr["re"], ones, zeros)
+                    e.slave.setRealInputDerivatives(vr["ve"], ones, zeros)
+                    b.slave.setRealInputDerivatives(vr["Fb"], ones, zeros)
                     self._advance(e, t, H, m, rec_engine)
                     self._advance(b, t, H, m, rec_body)
                 elif algorithm == "gauss_seidel":
-                    e.slave.setRealInputDerivatives(vr["re"], ones12, zeros12)
-                    e.slave.setRealInputDerivatives(vr["ve"], ones12, zeros12)
+                    e.slave.setRealInputDerivatives(vr["re"], ones, zeros)
+                    e.slave.setRealInputDerivatives(vr["ve"], ones, zeros)
                     self._advance(e, t, H, m, rec_engine)
                     F_end = np.array(e.slave.getReal(vr["F"]))
-                    b.slave.setRealInputDerivatives(vr["Fb"], ones12, list((F_end - self.F) / H))
+                    b.slave.setRealInputDerivatives(vr["Fb"], ones, list((F_end - self.F) / H))
                     self._advance(b, t, H, m, rec_body)
                 else:
                     # The body motion for the guessed ramp (exact for that ramp: the body is
                     # linear); the engine steps on it, the correction comes at the end.
                     state = b.slave.getFMUstate()
-                    b.slave.setRealInputDerivatives(vr["Fb"], ones12, list(dF / H))
+                    b.slave.setRealInputDerivatives(vr["Fb"], ones, list(dF / H))
                     b.slave.doStep(t, H)
                     r_pred = np.array(b.slave.getReal(vr["r"]))
                     v_pred = np.array(b.slave.getReal(vr["v"]))
@@ -345,8 +366,8 @@ class CoupledPair:
                     b.slave.freeFMUstate(state)
                     e.slave.setReal(vr["re"], list(r))
                     e.slave.setReal(vr["ve"], list(v))
-                    e.slave.setRealInputDerivatives(vr["re"], ones12, list((r_pred - r) / H))
-                    e.slave.setRealInputDerivatives(vr["ve"], ones12, list((v_pred - v) / H))
+                    e.slave.setRealInputDerivatives(vr["re"], ones, list((r_pred - r) / H))
+                    e.slave.setRealInputDerivatives(vr["ve"], ones, list((v_pred - v) / H))
                     self._advance(e, t, H, m, rec_engine)
                     F_pred = np.array(e.slave.getReal(vr["F"]))
                     if n % refresh == 0:
@@ -354,18 +375,18 @@ class CoupledPair:
                         M = I - K @ S_r - C @ S_v
                     delta = np.linalg.solve(M, F_pred - self.F - dF)
                     dF = dF + delta
-                    dF_next = dF if extrapolate else np.zeros(12)
+                    dF_next = dF if extrapolate else np.zeros(nf)
                     b.slave.setReal(vr["Fb"], list(self.F))
-                    b.slave.setRealInputDerivatives(vr["Fb"], ones12, list(dF / H))
+                    b.slave.setRealInputDerivatives(vr["Fb"], ones, list(dF / H))
                     self._advance(b, t, H, m, rec_body)
                     dF = dF_next
                 r, v = self._exchange()
                 row += m
-                samples[row - 1, :12] = self.F
-                samples[row - 1, 12:] = b.slave.getReal(vr["sw"])
+                samples[row - 1, :nf] = self.F
+                samples[row - 1, nf:] = b.slave.getReal(vr["sw"])
                 t_reached = (n + 1) * H
                 last = samples[base:row]
-                if not np.all(np.isfinite(last)) or np.max(np.abs(last[:, :12])) > FORCE_LIMIT:
+                if not np.all(np.isfinite(last)) or np.max(np.abs(last[:, :nf])) > FORCE_LIMIT:
                     raise Diverged(f"diverged at t = {t_reached:.4g} s")
         except Diverged as error:
             status = str(error)
@@ -373,7 +394,7 @@ class CoupledPair:
             cause = e.errors() or b.errors() or str(error)
             status = f"error at t = {t_reached:.4g} s: {cause}"
         wall = time.perf_counter() - begin
-        return Run(h=h_out, signals=dict(zip(SIGNALS, samples.T)), wall=wall, status=status,
+        return Run(h=h_out, signals=dict(zip(self.signals, samples.T)), wall=wall, status=status,
                    t_reached=t_reached)
 
 
@@ -398,9 +419,10 @@ def monolithic(engine_fmu, rpm: float, h: float = 1e-4, t_end: float = 1.0,
                    **(engine_parameters or {})})
         fmu.slave.enterInitializationMode()
         fmu.slave.exitInitializationMode()
-        vr = fmu.refs(SIGNALS)
+        recorded = signals(mount_count(variable_names(fmu.md)))
+        vr = fmu.refs(recorded)
         n = int(round(t_end / h))
-        samples = np.empty((n, len(SIGNALS)))
+        samples = np.empty((n, len(recorded)))
         begin = time.perf_counter()
         for k in range(n):
             fmu.slave.doStep(k * h, h)
@@ -408,17 +430,7 @@ def monolithic(engine_fmu, rpm: float, h: float = 1e-4, t_end: float = 1.0,
         wall = time.perf_counter() - begin
     finally:
         fmu.close()
-    return Run(h=h, signals=dict(zip(SIGNALS, samples.T)), wall=wall, status="ok", t_reached=t_end)
-
-
-def order_amplitudes(x, h: float, rpm: float, revolutions: int = 8, orders=ORDERS) -> np.ndarray:
-    """Amplitude of each engine order over the last ``revolutions`` of ``x`` (sampled every
-    ``h`` s): a DFT at the order's frequency over the samples spanning those revolutions."""
-    n = int(round(revolutions * 60.0 / rpm / h))
-    t = np.arange(n) * h
-    tail = np.asarray(x)[-n:]
-    return np.array([2.0 / n * abs(np.sum(tail * np.exp(-2j * np.pi * o * rpm / 60.0 * t)))
-                     for o in orders])
+    return Run(h=h, signals=dict(zip(recorded, samples.T)), wall=wall, status="ok", t_reached=t_end)
 
 
 def largest_deviation(reference: Run, run: Run, rpm: float, revolutions: int = 8,
@@ -430,12 +442,18 @@ def largest_deviation(reference: Run, run: Run, rpm: float, revolutions: int = 8
     component that is nearly zero by symmetry then does not count with its own scale). The
     reference is decimated to the run's sampling."""
     step = int(round(run.h / reference.h))
-    ref = {n: order_amplitudes(reference.signals[n][step - 1::step], run.h, rpm, revolutions)
-           for n in SIGNALS}
-    got = {n: order_amplitudes(run.signals[n], run.h, rpm, revolutions) for n in SIGNALS}
-    group = {n: max(ref[m].max() for m in (FORCES if n in FORCES else COMFORT)) for n in SIGNALS}
+
+    def orders_of(x) -> np.ndarray:
+        return np.array(list(order_amplitudes(x, revolutions, ORDERS, 60.0 / rpm / run.h).values()))
+
+    names = list(run.signals)
+    force_names = [n for n in names if n not in COMFORT]
+    ref = {n: orders_of(reference.signals[n][step - 1::step]) for n in names}
+    got = {n: orders_of(run.signals[n]) for n in names}
+    group = {n: max(ref[m].max() for m in (force_names if n in force_names else COMFORT))
+             for n in names}
     worst, where = 0.0, ""
-    for name in SIGNALS:
+    for name in names:
         scale = ref[name].max() if floor == "signal" else group[name]
         for o, x, y in zip(ORDERS, ref[name], got[name]):
             if x < 0.01 * scale:
@@ -457,7 +475,8 @@ def growth(reference: Run, run: Run, rpm: float, revolutions: int = 8) -> float:
     if n < 2:
         return float("nan")
     return max(np.ptp(run.signals[f][end - n:end])
-               / np.ptp(reference.signals[f][step - 1::step][end - n:end]) for f in FORCES)
+               / np.ptp(reference.signals[f][step - 1::step][end - n:end])
+               for f in run.signals if f not in COMFORT)
 
 
 # ----- the table ---------------------------------------------------------------------------------
@@ -502,7 +521,7 @@ def interface_numbers(engine_fmu, body_fmu, rpm: float, cache_dir, steps=STEPS,
     two_zeta_omega = float(mode @ Ainv @ (-A @ C) @ mode / (mode @ Ainv @ mode))
     stiff = [float(np.max(np.linalg.eigvalsh(-(K[3 * i:3 * i + 3, 3 * i:3 * i + 3]
                                               + K[3 * i:3 * i + 3, 3 * i:3 * i + 3].T) / 2)))
-             for i in range(MOUNTS)]
+             for i in range(K.shape[0] // AXES)]
     approx = {H: (float(np.linalg.norm(S[H][0] - A * H * H / 6) / np.linalg.norm(S[H][0])),
                   float(np.linalg.norm(S[H][1] - A * H / 2) / np.linalg.norm(S[H][1])))
               for H in S}
@@ -585,7 +604,8 @@ def main(argv=None):
     args = parser.parse_args(argv)
     if not args.table:
         parser.error("nothing to do: pass --table")
-    scale = {f"mount[{i}].stiffnessScale": args.stiffness_scale for i in range(1, MOUNTS + 1)}
+    mounts = mount_count(variable_names(read_model_description(args.engine)))
+    scale = {f"mount[{i}].stiffnessScale": args.stiffness_scale for i in range(1, mounts + 1)}
     table(args.engine, args.body, args.rpm, [s * 1e-3 for s in args.steps], args.algorithms,
           args.t_end, engine_parameters=scale if args.stiffness_scale != 1.0 else None)
 

@@ -15,8 +15,7 @@ import matplotlib.pyplot as plt  # noqa: E402
 import numpy as np  # noqa: E402
 import pandas as pd  # noqa: E402
 
-MAIN_ORDERS = (1.0, 1.5, 2.0, 3.0, 4.5)
-ALL_ORDERS = tuple(k / 2 for k in range(1, 13))
+from .spectra import MAIN_ORDERS, ORDERS  # noqa: E402
 HIGHEST_ORDER = 6.5  # the spectra of a sweep reach 6.5 orders
 # Colour range of a waterfall below its peak.
 DYNAMIC_RANGE_DB = 60.0
@@ -106,7 +105,7 @@ def _draw_colour_map(ax, data: pd.DataFrame, unit: str | None, top: float, vmin:
         mesh = ax.pcolormesh([edges[k], edges[k + 1]], f_edges, levels, cmap="inferno",
                              vmin=vmin, vmax=vmax, shading="flat", rasterized=True)
     rpm_line = np.array([0.0, edges[-1]])
-    for order in ALL_ORDERS:
+    for order in ORDERS:
         main = order in MAIN_ORDERS
         ax.plot(rpm_line, order * rpm_line / 60.0, "--" if main else ":", color="white",
                 lw=0.8 if main else 0.5, alpha=0.7 if main else 0.4)

@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import dataclasses
+import itertools
 import math
 import re
 import time
@@ -53,25 +54,60 @@ def set_value(slave: FMU2Slave, kind: str, vr: int, value) -> None:
         slave.setString([vr], [str(value)])
 
 
+def mount_count(names: Iterable[str]) -> int:
+    """How many mounts an FMU has: the highest ``i`` of its variables ``mount[i].…`` (``names``:
+    the variable names of its model description)."""
+    found = [int(m.group(1)) for name in names if (m := re.match(r"mount\[(\d+)\]\.", name))]
+    return max(found, default=0)
+
+
+def variable_names(model_description) -> list[str]:
+    return [v.name for v in model_description.modelVariables]
+
+
+# fmpy's logger proxy (which formats the FMU's printf-style messages) keeps ONE logger for the
+# whole process, the last one registered: each instance's own Python logger would receive every
+# instance's messages, and once it is freed the next message from any instance calls freed memory.
+# So one logger lives as long as the process and hands each message to the sink of the instance
+# it came from, named by the instance's component environment.
+_SINKS: dict[int, list] = {}
+_NEXT_SINK = itertools.count(1)
+
+
+def _dispatch(environment, _instance, status, category, message):
+    sink = _SINKS.get(environment or 0)
+    if sink is None:
+        return
+    label = STATUS_LABELS[status] if 0 <= status < len(STATUS_LABELS) else str(status)
+    sink.append(f"[{label}] {category.decode('utf-8', 'replace')}: "
+                f"{message.decode('utf-8', 'replace')}")
+
+
+_LOGGER = fmi2CallbackLoggerTYPE(_dispatch)
+
+
 def logging_callbacks(sink: list) -> fmi2CallbackFunctions:
-    """FMI callbacks whose logger appends "[status] category: message" lines to ``sink``."""
-
-    def logger(_env, _instance, status, category, message):
-        label = STATUS_LABELS[status] if 0 <= status < len(STATUS_LABELS) else str(status)
-        sink.append(f"[{label}] {category.decode('utf-8', 'replace')}: "
-                    f"{message.decode('utf-8', 'replace')}")
-
-    callbacks = fmi2CallbackFunctions()
-    callbacks.logger = fmi2CallbackLoggerTYPE(logger)
-    callbacks.allocateMemory = fmi2CallbackAllocateMemoryTYPE(calloc)
-    callbacks.freeMemory = fmi2CallbackFreeMemoryTYPE(free)
-    # The FMU formats its messages printf-style ("%s" and one argument): fmpy's proxy does that.
+    """FMI callbacks whose logger appends "[status] category: message" lines to ``sink`` (until
+    :func:`release_logging`)."""
     from ctypes import byref
 
     from fmpy.logging import addLoggerProxy
 
+    key = next(_NEXT_SINK)
+    _SINKS[key] = sink
+    callbacks = fmi2CallbackFunctions()
+    callbacks.logger = _LOGGER
+    callbacks.componentEnvironment = key
+    callbacks.allocateMemory = fmi2CallbackAllocateMemoryTYPE(calloc)
+    callbacks.freeMemory = fmi2CallbackFreeMemoryTYPE(free)
     addLoggerProxy(byref(callbacks))
     return callbacks
+
+
+def release_logging(callbacks: fmi2CallbackFunctions):
+    """Stops collecting the messages of the instance created with ``callbacks`` (after its
+    fmi2FreeInstance)."""
+    _SINKS.pop(callbacks.componentEnvironment or 0, None)
 
 
 @dataclasses.dataclass(frozen=True)
@@ -104,9 +140,12 @@ class OperatingPoint:
 class Runner:
     """One FMU instance; ``run_point`` resets it, so results never depend on earlier points."""
 
-    def __init__(self, fmu_path: str, instance_name: str = "emc"):
+    def __init__(self, fmu_path: str, instance_name: str = "emc", unzipdir: str | None = None):
+        """``unzipdir``: the FMU already extracted there (kept on close); else it is extracted
+        into a temporary directory of its own, removed on close."""
         self.md = read_model_description(fmu_path)
-        self.unzipdir = extract(fmu_path)
+        self.own_unzipdir = unzipdir is None
+        self.unzipdir = extract(fmu_path) if unzipdir is None else unzipdir
         self.vr = {v.name: v.valueReference for v in self.md.modelVariables}
         self.kind = {v.name: v.type for v in self.md.modelVariables}
         self.slave = FMU2Slave(
@@ -120,7 +159,8 @@ class Runner:
         try:
             self.slave.instantiate(callbacks=self.callbacks)
         except Exception as error:  # noqa: BLE001 - fmpy raises a bare Exception
-            shutil.rmtree(self.unzipdir, ignore_errors=True)
+            if self.own_unzipdir:
+                shutil.rmtree(self.unzipdir, ignore_errors=True)
             raise self.failure(f"instantiating {self.md.modelName}", error) from None
         # Errors and warnings always reach the logger; the model set-up events (scene, chassis
         # reduction or cache, periodic start) are cheap and tell what a failed point was doing.
@@ -135,7 +175,9 @@ class Runner:
         except Exception:  # noqa: BLE001 - a failed point leaves the instance in an error state
             pass
         self.slave.freeInstance()
-        shutil.rmtree(self.unzipdir, ignore_errors=True)
+        release_logging(self.callbacks)
+        if self.own_unzipdir:
+            shutil.rmtree(self.unzipdir, ignore_errors=True)
 
     def warnings(self) -> list[str]:
         """The FMU's warnings since the log was last cleared (a successful point may have some)."""
@@ -163,7 +205,9 @@ class Runner:
     def _set(self, name: str, value):
         set_value(self.slave, self.kind[name], self.vr[name], value)
 
-    def _start(self, start_values: dict):
+    def _start(self, start_values: dict, initialise: bool = True):
+        """Back to the instantiated state (reset), the start values set, initialisation mode
+        entered and, if ``initialise``, left."""
         if not self.fresh:
             self.slave.reset()
         self.fresh = False
@@ -171,7 +215,29 @@ class Runner:
         for name, value in start_values.items():
             self._set(name, value)
         self.slave.enterInitializationMode()
-        self.slave.exitInitializationMode()
+        if initialise:
+            self.slave.exitInitializationMode()
+
+    def get(self, names: Iterable[str]) -> list:
+        """The current values of the variables ``names``, each read with its type's getter."""
+        names = list(names)
+        getters = {"Real": self.slave.getReal, "Integer": self.slave.getInteger,
+                   "Boolean": self.slave.getBoolean, "String": self.slave.getString}
+        values = {}
+        for kind, getter in getters.items():
+            of_kind = [n for n in names if self.kind[n] == kind]
+            if of_kind:
+                values.update(zip(of_kind, getter([self.vr[n] for n in of_kind])))
+        return [values[n] for n in names]
+
+    def initial_values(self, start_values: dict, names: Iterable[str]) -> list:
+        """The values of ``names`` in initialisation mode for ``start_values``: calculated
+        parameters (outputs would build the model and give its static equilibrium)."""
+        try:
+            self._start(start_values, initialise=False)
+            return self.get(names)
+        except Exception as error:  # noqa: BLE001 - fmpy raises plain exceptions
+            raise self.failure("initialisation", error) from None
 
     def run_point(self, point: OperatingPoint, signals: list[str], case: str = "") -> dict:
         """Runs one point; returns the stationary window of ``signals`` sampled per step.
@@ -268,3 +334,19 @@ def fmu_from_content(content: bytes, sha256: str) -> str:
             out.write(content)
         os.replace(partial, path)
     return path
+
+
+def extracted(path: str, sha256: str) -> str:
+    """The FMU at ``path`` (with this checksum) extracted once per machine into the temporary
+    directory under its checksum; concurrent callers each extract into a directory of their own
+    and the first to rename it into place wins."""
+    import os
+
+    target = os.path.join(tempfile.gettempdir(), f"emc-fmu-{sha256}")
+    if not os.path.isdir(target):
+        partial = extract(path, tempfile.mkdtemp(prefix="emc-fmu-", suffix=".part"))
+        try:
+            os.rename(partial, target)
+        except OSError:  # another process was first
+            shutil.rmtree(partial, ignore_errors=True)
+    return target

@@ -15,49 +15,34 @@ import tempfile
 import time
 
 import numpy as np
-from fmpy import simulate_fmu
+from fmpy import read_model_description, simulate_fmu
 
+from emc.coupling import COMFORT, Run, forces, signals
+from emc.coupling import largest_deviation as coupling_deviation
+from emc.runner import mount_count, variable_names
 from emc.ssp import write_ssp
 
 ROOT = pathlib.Path(__file__).resolve().parents[2]
-FORCES = [f"mount[{i}].F[{j}]" for i in range(1, 5) for j in range(1, 4)]
-COMFORT = [f"steeringWheel.a[{j}]" for j in range(1, 4)]
-SIGNALS = FORCES + COMFORT
-ORDERS = np.arange(1, 13) * 0.5
 
 
-def order_amplitudes(x, h: float, rpm: float, revolutions: int, orders=ORDERS) -> np.ndarray:
-    """Amplitude of each engine order over the last ``revolutions`` of ``x`` (sampled every ``h``
-    s), by a DFT at the order's frequency over the samples spanning those revolutions."""
-    n = int(round(revolutions * 60.0 / rpm / h))
-    t = np.arange(n) * h
-    tail = np.asarray(x)[-n:]
-    return np.array([2.0 / n * abs(np.sum(tail * np.exp(-2j * np.pi * o * rpm / 60.0 * t)))
-                     for o in orders])
+def largest_deviation(reference: dict, other: dict, h: float, rpm: float,
+                      revolutions: int = 8) -> tuple[float, str]:
+    """The largest relative deviation of ``other``'s order amplitudes from ``reference``'s (both
+    sampled every ``h``), over the signals and the orders above 1 % of each signal's largest,
+    and where it is."""
+    def run(signals: dict) -> Run:
+        return Run(h=h, signals=signals, wall=0.0, status="ok", t_reached=len(next(iter(signals.values()))) * h)
 
-
-def largest_deviation(reference: dict, other: dict, h: float, rpm: float, revolutions: int = 8,
-                      threshold: float = 0.01) -> tuple[float, str]:
-    """The largest relative deviation of ``other``'s order amplitudes from ``reference``'s, over
-    the signals and the orders above ``threshold`` of each signal's largest, and where it is."""
-    worst, where = 0.0, ""
-    for name in SIGNALS:
-        a = order_amplitudes(reference[name], h, rpm, revolutions)
-        b = order_amplitudes(other[name], h, rpm, revolutions)
-        if not np.all(np.isfinite(b)):
-            return float("inf"), name
-        for o, x, y in zip(ORDERS, a, b):
-            if x >= threshold * a.max() and abs(y - x) / x > worst:
-                worst, where = abs(y - x) / x, f"{name} order {o}"
-    return worst, where
+    return coupling_deviation(run(reference), run(other), rpm, revolutions)
 
 
 def scene_2(engine_fmu, rpm: float, h: float, t_end: float, cache, rel_tol: float) -> dict:
     """The monolithic scene 2 through fmpy, sampled every ``h``."""
     start = {"scene": 2, "rpm": rpm, "chassis.cacheDir": str(cache), "solver.relTol": rel_tol}
+    recorded = signals(mount_count(variable_names(read_model_description(str(engine_fmu)))))
     r = simulate_fmu(str(engine_fmu), stop_time=t_end, output_interval=h, start_values=start,
-                     output=SIGNALS)
-    return {name: r[name][1:] for name in SIGNALS}
+                     output=recorded)
+    return {name: r[name][1:] for name in recorded}
 
 
 def split_in_libcosim(ssp, rpm: float, h: float, t_end: float) -> dict:
@@ -76,16 +61,17 @@ def split_in_libcosim(ssp, rpm: float, h: float, t_end: float) -> dict:
     vr_engine = {v.name.decode(): v.reference for v in execution.slave_variables(engine)}
     vr_body = {v.name.decode(): v.reference for v in execution.slave_variables(body)}
     execution.real_initial_value(engine, vr_engine["rpm"], rpm)
+    mount_forces = forces(mount_count(vr_engine))
     steps = int(round(t_end / h))
-    rows = np.full((steps, len(SIGNALS)), np.nan)
+    rows = np.full((steps, len(mount_forces) + len(COMFORT)), np.nan)
     for k in range(steps):
         if not execution.step():
             break
-        rows[k] = (observer.last_real_values(engine, [vr_engine[n] for n in FORCES])
+        rows[k] = (observer.last_real_values(engine, [vr_engine[n] for n in mount_forces])
                    + observer.last_real_values(body, [vr_body[n] for n in COMFORT]))
         if not np.all(np.isfinite(rows[k])):
             break
-    return dict(zip(SIGNALS, rows.T))
+    return dict(zip(mount_forces + COMFORT, rows.T))
 
 
 def compare(engine_fmu, body_fmu, rpm: float, h: float, t_end: float, work: pathlib.Path,

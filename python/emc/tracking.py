@@ -12,7 +12,7 @@ from __future__ import annotations
 import numpy as np
 import pandas as pd
 
-ORDERS = tuple(k / 2 for k in range(1, 13))  # 0.5 … 6.0
+from .spectra import ORDERS, order_amplitudes
 
 
 def resample_by_angle(crank_angle: np.ndarray, values: np.ndarray, samples_per_revolution: int):
@@ -47,11 +47,8 @@ def track_orders(crank_angle, rpm, samples: np.ndarray, signals: list[str],
         block = resampled[start:start + n]
         speed = float(np.mean(block[:, -1]))
         for j, signal in enumerate(signals):
-            x = block[:, j] - np.mean(block[:, j])
-            spectrum = np.fft.rfft(x)
-            for order in orders:
-                k = int(round(order * revolutions_per_block))
-                rows.append({"case": case, "rpm": speed, "signal": signal, "order": float(order),
-                             "frequency": order * speed / 60.0,
-                             "amplitude": 2.0 * abs(spectrum[k]) / n})
+            amplitudes = order_amplitudes(block[:, j], revolutions_per_block, orders)
+            for order, amplitude in amplitudes.items():
+                rows.append({"case": case, "rpm": speed, "signal": signal, "order": order,
+                             "frequency": order * speed / 60.0, "amplitude": amplitude})
     return pd.DataFrame(rows)

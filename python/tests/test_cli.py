@@ -4,6 +4,7 @@ content, warnings for what the sampling cannot represent, progress, default scen
 tracked in the crank-angle domain."""
 
 import datetime
+import functools
 import hashlib
 import json
 import os
@@ -16,7 +17,7 @@ from fmpy import read_model_description
 
 from emc import cli
 from emc.runner import PointFailed, fmu_from_content
-from emc.sweep import _run_partition, run_sweep, speed_points
+from emc.sweep import run_sweep, speed_points, sweep_point
 from emc.tracking import track_orders
 
 TINY = ["--serial", "--quiet", "--count", "1", "--rpm", "1500", "1500", "--revolutions", "2",
@@ -239,27 +240,30 @@ def test_default_scene_is_the_elastic_body_and_scene_1_still_works(fmu_path, tmp
 
 # --- warnings and progress ---------------------------------------------------------------------
 
-def test_warnings_for_aliasing_and_speeds_beyond_the_chassis_model(variables):
-    assert cli.sampling_warnings(variables, {"scene": 2}, 800, 2500, 72) == []
-    few = cli.sampling_warnings(variables, {"scene": 2}, 800, 2500, 10)
+def test_warnings_for_aliasing_and_speeds_beyond_the_chassis_model(variables, fmu_path):
+    def warnings(parameters, rpm_from, rpm_to, *spr, **step):
+        cutoff, = cli.cutoffs_in_use(str(fmu_path), [("", parameters)])
+        return cli.sampling_warnings(variables, parameters, rpm_from, rpm_to, *spr, **step,
+                                     cutoff=cutoff)
+
+    assert warnings({"scene": 2}, 800, 2500, 72) == []
+    few = warnings({"scene": 2}, 800, 2500, 10)
     assert any("--steps-per-rev 10: orders above 5 alias onto lower ones" in w for w in few)
     assert any("body modes up to the 225 Hz cut-off alias" in w for w in few)
     # 24 samples per revolution resolve order 6.5 but at 800 rpm only 160 Hz of the body.
-    body = cli.sampling_warnings(variables, {"scene": 2}, 800, 2500, 24)
+    body = warnings({"scene": 2}, 800, 2500, 24)
     assert len(body) == 1 and "resolves 160 Hz" in body[0]
-    fast = cli.sampling_warnings(variables, {"scene": 2}, 800, 3500, 72)
+    fast = warnings({"scene": 2}, 800, 3500, 72)
     assert any("exceed scene.maxRpm = 2500" in w for w in fast)
-    assert cli.sampling_warnings(variables, {"scene": 2, "scene.maxRpm": 3500.0}, 800, 3500,
-                                 72) == []
-    cut = cli.sampling_warnings(variables, {"scene": 2, "chassis.modeCutoff": 100.0}, 800, 2500,
-                                72)
+    assert warnings({"scene": 2, "scene.maxRpm": 3500.0}, 800, 3500, 72) == []
+    cut = warnings({"scene": 2, "chassis.modeCutoff": 100.0}, 800, 2500, 72)
     assert any("above chassis.modeCutoff = 100 Hz" in w for w in cut)
-    assert cli.sampling_warnings(variables, {"scene": 1}, 800, 3500, 72) == []
+    assert warnings({"scene": 1}, 800, 3500, 72) == []
     # A run-up samples every --step seconds: few samples per revolution at the top speed.
-    coarse = cli.sampling_warnings(variables, {"scene": 2}, 1000, 2500, step=4e-3)
+    coarse = warnings({"scene": 2}, 1000, 2500, step=4e-3)
     assert any(w.startswith("--step 0.004 s (6.0 samples per revolution at 2500 rpm)")
                for w in coarse)
-    assert cli.sampling_warnings(variables, {"scene": 2}, 1000, 2500, step=2e-4) == []
+    assert warnings({"scene": 2}, 1000, 2500, step=2e-4) == []
 
 
 def test_warnings_are_printed_once_before_the_run(fmu_path, tmp_path, capsys):
@@ -300,13 +304,21 @@ def test_fmu_content_is_written_once_under_its_checksum(fmu_path, tmp_path):
     assert digest in os.path.basename(path)
     first = os.stat(path).st_mtime_ns
     assert fmu_from_content(content, digest) == path and os.stat(path).st_mtime_ns == first
-    # A partition runs from the bytes alone: the caller's copy is gone.
+    # A worker runs from the bytes its plugin got alone: the caller's copy is gone.
+    from emc.distributed import FmuPlugin, evaluate_batch
+
     copy = tmp_path / "gone.fmu"
     shutil.copy(fmu_path, copy)
     copy.unlink()
     points = speed_points(1500, 1500, 1, revolutions=2, parameters=(("scene", 1),))
-    rows, warnings, failure = _run_partition(content, digest, points, ["mount[1].F[3]"], "")
-    assert failure is None and rows[0][0], "orders of the point"
+    plugin = FmuPlugin(content, digest)
+    plugin.setup(worker=None)
+    try:
+        evaluate = functools.partial(sweep_point, signals=["mount[1].F[3]"], case="")
+        results, failure = evaluate_batch(digest, evaluate, points)
+    finally:
+        plugin.teardown(worker=None)
+    assert failure is None and results[0][0].order_amplitude.size, "orders of the point"
 
 
 def test_a_relative_fmu_works_on_workers_with_another_working_directory(fmu_path, tmp_path,

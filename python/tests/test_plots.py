@@ -10,9 +10,9 @@ import pytest
 from matplotlib.collections import QuadMesh
 
 from emc import plots
+from emc.spectra import ORDERS
 
 SPEEDS = (1000.0, 1500.0, 2000.0)
-ORDERS = tuple(k / 2 for k in range(1, 13))
 
 
 def spectra_table(signal: str, peak: float, cases=("",)) -> pd.DataFrame:

@@ -5,7 +5,7 @@ import pandas as pd
 import pytest
 
 from emc.runner import OperatingPoint, Runner
-from emc.spectra import amplitude_spectrum, order_amplitudes
+from emc.spectra import ORDERS, amplitude_spectrum, order_amplitudes
 from emc.sweep import run_sweep, speed_points
 
 
@@ -31,19 +31,37 @@ def test_operating_points_reject_windows_without_half_orders():
         raise AssertionError(f"{bad} accepted")
 
 
-def test_dask_sweep_equals_serial_sweep(fmu_path):
-    points = speed_points(900, 2100, 3, revolutions=4)
-    signals = ["mount[1].F[3]", "mount[3].F[1]"]
+def test_dask_sweeps_equal_the_serial_sweep_for_any_worker_count(fmu_path):
+    """Workers keep their instance from batch to batch: whatever the worker count and batching,
+    the tables are the serial sweep's to the bit (scene 2, five points)."""
+    from emc.distributed import FmuPool
+
+    points = speed_points(900, 2100, 5, revolutions=4)
+    signals = ["mount[1].F[3]", "mount[3].F[1]", "steeringWheel.a[3]"]
     serial = run_sweep(str(fmu_path), points, signals, parallel=False, progress=False)
-    parallel = run_sweep(str(fmu_path), points, signals, parallel=True, workers=2, progress=False)
-    for a, b in zip(serial, parallel):
-        pd.testing.assert_frame_equal(a, b, check_exact=True)
+    for workers in (1, 2, 3):
+        with FmuPool(str(fmu_path), workers=workers, batches_per_worker=2) as pool:
+            assert pool.workers == workers
+            # Twice on the same pool: the second sweep runs on instances already used.
+            for _ in range(2):
+                parallel = run_sweep(str(fmu_path), points, signals, progress=False, pool=pool)
+                for a, b in zip(serial, parallel):
+                    pd.testing.assert_frame_equal(a, b, check_exact=True)
     orders = serial[0]
-    assert set(orders.rpm) == {900.0, 1500.0, 2100.0}
+    assert set(orders.rpm) == {900.0, 1200.0, 1500.0, 1800.0, 2100.0}
     # the 1.5 order of the gas torque dominates the vertical mount force
     main = orders[(orders.signal == "mount[1].F[3]") & (orders.order == 1.5)].amplitude
     other = orders[(orders.signal == "mount[1].F[3]") & (orders.order.isin([2.5, 3.5]))].amplitude
     assert main.min() > 10 * other.max()
+
+
+def test_batches_interleave_the_items_and_cover_each_once():
+    from emc.distributed import interleaved_batches
+
+    assert interleaved_batches(7, 3) == [[0, 3, 6], [1, 4], [2, 5]]
+    assert interleaved_batches(2, 8) == [[0], [1]]
+    groups = interleaved_batches(48, 8)
+    assert sorted(i for g in groups for i in g) == list(range(48))
 
 
 def test_study_engines_compares_the_inline_three_with_the_inline_four(fmu_path, tmp_path):
@@ -90,3 +108,44 @@ def test_settle_options_are_checked(fmu_path, tmp_path, capsys):
     assert main(base + ["--start", "settle", "--settle", "-5"]) == 2
     assert ">= 0" in capsys.readouterr().err
     assert main(base + ["--start", "settle", "--settle", "6"]) == 0
+
+
+def test_order_amplitudes_on_and_off_the_bins_recover_a_known_signal():
+    """The one order-amplitude routine: a window of whole samples per revolution (DFT bins) and
+    one of 545.45… samples per revolution (the DFT at each order's own frequency), several
+    signals at once, the mean removed."""
+    rpm = 1100.0
+    w = 2 * np.pi * rpm / 60.0
+    for h in (60.0 / rpm / 72, 1e-4):
+        per_revolution = 60.0 / rpm / h
+        t = np.arange(int(round(12 * per_revolution))) * h
+        x = 5.0 + 2.0 * np.cos(1.5 * w * t + 0.3) + 0.7 * np.sin(3.0 * w * t)
+        a = order_amplitudes(np.column_stack([x, 2 * x]), 8, ORDERS, per_revolution)
+        tol = 1e-9 if per_revolution == round(per_revolution) else 2e-3
+        np.testing.assert_allclose(a[1.5], [2.0, 4.0], atol=tol)
+        np.testing.assert_allclose(a[3.0], [0.7, 1.4], atol=tol)
+        assert max(np.max(a[o]) for o in ORDERS if o not in (1.5, 3.0)) < tol
+
+
+def test_instances_log_to_their_own_sink_and_outlive_each_other(fmu_path):
+    """fmpy's logger proxy keeps one logger per process: each instance's messages must still
+    reach its own log, and an instance closed first must not take the logger with it (a later
+    message of the other one called freed memory: a segmentation fault)."""
+    from emc.runner import PointFailed
+
+    broken = OperatingPoint(rpm=1500.0, revolutions=2,
+                            parameters=(("scene", 1), ("configFile", "/nonexistent/a.json")))
+    first = Runner(str(fmu_path), instance_name="first")
+    try:
+        second = Runner(str(fmu_path), instance_name="second")
+        with pytest.raises(PointFailed):
+            second.run_point(broken, ["mount[1].F[3]"])
+        assert any("/nonexistent/a.json" in line for line in second.log)
+        assert not first.log
+        second.close()
+        with pytest.raises(PointFailed) as failure:
+            first.run_point(broken, ["mount[1].F[3]"])
+        assert "/nonexistent/a.json" in failure.value.cause
+        assert any(line.startswith("[error]") for line in first.log)
+    finally:
+        first.close()

@@ -60,9 +60,9 @@ pub struct ModeDescription {
 }
 
 impl ModeDescription {
-    /// One-line human-readable summary.
-    pub fn summary(&self) -> String {
-        let kind = match &self.kind {
+    /// What the mode is, in words ("global torsion", "steering wheel vertical", …).
+    pub fn kind_label(&self) -> String {
+        match &self.kind {
             ModeKind::RigidBody(s) => format!("rigid body on suspension: {s}"),
             ModeKind::GlobalTorsion => "global torsion".into(),
             ModeKind::GlobalBending => "global bending".into(),
@@ -71,7 +71,12 @@ impl ModeDescription {
             ModeKind::SteeringColumn => "steering column (wheel rotation)".into(),
             ModeKind::FrontEnd => "front end".into(),
             ModeKind::Local(r) => format!("local: {r}"),
-        };
+        }
+    }
+
+    /// One-line human-readable summary.
+    pub fn summary(&self) -> String {
+        let kind = self.kind_label();
         format!(
             "{:3} {:8.2} Hz  {:<38} steering {:4.2} (wheel z {:4.2} y {:4.2}) front {:4.2} \
              twist {:4.2} bend {:4.2}",

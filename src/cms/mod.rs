@@ -21,6 +21,9 @@
 //! ([`orthogonalise`], the damping table), and [`dmig_of_reduction`] writes our own reduction
 //! in that form.
 //!
+//! Only the rows of named points are kept; [`recover_all_nodes`] recovers the simulated modes on
+//! every node when a tool asks (operating deflection shapes), outside any instance.
+//!
 //! Recovery points, in order: the layout's mount nodes (`mount_front_left`, `mount_front_right`,
 //! `mount_rear_left`, `mount_rear_right`, minus the one the three-mount layout removes), then the
 //! spec's `outputs` (default `steering_wheel`, `seat_rail`; any named FE node is allowed).
@@ -66,6 +69,7 @@ mod dmig_export;
 mod error;
 mod external;
 mod hash;
+mod recovery;
 mod reduce;
 mod reduced;
 mod sparse_ops;
@@ -83,6 +87,7 @@ pub use dmig_export::{dmig_of_reduction, DmigBody};
 pub use error::CmsError;
 pub use external::{reduce_external, ExternalBody};
 pub use hash::sha256_hex;
+pub use recovery::{recover_all_nodes, FullRecovery};
 pub use reduce::{reduce, reduce_detailed, reduce_with_notes, Reduction};
 pub use reduced::{RecoveryPoint, ReducedChassis};
 pub use sparse_ops::Partition;

@@ -15,7 +15,7 @@ use crate::model::{Mode, ModeKind};
 #[derive(Clone)]
 pub struct BodySimulation {
     model: BodyAlone,
-    notes: Vec<String>,
+    pub(super) notes: Vec<String>,
     replaced: Vec<Replaced>,
     time: f64,
     /// Modal coordinates, then their rates.
@@ -223,6 +223,7 @@ impl BodySimulation {
                     description: format!("body mode {k} on its suspension"),
                     powertrain_fraction: 0.0,
                     powertrain_directions: [0.0; 6],
+                    centre_of_mass_directions: [0.0; 6],
                     kinetic_fractions: Vec::new(),
                     mount_strain_fraction: 0.0,
                 }

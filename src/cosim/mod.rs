@@ -8,6 +8,7 @@
 
 pub mod body;
 pub mod error;
+pub mod export;
 mod inputs;
 pub mod periodic;
 pub mod runtime;
@@ -20,6 +21,7 @@ pub use crate::model::RampInput;
 pub use crate::model::{EffectSwitch, Effects};
 pub use body::{BodySimulation, BodyState};
 pub use error::{Error, Input};
+pub use export::ExportRequest;
 pub use inputs::Inputs;
 pub use runtime::{FmuKind, Runtime, RuntimeState};
 pub use scene::{ComfortPoints, FMU_MOUNTS};
@@ -216,12 +218,18 @@ impl Simulation {
     /// (engine at rest, mounts at their operating points), ascending in frequency: the coupled
     /// frequencies of a Campbell diagram. Independent of how far the simulation has run.
     pub fn natural_modes(&self) -> Result<Vec<crate::model::Mode>, Error> {
+        Ok(self.linearisation_model()?.modes(&self.equilibrium)?)
+    }
+
+    /// The model as it was at the static equilibrium (initial inputs, fade-in start): what
+    /// [`Self::natural_modes`] and the analysis export linearise at [`Self::equilibrium`].
+    fn linearisation_model(&self) -> Result<CoupledModel, Error> {
         let mut model = self.scene.clone();
         scene::apply_inputs(&mut model, &self.initial_inputs)?;
         model
             .set_fade_start(self.initial_time)
             .map_err(|e| e.to_string())?;
-        Ok(model.modes(&self.equilibrium)?)
+        Ok(model)
     }
 
     /// The coupled model being integrated.

@@ -42,10 +42,18 @@ impl Runtime {
         t0: f64,
         inputs: &Inputs,
     ) -> Result<Self, Error> {
-        Ok(match kind {
+        let mut runtime = match kind {
             FmuKind::Engine => Runtime::Engine(Box::new(Simulation::new(settings, t0, inputs)?)),
             FmuKind::Body => Runtime::Body(Box::new(BodySimulation::new(settings, t0, inputs)?)),
-        })
+        };
+        if let Some(request) = &settings.export {
+            let line = super::export::write(&runtime, settings, request)?;
+            match &mut runtime {
+                Runtime::Engine(s) => s.notes.push(line),
+                Runtime::Body(s) => s.notes.push(line),
+            }
+        }
+        Ok(runtime)
     }
 
     /// Rebuilds from the settings and a saved [`RuntimeState`].

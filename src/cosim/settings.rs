@@ -30,6 +30,9 @@ pub struct Settings {
     pub periodic_start: bool,
     /// Used by the elastic-body scene only.
     pub chassis: BodyOptions,
+    /// Write the modal data and the linearised model for the analyses at initialisation
+    /// ([`super::export`]).
+    pub export: Option<super::ExportRequest>,
 }
 
 impl Default for Settings {
@@ -45,6 +48,7 @@ impl Default for Settings {
             stability_limit_detection: true,
             periodic_start: false,
             chassis: BodyOptions::default(),
+            export: None,
         }
     }
 }

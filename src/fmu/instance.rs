@@ -12,7 +12,7 @@ use std::path::PathBuf;
 use super::guard::{self, Abi};
 use super::input_track::InputTrack;
 use super::logger::{Level, Logger};
-use super::parameters;
+use super::parameters::{self, Calculated};
 use super::state::Phase;
 use super::values::{Num, Store, Typed, Values, VarType};
 use crate::cosim::{self, FmuKind, Runtime};
@@ -476,10 +476,19 @@ impl Instance {
         {
             self.ensure_simulation()?;
         }
-        if indices
-            .iter()
-            .any(|i| causality(i) == Causality::CalculatedParameter)
-        {
+        let needs = |what: Calculated| {
+            indices.iter().any(|i| {
+                causality(i) == Causality::CalculatedParameter
+                    && parameters::calculated(T::table()[*i].vr) == what
+            })
+        };
+        if needs(Calculated::FromParameters) {
+            parameters::write_derived_parameters(&mut self.core.values)?;
+        }
+        if needs(Calculated::FromModel) {
+            self.ensure_simulation()?;
+        }
+        if needs(Calculated::NaturalModes) {
             self.ensure_natural_modes()?;
         }
         let values = self.core.values.of::<T>().as_slice();

@@ -15,7 +15,9 @@ use crate::cosim::{
 };
 use crate::model::inputs::AttachmentMotion;
 use crate::model::{ModelInputs, RampInput};
-use crate::variables::{boolean, integer, real, string, Parameters, BOOLEANS, INTEGERS, REALS};
+use crate::variables::{
+    boolean, integer, real, string, Parameters, BOOLEANS, INTEGERS, REALS, STRINGS,
+};
 
 /// The Boolean parameter of an effect switch.
 fn effect_parameter(switch: EffectSwitch) -> u32 {
@@ -96,6 +98,20 @@ pub fn settings(
                 (true, dir) => CacheSetting::Dir(PathBuf::from(dir)),
             },
         },
+        export: match p.analysis_export_folder.trim() {
+            "" if p.analysis_full_recovery => {
+                return Err(format!(
+                    "{} = true needs {}: the folder to write the shapes to",
+                    BOOLEANS[boolean::ANALYSIS_FULL_RECOVERY as usize].name,
+                    STRINGS[string::ANALYSIS_EXPORT_FOLDER as usize].name
+                ))
+            }
+            "" => None,
+            folder => Some(cosim::ExportRequest {
+                folder: PathBuf::from(folder),
+                full_recovery: p.analysis_full_recovery,
+            }),
+        },
     })
 }
 
@@ -175,11 +191,54 @@ pub fn write_effective_parameters(values: &mut Values, runtime: &cosim::Runtime)
         real::CRANK_SPEED_TIME_CONSTANT,
         model.follower().time_constant,
     );
+    for (slots, deflection) in real::MOUNT_STATIC_DEFLECTION
+        .iter()
+        .zip(model.operating_points())
+    {
+        for (&slot, d) in slots.iter().zip(deflection) {
+            r.put(slot, d);
+        }
+    }
     let effects = model.effects();
     for switch in EffectSwitch::ALL {
         values
             .booleans
             .put(effect_parameter(switch), effects.get(switch));
+    }
+}
+
+/// The calculated parameters that follow from the parameters alone, written when one is read so
+/// that reading them builds no model: the chassis mode cut-off in use.
+pub fn write_derived_parameters(values: &mut Values) -> Result<(), String> {
+    let cutoff = settings(values, None, None)?.chassis.cutoff_hz();
+    values.reals.put(real::CHASSIS_MODE_CUTOFF_IN_USE, cutoff);
+    Ok(())
+}
+
+/// What a calculated parameter needs before it can be read.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Calculated {
+    /// The parameters alone ([`write_derived_parameters`]).
+    FromParameters,
+    /// The model built at its starting point ([`write_effective_parameters`]).
+    FromModel,
+    /// The natural modes of the model linearised at its static equilibrium.
+    NaturalModes,
+}
+
+/// What the calculated parameter with value reference `vr` needs.
+pub fn calculated(vr: u32) -> Calculated {
+    let is = |index: u32| REALS[index as usize].vr == vr;
+    if is(real::CHASSIS_MODE_CUTOFF_IN_USE) {
+        Calculated::FromParameters
+    } else if real::MOUNT_STATIC_DEFLECTION
+        .iter()
+        .flatten()
+        .any(|&i| is(i))
+    {
+        Calculated::FromModel
+    } else {
+        Calculated::NaturalModes
     }
 }
 

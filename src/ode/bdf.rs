@@ -4,12 +4,13 @@
 use faer::Mat;
 
 use super::coefficients::{bdf_coefficients, L_MAX};
+use super::dense_lu::DenseLu;
 use super::error::BdfError;
-use super::jacobian::JacobianPattern;
-use super::linear_solver::{DenseLu, IterationMatrix};
-use super::newton::{eval_mass, eval_rhs};
+use super::evaluation::{eval_mass, eval_rhs};
+use super::linear_solver::IterationMatrix;
 use super::nordsieck::{wrms_norm, Nordsieck};
 use super::options::BdfOptions;
+use super::pattern::JacobianPattern;
 use super::problem::{OdeProblem, ProblemError};
 use super::stability::StabilityGuard;
 use super::stats::BdfStats;

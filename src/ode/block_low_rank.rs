@@ -14,7 +14,7 @@
 use faer::linalg::matmul::matmul;
 use faer::{Accum, Mat, MatMut, MatRef, Par};
 
-use super::linear_solver::DenseLu;
+use super::dense_lu::DenseLu;
 
 /// Which states form each diagonal block, and the rank of the coupling `U Vᵀ`.
 #[derive(Debug, Clone, PartialEq, Eq, serde::Serialize, serde::Deserialize)]

@@ -49,8 +49,13 @@ mod block_low_rank;
 // Index loops mirror CVODE's formulas, which address several arrays by one index.
 #[allow(clippy::needless_range_loop)]
 mod coefficients;
+// Index loops mirror CVODE's formulas, which address several arrays by one index.
+#[allow(clippy::needless_range_loop)]
+mod dense_lu;
 mod error;
+mod evaluation;
 mod jacobian;
+mod pattern;
 // Index loops mirror CVODE's formulas, which address several arrays by one index.
 #[allow(clippy::needless_range_loop)]
 mod linear_solver;
@@ -71,10 +76,10 @@ mod tests;
 
 pub use bdf::Bdf;
 pub use block_low_rank::{BlockLowRankJacobian, BlockLowRankLu, BlockLowRankShape};
+pub use dense_lu::DenseLu;
 pub use error::BdfError;
-pub use jacobian::JacobianPattern;
-pub use linear_solver::DenseLu;
 pub use options::{BdfOptions, Tolerance};
+pub use pattern::JacobianPattern;
 pub use problem::{OdeProblem, ProblemError};
 pub use snapshot::BdfSnapshot;
 pub use stats::BdfStats;

@@ -4,14 +4,12 @@
 //! Unknown: the correction `acor` to the predicted state. Residual
 //! `G(acor) = M (rl1 zn[1] + acor) - gamma f(t, zn[0] + acor)`.
 
-use faer::Mat;
-
 use super::bdf::{Bdf, NlsOutcome, StepFlag};
+use super::evaluation::{eval_mass, eval_rhs};
 use super::jacobian::{finite_difference_jacobian, DifferenceQuotient};
 use super::linear_solver::IterationMatrix;
 use super::nordsieck::wrms_norm;
 use super::problem::{OdeProblem, ProblemError};
-use super::stats::BdfStats;
 
 /// Refactor after this many steps with the same iteration matrix (CVODE msbp).
 const MSBP: u64 = 20;
@@ -33,43 +31,6 @@ enum ConvFail {
     None,
     Other,
     BadJacobian,
-}
-
-/// Evaluates `f` and rejects NaN/inf; counts the evaluation.
-pub(super) fn eval_rhs<P: OdeProblem>(
-    problem: &mut P,
-    stats: &mut BdfStats,
-    t: f64,
-    y: &[f64],
-    f: &mut [f64],
-) -> Result<(), ProblemError> {
-    stats.rhs_evals += 1;
-    problem.rhs(t, y, f)?;
-    if f.iter().all(|v| v.is_finite()) {
-        Ok(())
-    } else {
-        Err(ProblemError::NonFinite)
-    }
-}
-
-/// Writes `M(t, y)` into `m` (the cached matrix when it is constant) and rejects NaN/inf.
-pub(super) fn eval_mass<P: OdeProblem>(
-    problem: &mut P,
-    constant: Option<&Mat<f64>>,
-    t: f64,
-    y: &[f64],
-    m: &mut Mat<f64>,
-) -> Result<(), ProblemError> {
-    if let Some(c) = constant {
-        m.copy_from(c);
-        return Ok(());
-    }
-    m.fill(0.0);
-    problem.mass(t, y, m.as_mut())?;
-    if m.col_iter().any(|c| c.iter().any(|v| !v.is_finite())) {
-        return Err(ProblemError::NonFinite);
-    }
-    Ok(())
 }
 
 fn recoverable(e: ProblemError) -> NlsOutcome {

@@ -3,7 +3,7 @@
 use faer::MatMut;
 
 use super::block_low_rank::{BlockLowRankJacobian, BlockLowRankShape};
-use super::jacobian::JacobianPattern;
+use super::pattern::JacobianPattern;
 
 /// Why a problem could not evaluate its equations at the requested point.
 #[derive(Debug, Clone, PartialEq)]

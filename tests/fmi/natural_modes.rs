@@ -3,7 +3,7 @@
 //! Truth: the analytic frequencies of the decoupled rigid mount layout and the paper's Table 1.
 
 use crate::common::*;
-use engine_mount_chassis::fmi2::variables::{boolean, integer, real};
+use engine_mount_chassis::fmi2::variables::{boolean, integer, real, string};
 use engine_mount_chassis::paper::{TABLE1_RIGID, TABLE1_RING_CARRIER};
 
 const TWO_PI: f64 = 2.0 * std::f64::consts::PI;
@@ -157,4 +157,94 @@ fn a_stiffer_front_plate_raises_the_steering_wheel_modes_in_the_elastic_body() {
         pv > v * 1.005 && pl > l * 1.005,
         "steering wheel {v:.2} / {l:.2} Hz -> {pv:.2} / {pl:.2} Hz"
     );
+}
+
+#[test]
+fn the_chassis_cutoff_in_use_is_read_from_the_parameters_without_building_a_model() {
+    // Truth: the rule the parameters' descriptions state, 2500 rpm / 60 × order 4.5 × 1.2 =
+    // 225 Hz by default; an explicit chassis.modeCutoff is used as given. A configuration file
+    // that does not exist would fail any model build: the read must not need one.
+    let fmu = Fmu::load();
+    let cases: [(&[(u32, f64)], f64); 3] = [
+        (&[], 225.0),
+        (
+            &[
+                (real::SCENE_MAX_RPM, 4000.0),
+                (real::SCENE_MAX_ENGINE_ORDER, 3.0),
+            ],
+            240.0,
+        ),
+        (&[(real::CHASSIS_MODE_CUTOFF, 400.0)], 400.0),
+    ];
+    for (k, (parameters, want)) in cases.iter().enumerate() {
+        let s = fmu.instantiate(&format!("cutoff-{k}"));
+        assert_eq!(s.set_integer(&[integer::SCENE], &[2]), OK);
+        assert_eq!(
+            s.set_string(&[string::CONFIG_FILE], &["/nonexistent/vehicle.json"]),
+            OK
+        );
+        for (index, value) in parameters.iter() {
+            assert_eq!(s.set_real(&[*index], &[*value]), OK);
+        }
+        s.setup(0.0, None);
+        assert_eq!(s.enter_init(), OK);
+        let (status, cutoff) = s.get_real(&[real::CHASSIS_MODE_CUTOFF_IN_USE]);
+        assert_eq!(status, OK, "{:?}", s.logs());
+        assert!(
+            (cutoff[0] - want).abs() < 1e-9,
+            "case {k}: {} Hz",
+            cutoff[0]
+        );
+    }
+}
+
+#[test]
+fn static_mount_deflections_carry_the_load_torque_as_the_mount_rates_say() {
+    // Truth: at the design position the preloads carry the weight, so without a load torque the
+    // static deflections are zero; a load torque T about the crank axis (y) turns the powertrain
+    // on the mounts, and for the small turn the static deflections answer like linear springs:
+    // doubling every mount's stiffness halves them, and T and −T give deflections of opposite
+    // sign and (nearly) equal size.
+    let fmu = Fmu::load();
+    let deflections = |torque: f64, scale: f64| -> Vec<f64> {
+        let s = fmu.instantiate(&format!("static-{torque}-{scale}"));
+        assert_eq!(s.set_integer(&[integer::SCENE], &[1]), OK);
+        assert_eq!(s.set_real(&[real::LOAD_TORQUE], &[torque]), OK);
+        for i in real::MOUNT_STIFFNESS_SCALE {
+            assert_eq!(s.set_real(&[i], &[scale]), OK);
+        }
+        s.setup(0.0, None);
+        assert_eq!(s.enter_init(), OK);
+        let vrs: Vec<u32> = real::MOUNT_STATIC_DEFLECTION
+            .iter()
+            .flatten()
+            .copied()
+            .collect();
+        let (status, d) = s.get_real(&vrs);
+        assert_eq!(status, OK, "{:?}", s.logs());
+        d
+    };
+    assert!(deflections(0.0, 1.0).iter().all(|d| d.abs() < 1e-6));
+    let soft = deflections(50.0, 1.0);
+    let stiff = deflections(50.0, 2.0);
+    let reverse = deflections(-50.0, 1.0);
+    let largest = soft.iter().fold(0.0_f64, |m, d| m.max(d.abs()));
+    assert!(largest > 1e-4 && largest < 3e-3, "{soft:?}");
+    for k in 0..soft.len() {
+        if soft[k].abs() < 0.05 * largest {
+            continue;
+        }
+        assert!(
+            (stiff[k] / soft[k] - 0.5).abs() < 0.02,
+            "{k}: {} vs {}",
+            stiff[k],
+            soft[k]
+        );
+        assert!(
+            (reverse[k] / soft[k] + 1.0).abs() < 0.02,
+            "{k}: {} vs {}",
+            reverse[k],
+            soft[k]
+        );
+    }
 }

@@ -23,19 +23,23 @@
 //! with `φ' = ω_c − e_crank·ω_block`. That is what lets the mass and gas torques react on the block
 //! (paper §4.2) and keeps free vibration with the crank at rest conservative.
 
+pub mod decoupling;
 mod energy;
 mod evaluate;
 pub mod interface;
 pub mod jacobian;
 mod layout;
+pub mod linear;
 pub mod modes;
 mod nominal;
 pub mod outputs;
 pub mod snapshot;
 mod statics;
 
+pub use decoupling::{Axis, MountStiffness, RigidPowertrain};
 pub use evaluate::Evaluation;
 pub use layout::StateLayout;
+pub use linear::Linearisation;
 pub use modes::{mode_table, Direction, Mode, ModeKind};
 pub use nominal::{describe_absolute_tolerance, FALLBACK_NOMINAL, RESOLVED_FRACTION};
 pub use outputs::{BodyMotion, Outputs, PointMotion};

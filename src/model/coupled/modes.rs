@@ -4,7 +4,7 @@
 //! The right-hand side with the engine at rest (crank standing, no gas, mounts linearised at the
 //! operating point) is differentiated by central differences with respect to the vibration
 //! coordinates (powertrain positions and velocities, modal coordinates and rates; not the crank
-//! angle or the speed follower). The equations are explicit, so the eigenvalues of `∂f/∂y` give
+//! angle or the speed follower): the state matrix of [`super::linear`]. The equations are explicit, so the eigenvalues of `∂f/∂y` give
 //! frequency `|λ|/2π` and damping `−Re λ/|λ|` (faer's dense eigen solver).
 //!
 //! Each mode is described by where its kinetic energy sits. A powertrain mode (more than half of
@@ -19,8 +19,8 @@ use faer::Mat;
 use nalgebra::{Matrix6, Vector3};
 use num_complex::Complex64;
 
+use super::decoupling::shift;
 use super::CoupledModel;
-use crate::ode::OdeProblem;
 
 /// Direction of a body motion, vehicle axes.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -108,6 +108,11 @@ pub struct Mode {
     /// Powertrain kinetic energy per direction `[x, y, z, rx, ry, rz]`, summed over the
     /// powertrain bodies, as fractions of the powertrain's kinetic energy.
     pub powertrain_directions: [f64; 6],
+    /// The powertrain's kinetic energy per direction `[x, y, z, rx, ry, rz]` of each body's
+    /// motion taken at the powertrain's common centre of mass, as fractions of the powertrain's
+    /// kinetic energy (not clipped: a direction coupled to another through the inertia
+    /// products can carry a small negative share): a row of the decoupling table.
+    pub centre_of_mass_directions: [f64; 6],
     /// The same per powertrain body (name).
     pub kinetic_fractions: Vec<(String, [f64; 6])>,
     /// Strain energy fraction in the mounts (the rest is in the ring carriers).
@@ -167,33 +172,8 @@ impl CoupledModel {
     /// Eigenmodes at the equilibrium `y_eq` (from [`CoupledModel::static_equilibrium`]), sorted by
     /// frequency; overdamped and static eigenvalues are skipped.
     pub fn modes(&self, y_eq: &[f64]) -> Result<Vec<Mode>, String> {
-        self.check_state(y_eq).map_err(|e| format!("{e:?}"))?;
-        let coords = self.layout.vibration_coordinates();
-        let n = coords.len();
-        let dim = self.dim();
-        let mut jac = Mat::<f64>::zeros(n, n);
-        let mut fp = vec![0.0; dim];
-        let mut fm = vec![0.0; dim];
-        let mut y = y_eq.to_vec();
-        for (c, &jc) in coords.iter().enumerate() {
-            let h = 1e-7;
-            y[jc] = y_eq[jc] + h;
-            self.rhs_at_rest(&y, &mut fp)
-                .map_err(|e| format!("linearisation failed: {e:?}"))?;
-            y[jc] = y_eq[jc] - h;
-            self.rhs_at_rest(&y, &mut fm)
-                .map_err(|e| format!("linearisation failed: {e:?}"))?;
-            y[jc] = y_eq[jc];
-            for (r, &ir) in coords.iter().enumerate() {
-                jac[(r, c)] = (fp[ir] - fm[ir]) / (2.0 * h);
-            }
-        }
-        let masses: Vec<Matrix6<f64>> = self
-            .evaluate_mode(self.fade_start, y_eq, super::evaluate::Mode::AT_REST)
-            .dynamics
-            .iter()
-            .map(|d| d.mass)
-            .collect();
+        let jac = self.state_matrix(y_eq)?;
+        let masses = self.body_masses(y_eq);
         let mut modes: Vec<Mode> = oscillatory_eigenpairs(&jac)?
             .into_iter()
             .map(|(lam, x)| self.describe_mode(y_eq, &x, lam, &masses))
@@ -210,7 +190,7 @@ impl CoupledModel {
         y_eq: &[f64],
         x: &[Complex64],
         lam: Complex64,
-        masses: &[Matrix6<f64>],
+        masses: &[(Matrix6<f64>, Vector3<f64>)],
     ) -> Mode {
         let nb = self.layout.bodies();
         let m = self.layout.modes();
@@ -221,7 +201,26 @@ impl CoupledModel {
         let mut kinetic = Vec::with_capacity(nb);
         let mut directions = [0.0; 6];
         let mut engine_kinetic = 0.0;
-        for (b, mb) in masses.iter().enumerate() {
+        // The same at the common centre of mass: each body's twist moved there (the decoupling
+        // table's directions).
+        let cg = Self::common_centre_of_mass(masses);
+        let mut at_cg = [0.0; 6];
+        for (b, (mb, at)) in masses.iter().enumerate() {
+            let v = &x[6 * nb + 6 * b..6 * nb + 6 * b + 6];
+            let t = shift(&(at - cg));
+            let m_cg = (t.transpose() * mb * t).map(Complex64::from);
+            let v_ref = nalgebra::Vector6::from_iterator(v.iter().copied());
+            let w = t.map(Complex64::from).try_inverse().unwrap_or_default() * v_ref;
+            let mw = m_cg * w;
+            for i in 0..6 {
+                at_cg[i] += (w[i].conj() * mw[i]).re;
+            }
+        }
+        let at_cg_total: f64 = at_cg.iter().sum();
+        for e in at_cg.iter_mut() {
+            *e /= at_cg_total.max(f64::MIN_POSITIVE);
+        }
+        for (b, (mb, _)) in masses.iter().enumerate() {
             let v = &x[6 * nb + 6 * b..6 * nb + 6 * b + 6];
             let mut e = [0.0; 6];
             for i in 0..6 {
@@ -289,6 +288,7 @@ impl CoupledModel {
             kind,
             powertrain_fraction,
             powertrain_directions: directions,
+            centre_of_mass_directions: at_cg,
             kinetic_fractions: kinetic,
             mount_strain_fraction: mount_strain
                 / (mount_strain + ring_strain).max(f64::MIN_POSITIVE),

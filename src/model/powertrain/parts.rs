@@ -11,8 +11,6 @@
 
 use nalgebra::{Matrix3, Vector3};
 
-use super::part_moments::MovingPart;
-
 /// How a part moves relative to its body.
 #[derive(Debug, Clone, PartialEq)]
 pub enum PartMotion {
@@ -94,6 +92,141 @@ pub fn slider_crank_trig(sn: f64, cs: f64, r: f64, l: f64) -> (f64, f64, f64) {
     let w1 = -r * r * sn * cs / w;
     let w2 = -r * r * (cs * cs - sn * sn) / w - r.powi(4) * sn * sn * cs * cs / w.powi(3);
     (r * cs + w, -r * sn + w1, -r * cs + w2)
+}
+
+/// A moving part reduced to what its path needs at run time.
+#[derive(Debug, Clone, PartialEq)]
+pub(super) enum MovingPart {
+    /// Piston pin at `base + bore s(ψ)`, `ψ = φ − throw` (cos, sin of the throw kept).
+    Piston {
+        mass: f64,
+        base: Vector3<f64>,
+        bore: Vector3<f64>,
+        cos_throw: f64,
+        sin_throw: f64,
+        radius: f64,
+        conrod: f64,
+    },
+    /// Point at `base + radius (side sin ψ + bore cos ψ)`, `ψ = ratio φ + phase`.
+    Orbit {
+        mass: f64,
+        base: Vector3<f64>,
+        bore: Vector3<f64>,
+        side: Vector3<f64>,
+        radius: f64,
+        ratio: f64,
+        cos_phase: f64,
+        sin_phase: f64,
+    },
+}
+
+/// Sine and cosine of `ratio · φ` from those of `φ`: exact identities for the ratios engines use
+/// (±1, ±2), a fresh `sin_cos` otherwise.
+pub(super) fn multiple_angle(ratio: f64, phi: f64, sin: f64, cos: f64) -> (f64, f64) {
+    if ratio == 1.0 {
+        (sin, cos)
+    } else if ratio == -1.0 {
+        (-sin, cos)
+    } else if ratio == 2.0 {
+        (2.0 * sin * cos, cos * cos - sin * sin)
+    } else if ratio == -2.0 {
+        (-2.0 * sin * cos, cos * cos - sin * sin)
+    } else if ratio == 0.0 {
+        (0.0, 1.0)
+    } else {
+        (ratio * phi).sin_cos()
+    }
+}
+
+impl MovingPart {
+    /// The run-time form of a part that moves relative to its body, or the offset of a fixed one.
+    pub(super) fn of(part: &Part) -> Result<MovingPart, Vector3<f64>> {
+        let mass = part.mass;
+        match &part.motion {
+            PartMotion::Fixed { offset } => Err(*offset),
+            PartMotion::Piston {
+                crank_centre,
+                bore,
+                y,
+                throw,
+                radius,
+                conrod,
+            } => Ok(MovingPart::Piston {
+                mass,
+                base: crank_centre + Vector3::new(0.0, *y, 0.0),
+                bore: *bore,
+                cos_throw: throw.cos(),
+                sin_throw: throw.sin(),
+                radius: *radius,
+                conrod: *conrod,
+            }),
+            PartMotion::Orbit {
+                centre,
+                bore,
+                y,
+                radius,
+                ratio,
+                phase,
+            } => Ok(MovingPart::Orbit {
+                mass,
+                base: centre + Vector3::new(0.0, *y, 0.0),
+                bore: *bore,
+                side: Vector3::y().cross(bore),
+                radius: *radius,
+                ratio: *ratio,
+                cos_phase: phase.cos(),
+                sin_phase: phase.sin(),
+            }),
+        }
+    }
+
+    /// The part's mass.
+    pub(super) fn mass(&self) -> f64 {
+        match self {
+            MovingPart::Piston { mass, .. } | MovingPart::Orbit { mass, .. } => *mass,
+        }
+    }
+
+    /// `(ρ, ρ', ρ'')` at crank angle `phi` with `(sin φ, cos φ)` given.
+    pub(super) fn path(&self, phi: f64, sin: f64, cos: f64) -> [Vector3<f64>; 3] {
+        match self {
+            MovingPart::Piston {
+                base,
+                bore,
+                cos_throw,
+                sin_throw,
+                radius,
+                conrod,
+                ..
+            } => {
+                let sn = sin * cos_throw - cos * sin_throw;
+                let cs = cos * cos_throw + sin * sin_throw;
+                let (s, s1, s2) = slider_crank_trig(sn, cs, *radius, *conrod);
+                [base + bore * s, bore * s1, bore * s2]
+            }
+            MovingPart::Orbit {
+                base,
+                bore,
+                side,
+                radius,
+                ratio,
+                cos_phase,
+                sin_phase,
+                ..
+            } => {
+                let (sr, cr) = multiple_angle(*ratio, phi, sin, cos);
+                let sn = sr * cos_phase + cr * sin_phase;
+                let cs = cr * cos_phase - sr * sin_phase;
+                let radial = side * sn + bore * cs;
+                let tangential = side * cs - bore * sn;
+                [
+                    base + radial * *radius,
+                    tangential * (ratio * radius),
+                    radial * (-ratio * ratio * radius),
+                ]
+            }
+        }
+    }
 }
 
 impl Part {

@@ -1,0 +1,469 @@
+"""``emc tpa``, ``emc frf``, ``emc ods``, ``emc decoupling``: why the body vibrates.
+
+Each command instantiates the FMU with ``analysis.exportFolder`` so that the modal data and the
+linearised model it analyses are the ones the FMU simulates (:mod:`emc.modal`), runs what it
+needs (speed points on their periodic steady state, sine excitations), writes tables (CSV),
+plots and ``metadata.json`` (the FMU by checksum, the settings, the command) into ``--out``.
+"""
+
+from __future__ import annotations
+
+import pathlib
+import sys
+import time
+
+import numpy as np
+import pandas as pd
+
+from . import decoupling, frf, ods, tpa
+from .modal import OUTPUT_POINTS, body_point_of, export_from_fmu
+from .runner import OperatingPoint, Runner
+
+TPA_ORDERS = tuple(k / 2 for k in range(1, 13))
+
+
+def _cli():
+    from . import cli
+
+    return cli
+
+
+def _progress(total: int, what: str, unit: str, quiet: bool):
+    if quiet:
+        return None
+    from tqdm import tqdm
+
+    return tqdm(total=total, desc=what, unit=unit, file=sys.stderr)
+
+
+def _mount_names(export) -> dict:
+    return {m["mount"]: m["name"] for m in (export.powertrain or {}).get("mounts", [])}
+
+
+def check_responses(responses: list[str], export, variables: dict) -> list[str]:
+    """Each response an acceleration of a body point the export recovers: an FMU output
+    (``steeringWheel.a[3]``) or ``<point>.a[j]`` for any recovered point."""
+    cli = _cli()
+    points = list(export.body.shapes) if export.body is not None else []
+    for r in responses:
+        try:
+            point, _ = body_point_of(r)
+        except ValueError as error:
+            raise cli.UsageError(f"--response {r}: {error}") from None
+        if point not in points:
+            fmu_names = [f"{k}.a[1..3]" for k, v in OUTPUT_POINTS.items() if v in points]
+            raise cli.UsageError(
+                f"--response {r}: unknown output point {point!r}; the body recovers "
+                f"{', '.join(points) or 'no point (is scene=2 set?)'} (FMU outputs "
+                f"{', '.join(fmu_names)}; any point as <point>.a[1..3])")
+    return responses
+
+
+def export_for(args, parameters: dict, full_recovery: bool = False):
+    cli = _cli()
+    try:
+        return export_from_fmu(args.fmu, parameters, full_recovery=full_recovery)
+    except ValueError as error:
+        raise cli.UsageError(str(error)) from None
+
+
+def run_points(args, parameters: dict, speeds: list[float], signals: list[str],
+               revolutions: int, steps: int, case: str = "") -> dict:
+    """Each speed on its periodic steady state: the samples of ``signals`` per speed."""
+    bar = _progress(len(speeds), case or "speeds", "point", args.quiet)
+    out = {}
+    try:
+        with Runner(args.fmu) as runner:
+            for rpm in speeds:
+                point = OperatingPoint(rpm=rpm, revolutions=revolutions,
+                                       steps_per_revolution=steps,
+                                       load_torque=getattr(args, "load_torque", 0.0),
+                                       parameters=tuple(parameters.items()))
+                result = runner.run_point(point, signals, case)
+                out[rpm] = {s: result["samples"][:, k] for k, s in enumerate(signals)}
+                if bar is not None:
+                    bar.update(1)
+    finally:
+        if bar is not None:
+            bar.close()
+    return out
+
+
+# The paths add up to the simulated response only as well as the integrator solved it: at the
+# FMU's default 1e-5 the weak orders of a sweep (1 % of the largest) close within 1.5e-2, at 1e-7
+# within 5.3e-4 (800–2500 rpm, 18 points, the default car).
+CLOSING_TOLERANCE = 1e-7
+
+
+def with_closing_tolerance(parameters: dict) -> dict:
+    """``parameters`` with solver.relTol tightened to :data:`CLOSING_TOLERANCE` unless set."""
+    return {"solver.relTol": CLOSING_TOLERANCE, **parameters}
+
+
+def check_order(order: float):
+    if order not in TPA_ORDERS:
+        raise _cli().UsageError(f"--order {order:g}: one of 0.5, 1, 1.5 … 6 (the half orders a "
+                                "window of whole working cycles resolves)")
+
+
+# ----- emc tpa ---------------------------------------------------------------------------------
+
+def tpa_case(args, variables: dict, label: str, parameters: dict, speeds: list[float],
+             responses: list[str]) -> tuple[pd.DataFrame, object]:
+    """One case: its export, its speed points, its path contributions."""
+    export = export_for(args, parameters)
+    if export.body is None:
+        raise _cli().UsageError("transfer paths need the elastic body: --set scene=2")
+    check_responses(responses, export, variables)
+    recorded = [r for r in responses if r in variables]
+    samples = run_points(args, parameters, speeds, tpa.force_signals(export) + recorded,
+                         args.revolutions, args.steps_per_rev, case=label)
+    table = pd.concat([tpa.contributions(export, r, samples[rpm], args.revolutions, rpm,
+                                         case=label)
+                       for rpm in speeds for r in responses], ignore_index=True)
+    return table, export
+
+
+def cmd_tpa(args) -> int:
+    cli = _cli()
+    cli.check_range("--count", args.count, 1)
+    cli.check_range("--steps-per-rev", args.steps_per_rev, 14, 10000)
+    if args.revolutions < 2 or args.revolutions % 2:
+        raise cli.UsageError(f"--revolutions must be even and >= 2, got {args.revolutions}")
+    check_order(args.order)
+    variables, cases = cli.prepare(args)
+    cli.check_speeds(args.rpm, increasing=args.count > 1, highest=cli.highest_speed(variables))
+    cases = [(label, with_closing_tolerance(parameters)) for label, parameters in cases]
+    at = args.at if args.at is not None else args.rpm[0]
+    if not args.rpm[0] <= at <= args.rpm[1]:
+        raise cli.UsageError(f"--at {at:g} rpm is outside the sweep --rpm {args.rpm[0]:g} "
+                             f"{args.rpm[1]:g}")
+    responses = args.response or ["steeringWheel.a[3]"]
+    for r in responses:
+        try:
+            body_point_of(r)
+        except ValueError as error:
+            raise cli.UsageError(f"--response {r}: {error}") from None
+    cli.reduction_notice(cases[0][1], variables)
+    speeds = sorted(set(np.round(np.linspace(args.rpm[0], args.rpm[1], args.count), 6)) | {at})
+    out = pathlib.Path(args.out)
+    out.mkdir(parents=True, exist_ok=True)
+    started = time.perf_counter()
+    tables, exports = [], {}
+    for label, parameters in cases:
+        table, exports[label] = tpa_case(args, variables, label, parameters, speeds, responses)
+        tables.append(table)
+    table = pd.concat(tables, ignore_index=True)
+    cli.save(table, str(out / "tpa.csv"))
+    names = _mount_names(exports[cases[0][0]])
+    summary = {}
+    recorded = [r for r in responses if r in variables]
+    if recorded:
+        closure = tpa.closure(table[table.response.isin(recorded)])
+        cli.save(closure, str(out / "closure.csv"))
+        significant = closure[closure.significant]
+        summary["closure_max_relative_error"] = float(significant.relative_error.max())
+    labels = [label for label, _ in cases]
+    for r in responses:
+        name = cli.safe_name(r)
+        for label in labels:
+            suffix = f"_{cli.safe_name(label)}" if label else ""
+            tpa.plot_ranked(table, at, args.order, r,
+                            str(out / f"tpa_ranked_{name}{suffix}.png"), names, case=label)
+            if len(speeds) > 1:
+                tpa.plot_over_speed(table, args.order, r,
+                                    str(out / f"tpa_over_speed_{name}{suffix}.png"), names,
+                                    case=label)
+            ranked = tpa.ranked(table, at, args.order, r, case=label)
+            print(f"{r}, order {args.order:g} at {at:g} rpm ({args.order * at / 60:.1f} Hz)"
+                  f"{', case ' + repr(label) if label else ''}:")
+            shown = ranked[["amplitude", "phase_deg", "in_phase", "share"]].head(6).copy()
+            shown.insert(0, "path", [tpa.path_label(int(m), tpa.AXES.index(d) + 1, names)
+                                     for m, d in zip(ranked.mount[:6], ranked.direction[:6])])
+            print(shown.to_string(index=False, float_format=lambda v: f"{v:.4g}"))
+            dominant = tpa.dominant_path(table, at, args.order, r, case=label)
+            total = tpa.complex_values(table[(table.case == label) & (table.response == r)
+                                             & (table.order == args.order)
+                                             & np.isclose(table.rpm, at)
+                                             & (table.path == "sum")])[0]
+            summary.setdefault(r, {})[label] = {"dominant_path": str(dominant.path),
+                                                "share": float(dominant.share),
+                                                "dominant_amplitude": float(dominant.amplitude),
+                                                "total_amplitude": float(abs(total))}
+        if len(cases) > 1:
+            first = summary[r][labels[0]]["dominant_path"]
+            tpa.plot_cases(table, args.order, r, first, labels,
+                           str(out / f"tpa_cases_{name}.png"), names, at=at)
+            print(f"{r}, order {args.order:g} at {at:g} rpm, {first} and the total per case:")
+            for label in labels:
+                one = tpa.ranked(table, at, args.order, r, case=label).set_index("path")
+                print(f"  {label or 'model'}: {first} {one.amplitude[first]:.4g}, total "
+                      f"{summary[r][label]['total_amplitude']:.4g}")
+    cli.write_metadata(out, args, variables, cases,
+                       {"tpa": {"speeds": speeds, "at": at, "order": args.order,
+                                "responses": responses, "revolutions": args.revolutions,
+                                "steps_per_revolution": args.steps_per_rev, **summary},
+                        "export": exports[cases[0][0]].manifest})
+    if "closure_max_relative_error" in summary:
+        print(f"closure: the 12 paths add up to the simulated response within "
+              f"{summary['closure_max_relative_error']:.2e} (every order above 1 % of the "
+              "largest)")
+    print(f"{len(cases) * len(speeds)} points in {time.perf_counter() - started:.1f} s -> {out}")
+    return 0
+
+
+# ----- emc frf ---------------------------------------------------------------------------------
+
+def cmd_frf(args) -> int:
+    cli = _cli()
+    cli.check_range("--freq FROM", args.freq[0], 0.0, strict_low=True)
+    cli.check_range("--freq TO", args.freq[1], args.freq[0], strict_low=True)
+    cli.check_range("--points", args.points, 2)
+    for f in args.verify or []:
+        cli.check_range("--verify", f, 0.0, strict_low=True)
+    variables, cases = cli.prepare(args, cases_wanted=False)
+    parameters = cases[0][1]
+    cli.reduction_notice(parameters, variables)
+    export = export_for(args, parameters)
+    if export.body is None:
+        raise cli.UsageError("transfer functions need the elastic body: --set scene=2")
+    responses = check_responses(args.response or ["steeringWheel.a[3]"], export, variables)
+    out = pathlib.Path(args.out)
+    out.mkdir(parents=True, exist_ok=True)
+    freqs = np.geomspace(args.freq[0], args.freq[1], args.points)
+    marks = {f"order {o:g} at {args.mark_rpm:g} rpm": o * args.mark_rpm / 60.0
+             for o in (args.mark_order or [])} if args.mark_rpm else {}
+    summary = {}
+    for r in responses:
+        name = cli.safe_name(r)
+        body = frf.body_frf(export, r, freqs)
+        coupled = frf.coupled_frf(export, [r], freqs)
+        cli.save(body, str(out / f"frf_body_{name}.csv"))
+        cli.save(coupled, str(out / f"frf_coupled_{name}.csv"))
+        checks = None
+        if args.verify:
+            checks = verify(args, parameters, export, r)
+            cli.save(checks, str(out / f"frf_check_{name}.csv"))
+            summary[r] = {"largest_relative_error": float(checks.relative_error.max())}
+            print(checks[["frequency", "amplitude", "linearised_amplitude", "relative_error"]]
+                  .to_string(index=False, float_format=lambda v: f"{v:.4g}"))
+        frf.plot(body, str(out / f"frf_body_{name}.png"), "m/s²/N",
+                 f"Body accelerance to {r} from a force at each mount point "
+                 f"({len(export.body.omega)} modes as simulated)", top=args.top, marks=marks)
+        frf.plot(coupled, str(out / f"frf_coupled_{name}.png"), "m/s²/(N m)",
+                 f"Coupled system linearised at its static equilibrium: {r} per unit load "
+                 "torque (roll moment on the housing)", checks=checks, marks=marks)
+    cli.write_metadata(out, args, variables, cases,
+                       {"frf": {"frequencies": [args.freq[0], args.freq[1], args.points],
+                                "responses": responses, "verify": args.verify or [], **summary},
+                        "export": export.manifest})
+    print(f"transfer functions of {', '.join(responses)} -> {out}")
+    return 0
+
+
+def verify(args, parameters: dict, export, response: str) -> pd.DataFrame:
+    """The coupled transfer function at each --verify frequency from a sine on the FMU's load
+    torque (engine at rest: rpm 0, excitation off, so the operating point is the
+    linearisation's)."""
+    at_rest = {**parameters, "rpm": 0.0, "effects.gasForces": False,
+               "effects.massForces": False, "solver.relTol": args.verify_rtol}
+    linear = frf.coupled_frf(export_for(args, at_rest), [response], args.verify)
+    bar = _progress(len(args.verify), "sine excitation", "frequency", args.quiet)
+    rows = []
+    try:
+        for f in args.verify:
+            y = frf.sine_response(args.fmu, at_rest, "loadTorque", [response], f,
+                                  args.verify_amplitude)[response]
+            h = linear[linear.frequency == f]
+            z = complex(h.re.iloc[0], h.im.iloc[0])
+            rows.append({"frequency": f, "input": "loadTorque", "amplitude": abs(y),
+                         "phase_deg": np.degrees(np.angle(y)), "linearised_amplitude": abs(z),
+                         "linearised_phase_deg": np.degrees(np.angle(z)),
+                         "relative_error": abs(y - z) / abs(z)})
+            if bar is not None:
+                bar.update(1)
+    finally:
+        if bar is not None:
+            bar.close()
+    return pd.DataFrame(rows)
+
+
+# ----- emc ods ---------------------------------------------------------------------------------
+
+def cmd_ods(args) -> int:
+    cli = _cli()
+    check_order(args.order)
+    variables, cases = cli.prepare(args, cases_wanted=False)
+    cli.check_range("--rpm-point", args.rpm_point, 0.0, cli.highest_speed(variables),
+                    strict_low=True)
+    parameters = with_closing_tolerance(cases[0][1])
+    cli.reduction_notice(parameters, variables)
+    print("note: recovering the body's modes on every node (the reduction is run once more)",
+          file=sys.stderr)
+    export = export_for(args, parameters, full_recovery=True)
+    signals = ods.signals(export) + [s for s in args.compare if s in variables]
+    check_responses(args.compare, export, variables)
+    out = pathlib.Path(args.out)
+    out.mkdir(parents=True, exist_ok=True)
+    samples = run_points(args, parameters, [args.rpm_point], signals, args.revolutions,
+                         args.steps_per_rev)[args.rpm_point]
+    shape = ods.operating_shape(export, samples, args.revolutions, args.rpm_point, args.order)
+    stem = f"ods_{args.rpm_point:g}rpm_order{args.order:g}"
+    ods.write_vtu(shape, str(out / f"{stem}.vtu"))
+    labels = {p: export.body.nodes[p] for p in export.body.shapes if not p.startswith("mount_")}
+    ods.plot(shape, str(out / f"{stem}.png"), point_labels=labels)
+    rows = []
+    w = 2 * np.pi * shape["frequency"]
+    for r in args.compare:
+        point, dof = body_point_of(r)
+        node = export.body.nodes[point]
+        u = shape["body"][node, dof]
+        row = {"response": r, "node": node, "ods_displacement": abs(u),
+               "ods_phase_deg": np.degrees(np.angle(u))}
+        if r in samples:
+            from .spectra import order_components
+
+            a = order_components(samples[r], args.revolutions, [args.order])[0]
+            row.update({"simulated_displacement": abs(a / -w**2),
+                        "relative_difference": abs(u - a / -w**2) / abs(a / -w**2)})
+        rows.append(row)
+    for r in args.compare:
+        point, dof = body_point_of(r)
+        modes = ods.modal_contributions(shape, export, point, dof)
+        cli.save(modes, str(out / f"{stem}_modes_{cli.safe_name(r)}.csv"))
+        print(f"body modes carrying {r} (displacement, share in phase with the whole):")
+        print(modes.to_string(index=False, float_format=lambda v: f"{v:.4g}"))
+    points = pd.DataFrame(rows)
+    if len(points):
+        cli.save(points, str(out / f"{stem}_points.csv"))
+        print(points.to_string(index=False, float_format=lambda v: f"{v:.4g}"))
+    cli.write_metadata(out, args, variables, [("", parameters)],
+                       {"ods": {"rpm": args.rpm_point, "order": args.order,
+                                "frequency": shape["frequency"], "nodes": len(shape["nodes"]),
+                                "revolutions": args.revolutions},
+                        "export": export.manifest})
+    print(f"operating deflection shape, order {args.order:g} at {args.rpm_point:g} rpm "
+          f"({shape['frequency']:.1f} Hz) -> {out / (stem + '.vtu')}")
+    return 0
+
+
+# ----- emc decoupling --------------------------------------------------------------------------
+
+def cmd_decoupling(args) -> int:
+    cli = _cli()
+    variables, cases = cli.prepare(args, cases_wanted=False)
+    parameters = cases[0][1]
+    out = pathlib.Path(args.out)
+    out.mkdir(parents=True, exist_ok=True)
+    record = {}
+    for scene, where in ((1, "on ground"), (2, "in the body")):
+        if scene == 2:
+            cli.reduction_notice({**parameters, "scene": 2}, variables)
+        export = export_for(args, {**parameters, "scene": scene})
+        rows = decoupling.table(export)
+        check = (decoupling.rigid_modes_6x6(export.powertrain) if scene == 1
+                 else decoupling.rigid_modes_in_body(export.powertrain, export))
+        axis = decoupling.axes(export.powertrain)
+        name = "ground" if scene == 1 else "body"
+        cli.save(rows, str(out / f"decoupling_{name}.csv"))
+        cli.save(check, str(out / f"decoupling_{name}_independent.csv"))
+        decoupling.plot(rows, str(out / f"decoupling_{name}.png"), axis=axis,
+                        title=f"Decoupling table, powertrain on its mounts {where} "
+                              f"(scene {scene})")
+        print(f"powertrain on its mounts {where}: the FMU's rigid modes, kinetic energy [%] at "
+              "the centre of mass")
+        print(rows.drop(columns=["kind", "powertrain_share"])
+              .to_string(index=False, formatters={c: "{:.1f}".format for c in rows.columns
+                                                  if c.startswith("KE_")},
+                         float_format=lambda v: f"{v:.3g}"))
+        print(f"  independent {'6x6' if scene == 1 else '(6 + body modes)'} computation from "
+              "the exported mass and stiffness (undamped): "
+              + ", ".join(f"{f:.2f}" for f in check.frequency_hz) + " Hz")
+        print(f"  torque-roll axis vs the mounts' elastic axis: {axis['angle_deg']:.2f}° apart, "
+              f"elastic axis {1e3 * axis['offset_m']:.1f} mm from the centre of mass")
+        record[name] = {"frequencies_hz": rows.frequency_hz.tolist(),
+                        "independent_hz": check.frequency_hz.tolist(),
+                        "axis_angle_deg": axis["angle_deg"], "axis_offset_m": axis["offset_m"]}
+    cli.write_metadata(out, args, variables, cases, {"decoupling": record})
+    print(f"decoupling tables -> {out}")
+    return 0
+
+
+# ----- registration ----------------------------------------------------------------------------
+
+def add_parsers(sub) -> None:
+    """Registers ``emc tpa``, ``emc frf``, ``emc ods`` and ``emc decoupling``."""
+
+    def common(p):
+        p.add_argument("--fmu", default="dist/EngineMountChassis.fmu",
+                       help="the packaged FMU (default dist/EngineMountChassis.fmu)")
+        p.add_argument("--set", action="append", metavar="NAME=VALUE",
+                       help="FMU start value (repeatable; checked against the model "
+                            "description; default scene=2)")
+        p.add_argument("--out", required=True, help="result folder (tables, plots, "
+                                                    "metadata.json)")
+        p.add_argument("--quiet", action="store_true", help="no progress bars")
+
+    def window(p, revolutions: int, steps: int):
+        p.add_argument("--revolutions", type=int, default=revolutions,
+                       help=f"analysed window per speed, whole revolutions (even; default "
+                            f"{revolutions})")
+        p.add_argument("--steps-per-rev", type=int, default=steps,
+                       help=f"samples per revolution (default {steps})")
+        p.add_argument("--load-torque", type=float, default=0.0, help="N·m, every point")
+
+    t = sub.add_parser("tpa", help="transfer path analysis per order: each mount and "
+                                   "direction's contribution to a body point over speed")
+    common(t)
+    t.add_argument("--rpm", nargs=2, type=float, default=[800.0, 2500.0],
+                   metavar=("FROM", "TO"), help="speed range, rpm (default 800 2500)")
+    t.add_argument("--count", type=int, default=18, help="speed points (default 18)")
+    t.add_argument("--at", type=float, default=None,
+                   help="speed of the ranked contributions, rpm, within the range (added to "
+                        "the points; default FROM)")
+    t.add_argument("--order", type=float, default=1.5, help="order of the plots (default 1.5)")
+    t.add_argument("--response", action="append",
+                   help="acceleration to explain: steeringWheel.a[1..3], seat.a[1..3] or "
+                        "<body point>.a[1..3] (repeatable; default steeringWheel.a[3])")
+    t.add_argument("--case", action="append", metavar="NAME[:NAME=VALUE,...]",
+                   help="a case with its own settings on top of --set (repeatable): each case "
+                        "is analysed and the first case's dominant path compared across them")
+    window(t, 8, 72)
+    t.set_defaults(func=cmd_tpa)
+
+    f = sub.add_parser("frf", help="transfer functions: the body's accelerance from each mount "
+                                   "point, and the coupled system's from the load torque")
+    common(f)
+    f.add_argument("--freq", nargs=2, type=float, default=[2.0, 200.0], metavar=("FROM", "TO"),
+                   help="frequency range, Hz (default 2 200)")
+    f.add_argument("--points", type=int, default=600, help="frequencies, log-spaced (default 600)")
+    f.add_argument("--response", action="append",
+                   help="acceleration output (repeatable; default steeringWheel.a[3])")
+    f.add_argument("--top", type=int, default=6, help="body paths drawn (largest peaks; default 6)")
+    f.add_argument("--verify", type=float, nargs="+", metavar="HZ",
+                   help="check the coupled transfer function at these frequencies against a "
+                        "sine on the FMU's load torque in the time domain")
+    f.add_argument("--verify-amplitude", type=float, default=20.0,
+                   help="sine amplitude of --verify, N m (default 20)")
+    f.add_argument("--verify-rtol", type=float, default=1e-6,
+                   help="solver.relTol of the --verify runs (default 1e-6)")
+    f.add_argument("--mark-rpm", type=float, help="mark the --mark-order frequencies at this speed")
+    f.add_argument("--mark-order", type=float, action="append", help="order to mark (repeatable)")
+    f.set_defaults(func=cmd_frf)
+
+    o = sub.add_parser("ods", help="operating deflection shape of one order at one speed: the "
+                                   "whole body as VTU (ParaView) and a picture")
+    common(o)
+    o.add_argument("--rpm-point", type=float, required=True, help="engine speed, rpm")
+    o.add_argument("--order", type=float, default=1.5, help="engine order (default 1.5)")
+    o.add_argument("--compare", action="append", default=[],
+                   help="an acceleration output whose point's shape is compared with the "
+                        "simulation (repeatable, e.g. steeringWheel.a[3])")
+    window(o, 8, 72)
+    o.set_defaults(func=cmd_ods)
+
+    d = sub.add_parser("decoupling", help="the mount decoupling table: rigid modes of the "
+                                          "powertrain on ground and in the body, kinetic energy "
+                                          "per direction, torque-roll axis")
+    common(d)
+    d.set_defaults(func=cmd_decoupling)
