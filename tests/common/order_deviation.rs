@@ -89,3 +89,22 @@ pub fn largest_per_order(deviations: &[OrderDeviation]) -> [f64; HALF_ORDERS] {
     }
     worst
 }
+
+/// Asserts every deviation below `bound` (relative), naming the signal and order of the first
+/// beyond it; returns the largest.
+pub fn assert_within(deviations: &[OrderDeviation], bound: f64, what: &str) -> f64 {
+    let mut worst = 0.0f64;
+    for d in deviations {
+        worst = worst.max(d.relative);
+        assert!(
+            d.relative < bound,
+            "{what}, signal {}, order {}: split {:.5e} vs scene 2 {:.5e} ({:.2} %)",
+            d.signal,
+            d.order,
+            d.run,
+            d.reference,
+            d.relative * 100.0
+        );
+    }
+    worst
+}
