@@ -20,7 +20,7 @@ use std::sync::{Arc, Mutex};
 use std::time::Instant;
 
 use engine_mount_chassis::cosim::{
-    EffectSwitch, Inputs, SceneKind, Settings, Signal, Simulation, VehicleOverrides,
+    EffectSwitch, Inputs, RampInput, SceneKind, Settings, Simulation, VehicleOverrides,
     RPM_TO_RAD_PER_S,
 };
 
@@ -96,20 +96,20 @@ fn run(case: &Case, duration: f64, ramp: f64) -> Outcome {
         let (e, de) = envelope(t);
         let u = case.amplitude * e * (w * t).sin();
         let du = case.amplitude * (de * (w * t).sin() + e * w * (w * t).cos());
-        let mut inputs = base;
+        let mut inputs = base.clone();
         match case.input {
             Input::Torque => {
-                inputs.load_torque = Signal {
+                inputs.model.load_torque = RampInput {
                     value: u,
-                    derivative: du,
-                    reference_time: t,
+                    rate: du,
+                    since: t,
                 }
             }
             Input::Rpm => {
-                inputs.crank_speed = Signal {
+                inputs.model.crank_speed = RampInput {
                     value: (case.rpm + u) * RPM_TO_RAD_PER_S,
-                    derivative: du * RPM_TO_RAD_PER_S,
-                    reference_time: t,
+                    rate: du * RPM_TO_RAD_PER_S,
+                    since: t,
                 }
             }
         }
@@ -132,7 +132,11 @@ fn row(o: &Outcome) -> String {
     };
     format!(
         "| {} | {} | {} | {} | {:.0e} | {result} | {} | {} | {:.1} |",
-        if matches!(c.scene, SceneKind::Ground) { 1 } else { 2 },
+        if matches!(c.scene, SceneKind::Ground) {
+            1
+        } else {
+            2
+        },
         c.name,
         c.amplitude,
         c.frequency,
