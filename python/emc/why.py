@@ -15,7 +15,7 @@ import time
 import numpy as np
 import pandas as pd
 
-from . import decoupling, frf, ods, tpa
+from . import decoupling, frf, ods, tpa, tpa_time
 from .modal import OUTPUT_POINTS, body_point_of, export_from_fmu
 from .runner import OperatingPoint, Runner
 
@@ -100,6 +100,18 @@ def with_closing_tolerance(parameters: dict) -> dict:
     return {"solver.relTol": CLOSING_TOLERANCE, **parameters}
 
 
+def parse_responses(args) -> list[str]:
+    """``--response`` (default the steering wheel's vertical acceleration), each an
+    acceleration output."""
+    responses = args.response or ["steeringWheel.a[3]"]
+    for r in responses:
+        try:
+            body_point_of(r)
+        except ValueError as error:
+            raise _cli().UsageError(f"--response {r}: {error}") from None
+    return responses
+
+
 def check_order(order: float):
     if order not in TPA_ORDERS:
         raise _cli().UsageError(f"--order {order:g}: one of 0.5, 1, 1.5 … 6 (the half orders a "
@@ -124,6 +136,73 @@ def tpa_case(args, variables: dict, label: str, parameters: dict, speeds: list[f
     return table, export
 
 
+def report_paths(table: pd.DataFrame, names: dict, responses: list[str], labels: list[str],
+                 at_of, order: float, recorded: list[str], out: pathlib.Path) -> dict:
+    """What ``emc tpa`` and its run-up and coupled forms write and print from the table of path
+    contributions: closure.csv, the ranked paths at the speed ``at_of(case)`` and the paths over
+    speed per response and case, the cases compared; returns the summary for metadata.json."""
+    cli = _cli()
+    summary = {}
+    if recorded:
+        closure = tpa.closure(table[table.response.isin(recorded)])
+        cli.save(closure, str(out / "closure.csv"))
+        significant = closure[closure.significant]
+        summary["closure_max_relative_error"] = float(significant.relative_error.max())
+        if "quasi_static_re" in table:
+            quasi = tpa.closure(table[table.response.isin(recorded)], prefix="quasi_static_")
+            significant = quasi[quasi.significant]
+            summary["quasi_static_closure"] = {
+                "median_relative_error": float(significant.relative_error.median()),
+                "max_relative_error": float(significant.relative_error.max())}
+    for r in responses:
+        name = cli.safe_name(r)
+        for label in labels:
+            at = at_of(label)
+            suffix = f"_{cli.safe_name(label)}" if label else ""
+            tpa.plot_ranked(table, at, order, r, str(out / f"tpa_ranked_{name}{suffix}.png"),
+                            names, case=label)
+            if table[table.case == label].rpm.nunique() > 1:
+                tpa.plot_over_speed(table, order, r,
+                                    str(out / f"tpa_over_speed_{name}{suffix}.png"), names,
+                                    case=label)
+            ranked = tpa.ranked(table, at, order, r, case=label)
+            print(f"{r}, order {order:g} at {at:g} rpm ({order * at / 60:.1f} Hz)"
+                  f"{', case ' + repr(label) if label else ''}:")
+            shown = ranked[["amplitude", "phase_deg", "in_phase", "share"]].head(6).copy()
+            shown.insert(0, "path", [tpa.path_label(int(m), tpa.AXES.index(d) + 1, names)
+                                     for m, d in zip(ranked.mount[:6], ranked.direction[:6])])
+            print(shown.to_string(index=False, float_format=lambda v: f"{v:.4g}"))
+            dominant = tpa.dominant_path(table, at, order, r, case=label)
+            total = tpa.complex_values(table[(table.case == label) & (table.response == r)
+                                             & (table.order == order)
+                                             & np.isclose(table.rpm, at)
+                                             & (table.path == "sum")])[0]
+            summary.setdefault(r, {})[label] = {"at": at, "dominant_path": str(dominant.path),
+                                                "share": float(dominant.share),
+                                                "dominant_amplitude": float(dominant.amplitude),
+                                                "total_amplitude": float(abs(total))}
+        if len(labels) > 1:
+            first = summary[r][labels[0]]["dominant_path"]
+            tpa.plot_cases(table, order, r, first, labels,
+                           str(out / f"tpa_cases_{name}.png"), names, at=at_of(labels[0]))
+            print(f"{r}, order {order:g}, {first} and the total per case:")
+            for label in labels:
+                one = tpa.ranked(table, at_of(label), order, r, case=label).set_index("path")
+                print(f"  {label or 'model'} at {at_of(label):g} rpm: {first} "
+                      f"{one.amplitude[first]:.4g}, total "
+                      f"{summary[r][label]['total_amplitude']:.4g}")
+    if "closure_max_relative_error" in summary:
+        print(f"closure: the 12 paths add up to the simulated response within "
+              f"{summary['closure_max_relative_error']:.2e} (every order above 1 % of the "
+              "largest)")
+    if "quasi_static_closure" in summary:
+        q = summary["quasi_static_closure"]
+        print(f"force × transfer function (quasi-stationary) against the simulated response: "
+              f"median {q['median_relative_error']:.2e}, largest "
+              f"{q['max_relative_error']:.2e}")
+    return summary
+
+
 def cmd_tpa(args) -> int:
     cli = _cli()
     cli.check_range("--count", args.count, 1)
@@ -138,12 +217,7 @@ def cmd_tpa(args) -> int:
     if not args.rpm[0] <= at <= args.rpm[1]:
         raise cli.UsageError(f"--at {at:g} rpm is outside the sweep --rpm {args.rpm[0]:g} "
                              f"{args.rpm[1]:g}")
-    responses = args.response or ["steeringWheel.a[3]"]
-    for r in responses:
-        try:
-            body_point_of(r)
-        except ValueError as error:
-            raise cli.UsageError(f"--response {r}: {error}") from None
+    responses = parse_responses(args)
     cli.reduction_notice(cases[0][1], variables)
     speeds = sorted(set(np.round(np.linspace(args.rpm[0], args.rpm[1], args.count), 6)) | {at})
     out = pathlib.Path(args.out)
@@ -155,60 +229,97 @@ def cmd_tpa(args) -> int:
         tables.append(table)
     table = pd.concat(tables, ignore_index=True)
     cli.save(table, str(out / "tpa.csv"))
-    names = _mount_names(exports[cases[0][0]])
-    summary = {}
-    recorded = [r for r in responses if r in variables]
-    if recorded:
-        closure = tpa.closure(table[table.response.isin(recorded)])
-        cli.save(closure, str(out / "closure.csv"))
-        significant = closure[closure.significant]
-        summary["closure_max_relative_error"] = float(significant.relative_error.max())
-    labels = [label for label, _ in cases]
-    for r in responses:
-        name = cli.safe_name(r)
-        for label in labels:
-            suffix = f"_{cli.safe_name(label)}" if label else ""
-            tpa.plot_ranked(table, at, args.order, r,
-                            str(out / f"tpa_ranked_{name}{suffix}.png"), names, case=label)
-            if len(speeds) > 1:
-                tpa.plot_over_speed(table, args.order, r,
-                                    str(out / f"tpa_over_speed_{name}{suffix}.png"), names,
-                                    case=label)
-            ranked = tpa.ranked(table, at, args.order, r, case=label)
-            print(f"{r}, order {args.order:g} at {at:g} rpm ({args.order * at / 60:.1f} Hz)"
-                  f"{', case ' + repr(label) if label else ''}:")
-            shown = ranked[["amplitude", "phase_deg", "in_phase", "share"]].head(6).copy()
-            shown.insert(0, "path", [tpa.path_label(int(m), tpa.AXES.index(d) + 1, names)
-                                     for m, d in zip(ranked.mount[:6], ranked.direction[:6])])
-            print(shown.to_string(index=False, float_format=lambda v: f"{v:.4g}"))
-            dominant = tpa.dominant_path(table, at, args.order, r, case=label)
-            total = tpa.complex_values(table[(table.case == label) & (table.response == r)
-                                             & (table.order == args.order)
-                                             & np.isclose(table.rpm, at)
-                                             & (table.path == "sum")])[0]
-            summary.setdefault(r, {})[label] = {"dominant_path": str(dominant.path),
-                                                "share": float(dominant.share),
-                                                "dominant_amplitude": float(dominant.amplitude),
-                                                "total_amplitude": float(abs(total))}
-        if len(cases) > 1:
-            first = summary[r][labels[0]]["dominant_path"]
-            tpa.plot_cases(table, args.order, r, first, labels,
-                           str(out / f"tpa_cases_{name}.png"), names, at=at)
-            print(f"{r}, order {args.order:g} at {at:g} rpm, {first} and the total per case:")
-            for label in labels:
-                one = tpa.ranked(table, at, args.order, r, case=label).set_index("path")
-                print(f"  {label or 'model'}: {first} {one.amplitude[first]:.4g}, total "
-                      f"{summary[r][label]['total_amplitude']:.4g}")
+    summary = report_paths(table, _mount_names(exports[cases[0][0]]), responses,
+                           [label for label, _ in cases], lambda label: at, args.order,
+                           [r for r in responses if r in variables], out)
     cli.write_metadata(out, args, variables, cases,
                        {"tpa": {"speeds": speeds, "at": at, "order": args.order,
                                 "responses": responses, "revolutions": args.revolutions,
                                 "steps_per_revolution": args.steps_per_rev, **summary},
                         "export": exports[cases[0][0]].manifest})
-    if "closure_max_relative_error" in summary:
-        print(f"closure: the 12 paths add up to the simulated response within "
-              f"{summary['closure_max_relative_error']:.2e} (every order above 1 % of the "
-              "largest)")
     print(f"{len(cases) * len(speeds)} points in {time.perf_counter() - started:.1f} s -> {out}")
+    return 0
+
+
+# ----- emc tpa-runup ---------------------------------------------------------------------------
+
+def start_cycle(args, parameters: dict, export, initial: np.ndarray) -> tuple[np.ndarray, float]:
+    """One working cycle of the mount forces on the periodic steady state at the run-up's start
+    speed, from the start's crank angle on (the run-up's modal state at its start), checked
+    against the run-up's first forces."""
+    rpm = args.rpm[0]
+    point = OperatingPoint(rpm=rpm, revolutions=2,
+                           steps_per_revolution=tpa_time.CYCLE_STEPS_PER_REVOLUTION,
+                           load_torque=args.load_torque, parameters=tuple(parameters.items()))
+    with Runner(args.fmu) as runner:
+        samples = runner.run_point(point, tpa.force_signals(export))["samples"]
+    cycle = np.roll(samples, 1, axis=0)  # the last sample closes the cycle: t = 0
+    mismatch = np.max(np.abs(cycle[0] - initial[:cycle.shape[1]]))
+    if mismatch > 1e-4 * np.max(np.abs(cycle)):
+        print(f"warning: the run-up's start is {mismatch:.3g} N off the periodic cycle at "
+              f"{rpm:g} rpm: its paths start with a transient", file=sys.stderr)
+    return cycle, 2 * 60.0 / rpm
+
+
+def cmd_tpa_runup(args) -> int:
+    cli = _cli()
+    cli.check_range("--duration", args.duration, 0.0, strict_low=True)
+    cli.check_range("--step", args.step, 0.0, 0.01, strict_low=True)
+    if args.block_revolutions < 2 or args.block_revolutions % 2:
+        raise cli.UsageError(f"--block-revolutions must be even and >= 2 (half orders on "
+                             f"bins), got {args.block_revolutions}")
+    check_order(args.order)
+    variables, cases = cli.prepare(args)
+    cli.check_speeds(args.rpm, increasing=True, highest=cli.highest_speed(variables))
+    revolutions = (args.rpm[0] + args.rpm[1]) / 2.0 / 60.0 * args.duration
+    if revolutions < 2 * args.block_revolutions:
+        raise cli.UsageError(f"a run-up of {args.duration:g} s turns the crank "
+                             f"{revolutions:.1f} times: too few for blocks of "
+                             f"{args.block_revolutions} revolutions (lengthen --duration)")
+    at = args.at if args.at is not None else args.rpm[0]
+    if not args.rpm[0] <= at <= args.rpm[1]:
+        raise cli.UsageError(f"--at {at:g} rpm is outside the run-up --rpm {args.rpm[0]:g} "
+                             f"{args.rpm[1]:g}")
+    responses = parse_responses(args)
+    periodic = args.start == "periodic"
+    cases = [(label, with_closing_tolerance(parameters)) for label, parameters in cases]
+    cli.reduction_notice(cases[0][1], variables)
+    out = pathlib.Path(args.out)
+    out.mkdir(parents=True, exist_ok=True)
+    started = time.perf_counter()
+    tables, exports, warnings = [], {}, []
+    for label, parameters in cases:
+        export = exports[label] = export_for(args, parameters)
+        if export.body is None:
+            raise cli.UsageError("transfer paths need the elastic body: --set scene=2")
+        check_responses(responses, export, variables)
+        recorded = [r for r in responses if r in variables]
+        start_values = {**parameters, "loadTorque": args.load_torque}
+        if periodic:
+            start_values["initialization.periodic"] = True
+        run = cli.run_up(args, tpa.force_signals(export) + recorded, start_values, label)
+        warnings += run["warnings"]
+        cycle = start_cycle(args, parameters, export, run["initial"]) if periodic else None
+        tables.append(tpa_time.runup_paths(export, run, responses, cycle,
+                                           args.block_revolutions, case=label))
+    table = pd.concat(tables, ignore_index=True)
+    cli.fmu_warnings_summary(warnings)
+    cli.save(table, str(out / "tpa_runup.csv"))
+    labels = [label for label, _ in cases]
+    speeds = {label: np.sort(table[table.case == label].rpm.unique()) for label in labels}
+    at_of = {label: float(v[np.argmin(np.abs(v - at))]) for label, v in speeds.items()}
+    summary = report_paths(table, _mount_names(exports[labels[0]]), responses, labels,
+                           at_of.__getitem__, args.order,
+                           [r for r in responses if r in variables], out)
+    cli.write_metadata(out, args, variables, cases,
+                       {"tpa_runup": {"from": args.rpm[0], "to": args.rpm[1],
+                                      "duration": args.duration, "step": args.step,
+                                      "block_revolutions": args.block_revolutions,
+                                      "start": args.start, "at": at, "order": args.order,
+                                      "responses": responses, **summary},
+                        "export": exports[labels[0]].manifest}, warnings)
+    print(f"{len(cases)} run-up(s), {sum(len(v) for v in speeds.values())} blocks in "
+          f"{time.perf_counter() - started:.1f} s -> {out}")
     return 0
 
 
@@ -392,7 +503,8 @@ def cmd_decoupling(args) -> int:
 # ----- registration ----------------------------------------------------------------------------
 
 def add_parsers(sub) -> None:
-    """Registers ``emc tpa``, ``emc frf``, ``emc ods`` and ``emc decoupling``."""
+    """Registers ``emc tpa``, ``emc tpa-runup``, ``emc frf``, ``emc ods`` and
+    ``emc decoupling``."""
 
     def common(p):
         p.add_argument("--fmu", default="dist/EngineMountChassis.fmu",
@@ -430,6 +542,30 @@ def add_parsers(sub) -> None:
                         "is analysed and the first case's dominant path compared across them")
     window(t, 8, 72)
     t.set_defaults(func=cmd_tpa)
+
+    u = sub.add_parser("tpa-runup", help="transfer paths of a run-up: each mount and "
+                                         "direction's contribution per order, order-tracked")
+    common(u)
+    u.add_argument("--rpm", nargs=2, type=float, default=[800.0, 2500.0],
+                   metavar=("FROM", "TO"), help="speed range, rpm (default 800 2500)")
+    u.add_argument("--duration", type=float, default=20.0, help="s, FROM to TO (default 20)")
+    u.add_argument("--step", type=float, default=2e-4,
+                   help="communication step, s: the outputs' sampling (default 2e-4)")
+    u.add_argument("--block-revolutions", type=int, default=4,
+                   help="revolutions per order-tracking block (even; default 4)")
+    u.add_argument("--start", choices=("periodic", "fade-in"), default="periodic",
+                   help="periodic (default): on the periodic steady state at FROM; fade-in: "
+                        "from the static equilibrium, the excitation faded in")
+    u.add_argument("--load-torque", type=float, default=0.0, help="N·m, constant")
+    u.add_argument("--at", type=float, default=None,
+                   help="speed of the ranked contributions, rpm: the block nearest it "
+                        "(default FROM)")
+    u.add_argument("--order", type=float, default=1.5, help="order of the plots (default 1.5)")
+    u.add_argument("--response", action="append",
+                   help="acceleration to explain (repeatable; default steeringWheel.a[3])")
+    u.add_argument("--case", action="append", metavar="NAME[:NAME=VALUE,...]",
+                   help="a case with its own settings on top of --set (repeatable)")
+    u.set_defaults(func=cmd_tpa_runup)
 
     f = sub.add_parser("frf", help="transfer functions: the body's accelerance from each mount "
                                    "point, and the coupled system's from the load torque")
