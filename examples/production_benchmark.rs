@@ -399,6 +399,7 @@ fn run_deck(dir: &Path, cutoff_hz: f64, modes: usize) -> Res<()> {
             path: main.clone(),
             points: points_of(dir)?,
             include_root: None,
+            damping: None,
         },
         ..VehicleConfig::default()
     };

@@ -16,7 +16,7 @@ from .runner import Runner
 from .spectra import MAIN_ORDERS, ORDERS
 
 # Body modes damped at most this much are resonant enough to mark their crossings.
-LIGHT_DAMPING = 0.02
+LIGHT_DAMPING = 0.075
 
 
 def natural_modes(fmu_path: str, parameters: dict | None = None, case: str = "") -> pd.DataFrame:
@@ -74,8 +74,8 @@ def plot(modes: pd.DataFrame, rpm_from: float, rpm_to: float, path: str, title: 
                    lw=1.6 if powertrain else 0.5,
                    alpha=0.9 if powertrain else (0.6 if mode.damping <= LIGHT_DAMPING else 0.2))
     # Crossings that matter: every powertrain mode's, and the body modes' that are lightly
-    # damped (resonant amplification 1/(2ζ) ≥ 25); the 10 %-damped body modes above 100 Hz
-    # barely amplify.
+    # damped (resonant amplification 1/(2ζ) ≥ 6.7: the body's physical modes at the default
+    # 5 %); the interface modes above the cut-off (10 % and more) barely amplify.
     cross = crossings(shown, rpm_from, rpm_to)
     damping = shown.set_index("mode").damping
     resonant = cross["mode"].map(damping) <= LIGHT_DAMPING
@@ -87,7 +87,7 @@ def plot(modes: pd.DataFrame, rpm_from: float, rpm_to: float, path: str, title: 
         plt.Line2D([], [], color="tab:red", lw=1.6, marker="o",
                    label="powertrain mode (≥ 50 % of kinetic energy in the engine) and crossing"),
         plt.Line2D([], [], color="tab:blue", lw=0.8, marker="x",
-                   label=f"body mode; crossing marked where damping ≤ {LIGHT_DAMPING:.0%}"),
+                   label=f"body mode; crossing marked where damping ≤ {LIGHT_DAMPING:.1%}"),
         plt.Line2D([], [], color="0.35", lw=1.0,
                    label="engine orders " + ", ".join(f"{o:g}" for o in MAIN_ORDERS)
                    + " (others dotted)"),

@@ -32,6 +32,7 @@ import time
 import numpy as np
 import pandas as pd
 
+from . import band as bands
 from . import plots
 from .comfort import comfort_table
 from .runner import PointFailed, Runner
@@ -416,31 +417,65 @@ def highest_speed(variables: dict) -> float:
 
 
 def sweep_cases(args, cases: list[tuple[str, dict]], signals: list[str], out: pathlib.Path,
-                point_options: dict) -> tuple[pd.DataFrame, pd.DataFrame, list[str]]:
-    """Every case's speed points (serial or on Dask), the FMU's warnings summarised, the order
-    and spectrum tables of all cases written; returns (orders, spectra, FMU warnings)."""
+                point_options: dict, band: bands.Band | None = None
+                ) -> tuple[pd.DataFrame, pd.DataFrame, list[str]]:
+    """Every case's speed points (serial or on Dask), at the band's three bounds if a band is
+    given (a ``bound`` column then), the FMU's warnings summarised, the order and spectrum tables
+    of all cases written; returns (orders, spectra, FMU warnings)."""
     from .distributed import FmuPool
 
-    tables, fmu_warnings = [], []
-    # One pool for every case: its workers start and load the FMU once.
+    fmu_warnings = []
+    # One pool for every case and bound: its workers start and load the FMU once.
     pool = None if args.serial else FmuPool(args.fmu, args.workers, args.scheduler)
-    try:
+
+    def run(_settings: dict, bound: str | None = None):
+        tables = []
         for label, parameters in cases:
+            if bound is not None:
+                parameters = band.applied(parameters, bound)
             points = speed_points(args.rpm[0], args.rpm[1], args.count,
                                   parameters=tuple(parameters.items()), **point_options)
             tables.append(run_sweep(args.fmu, points, signals=signals, case=label,
                                     parallel=not args.serial, progress=not args.quiet,
                                     warnings=fmu_warnings, pool=pool))
+        return (pd.concat([t[0] for t in tables], ignore_index=True),
+                pd.concat([t[1] for t in tables], ignore_index=True))
+
+    try:
+        if band is None:
+            orders, spectra = run({})
+        else:
+            result = bands.run_band(run, band)
+            orders, spectra = result.stack(0), result.stack(1)
     finally:
         if pool is not None:
             pool.close()
     fmu_warnings_summary(fmu_warnings)
-    orders = pd.concat([t[0] for t in tables], ignore_index=True)
-    spectra = pd.concat([t[1] for t in tables], ignore_index=True)
     suffix = ".parquet" if args.parquet else ".csv"
     save(orders, str(out / f"orders{suffix}"))
     save(spectra, str(out / f"spectra{suffix}"))
     return orders, spectra, fmu_warnings
+
+
+def band_of(args, variables: dict, cases: list[tuple[str, dict]]) -> bands.Band | None:
+    """The damping band the options ask for, its settings checked like --set values."""
+    try:
+        band = bands.from_options(args, variables)
+    except ValueError as error:
+        raise UsageError(str(error)) from None
+    if band is not None:
+        for _, parameters in cases:
+            for bound in ("low", "high"):
+                for name in band.settings(bound):
+                    typed_value(variables[name], repr(band.applied(parameters, bound)[name]))
+    return band
+
+
+def band_metadata(band: bands.Band | None) -> dict:
+    if band is None:
+        return {}
+    return {"band": {"description": band.description, "low": band.low,
+                     "nominal": band.nominal, "high": band.high}}
 
 
 def cmd_sweep(args) -> int:
@@ -450,6 +485,7 @@ def cmd_sweep(args) -> int:
     check_range("--load-torque", args.load_torque)
     options = start_options(args)
     variables, cases = prepare(args)
+    band = band_of(args, variables, cases)
     check_speeds(args.rpm, increasing=args.count > 1, highest=highest_speed(variables))
     signals = analysed_signals(args, variables, default_signals(variables))
     warn_cases([(label, sampling_warnings(variables, parameters, args.rpm[0], args.rpm[1],
@@ -461,12 +497,15 @@ def cmd_sweep(args) -> int:
     started = time.perf_counter()
     orders, spectra, fmu_warnings = sweep_cases(
         args, cases, signals, out, {**options, "steps_per_revolution": args.steps_per_rev,
-                                    "load_torque": args.load_torque})
+                                    "load_torque": args.load_torque}, band)
     elapsed = time.perf_counter() - started
     suffix = ".parquet" if args.parquet else ".csv"
     units = units_of(variables)
     labels = [label for label, _ in cases]
-    for signal in args.plot or signals[:1]:
+    if band is not None:
+        bands.report_sweep(out, band, orders, spectra, signals, args.plot or signals[:1], units,
+                           suffix)
+    for signal in [] if band is not None else args.plot or signals[:1]:
         name = safe_name(signal)
         if len(cases) == 1:
             plots.waterfall(spectra, signal, str(out / f"waterfall_{name}.png"), unit=units.get(signal))
@@ -475,16 +514,18 @@ def cmd_sweep(args) -> int:
         else:
             plots.side_by_side(spectra, orders, signal, labels, str(out / f"waterfall_{name}.png"),
                                str(out / f"order_cuts_{name}.png"), unit=units.get(signal))
-    exposure = comfort_table(spectra)
+    exposure = comfort_table(spectra) if band is None else pd.DataFrame()
     if not exposure.empty:
         save(exposure, str(out / f"comfort{suffix}"))
         plots.comfort(exposure, str(out / "comfort.png"), cases=labels)
     write_metadata(out, args, variables, cases,
                    {"speeds": {"from": args.rpm[0], "to": args.rpm[1], "count": args.count},
                     "start": options, "steps_per_revolution": args.steps_per_rev,
-                    "load_torque": args.load_torque, "signals": signals},
+                    "load_torque": args.load_torque, "signals": signals,
+                    **band_metadata(band)},
                    fmu_warnings)
-    print(f"{len(cases) * args.count} points in {elapsed:.1f} s -> {out}")
+    runs = len(cases) * args.count * (1 if band is None else len(bands.BOUNDS))
+    print(f"{runs} points in {elapsed:.1f} s -> {out}")
     return 0
 
 
@@ -496,6 +537,7 @@ def cmd_runup(args) -> int:
         raise UsageError(f"--block-revolutions must be even and >= 2 (half orders on bins), "
                          f"got {args.block_revolutions}")
     variables, cases = prepare(args)
+    band = band_of(args, variables, cases)
     check_speeds(args.rpm, increasing=True, highest=highest_speed(variables))
     revolutions = (args.rpm[0] + args.rpm[1]) / 2.0 / 60.0 * args.duration
     if revolutions < 2 * args.block_revolutions:
@@ -515,23 +557,29 @@ def cmd_runup(args) -> int:
     out.mkdir(parents=True, exist_ok=True)
     started = time.perf_counter()
     records, tracked, fmu_warnings = [], [], []
-    for label, parameters in cases:
+    runs = ([(label, None, parameters) for label, parameters in cases] if band is None else
+            [(label, bound, band.applied(parameters, bound))
+             for bound in bands.BOUNDS for label, parameters in cases])
+    for label, bound, parameters in runs:
         start_values = {**parameters, "loadTorque": args.load_torque}
         if periodic:
             # Start on the periodic steady state at FROM: no fade-in transient at the start.
             start_values["initialization.periodic"] = True
-        result = run_up(args, signals, start_values, label)
+        result = run_up(args, signals, start_values, label, bound)
         fmu_warnings += result["warnings"]
         table = pd.DataFrame(result["samples"], columns=signals)
         table.insert(0, "crankAngle", result["crank_angle"])
         table.insert(0, "rpm", result["rpm"])
         table.insert(0, "time", np.arange(1, len(table) + 1) * result["dt"])
         table.insert(0, "case", label)
-        records.append(table)
         # Order tracking: blocks of whole revolutions in the crank-angle domain.
-        tracked.append(track_orders(result["crank_angle"], result["rpm"], result["samples"],
-                                    signals, revolutions_per_block=args.block_revolutions,
-                                    case=label))
+        orders_of_run = track_orders(result["crank_angle"], result["rpm"], result["samples"],
+                                     signals, revolutions_per_block=args.block_revolutions,
+                                     case=label)
+        if bound is not None:
+            table, orders_of_run = (bands.with_bound(t, bound) for t in (table, orders_of_run))
+        records.append(table)
+        tracked.append(orders_of_run)
     elapsed = time.perf_counter() - started
     fmu_warnings_summary(fmu_warnings)
     suffix = ".parquet" if args.parquet else ".csv"
@@ -543,7 +591,9 @@ def cmd_runup(args) -> int:
     rate = (args.rpm[1] - args.rpm[0]) / args.duration
     what = (f"run-up {args.rpm[0]:g}→{args.rpm[1]:g} rpm in {args.duration:g} s "
             f"({rate:.0f} rpm/s),\norder-tracked in {args.block_revolutions}-revolution blocks")
-    for signal in args.plot or signals:
+    if band is not None:
+        bands.report_runup(out, band, orders, args.plot or signals, units, what, suffix)
+    for signal in [] if band is not None else args.plot or signals:
         name = safe_name(signal)
         plots.order_map(orders, signal, str(out / f"runup_order_map_{name}.png"),
                         unit=units.get(signal), cases=labels,
@@ -555,19 +605,22 @@ def cmd_runup(args) -> int:
                    {"runup": {"from": args.rpm[0], "to": args.rpm[1], "duration": args.duration,
                               "step": args.step, "block_revolutions": args.block_revolutions,
                               "start": "periodic" if periodic else "fade-in",
-                              "load_torque": args.load_torque, "signals": signals}},
+                              "load_torque": args.load_torque, "signals": signals},
+                    **band_metadata(band)},
                    fmu_warnings)
-    print(f"{len(cases)} run-up(s) in {elapsed:.1f} s -> {out}")
+    print(f"{len(runs)} run-up(s) in {elapsed:.1f} s -> {out}")
     return 0
 
 
-def run_up(args, signals: list[str], start_values: dict, case: str) -> dict:
+def run_up(args, signals: list[str], start_values: dict, case: str,
+           bound: str | None = None) -> dict:
     """One run-up with a progress bar over the simulated time."""
     bar = None
     if not args.quiet:
         from tqdm import tqdm
 
-        bar = tqdm(total=args.duration, desc=case or "run-up", unit="s", file=sys.stderr,
+        desc = " ".join(x for x in (case, bound and f"{bound} damping") if x) or "run-up"
+        bar = tqdm(total=args.duration, desc=desc, unit="s", file=sys.stderr,
                    bar_format="{l_bar}{bar}| {n:.2f}/{total:g} s simulated [{elapsed}<{remaining}]")
 
     def progress(simulated: float):
@@ -777,6 +830,7 @@ def build_parser() -> argparse.ArgumentParser:
     s.add_argument("--load-torque", type=float, default=0.0, help="N·m, every point")
     s.add_argument("--plot", action="append",
                    help="analysed signal to plot (repeatable; default: the first)")
+    bands.add_options(s)
     parallel_options(s)
     s.set_defaults(func=cmd_sweep)
 
@@ -795,6 +849,7 @@ def build_parser() -> argparse.ArgumentParser:
     r.add_argument("--load-torque", type=float, default=0.0, help="N·m, constant")
     r.add_argument("--plot", action="append",
                    help="analysed signal to plot (repeatable; default: every --signal)")
+    bands.add_options(r)
     r.set_defaults(func=cmd_runup)
 
     c = sub.add_parser("campbell", help="Campbell diagram: engine orders against the model's "

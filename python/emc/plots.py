@@ -179,25 +179,14 @@ def order_cuts_figure(orders: pd.DataFrame, signal: str, unit: str | None = None
         ax.set_title(title or f"{signal}: order cuts", fontsize=10)
         fig.tight_layout()
         return fig
-    columns = min(3, len(cut_orders))
-    rows = -(-len(cut_orders) // columns)
-    fig, axes = plt.subplots(rows, columns, figsize=(4.3 * columns, 3.3 * rows + 0.9),
-                             sharex=True, sharey=True, squeeze=False, layout="constrained")
-    for k, ax in enumerate(axes.flat):
-        if k >= len(cut_orders):
-            ax.set_visible(False)
-            continue
-        order = cut_orders[k]
+    fig, axes = order_panels(len(cut_orders))
+    for k, (ax, order) in enumerate(zip(axes.flat, cut_orders)):
         for j, case in enumerate(cases):
             d = data[(data.case.fillna("") == case) & np.isclose(data.order, order)]
             d = d.sort_values("rpm")
             ax.plot(d.rpm, d.amplitude, label=case_label(case),
                     **case_style(j, len(d), len(cases)))
-        _cut_axes(ax, data.amplitude)
-        ax.set_title(f"order {order:g}", fontsize=10)
-        if k % columns == 0:
-            ax.set_ylabel(ylabel)
-        ax.tick_params(labelbottom=True)
+        order_panel_axes(ax, k, order, axes.shape[1], ylabel, data.amplitude)
     handles, labels = axes.flat[0].get_legend_handles_labels()
     fig.legend(handles, labels, loc="outside lower center", ncol=min(len(cases), 4),
                fontsize=9, frameon=False)
@@ -208,6 +197,27 @@ def order_cuts_figure(orders: pd.DataFrame, signal: str, unit: str | None = None
 def order_cuts(orders: pd.DataFrame, signal: str, path: str, unit: str | None = None,
                title: str | None = None, cut_orders=MAIN_ORDERS, cases: list[str] | None = None):
     _save(order_cuts_figure(orders, signal, unit, title, cut_orders, cases), path)
+
+
+def order_panels(count: int, extra_height: float = 0.9):
+    """A figure with one panel per order, three to a row, on shared axes (unused panels
+    hidden); returns (figure, axes)."""
+    columns = min(3, count)
+    rows = -(-count // columns)
+    fig, axes = plt.subplots(rows, columns, figsize=(4.3 * columns, 3.3 * rows + extra_height),
+                             sharex=True, sharey=True, squeeze=False, layout="constrained")
+    for ax in axes.flat[count:]:
+        ax.set_visible(False)
+    return fig, axes
+
+
+def order_panel_axes(ax, k: int, order: float, columns: int, ylabel: str, amplitudes):
+    """Scales, grid, title and (first column) label of order panel ``k``."""
+    _cut_axes(ax, amplitudes)
+    ax.set_title(f"order {order:g}", fontsize=10)
+    if k % columns == 0:
+        ax.set_ylabel(ylabel)
+    ax.tick_params(labelbottom=True)
 
 
 def _cut_axes(ax, amplitudes):

@@ -279,6 +279,8 @@ mod tests {
                 position: [0.0, 1.0, 2.0],
                 shape: vec![[1.0; 6], [2.0; 6]],
             }],
+            cutoff_hz: None,
+            own_damping: None,
         }
     }
 

@@ -78,13 +78,14 @@ fn symmetric<'f>(file: &'f DmigFile, name: &str) -> Result<&'f DmigMatrix, CmsEr
     Ok(m)
 }
 
-/// The kept modal coordinates, ascending id: the Rayleigh frequency of each selects it.
+/// The kept modal coordinates, ascending id, and the highest Rayleigh frequency among them (Hz,
+/// 0 if none is kept): the Rayleigh frequency of each selects it.
 fn select_modal(
     k: &DmigMatrix,
     m: &DmigMatrix,
     modal: &[DmigDof],
     selection: ModeSelection,
-) -> Result<Vec<DmigDof>, CmsError> {
+) -> Result<(Vec<DmigDof>, f64), CmsError> {
     let mut hz = Vec::with_capacity(modal.len());
     for &q in modal {
         let (kq, mq) = (k.get(q, q), m.get(q, q));
@@ -99,7 +100,7 @@ fn select_modal(
         }
         hz.push(((kq / mq).sqrt() / (2.0 * std::f64::consts::PI), q));
     }
-    let mut kept: Vec<DmigDof> = match selection {
+    let kept: Vec<(f64, DmigDof)> = match selection {
         ModeSelection::Count(n) => {
             if n > modal.len() {
                 return Err(invalid(format!(
@@ -109,12 +110,74 @@ fn select_modal(
                 )));
             }
             hz.sort_by(|a, b| a.0.total_cmp(&b.0));
-            hz.iter().take(n).map(|&(_, q)| q).collect()
+            hz.into_iter().take(n).collect()
         }
-        ModeSelection::CutoffHz(f) => hz.iter().filter(|(h, _)| *h < f).map(|&(_, q)| q).collect(),
+        ModeSelection::CutoffHz(f) => hz.into_iter().filter(|(h, _)| *h < f).collect(),
     };
+    let top = kept.iter().map(|&(h, _)| h).fold(0.0, f64::max);
+    let mut kept: Vec<DmigDof> = kept.into_iter().map(|(_, q)| q).collect();
     kept.sort_unstable();
-    Ok(kept)
+    Ok((kept, top))
+}
+
+/// The recovery matrix `name`, checked before anything is computed with it: a rectangular matrix
+/// (Nastran's `PHIOUT`) whose columns are the a-set DOFs of the stiffness matrix — all of them,
+/// as its header's `NCOL` must say — and whose rows are DOFs outside the a-set.
+fn recovery_matrix<'f>(
+    body: &ExternalBody<'f>,
+    name: &str,
+    k: &DmigMatrix,
+    m: &DmigMatrix,
+    a_set: &BTreeSet<DmigDof>,
+) -> Result<&'f DmigMatrix, CmsError> {
+    let rec = body.file.matrix(name).map_err(CmsError::from)?;
+    if rec.name == k.name || rec.name == m.name {
+        return Err(invalid(format!(
+            "recovery matrix {} is also the {} matrix: a recovery matrix (Nastran's PHIOUT) \
+             gives the motion of output DOFs outside the a-set in terms of the a-set DOFs of {}",
+            rec.name,
+            if rec.name == k.name {
+                "stiffness"
+            } else {
+                "mass"
+            },
+            k.name
+        )));
+    }
+    if !matches!(rec.form, 2 | 9) {
+        return Err(invalid(format!(
+            "recovery matrix {} has form IFO = {}: a recovery matrix is rectangular (IFO 2 or \
+             9), rows the output DOFs, columns the a-set DOFs of {}",
+            rec.name, rec.form, k.name
+        )));
+    }
+    if let Some(ncol) = rec.ncol.filter(|&n| n != a_set.len()) {
+        return Err(invalid(format!(
+            "recovery matrix {} declares NCOL = {ncol} in its header, but {} has {} DOFs (the \
+             a-set): the recovery matrix has one column per a-set DOF",
+            rec.name,
+            k.name,
+            a_set.len()
+        )));
+    }
+    if let Some(&(col, _)) = rec.entries.keys().find(|(c, _)| !a_set.contains(c)) {
+        return Err(invalid(format!(
+            "recovery matrix {} has a column for {}, which is not a DOF of {}",
+            rec.name,
+            dof_name(col),
+            k.name
+        )));
+    }
+    if let Some(&(_, row)) = rec.entries.keys().find(|(_, r)| a_set.contains(r)) {
+        return Err(invalid(format!(
+            "recovery matrix {} has a row for {}, which is a DOF of {}: its rows are the output \
+             DOFs outside the a-set",
+            rec.name,
+            dof_name(row),
+            k.name
+        )));
+    }
+    Ok(rec)
 }
 
 /// The body given by Craig-Bampton matrices, reduced to its modes like our own reduction.
@@ -149,10 +212,18 @@ pub fn reduce_external(body: &ExternalBody<'_>) -> Result<ReducedChassis, CmsErr
 
     // Coordinates: the kept modal ones, then the mounts' boundary DOFs in mount order (the
     // order of our own reduction's constraint modes), then any other boundary DOF.
-    let mut coords = select_modal(k, m, &modal, body.selection)?;
+    let (mut coords, cutoff_hz) = select_modal(k, m, &modal, body.selection)?;
     let mut interface_dofs = Vec::new();
+    let mut interface_grids: Vec<(u32, &String)> = Vec::new();
     for name in body.interface {
         let g = grid_of(name, "mount body node")?;
+        if let Some((_, other)) = interface_grids.iter().find(|(h, _)| *h == g) {
+            return Err(invalid(format!(
+                "mount body nodes '{other}' and '{name}' are both GRID {g}: two mounts on one \
+                 grid (each mount needs its own boundary grid)"
+            )));
+        }
+        interface_grids.push((g, name));
         for c in 1..=3u8 {
             if !boundary.contains(&(g, c)) {
                 return Err(invalid(format!(
@@ -183,23 +254,12 @@ pub fn reduce_external(body: &ExternalBody<'_>) -> Result<ReducedChassis, CmsErr
             m.name
         )));
     }
-    let (omega, coefficients) = orthogonalise(&k_r, &m_r)?;
-
     let recovery = match body.recovery {
-        Some(name) => {
-            let rec = body.file.matrix(name).map_err(CmsError::from)?;
-            if let Some(&(col, _)) = rec.entries.keys().find(|(c, _)| !a_set.contains(c)) {
-                return Err(invalid(format!(
-                    "recovery matrix {} has a column for {}, which is not a DOF of {}",
-                    rec.name,
-                    dof_name(col),
-                    k.name
-                )));
-            }
-            Some(rec)
-        }
+        Some(name) => Some(recovery_matrix(body, name, k, m, &a_set)?),
         None => None,
     };
+    let (omega, coefficients) = orthogonalise(&k_r, &m_r)?;
+
     let rows: BTreeMap<DmigDof, Vec<(DmigDof, f64)>> = recovery.map_or_else(BTreeMap::new, |rec| {
         let mut rows: BTreeMap<DmigDof, Vec<(DmigDof, f64)>> = BTreeMap::new();
         for (&(col, row), &v) in &rec.entries {
@@ -265,6 +325,8 @@ pub fn reduce_external(body: &ExternalBody<'_>) -> Result<ReducedChassis, CmsErr
         zeta: table_damping(&omega, body.damping),
         omega,
         points,
+        cutoff_hz: Some(cutoff_hz),
+        own_damping: None,
     })
 }
 

@@ -82,7 +82,9 @@ pub use cache::{
 pub use craig_bampton::{
     craig_bampton, craig_bampton_basis, orthogonalise, CraigBampton, CraigBamptonBasis,
 };
-pub use damping::{DampingBand, DampingTable};
+pub use damping::{
+    BodyDamping, DampingTable, DampingUnit, OwnDamping, TableError, DEFAULT_BODY_DAMPING_RATIO,
+};
 pub use dmig_export::{dmig_of_reduction, DmigBody};
 pub use error::CmsError;
 pub use external::{reduce_external, ExternalBody};

@@ -3,7 +3,7 @@
 //! the output points).
 
 use super::craig_bampton::{craig_bampton, CraigBampton};
-use super::damping::table_damping;
+use super::damping::{table_damping, DampingTable, DampingUnit, OwnDamping};
 use super::error::CmsError;
 use super::external::reduce_dmig_source;
 use super::reduced::{RecoveryPoint, ReducedChassis};
@@ -73,17 +73,19 @@ pub(crate) struct Model {
     pub mounts: Vec<(String, usize)>,
     pub interface: Vec<usize>,
     pub notes: Vec<String>,
+    pub own_damping: Option<OwnDamping>,
 }
 
 /// Builds and assembles the body `spec` describes (procedural or deck; a DMIG body has no FE
 /// model).
 pub(crate) fn model(spec: &ReductionSpec) -> Result<Model, CmsError> {
     spec.validate()?;
-    let (chassis, names, notes) = match &spec.body {
+    let (chassis, names, notes, own_damping) = match &spec.body {
         BodySource::Procedural(config) => (
             Chassis::build(config)?,
             BodyNames::Mesh(MeshIndices),
             Vec::new(),
+            None,
         ),
         BodySource::Deck(deck) => deck_body(deck)?,
         BodySource::Dmig(_) => {
@@ -115,6 +117,7 @@ pub(crate) fn model(spec: &ReductionSpec) -> Result<Model, CmsError> {
         mounts,
         interface,
         notes,
+        own_damping,
     })
 }
 
@@ -205,7 +208,12 @@ pub fn reduce_detailed(spec: &ReductionSpec) -> Result<Reduction, CmsError> {
             recovery_point(&model.chassis, &model.assembled.dofs, &modes, name, node)
         })
         .collect::<Result<Vec<_>, _>>()?;
-    let mut zeta = table_damping(&modes.omega, &spec.damping);
+    // A body's own table (a deck's TABDMP1) comes before the spec's.
+    let table = model
+        .own_damping
+        .as_ref()
+        .map_or(&spec.damping, |own| &own.table);
+    let mut zeta = table_damping(&modes.omega, table);
     if spec.discrete_dampers {
         for (k, z) in zeta.iter_mut().enumerate() {
             *z += projected_damping(&model.assembled.c, &modes, k) / (2.0 * modes.omega[k]);
@@ -215,6 +223,8 @@ pub fn reduce_detailed(spec: &ReductionSpec) -> Result<Reduction, CmsError> {
         omega: modes.omega.clone(),
         zeta,
         points,
+        cutoff_hz: Some(modes.fixed_interface_hz.iter().copied().fold(0.0, f64::max)),
+        own_damping: model.own_damping,
     };
     Ok(Reduction {
         chassis: model.chassis,
@@ -229,7 +239,9 @@ pub fn reduce_detailed(spec: &ReductionSpec) -> Result<Reduction, CmsError> {
 /// The body of a bulk data deck, its points named, checked (poor element shapes are warnings,
 /// as in Nastran), with its names and the notes for the log; the content must still be what
 /// the spec's checksum says (the cache key was made from it).
-fn deck_body(deck: &BulkDeckBody) -> Result<(Chassis, BodyNames, Vec<String>), CmsError> {
+fn deck_body(
+    deck: &BulkDeckBody,
+) -> Result<(Chassis, BodyNames, Vec<String>, Option<OwnDamping>), CmsError> {
     let options = crate::nastran::DeckOptions {
         include_root: deck.include_root.clone(),
         ..Default::default()
@@ -249,6 +261,11 @@ fn deck_body(deck: &BulkDeckBody) -> Result<(Chassis, BodyNames, Vec<String>), C
     let mut notes = std::mem::take(&mut body.notes);
     notes.extend(warnings);
     let unused = body.unused_grids.iter().copied().collect();
+    let own_damping = body
+        .damping
+        .as_ref()
+        .map(|card| deck_damping(card, deck))
+        .transpose()?;
     Ok((
         Chassis {
             mesh: body.mesh,
@@ -256,7 +273,45 @@ fn deck_body(deck: &BulkDeckBody) -> Result<(Chassis, BodyNames, Vec<String>), C
         },
         BodyNames::Deck { names, unused },
         notes,
+        own_damping,
     ))
+}
+
+/// The deck's `TABDMP1` as the body's damping table, checked; a bad table is refused naming the
+/// card, its id and the line of the offending point.
+fn deck_damping(
+    card: &crate::nastran::DampingTableCard,
+    deck: &BulkDeckBody,
+) -> Result<OwnDamping, CmsError> {
+    let unit = DampingUnit::from_nastran(card.kind).ok_or_else(|| {
+        CmsError::InvalidInput(format!(
+            "bulk data deck {}: TABDMP1 {} at line {}: damping type '{}' is not handled",
+            deck.path.display(),
+            card.id,
+            card.loc,
+            card.kind
+        ))
+    })?;
+    let table = DampingTable {
+        unit,
+        points: card.points.clone(),
+    };
+    table.check().map_err(|e| {
+        let at = e
+            .point
+            .and_then(|i| card.point_lines.get(i))
+            .unwrap_or(&card.loc);
+        CmsError::InvalidInput(format!(
+            "bulk data deck {}: Nastran bulk data line {at}: TABDMP1 {} (card at line {}): {e}",
+            deck.path.display(),
+            card.id,
+            card.loc
+        ))
+    })?;
+    Ok(OwnDamping {
+        source: format!("TABDMP1 {} at line {} of the deck", card.id, card.loc),
+        table,
+    })
 }
 
 /// `φ_kᵀ C φ_k` of mode `k`.

@@ -2,6 +2,8 @@
 
 use serde::{Deserialize, Serialize};
 
+use super::damping::OwnDamping;
+
 /// A point of the chassis whose motion is recovered from the modal coordinates.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct RecoveryPoint {
@@ -25,6 +27,15 @@ pub struct ReducedChassis {
     pub zeta: Vec<f64>,
     /// Interface (mount) nodes first, then output points.
     pub points: Vec<RecoveryPoint>,
+    /// The modes above this frequency (Hz) are the interface modes of the reduction, whose
+    /// frequencies follow from the constraint modes, not from the structure: the highest
+    /// fixed-interface mode kept (0 if none was). `None`: not known (modal data from a file).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub cutoff_hz: Option<f64>,
+    /// The damping the body brought with it (a deck's `TABDMP1` named by `SDAMPING`), which
+    /// `zeta` follows; the scene applies it unless the vehicle configuration gives a damping.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub own_damping: Option<OwnDamping>,
 }
 
 impl ReducedChassis {
@@ -39,6 +50,8 @@ impl ReducedChassis {
             omega: Vec::new(),
             zeta: Vec::new(),
             points: Vec::new(),
+            cutoff_hz: None,
+            own_damping: None,
         }
     }
 
@@ -63,6 +76,8 @@ impl ReducedChassis {
                     ..p.clone()
                 })
                 .collect(),
+            cutoff_hz: self.cutoff_hz,
+            own_damping: self.own_damping.clone(),
         }
     }
 }

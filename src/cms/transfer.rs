@@ -121,6 +121,8 @@ mod tests {
                 position: [0.0; 3],
                 shape: vec![[0.0, 0.0, 0.5, 0.0, 0.0, 0.0]],
             }],
+            cutoff_hz: None,
+            own_damping: None,
         }
     }
 

@@ -325,7 +325,7 @@ const _: fmi2GetStringTYPE = Some(fmi2GetString);
 /// variable may be set in this phase: fixed parameters only before initialisation ends) before any
 /// is applied, so a refused call changes nothing. An input set between steps takes effect at the
 /// next fmi2DoStep: as a ramp with a derivative set by fmi2SetRealInputDerivatives, otherwise as
-/// a first-order hold of the values set (see [`super::input_track`]).
+/// a first-order hold of the values set (see [`crate::fmu::input_track`]).
 #[no_mangle]
 pub extern "C" fn fmi2SetReal(
     c: fmi2Component,

@@ -1,5 +1,5 @@
 //! FMI 2.0 value references: each type's variables are numbered from its base in
-//! [`VR_BASE`](crate::variables::VR_BASE), so a value reference is a position among the variables
+//! [`crate::variables::VR_BASE`], so a value reference is a position among the variables
 //! of its type.
 
 use crate::fmu::values::{Slot, VarType};

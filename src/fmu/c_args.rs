@@ -19,10 +19,10 @@ pub unsafe fn array<'a, T>(ptr: *const T, n: usize, name: &str) -> Result<&'a [T
     }
 }
 
-/// As [`array`], for writing.
+/// As [`array()`], for writing.
 ///
 /// # Safety
-/// As [`array`], and the elements must be writable.
+/// As [`array()`], and the elements must be writable.
 pub unsafe fn array_mut<'a, T>(ptr: *mut T, n: usize, name: &str) -> Result<&'a mut [T], String> {
     if n == 0 {
         Ok(&mut [])
@@ -61,7 +61,7 @@ pub unsafe fn text(ptr: *const c_char) -> Option<String> {
 /// Strings from the C array `name` of `n` C strings; null or non-UTF-8 entries are refused.
 ///
 /// # Safety
-/// As [`array`], each entry null or a NUL-terminated string valid for the call.
+/// As [`array()`], each entry null or a NUL-terminated string valid for the call.
 pub unsafe fn texts(
     ptr: *const *const c_char,
     n: usize,

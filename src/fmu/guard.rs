@@ -78,7 +78,7 @@ pub struct Handle {
 }
 
 impl Abi {
-    /// [`entry`] for this standard, with the status as the standard's C status (fmi2Status and
+    /// `entry` for this standard, with the status as the standard's C status (fmi2Status and
     /// fmi3Status number the statuses as [`Status`]).
     pub fn entry(
         &self,

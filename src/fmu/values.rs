@@ -88,7 +88,7 @@ pub trait VarType: Clone + PartialEq + Serialize + DeserializeOwned + 'static {
     type Start: 'static;
     /// `Real`, `Integer`, `Boolean` or `String`.
     const NAME: &'static str;
-    /// Position of the type in [`VR_BASE`].
+    /// Position of the type in [`crate::variables::VR_BASE`].
     const TYPE_INDEX: usize;
     /// The type's variables.
     fn table() -> &'static [Variable<Self::Start>];

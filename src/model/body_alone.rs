@@ -285,6 +285,8 @@ mod tests {
                 position: [0.0; 3],
                 shape: vec![[0.0, 0.0, 1.0, 0.0, 0.0, 0.0]],
             }],
+            cutoff_hz: None,
+            own_damping: None,
         };
         BodyAlone {
             body,

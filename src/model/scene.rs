@@ -3,8 +3,8 @@
 //! scene needs (scene 2, Table 1 middle column).
 
 use crate::cms::{
-    reduce_cached_with_notes, BodySource, BulkDeckBody, CacheOutcome, CacheSetting, DmigBodySource,
-    InterfaceDofs, ModeSelection, ReducedChassis, ReductionSpec,
+    reduce_cached_with_notes, BodyDamping, BodySource, BulkDeckBody, CacheOutcome, CacheSetting,
+    DmigBodySource, InterfaceDofs, ModeSelection, ReducedChassis, ReductionSpec,
 };
 
 use super::body_alone::BodyAlone;
@@ -80,7 +80,8 @@ pub struct BodyOptions {
     /// All six DOFs of the mount nodes as interface (rotational constraint modes, kHz), instead
     /// of the translations (the mounts transmit forces only).
     pub interface_rotations: bool,
-    /// Factor on every modal damping ratio (1 = the ADAMS table; 0 = undamped).
+    /// Factor on the body's physical modal damping, its table and per-mode overrides (1 = as
+    /// configured; 0 = undamped); the numerical damping of the interface modes stays.
     pub modal_damping_scale: f64,
     /// Procedural body only: the transverse stiffening bar between the front girders.
     pub stiffening_bar: bool,
@@ -92,7 +93,8 @@ pub struct BodyOptions {
 
 impl Default for BodyOptions {
     /// The paper's question: engine orders up to 4.5 at up to 2500 rpm (an automatic cut-off of
-    /// 225 Hz), translational interface, the ADAMS damping table, the body as designed, cached.
+    /// 225 Hz), translational interface, the body's damping as configured, the body as designed,
+    /// cached.
     fn default() -> Self {
         BodyOptions {
             mode_cutoff_hz: 0.0,
@@ -318,7 +320,7 @@ pub fn reduction_spec(
 ) -> Result<(ReductionSpec, String), SceneError> {
     options.validate()?;
     let body = match &vehicle.body {
-        BodyConfig::Procedural { chassis } => {
+        BodyConfig::Procedural { chassis, .. } => {
             let mut chassis = chassis.clone();
             chassis.options.stiffening_bar |= options.stiffening_bar;
             chassis.options.stiff_front_plate |= options.stiff_front_plate;
@@ -328,6 +330,7 @@ pub fn reduction_spec(
             path,
             points,
             include_root,
+            ..
         } => {
             options.procedural_only("a bulk data deck")?;
             // Streaming over the deck and its INCLUDEs: the key follows every file's content
@@ -348,6 +351,7 @@ pub fn reduction_spec(
             recovery,
             points,
             include_root,
+            ..
         } => {
             options.procedural_only("given as Craig-Bampton matrices (DMIG)")?;
             if options.interface_rotations {
@@ -404,6 +408,50 @@ fn file_digest(
     crate::nastran::deck_digest(path, &options)
 }
 
+/// Sets the modal damping of `body`: the vehicle configuration's body damping, else the body's
+/// own (a deck's `TABDMP1` named by `SDAMPING`; a reduced body read from a file keeps its
+/// ratios), else the default; the physical part scaled by `scale`. Returns what was applied,
+/// for the log.
+fn apply_damping(
+    body: &mut ReducedChassis,
+    vehicle: &VehicleConfig,
+    scale: f64,
+) -> Result<String, SceneError> {
+    let given = vehicle.body.damping();
+    if given.is_none() {
+        if let BodyConfig::Reduced { .. } = vehicle.body {
+            for z in &mut body.zeta {
+                *z *= scale;
+            }
+            return Ok(format!("modal damping x{scale} (the file's ratios)"));
+        }
+    }
+    let (damping, origin) = match (given, &body.own_damping) {
+        (Some(d), _) => (d.clone(), "the vehicle configuration's".to_owned()),
+        (None, Some(own)) => (
+            BodyDamping::from_table(own.table.clone()),
+            format!("the body's {}", own.source),
+        ),
+        (None, None) => (BodyDamping::default(), "the default".to_owned()),
+    };
+    let hz: Vec<f64> = body
+        .omega
+        .iter()
+        .map(|w| w / (2.0 * std::f64::consts::PI))
+        .collect();
+    body.zeta = damping
+        .ratios(&hz, body.cutoff_hz, scale)
+        .map_err(|e| SceneError::Model(format!("body.damping: {e}")))?;
+    let interface = match body.cutoff_hz {
+        Some(c) => {
+            let above = hz.iter().filter(|f| **f > c).count();
+            format!("; {above} interface modes above {c:.1} Hz damped numerically")
+        }
+        None => String::new(),
+    };
+    Ok(format!("modal damping x{scale} ({origin}){interface}"))
+}
+
 /// The reduced body the scene asks for, from the cache or freshly reduced (timed for the log).
 pub fn body(
     vehicle: &VehicleConfig,
@@ -455,7 +503,7 @@ pub fn body(
             let notes: String = notes.iter().map(|n| format!("; {n}")).collect();
             (body, format!("{what}, {source}{notes}"))
         }
-        BodyConfig::Reduced { path } => {
+        BodyConfig::Reduced { path, .. } => {
             options.procedural_only("a reduced model from a file")?;
             let text = crate::text_file::read_limited(path, crate::text_file::DATA_LIMIT)
                 .map_err(|e| format!("reduced body: {e}"))?;
@@ -468,14 +516,14 @@ pub fn body(
     let mut body = if flexible {
         body
     } else {
-        body.keep_below(RIGID_BODY_HZ)
+        // The rigid-body modes on the suspension are the body's physical modes here.
+        let mut rigid = body.keep_below(RIGID_BODY_HZ);
+        rigid.cutoff_hz = rigid.cutoff_hz.map(|_| RIGID_BODY_HZ);
+        rigid
     };
-    for z in &mut body.zeta {
-        *z *= options.modal_damping_scale;
-    }
+    let damping_origin = apply_damping(&mut body, vehicle, options.modal_damping_scale)?;
     let note = format!(
-        "{origin}, modal damping x{}: {} modes, {:.1}..{:.1} Hz, in {seconds:.2} s",
-        options.modal_damping_scale,
+        "{origin}, {damping_origin}: {} modes, {:.1}..{:.1} Hz, in {seconds:.2} s",
         body.n_modes(),
         body.omega.first().copied().unwrap_or(0.0) / (2.0 * std::f64::consts::PI),
         body.omega.last().copied().unwrap_or(0.0) / (2.0 * std::f64::consts::PI),

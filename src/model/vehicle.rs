@@ -20,6 +20,7 @@ use super::powertrain::defaults::{POWERTRAIN_CG, POWERTRAIN_MASS};
 use super::validate::{err, positive, ConfigError};
 use crate::chassis::config::ChassisConfig;
 use crate::chassis::{SEAT_RAIL, STEERING_WHEEL};
+use crate::cms::BodyDamping;
 
 /// Where the elastic body comes from (used when the scene has a body).
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
@@ -31,6 +32,9 @@ pub enum BodyConfig {
     Procedural {
         /// The chassis's geometry, sections, materials, trim and suspension.
         chassis: Box<ChassisConfig>,
+        /// Modal damping of the body (`None`: [`BodyDamping::default`]).
+        #[serde(default, skip_serializing_if = "Option::is_none")]
+        damping: Option<BodyDamping>,
     },
     /// A user's body from a Nastran bulk data deck ([`crate::nastran`]), reduced by
     /// Craig-Bampton like the procedural one; `points` names the GRID ids the mounts
@@ -47,6 +51,10 @@ pub enum BodyConfig {
         /// configuration file's folder).
         #[serde(default, skip_serializing_if = "Option::is_none")]
         include_root: Option<PathBuf>,
+        /// Modal damping of the body (`None`: the deck's own `TABDMP1` named by `SDAMPING` in
+        /// its case control, else [`BodyDamping::default`]).
+        #[serde(default, skip_serializing_if = "Option::is_none")]
+        damping: Option<BodyDamping>,
     },
     /// A body reduced elsewhere: Craig-Bampton matrices in Nastran `DMIG` form
     /// ([`crate::nastran::read_dmig_file`], [`crate::cms::reduce_external`]), reduced to its
@@ -71,6 +79,9 @@ pub enum BodyConfig {
         /// configuration file's folder).
         #[serde(default, skip_serializing_if = "Option::is_none")]
         include_root: Option<PathBuf>,
+        /// Modal damping of the body (`None`: [`BodyDamping::default`]).
+        #[serde(default, skip_serializing_if = "Option::is_none")]
+        damping: Option<BodyDamping>,
     },
     /// Modal data of an already reduced body: the JSON of a [`crate::cms::ReducedChassis`]
     /// (frequencies, damping ratios, named points with their mode-shape rows). A relative path is
@@ -78,7 +89,23 @@ pub enum BodyConfig {
     Reduced {
         /// The JSON file of the reduced body.
         path: PathBuf,
+        /// Modal damping of the body in place of the file's ratios (`None`: the file's).
+        #[serde(default, skip_serializing_if = "Option::is_none")]
+        damping: Option<BodyDamping>,
     },
+}
+
+impl BodyConfig {
+    /// The body's modal damping as the configuration gives it (`None`: the body's own, or the
+    /// default; see each kind).
+    pub fn damping(&self) -> Option<&BodyDamping> {
+        match self {
+            BodyConfig::Procedural { damping, .. }
+            | BodyConfig::Nastran { damping, .. }
+            | BodyConfig::Dmig { damping, .. }
+            | BodyConfig::Reduced { damping, .. } => damping.as_ref(),
+        }
+    }
 }
 
 /// A deck named by a configuration file must lie in `root` (checked on the resolved paths, so
@@ -175,7 +202,8 @@ pub fn default_mounts(weight: f64) -> Vec<MountConfig> {
 
 impl Default for VehicleConfig {
     /// The paper's vehicle: the Steyr M13 inline-3 on four mounts in the procedural FIAT Brava
-    /// body, steering wheel and seat rail as outputs.
+    /// body with the default modal damping ([`BodyDamping::default`]), steering wheel and seat
+    /// rail as outputs.
     fn default() -> Self {
         let gravity = 9.81;
         Self {
@@ -184,6 +212,7 @@ impl Default for VehicleConfig {
             mounts: default_mounts(POWERTRAIN_MASS * gravity),
             body: BodyConfig::Procedural {
                 chassis: Box::default(),
+                damping: Some(BodyDamping::default()),
             },
             outputs: vec![STEERING_WHEEL.to_string(), SEAT_RAIL.to_string()],
             effects: Effects::default(),
@@ -251,7 +280,7 @@ impl VehicleConfig {
             .map_err(|e| err("file", e))?;
         let mut config = Self::from_json(&text)?;
         let dir = path.parent().unwrap_or(std::path::Path::new(""));
-        if let BodyConfig::Reduced { path: body }
+        if let BodyConfig::Reduced { path: body, .. }
         | BodyConfig::Nastran { path: body, .. }
         | BodyConfig::Dmig { path: body, .. } = &mut config.body
         {
@@ -313,6 +342,12 @@ impl VehicleConfig {
             }
         }
         self.validate_body_points()?;
+        if let Some(damping) = self.body.damping() {
+            damping.check().map_err(|e| {
+                let (field, message) = e.split_once(": ").unwrap_or(("", e.as_str()));
+                err(format!("body.damping.{field}"), message.to_string())
+            })?;
+        }
         if let Some(i) = self.outputs.iter().position(|o| o.trim().is_empty()) {
             return Err(err(
                 format!("outputs[{i}]"),
@@ -323,7 +358,8 @@ impl VehicleConfig {
     }
 
     /// Every named point of a bulk-deck body must be a node the vehicle uses (a mount's body
-    /// node or an output): a misspelt name would otherwise be ignored.
+    /// node or an output): a misspelt name would otherwise be ignored; and no two active mounts
+    /// may attach to one GRID.
     fn validate_body_points(&self) -> Result<(), ConfigError> {
         let (BodyConfig::Nastran { points, .. } | BodyConfig::Dmig { points, .. }) = &self.body
         else {
@@ -336,16 +372,38 @@ impl VehicleConfig {
                     .iter()
                     .any(|m| m.body_node.as_deref() == Some(name))
         };
-        match points.keys().find(|name| !used(name)) {
-            Some(name) => Err(err(
+        if let Some(name) = points.keys().find(|name| !used(name)) {
+            return Err(err(
                 format!("body.points.{name}"),
                 format!(
                     "body point '{name}' is neither a mount's body_node nor an output ({})",
                     self.outputs.join(", ")
                 ),
-            )),
-            None => Ok(()),
+            ));
         }
+        // Two mounts on one grid would make the interface singular far downstream.
+        let mut seen: Vec<(u32, usize)> = Vec::new();
+        for (i, m) in self.mounts.iter().enumerate().filter(|(_, m)| m.active) {
+            let Some(grid) = m.body_node.as_ref().and_then(|n| points.get(n)) else {
+                continue;
+            };
+            if let Some(&(_, j)) = seen.iter().find(|(g, _)| g == grid) {
+                let other = &self.mounts[j];
+                return Err(err(
+                    format!("mounts[{i}].body_node"),
+                    format!(
+                        "mounts '{}' and '{}' both attach to GRID {grid} (body points '{}' and \
+                         '{}'): each mount needs its own grid",
+                        other.name,
+                        m.name,
+                        other.body_node.as_deref().unwrap_or(""),
+                        m.body_node.as_deref().unwrap_or("")
+                    ),
+                ));
+            }
+            seen.push((*grid, i));
+        }
+        Ok(())
     }
 
     /// The body nodes the active mounts attach to, in mount order (the body's interface).

@@ -344,10 +344,77 @@ pub(super) fn case_control_spc(line: &str, loc: &Loc) -> Result<Option<u32>, FeE
     })
 }
 
+/// `SDAMPING = n` of the case control (the command abbreviated to four letters at least, with
+/// an optional `(STRUCTURE)`; `SDAMPING(FLUID)` concerns no structure and is passed over): the
+/// `TABDMP1` of the structure's modal damping.
+pub(super) fn case_control_sdamping(line: &str, loc: &Loc) -> Result<Option<u32>, FeError> {
+    let upper = strip_comment(line).trim().to_ascii_uppercase();
+    let word_end = upper
+        .find(|c: char| !c.is_ascii_alphabetic())
+        .unwrap_or(upper.len());
+    let word = &upper[..word_end];
+    if word.len() < 4 || !"SDAMPING".starts_with(word) {
+        return Ok(None);
+    }
+    let bad = || {
+        lex_error(
+            loc,
+            format!(
+                "case control '{}' is not SDAMPING = <TABDMP1 id>",
+                shown(&upper)
+            ),
+        )
+    };
+    let mut rest = upper[word_end..].trim_start();
+    if let Some(qualified) = rest.strip_prefix('(') {
+        let (qualifier, after) = qualified.split_once(')').ok_or_else(bad)?;
+        match qualifier.trim() {
+            "STRUCTURE" | "STRUC" => {}
+            "FLUID" => return Ok(None),
+            _ => return Err(bad()),
+        }
+        rest = after.trim_start();
+    }
+    let value = rest.strip_prefix('=').ok_or_else(bad)?;
+    value.trim().parse::<u32>().map(Some).map_err(|_| bad())
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
     use crate::nastran::lex;
+
+    #[test]
+    fn sdamping_in_its_spellings() {
+        let loc = Loc {
+            line: 3,
+            file: None,
+        };
+        for (text, id) in [
+            ("SDAMPING = 12", Some(12)),
+            ("  sdamping=7 $ table", Some(7)),
+            ("SDAMP = 3", Some(3)),
+            ("SDAMPING(STRUCTURE) = 4", Some(4)),
+            ("SDAMPING (FLUID) = 5", None),
+            ("SPC = 1", None),
+            ("SDA = 1", None),
+            ("SUBCASE 1", None),
+        ] {
+            assert_eq!(case_control_sdamping(text, &loc).unwrap(), id, "{text}");
+        }
+        for text in [
+            "SDAMPING = ALL",
+            "SDAMPING(X) = 1",
+            "SDAMPING 12",
+            "SDAMPING = -1",
+        ] {
+            let e = case_control_sdamping(text, &loc).unwrap_err().to_string();
+            assert!(
+                e.contains("line 3") && e.contains("SDAMPING = <TABDMP1 id>"),
+                "{e}"
+            );
+        }
+    }
 
     #[test]
     fn nastran_reals_in_all_their_forms() {

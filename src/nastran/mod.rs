@@ -144,6 +144,7 @@ mod writer;
 use std::collections::BTreeMap;
 use std::path::Path;
 
+pub use cards::DampingTableCard;
 pub use dmig::{parse_dmig_str, read_dmig_file, write_dmig_file, DmigDof, DmigFile, DmigMatrix};
 pub use lexer::{classify, parse_real, Deck, Field, Loc, RawCard, Value};
 pub use names::DeckNames;
@@ -194,6 +195,8 @@ pub struct NastranBody {
     pub unused_grids: Vec<u32>,
     /// What the reader decided that the user should know (dropped grids), one log line each.
     pub notes: Vec<String>,
+    /// The `TABDMP1` the case control's `SDAMPING` names, if any: the body's own modal damping.
+    pub damping: Option<DampingTableCard>,
 }
 
 impl NastranBody {
@@ -245,7 +248,7 @@ pub fn parse_reader(
 ) -> Result<NastranBody, FeError> {
     let mut cards = to_mesh::Collector::new();
     let info = reader::read_from(input, limits, &mut cards)?;
-    to_mesh::build(cards, info.spc_selection)
+    to_mesh::build(cards, &info)
 }
 
 /// Reads a bulk data file and its `INCLUDE`s with the default [`DeckOptions`].
@@ -254,7 +257,7 @@ pub fn read_bulk_deck(path: &Path) -> Result<NastranBody, FeError> {
     let options = DeckOptions::default();
     let info =
         reader::read_file(path, &options, &mut cards, false).map_err(|e| prefixed(path, e))?;
-    to_mesh::build(cards, info.spc_selection).map_err(|e| prefixed(path, e))
+    to_mesh::build(cards, &info).map_err(|e| prefixed(path, e))
 }
 
 fn prefixed(path: &Path, e: FeError) -> FeError {
@@ -274,7 +277,7 @@ pub fn read_bulk_deck_with(
 ) -> Result<(NastranBody, String), FeError> {
     let mut cards = to_mesh::Collector::new();
     let info = reader::read_file(path, options, &mut cards, true).map_err(|e| prefixed(path, e))?;
-    let body = to_mesh::build(cards, info.spc_selection).map_err(|e| prefixed(path, e))?;
+    let body = to_mesh::build(cards, &info).map_err(|e| prefixed(path, e))?;
     Ok((body, info.sha256))
 }
 

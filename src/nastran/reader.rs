@@ -11,8 +11,8 @@ use std::sync::Arc;
 use sha2::{Digest, Sha256};
 
 use super::lexer::{
-    case_control_spc, is_begin_bulk, lex_error, shown, split_line, strip_comment, CardSink, Deck,
-    Field, Loc, RawCard,
+    case_control_sdamping, case_control_spc, is_begin_bulk, lex_error, shown, split_line,
+    strip_comment, CardSink, Deck, Field, Loc, RawCard,
 };
 use crate::fe::error::FeError;
 
@@ -57,6 +57,8 @@ pub struct DeckOptions {
 pub(crate) struct DeckInfo {
     /// `SPC = n` of the case control, if any.
     pub spc_selection: Option<u32>,
+    /// `SDAMPING = n` of the case control and where it is, if any.
+    pub sdamping: Option<(u32, Loc)>,
     /// SHA-256 (hex) of the deck: of the file itself when it includes nothing, else of the
     /// list of (file, SHA-256 of the file) in the order the files were opened ("" unless
     /// hashing was asked for).
@@ -203,6 +205,7 @@ struct DeckReader<'a, 's> {
     open: Option<Open>,
     cards: usize,
     spc_selection: Option<u32>,
+    sdamping: Option<(u32, Loc)>,
     /// First error of the bulk-data reading of lines before a `BEGIN BULK` that may follow.
     tentative_error: Option<FeError>,
     /// First error of the control reading of the same lines.
@@ -242,6 +245,7 @@ impl<'a, 's> DeckReader<'a, 's> {
             open: None,
             cards: 0,
             spc_selection: None,
+            sdamping: None,
             tentative_error: None,
             control_error: None,
             first_include: None,
@@ -347,6 +351,7 @@ impl<'a, 's> DeckReader<'a, 's> {
                     self.end_of_bulk(None)?;
                 }
                 self.spc_selection = None;
+                self.sdamping = None;
             }
         }
         let sha256 = match self.digests.as_slice() {
@@ -365,6 +370,7 @@ impl<'a, 's> DeckReader<'a, 's> {
         };
         Ok(DeckInfo {
             spc_selection: self.spc_selection,
+            sdamping: self.sdamping,
             sha256,
             peak_line_bytes: self.peak_line_bytes,
         })
@@ -391,7 +397,8 @@ impl<'a, 's> DeckReader<'a, 's> {
                 return Err(lex_error(
                     at,
                     "INCLUDE before BEGIN BULK is not supported (executive and case control are \
-                     read only for SPC = n); move the INCLUDE into the bulk data",
+                     read only for SPC = n and SDAMPING = n); move the INCLUDE into the bulk \
+                     data",
                 ));
             }
             self.sink.reset();
@@ -410,6 +417,20 @@ impl<'a, 's> DeckReader<'a, 's> {
                     ));
                 }
                 Ok(Some(set)) => self.spc_selection = Some(set),
+                Ok(None) => {}
+                Err(e) => self.control_error = Some(e),
+            }
+        }
+        if self.control_error.is_none() {
+            match case_control_sdamping(raw, &loc) {
+                Ok(Some(id)) if self.sdamping.as_ref().is_some_and(|(s, _)| *s != id) => {
+                    self.control_error = Some(lex_error(
+                        &loc,
+                        "subcases select different SDAMPING tables; one body has one modal \
+                         damping",
+                    ));
+                }
+                Ok(Some(id)) => self.sdamping = Some((id, loc.clone())),
                 Ok(None) => {}
                 Err(e) => self.control_error = Some(e),
             }

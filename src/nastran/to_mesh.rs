@@ -7,6 +7,7 @@ use nalgebra::{Matrix3, Vector3};
 
 use super::cards::{self, Orientation, Reader, ScalarValue, SystemKind};
 use super::lexer::{CardSink, Loc, RawCard, Value};
+use super::reader::DeckInfo;
 use super::solid_cards;
 use super::NastranBody;
 use crate::fe::error::FeError;
@@ -19,11 +20,11 @@ mod shell_cards;
 
 /// Every bulk data card the reader accepts: the dispatch in `Cards::add` takes exactly these
 /// (a test feeds each one), and the refusal of any other card lists them.
-pub(crate) const SUPPORTED_CARDS: [&str; 35] = [
+pub(crate) const SUPPORTED_CARDS: [&str; 36] = [
     "GRID", "CORD2R", "CORD2C", "CORD2S", "MAT1", "MAT2", "MAT8", "PSHELL", "PBAR", "PBEAM",
     "PELAS", "PDAMP", "PBUSH", "PSOLID", "CQUAD4", "CTRIA3", "CBAR", "CBEAM", "CTETRA", "CPENTA",
     "CHEXA", "CONM1", "CONM2", "CBUSH", "CELAS1", "CELAS2", "CDAMP1", "CDAMP2", "RBE2", "RBE3",
-    "SPC", "SPC1", "PARAM", "EIGRL", "EIGR",
+    "SPC", "SPC1", "PARAM", "EIGRL", "EIGR", "TABDMP1",
 ];
 
 /// Parameters that only steer output or solution bookkeeping: accepted and ignored.
@@ -68,6 +69,7 @@ struct Cards {
     solids: BTreeMap<u32, solid_cards::SolidElement>,
     solid_properties: BTreeMap<u32, solid_cards::Psolid>,
     supports: Vec<(cards::Support, Loc)>,
+    damping_tables: BTreeMap<u32, cards::DampingTableCard>,
     element_lines: BTreeMap<u32, (Loc, &'static str)>,
     mass_scale: f64,
 }
@@ -247,6 +249,10 @@ impl Cards {
                     insert_unique(&mut c.solid_properties, "PSOLID", p.id, &line, p)?;
                 }
                 "PARAM" => c.param(&r)?,
+                "TABDMP1" => {
+                    let t = cards::tabdmp1(&r)?;
+                    insert_unique(&mut c.damping_tables, "TABDMP1", t.id, &line, t)?;
+                }
                 // Eigenvalue extraction requests: the caller chooses the modes.
                 "EIGRL" | "EIGR" => {}
                 // A listed card without an arm: the table test names it.
@@ -499,8 +505,10 @@ impl CardSink for Collector {
     }
 }
 
-/// Builds the body from the cards read and the SPC set the case control selects.
-pub(crate) fn build(cards: Collector, spc_selection: Option<u32>) -> Result<NastranBody, FeError> {
+/// Builds the body from the cards read and the SPC set and the damping table the case control
+/// selects.
+pub(crate) fn build(cards: Collector, info: &DeckInfo) -> Result<NastranBody, FeError> {
+    let spc_selection = info.spc_selection;
     let mut c = cards.0;
     let systems = Systems::new(&c.systems)?;
     let mut body = NastranBody {
@@ -511,7 +519,25 @@ pub(crate) fn build(cards: Collector, spc_selection: Option<u32>) -> Result<Nast
         element_cards: BTreeMap::new(),
         unused_grids: Vec::new(),
         notes: Vec::new(),
+        damping: None,
     };
+    if let Some((id, at)) = &info.sdamping {
+        let table = c.damping_tables.remove(id).ok_or_else(|| {
+            let tables: Vec<String> = c.damping_tables.keys().map(u32::to_string).collect();
+            mesh_error(
+                at,
+                format!(
+                    "SDAMPING = {id} names no TABDMP1 (the deck's TABDMP1 ids: {})",
+                    if tables.is_empty() {
+                        "none".to_string()
+                    } else {
+                        tables.join(", ")
+                    }
+                ),
+            )
+        })?;
+        body.damping = Some(table);
+    }
     for (&id, g) in &c.grids {
         let x = Vector3::from(g.x);
         let p = match g.cp {

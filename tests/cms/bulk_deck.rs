@@ -61,6 +61,7 @@ pub(crate) fn default_vehicle_as_deck(
         path,
         points,
         include_root: None,
+        damping: None,
     };
     vehicle
 }

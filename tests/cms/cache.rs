@@ -174,11 +174,11 @@ fn concurrent_writers_leave_one_complete_entry() {
 fn invalid_spec_is_an_error_not_a_cache_entry() {
     let dir = temp_dir("invalid");
     let mut bad = spec();
-    bad.damping.above = f64::NAN;
+    bad.damping.points[3][1] = f64::NAN;
     let e = reduce_cached(&bad, &CacheSetting::Dir(dir.clone()))
         .unwrap_err()
         .to_string();
-    assert!(e.contains("above"), "{e}");
+    assert!(e.contains("point 3"), "{e}");
     let mut bad = spec();
     bad.outputs.push("no_such_node".into());
     let e = reduce_cached(&bad, &CacheSetting::Dir(dir.clone()))

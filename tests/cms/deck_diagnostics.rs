@@ -11,9 +11,7 @@ use engine_mount_chassis::cms::{
 };
 use engine_mount_chassis::nastran::{deck_digest, DeckOptions};
 
-#[path = "../common/plate_deck.rs"]
-mod plate_deck;
-use plate_deck::plate;
+use crate::plate_deck::{self, plate};
 
 /// The plate held by 1e5 N/m springs at its corners.
 fn corner_springs() -> String {
@@ -23,20 +21,34 @@ fn corner_springs() -> String {
 /// A reduction spec for `deck` written to a fresh folder, mounts at four interior grids
 /// (`mount_c` at `third_mount`).
 fn spec(name: &str, deck: &str, third_mount: u32) -> (ReductionSpec, PathBuf) {
-    let dir = std::env::temp_dir().join(format!("emc-diag-{name}-{}", std::process::id()));
-    let _ = std::fs::remove_dir_all(&dir);
-    std::fs::create_dir_all(&dir).unwrap();
-    let path = dir.join("plate.bdf");
-    std::fs::write(&path, deck).unwrap();
-    let points: BTreeMap<String, u32> = [
+    let points = [
         ("mount_a", 1011),
         ("mount_b", 1015),
         ("mount_c", third_mount),
         ("mount_d", 1025),
-    ]
-    .into_iter()
-    .map(|(n, g)| (n.to_string(), g))
-    .collect();
+    ];
+    deck_spec(
+        &format!("diag-{name}"),
+        deck,
+        &points,
+        ModeSelection::Count(6),
+    )
+}
+
+/// A reduction spec for `deck` written to a fresh folder (`emc-{name}-…`), its translational
+/// interface the named GRIDs, no outputs.
+pub(crate) fn deck_spec(
+    name: &str,
+    deck: &str,
+    mounts: &[(&str, u32)],
+    selection: ModeSelection,
+) -> (ReductionSpec, PathBuf) {
+    let dir = std::env::temp_dir().join(format!("emc-{name}-{}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&dir);
+    std::fs::create_dir_all(&dir).unwrap();
+    let path = dir.join("plate.bdf");
+    std::fs::write(&path, deck).unwrap();
+    let points: BTreeMap<String, u32> = mounts.iter().map(|(n, g)| (n.to_string(), *g)).collect();
     let spec = ReductionSpec {
         body: BodySource::Deck(BulkDeckBody {
             sha256: deck_digest(&path, &DeckOptions::default()).unwrap(),
@@ -46,7 +58,7 @@ fn spec(name: &str, deck: &str, third_mount: u32) -> (ReductionSpec, PathBuf) {
         }),
         interface: points.keys().cloned().collect(),
         interface_dofs: InterfaceDofs::Translations,
-        selection: ModeSelection::Count(6),
+        selection,
         outputs: Vec::new(),
         ..ReductionSpec::default()
     };

@@ -310,3 +310,53 @@ fn malformed_dmig_is_refused_naming_card_and_line_or_matrix() {
     );
     let _ = std::fs::remove_dir_all(&dir);
 }
+
+/// The gaps a trial found: a recovery matrix whose header's `NCOL` is not the a-set size, the
+/// stiffness matrix named as recovery matrix, two mounts on one GRID — each refused before any
+/// computation, naming the matrix or the mounts (they failed as a Newton or positive-definiteness
+/// error far downstream).
+#[test]
+fn recovery_and_mount_grid_mistakes_are_refused_up_front() {
+    let dir = temp_dir("gaps");
+    let vehicle = dmig_vehicle(&dir, |_| {});
+    let text = std::fs::read_to_string(dir.join("body.pch")).unwrap();
+    let header = text
+        .lines()
+        .find(|l| l.starts_with("DMIG,PHIOUT,"))
+        .expect("recovery header")
+        .to_string();
+    let a_set = header.rsplit(',').next().unwrap().to_string();
+    for ncol in ["7", "1000000000"] {
+        let wrong = header.replace(&format!(",,,{a_set}"), &format!(",,,{ncol}"));
+        std::fs::write(dir.join("body.pch"), text.replace(&header, &wrong)).unwrap();
+        let e = body(&vehicle, &options()).unwrap_err().to_string();
+        assert!(
+            e.contains(&format!("PHIOUT declares NCOL = {ncol}"))
+                && e.contains(&format!("KAAX has {a_set} DOFs")),
+            "{e}"
+        );
+    }
+    std::fs::write(dir.join("body.pch"), &text).unwrap();
+
+    let kaax = dmig_vehicle(&dir, |c| c["body"]["recovery"] = "KAAX".into());
+    let e = body(&kaax, &options()).unwrap_err().to_string();
+    assert!(
+        e.contains("recovery matrix KAAX is also the stiffness matrix"),
+        "{e}"
+    );
+
+    let file = dir.join("vehicle.json");
+    let mut config: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(&file).unwrap()).unwrap();
+    let front_left = config["body"]["points"]["mount_front_left"].clone();
+    config["body"]["points"]["mount_front_right"] = front_left.clone();
+    std::fs::write(&file, config.to_string()).unwrap();
+    let e = VehicleConfig::from_file(&file).unwrap_err().to_string();
+    assert!(
+        e.contains("mounts[1].body_node")
+            && e.contains("mounts 'front_left' and 'front_right' both attach to GRID")
+            && e.contains(&front_left.to_string()),
+        "{e}"
+    );
+    let _ = std::fs::remove_dir_all(&dir);
+}

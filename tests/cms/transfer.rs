@@ -233,8 +233,8 @@ fn doubling_the_modal_damping_halves_the_resonance_peaks() {
     let base = DampingTable::default();
     let doubled = base.scaled(2.0);
     let r = &fine().reduced;
-    let one = with_zeta(r, |w| base.zeta(w / (2.0 * std::f64::consts::PI)));
-    let two = with_zeta(r, |w| doubled.zeta(w / (2.0 * std::f64::consts::PI)));
+    let one = with_zeta(r, |w| base.ratio(w / (2.0 * std::f64::consts::PI)));
+    let two = with_zeta(r, |w| doubled.ratio(w / (2.0 * std::f64::consts::PI)));
     assert_eq!(
         &one.zeta, &r.zeta,
         "the reduction applies the default table"

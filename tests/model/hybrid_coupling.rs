@@ -50,6 +50,8 @@ fn rigid_chassis(cfg: &VehicleConfig, mass: f64, hz: [f64; 3]) -> ReducedChassis
         omega: hz.iter().map(|f| TWO_PI * f).collect(),
         zeta: vec![0.0; 3],
         points,
+        cutoff_hz: None,
+        own_damping: None,
     }
 }
 

@@ -1,6 +1,7 @@
 //! Integration tests of the co-simulation runtime (`src/cosim`): scene 2 stepping and the hard cases.
 
 mod coupling;
+mod damping;
 mod hard_cases;
 mod hybrid_cosim;
 mod periodic_start;
