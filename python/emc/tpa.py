@@ -257,3 +257,36 @@ def plot_cases(table: pd.DataFrame, order: float, response: str, path_name: str,
     fig.tight_layout()
     fig.savefig(path, dpi=120)
     plt.close(fig)
+
+
+def plot_over_speed_band(table: pd.DataFrame, order: float, response: str, path: str,
+                         names: dict | None = None, case: str = "", top: int = 4):
+    """The largest path contributions of one order over speed and their sum, each with its
+    damping band (``bound`` column: low, nominal, high), the nominal line over the band."""
+    from .band import draw_band, wide
+
+    plt = _pyplot()
+    data = table[(table.case == case) & (table.response == response) & (table.order == order)]
+    curves = wide(data, ["rpm", "path", "mount", "direction"], ["amplitude"])
+    paths = curves[~curves.path.isin(["sum", "simulated"])]
+    biggest = (paths.groupby("path").amplitude_nominal.max().sort_values(ascending=False)
+               .head(top).index)
+    fig, ax = plt.subplots(figsize=(9, 5.5))
+    for k, p in enumerate(biggest):
+        d = paths[paths.path == p].sort_values("rpm")
+        m, direction = int(d.mount.iloc[0]), d.direction.iloc[0]
+        draw_band(ax, d.rpm, d.amplitude_low, d.amplitude_nominal, d.amplitude_high,
+                  label=path_label(m, AXES.index(direction) + 1, names), color=f"C{k}", lw=1.2)
+    total = curves[curves.path == "sum"].sort_values("rpm")
+    draw_band(ax, total.rpm, total.amplitude_low, total.amplitude_nominal, total.amplitude_high,
+              label="sum of the 12 paths", color="k", lw=2.0)
+    ax.set_yscale("log")
+    ax.set_xlabel("engine speed [rpm]")
+    ax.set_ylabel(f"{response}, order {order:g} [m/s²]")
+    ax.set_title(f"Path contributions of order {order:g} to {response} with the damping band "
+                 f"(nominal line, band shaded){': ' + case if case else ''}", fontsize=10)
+    ax.grid(True, which="both", alpha=0.3)
+    ax.legend(fontsize=8)
+    fig.tight_layout()
+    fig.savefig(path, dpi=120)
+    plt.close(fig)

@@ -128,8 +128,8 @@ def window_paths(export: Export, forces: HeldForces, responses: dict, revolution
     """Path contributions per order over the window of ``revolutions`` revolutions from
     ``window_start`` (s) of a run at constant speed: the body driven by ``forces`` (the ramps a
     master applied, :class:`emc.synthesis.HeldForces`) from ``initial`` (modal state at t = 0,
-    None: at rest). ``responses``: name → the body's simulated response, sampled like the
-    forces' reads (None if not recorded)."""
+    None: at rest). ``responses``: name → the body's simulated response sampled after each
+    output step (t = dt, 2 dt, …), or None where it was not recorded."""
     if export.body is None:
         raise ValueError("the export has no elastic body")
     names = list(responses)
@@ -138,15 +138,17 @@ def window_paths(export: Export, forces: HeldForces, responses: dict, revolution
     dt = forces.dt * forces.every
     first = int(round(window_start / dt))
     n = int(round(revolutions * 60.0 / rpm / dt))
-    if first + n > len(paths):
-        raise ValueError(f"the run ends before its window ({(first + n) * dt:.3f} s)")
-    window = slice(first + 1, first + n + 1)  # samples after each step: t = dt … n dt
+    if first < 0 or first + n >= len(paths):
+        raise ValueError(f"the window {window_start:.4g} s + {revolutions} revolutions lies "
+                         f"outside the run ({(len(paths) - 1) * dt:.4g} s)")
+    window = slice(first + 1, first + n + 1)  # t = (first + 1) dt … (first + n) dt
     per_revolution = 60.0 / rpm / dt
     paths_c = order_components(paths[window].reshape(n, -1), revolutions, orders,
                                per_revolution).reshape(len(orders), len(names), -1)
-    read = forces.read[::forces.every]
-    forces_c = order_components(read[window], revolutions, orders, per_revolution)
-    simulated = {r: order_components(np.asarray(y)[window], revolutions, orders, per_revolution)
+    forces_c = order_components(forces.read[::forces.every][window], revolutions, orders,
+                                per_revolution)
+    simulated = {r: order_components(np.asarray(y)[first:first + n], revolutions, orders,
+                                     per_revolution)[None]
                  for r, y in responses.items() if y is not None}
-    return _complex_table(export, names, [rpm], paths_c[None], forces_c[None],
-                          {r: v[None] for r, v in simulated.items()}, orders, case)
+    return _complex_table(export, names, [rpm], paths_c[None], forces_c[None], simulated,
+                          orders, case)

@@ -388,3 +388,74 @@ def test_tpa_runup_writes_tables_plots_and_metadata(capsys, tmp_path, fmu_path):
     assert {"quasi_static_amplitude", "force_amplitude", "transfer_amplitude"} <= set(table)
     for name in ("closure.csv", "tpa_ranked_seat.a3.png", "tpa_over_speed_seat.a3.png"):
         assert (tmp_path / name).is_file(), name
+
+
+def test_the_engine_fmu_on_the_body_fmu_has_the_paths_of_the_single_fmu(capsys, tmp_path,
+                                                                          fmu_path,
+                                                                          body_fmu_path):
+    """Scene 3: the paths from the forces the master exchanged and the body FMU's exported modes
+    add up to the body FMU's response (the synthesis integrates the forces the body was given,
+    from the static state it started in), and after the settling second their order 1.5 is the
+    single FMU's (scene 2, a second method: one integrator, no master) path by path."""
+    code, out = run(capsys, "tpa-coupled", "--fmu", str(fmu_path), "--body-fmu",
+                    str(body_fmu_path), "--out", str(tmp_path / "coupled"), "--quiet",
+                    "--rpm-point", "1100")
+    assert code == 0, out.err
+    meta = json.loads((tmp_path / "coupled" / "metadata.json").read_text())["tpa_coupled"]
+    assert meta["closure_max_relative_error"] < 1e-8
+    assert meta["quasi_static_closure"]["max_relative_error"] < 2e-2
+    coupled = pd.read_csv(tmp_path / "coupled" / "tpa_coupled.csv")
+    code, out = run(capsys, "tpa", "--fmu", str(fmu_path), "--out", str(tmp_path / "single"),
+                    "--quiet", "--rpm", "1100", "1100", "--count", "1")
+    assert code == 0, out.err
+    single = pd.read_csv(tmp_path / "single" / "tpa.csv")
+    pick = lambda t: (t[(t.order == 1.5) & (t.response == "steeringWheel.a[3]")]  # noqa: E731
+                      .set_index("path").amplitude)
+    a, b = pick(coupled), pick(single)
+    big = b[b > 0.01 * b.max()].index
+    assert len(big) >= 5  # the four vertical paths and the sum
+    assert np.max(np.abs(a[big] / b[big] - 1)) < 1e-3, (a[big] / b[big]).to_dict()
+
+
+def test_the_paths_with_the_damping_band(capsys, tmp_path, fmu_path):
+    """At 1100 rpm the 1.5 order sits on the 26.5 Hz body mode: the least damped bound gives the
+    highest wheel level and every bound's paths close."""
+    code, out = run(capsys, "tpa", "--fmu", str(fmu_path), "--out", str(tmp_path), "--quiet",
+                    "--rpm", "1000", "1200", "--count", "2", "--at", "1100", "--band")
+    assert code == 0, out.err
+    table = pd.read_csv(tmp_path / "tpa.csv", dtype={"case": str}).fillna({"case": ""})
+    for bound in ("low", "nominal", "high"):
+        closure = tpa.closure(table[table.bound == bound])
+        assert closure[closure.significant].relative_error.max() < 1e-3, bound
+    meta = json.loads((tmp_path / "metadata.json").read_text())
+    assert meta["band"]["low"]["chassis.modalDampingScale"] == 0.6
+    band = meta["tpa"]["steeringWheel.a[3]"][""]["band"]
+    levels = [band[b]["total_amplitude"] for b in ("low", "nominal", "high")]
+    assert levels[0] > levels[1] > levels[2]
+    assert band["nominal"]["dominant_path"] == "mount[1] z"
+    wide = pd.read_csv(tmp_path / "tpa_band.csv")
+    assert {"amplitude_low", "amplitude_nominal", "amplitude_high"} <= set(wide)
+    assert (tmp_path / "tpa_band_steeringWheel.a3.png").is_file()
+
+
+def test_the_transfer_functions_and_the_shape_with_the_damping_band(capsys, tmp_path, fmu_path):
+    """A resonance peak's accelerance scales with 1 / damping: at the 26.5 Hz bending mode the
+    body's modal damping x0.6 and x1.4 give 1/0.6 and 1/1.4 of the nominal peak. The operating
+    shape at every bound holds the simulated wheel motion of that bound."""
+    code, out = run(capsys, "frf", "--fmu", str(fmu_path), "--out", str(tmp_path / "frf"),
+                    "--quiet", "--freq", "25", "28.5", "--points", "351", "--band")
+    assert code == 0, out.err
+    body = pd.read_csv(tmp_path / "frf" / "frf_body_steeringWheel.a3.csv")
+    peak = body[body.input == "mount[1].F[3]"].groupby("bound").amplitude.max()
+    assert abs(peak["low"] / peak["nominal"] * 0.6 - 1) < 0.03, peak.to_dict()
+    assert abs(peak["high"] / peak["nominal"] * 1.4 - 1) < 0.03, peak.to_dict()
+    coupled = pd.read_csv(tmp_path / "frf" / "frf_coupled_steeringWheel.a3.csv")
+    assert set(coupled.bound) == {"low", "nominal", "high"}
+    code, out = run(capsys, "ods", "--fmu", str(fmu_path), "--out", str(tmp_path / "ods"),
+                    "--quiet", "--rpm-point", "1100", "--compare", "steeringWheel.a[3]", "--band")
+    assert code == 0, out.err
+    points = pd.read_csv(tmp_path / "ods" / "ods_1100rpm_order1.5_points.csv")
+    for bound in ("low", "nominal", "high"):
+        assert points[f"relative_difference_{bound}"].max() < 1e-4, bound
+    shape = points.iloc[0]
+    assert shape.ods_displacement_low > shape.ods_displacement_nominal > shape.ods_displacement_high
