@@ -5,7 +5,7 @@
 //! - `variables.rs` (the value-reference table the FMI layer includes),
 //! - `index.html` and `body.index.html` (the FMUs' documentation pages),
 //! - `exports.map`, a linker version script that exports exactly the fmi2 and fmi3 functions;
-//! - the FMI 3.0 files of the engine FMU (`build/fmi3_description.rs`).
+//! - the FMI 3.0 files of both FMUs (`build/fmi3_description.rs`).
 //!
 //! The GUIDs are hashes of the table's content, so the XML and the binary can never disagree.
 
@@ -169,7 +169,7 @@ fn main() {
         &(rust_table(&table, &scalars, &families, &fmus)
             + &fmi3_description::rust_map(&table, &families)),
     );
-    fmi3_description::write_files(&out, &table, &families, &fmus[0].guid);
+    fmi3_description::write_files(&out, &table, &families, &fmus);
 
     let mut map = String::from("{\n  global:\n");
     for f in FMI2_FUNCTIONS
@@ -434,9 +434,12 @@ fn model_description(table: &Value, scalars: &[Scalar], families: &[Family], fmu
 
 /// The parts of a model description that FMI 2.0 and 3.0 share, in the order both schemas
 /// want them: `UnitDefinitions`, `LogCategories`, `DefaultExperiment`.
+/// Writes the unit definitions, the type definitions `types` writes (none in FMI 2.0), the log
+/// categories and the default experiment, in the order both schemas have them.
 fn write_units_categories_experiment(
     w: &mut Writer<Vec<u8>>,
     table: &Value,
+    types: &dyn Fn(&mut Writer<Vec<u8>>) -> std::io::Result<()>,
 ) -> std::io::Result<()> {
     let array = |key: &str| -> Vec<Value> {
         table
@@ -479,6 +482,7 @@ fn write_units_categories_experiment(
             }
             Ok(())
         })?;
+    types(w)?;
     w.create_element("LogCategories").write_inner_content(|w| {
         for c in array("logCategories") {
             let category = vec![
@@ -546,7 +550,7 @@ fn write_model_description(
             attr("providesDirectionalDerivative", true),
         ];
         element(w, "CoSimulation", &co_simulation).write_empty()?;
-        write_units_categories_experiment(w, table)?;
+        write_units_categories_experiment(w, table, &|_| Ok(()))?;
         w.create_element("ModelVariables")
             .write_inner_content(|w| {
                 for (index, s) in scalars.iter().enumerate() {

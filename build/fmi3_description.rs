@@ -11,7 +11,7 @@
 //! scalar keeps its 2.0 value reference and arrays never overlap; `time` and `modes.size`, which
 //! have no 2.0 counterpart, sit above the 2.0 ranges.
 
-use super::{attr, element, fail, opt_str, str_field, value_text, vr_base, Family, VR_BASE};
+use super::{attr, element, fail, opt_str, str_field, value_text, vr_base, Family, Fmu, VR_BASE};
 use quick_xml::events::{BytesDecl, Event};
 use quick_xml::Writer;
 use serde_json::Value;
@@ -122,23 +122,28 @@ fn type3(ty: &str) -> &'static str {
 }
 
 /// The 3.0 variables of the table's entries, in table order.
-fn variables<'a>(table: &'a Value, families: &'a [Family]) -> Vec<Var3<'a>> {
+fn variables<'a>(table: &'a Value, families: &'a [Family], mask: u8) -> Vec<Var3<'a>> {
     let entries = table
         .get("variables")
         .and_then(Value::as_array)
         .unwrap_or_else(|| fail("`variables` must be an array"));
     let mut names = std::collections::BTreeSet::new();
-    // The FMI 3.0 FMU is the engine FMU's twin: the body FMU's variables are not its own.
-    let in_engine = |entry: &Value| {
-        entry
-            .get("fmus")
-            .and_then(Value::as_array)
-            .is_none_or(|l| l.iter().any(|f| f.as_str() == Some("engine")))
+    // Each 3.0 FMU is its 2.0 twin: the variables tagged for it (untagged: the engine's).
+    let in_fmu = |entry: &Value| {
+        let tagged = |name: &str| {
+            entry
+                .get("fmus")
+                .and_then(Value::as_array)
+                .is_some_and(|l| l.iter().any(|f| f.as_str() == Some(name)))
+        };
+        let untagged = entry.get("fmus").is_none();
+        (mask & super::ENGINE != 0 && (untagged || tagged("engine")))
+            || (mask & super::BODY != 0 && tagged("body"))
     };
     let vars: Vec<Var3> = entries
         .iter()
         .zip(families)
-        .filter(|(entry, _)| in_engine(entry))
+        .filter(|(entry, _)| in_fmu(entry))
         .map(|(entry, family)| {
             let name = family.name.replace("[{i}]", "").replace("[{j}]", "");
             if name.contains('{') {
@@ -180,9 +185,16 @@ fn modes_max(vars: &[Var3]) -> usize {
         .unwrap_or_else(|| fail("no natural-mode array (calculatedParameter with dims)"))
 }
 
-/// The description of an array: the family's, with its placeholders named.
+/// The description of an array: the family's, with its placeholders named. A 3.0 description
+/// must not speak of FMI 2.0's functions (the table's descriptions serve both standards).
 fn description3(v: &Var3) -> String {
     let text = v.family.description.replace("{i}", "i").replace("{j}", "j");
+    if text.contains("fmi2") {
+        fail(&format!(
+            "{}: the description names an FMI 2.0 function; say what it does for both standards",
+            v.family.name
+        ));
+    }
     match v.family.dims.len() {
         0 => text,
         1 => format!("{text}. Array element [i]"),
@@ -190,20 +202,30 @@ fn description3(v: &Var3) -> String {
     }
 }
 
-/// Writes `fmi3/modelDescription.xml` and `fmi3/terminalsAndIcons.xml` below `out`.
-pub fn write_files(out: &std::path::Path, table: &Value, families: &[Family], guid: &str) {
+/// Writes, below `out/fmi3`, each FMU's `modelDescription.xml` and `terminalsAndIcons.xml`
+/// (the body FMU's prefixed `body.`, as the 2.0 files).
+pub fn write_files(out: &std::path::Path, table: &Value, families: &[Family], fmus: &[Fmu]) {
     let dir = out.join("fmi3");
     std::fs::create_dir_all(&dir)
         .unwrap_or_else(|e| fail(&format!("cannot create {}: {e}", dir.display())));
-    let vars = variables(table, families);
-    let mut w = Writer::new_with_indent(Vec::new(), b' ', 2);
-    write_model_description(&mut w, table, &vars, guid)
-        .unwrap_or_else(|e| fail(&format!("writing the FMI 3.0 modelDescription.xml: {e}")));
-    super::write(&dir.join("modelDescription.xml"), &finish(w));
-    let mut w = Writer::new_with_indent(Vec::new(), b' ', 2);
-    write_terminals(&mut w, &vars)
-        .unwrap_or_else(|e| fail(&format!("writing terminalsAndIcons.xml: {e}")));
-    super::write(&dir.join("terminalsAndIcons.xml"), &finish(w));
+    for fmu in fmus {
+        let prefix = if fmu.mask == super::BODY { "body." } else { "" };
+        let vars = variables(table, families, fmu.mask);
+        let mut w = Writer::new_with_indent(Vec::new(), b' ', 2);
+        write_model_description(&mut w, table, &vars, fmu)
+            .unwrap_or_else(|e| fail(&format!("writing the FMI 3.0 modelDescription.xml: {e}")));
+        super::write(
+            &dir.join(format!("{prefix}modelDescription.xml")),
+            &finish(w),
+        );
+        let mut w = Writer::new_with_indent(Vec::new(), b' ', 2);
+        write_terminals(&mut w, &vars, fmu.mask)
+            .unwrap_or_else(|e| fail(&format!("writing terminalsAndIcons.xml: {e}")));
+        super::write(
+            &dir.join(format!("{prefix}terminalsAndIcons.xml")),
+            &finish(w),
+        );
+    }
 }
 
 fn finish(w: Writer<Vec<u8>>) -> String {
@@ -216,14 +238,14 @@ fn write_model_description(
     w: &mut Writer<Vec<u8>>,
     table: &Value,
     vars: &[Var3],
-    guid: &str,
+    fmu: &Fmu,
 ) -> std::io::Result<()> {
     w.write_event(Event::Decl(BytesDecl::new("1.0", Some("UTF-8"), None)))?;
     let root = vec![
         attr("fmiVersion", "3.0"),
-        attr("modelName", str_field(table, "modelName")),
-        attr("instantiationToken", guid),
-        attr("description", str_field(table, "description")),
+        attr("modelName", fmu.model_name),
+        attr("instantiationToken", &fmu.guid),
+        attr("description", fmu.description),
         attr("author", str_field(table, "author")),
         attr("version", str_field(table, "version")),
         attr("generationTool", "engine_mount_chassis build.rs"),
@@ -233,16 +255,21 @@ fn write_model_description(
         // No event mode, no intermediate update, no early return: fmi3DoStep always completes
         // the step (or stops at a failure, reported by fmi3Discard).
         let co_simulation = vec![
-            attr("modelIdentifier", str_field(table, "modelIdentifier")),
+            attr("modelIdentifier", fmu.identifier),
             attr("needsExecutionTool", false),
             attr("canBeInstantiatedOnlyOncePerProcess", false),
             attr("canGetAndSetFMUState", true),
             attr("canSerializeFMUState", true),
-            attr("providesDirectionalDerivative", false),
+            // fmi3GetDirectionalDerivative: outputs with respect to the interface inputs.
+            attr("providesDirectionalDerivatives", true),
             attr("providesAdjointDerivatives", false),
             attr("providesPerElementDependencies", false),
             attr("canHandleVariableCommunicationStepSize", true),
-            attr("maxOutputDerivativeOrder", 1),
+            // fmi3GetOutputDerivatives: the engine's outputs (the body alone has none).
+            attr(
+                "maxOutputDerivativeOrder",
+                u8::from(fmu.mask == super::ENGINE),
+            ),
             attr("providesIntermediateUpdate", false),
             attr("mightReturnEarlyFromDoStep", false),
             attr("canReturnEarlyAfterIntermediateUpdate", false),
@@ -250,7 +277,7 @@ fn write_model_description(
             attr("providesEvaluateDiscreteStates", false),
         ];
         element(w, "CoSimulation", &co_simulation).write_empty()?;
-        super::write_units_categories_experiment(w, table)?;
+        super::write_units_categories_experiment(w, table, &|w| write_types(w, vars))?;
         let max = modes_max(vars);
         w.create_element("ModelVariables")
             .write_inner_content(|w| {
@@ -260,7 +287,7 @@ fn write_model_description(
                     attr("causality", "independent"),
                     attr("variability", "continuous"),
                     attr("description", "Simulation time"),
-                    attr("unit", "s"),
+                    attr("declaredType", type_name("s", None)),
                 ];
                 element(w, "Float64", &time).write_empty()?;
                 let mut sized_written = false;
@@ -339,6 +366,40 @@ fn write_model_description(
     Ok(())
 }
 
+/// The name of the Float64 type of `unit` shown in `display`: the variables carry their unit and
+/// display unit through a declared type, as the Reference-FMUs do.
+fn type_name(unit: &str, display: Option<&str>) -> String {
+    match display {
+        Some(d) if d != unit => format!("{unit} [{d}]"),
+        _ => unit.to_owned(),
+    }
+}
+
+/// `<TypeDefinitions>`: one Float64 type per unit and display unit the variables (and `time`)
+/// use.
+fn write_types(w: &mut Writer<Vec<u8>>, vars: &[Var3]) -> std::io::Result<()> {
+    let mut types = std::collections::BTreeMap::new();
+    types.insert(type_name("s", None), ("s".to_owned(), None));
+    for v in vars {
+        if let Some(u) = opt_str(v.entry, "unit") {
+            let display = opt_str(v.entry, "displayUnit");
+            types.insert(type_name(&u, display.as_deref()), (u, display));
+        }
+    }
+    w.create_element("TypeDefinitions")
+        .write_inner_content(|w| {
+            for (name, (unit, display)) in &types {
+                let mut a = vec![attr("name", name), attr("unit", unit)];
+                if let Some(d) = display {
+                    a.push(attr("displayUnit", d));
+                }
+                element(w, "Float64Type", &a).write_empty()?;
+            }
+            Ok(())
+        })?;
+    Ok(())
+}
+
 fn write_variable(w: &mut Writer<Vec<u8>>, v: &Var3) -> std::io::Result<()> {
     let e = v.entry;
     let ty = v.family.ty;
@@ -361,10 +422,14 @@ fn write_variable(w: &mut Writer<Vec<u8>>, v: &Var3) -> std::io::Result<()> {
         }
     }
     if let Some(u) = opt_str(e, "unit") {
-        a.push(attr("unit", u));
-    }
-    if let Some(u) = opt_str(e, "displayUnit") {
-        a.push(attr("displayUnit", u));
+        if ty != "Real" {
+            fail(&format!(
+                "{}: only Float64 variables have units in FMI 3.0",
+                v.name
+            ));
+        }
+        let display = opt_str(e, "displayUnit");
+        a.push(attr("declaredType", type_name(&u, display.as_deref())));
     }
     if matches!(ty, "Real" | "Integer") {
         for key in ["min", "max"] {
@@ -393,57 +458,91 @@ fn write_variable(w: &mut Writer<Vec<u8>>, v: &Var3) -> std::io::Result<()> {
     Ok(())
 }
 
+/// A terminal: its name, description and members as (variable, memberName).
+type Terminal<'a> = (&'a str, &'a str, &'a [(&'a str, &'a str)]);
+
 /// Terminals: the engine's inputs, the mounts' port to the body (the external body's motion
 /// in, the mount forces out), the scales of the mount characteristics, the powertrain's motion
 /// and the comfort points.
-fn write_terminals(w: &mut Writer<Vec<u8>>, vars: &[Var3]) -> std::io::Result<()> {
-    let terminals: [(&str, &str, &[&str]); 5] = [
+fn write_terminals(w: &mut Writer<Vec<u8>>, vars: &[Var3], mask: u8) -> std::io::Result<()> {
+    // (variable, memberName): a bus terminal's members are matched by name, so within a
+    // terminal every memberName is distinct.
+    let terminals: [Terminal; 5] = [
         (
             "engine",
             "Engine operating point: speed set-point and drivetrain load torque",
-            &["rpm", "loadTorque"],
+            &[("rpm", "rpm"), ("loadTorque", "loadTorque")],
         ),
         (
             "bodyPort",
             "The mounts' port to the body: per mount the body point's displacement and velocity in (scene 3, an external body), the mount's force on the body out; connects one to one to EngineMountBody's mount.r, mount.v and mount.F",
-            &["mount.body.r", "mount.body.v", "mount.F"],
+            &[("mount.body.r", "r"), ("mount.body.v", "v"), ("mount.F", "F")],
         ),
         (
             "mounts",
             "The engine mounts' characteristics: scales of their stiffness and damping",
-            &["mount.stiffnessScale", "mount.dampingScale"],
+            &[
+                ("mount.stiffnessScale", "stiffnessScale"),
+                ("mount.dampingScale", "dampingScale"),
+            ],
         ),
         (
             "powertrain",
             "Motion of the powertrain (housing) centre of gravity",
-            &["powertrain.r", "powertrain.phi", "powertrain.a", "crankAngle"],
+            &[
+                ("powertrain.r", "r"),
+                ("powertrain.phi", "phi"),
+                ("powertrain.a", "a"),
+                ("crankAngle", "crankAngle"),
+            ],
         ),
         (
             "comfort",
             "Comfort points of the car body: steering wheel and driver's seat rail accelerations",
-            &["steeringWheel.a", "seat.a"],
+            &[("steeringWheel.a", "steeringWheelA"), ("seat.a", "seatA")],
         ),
     ];
+    let body: [Terminal; 2] = [
+        (
+            "bodyPort",
+            "The body's port to the mounts: per mount the force on the body in, the body point's displacement, velocity and acceleration out; connects one to one to EngineMountChassis' mount.F, mount.body.r and mount.body.v (scene 3)",
+            &[
+                ("mount.F", "F"),
+                ("mount.r", "r"),
+                ("mount.v", "v"),
+                ("mount.a", "a"),
+            ],
+        ),
+        terminals[4],
+    ];
+    let terminals: &[Terminal] = if mask == super::BODY {
+        &body
+    } else {
+        &terminals
+    };
     w.write_event(Event::Decl(BytesDecl::new("1.0", Some("UTF-8"), None)))?;
     element(w, "fmiTerminalsAndIcons", &vec![attr("fmiVersion", "3.0")]).write_inner_content(
         |w| {
             w.create_element("Terminals").write_inner_content(|w| {
-                for (name, description, members) in terminals {
+                for &(name, description, members) in terminals {
                     let terminal = vec![
                         attr("name", name),
                         attr("matchingRule", "bus"),
                         attr("description", description),
                     ];
+                    let mut member_names = std::collections::BTreeSet::new();
                     element(w, "Terminal", &terminal).write_inner_content(|w| {
-                        for member in members {
+                        for (member, member_name) in members {
                             let v = vars
                                 .iter()
                                 .find(|v| v.name == *member)
                                 .unwrap_or_else(|| fail(&format!("terminal member {member}")));
-                            let short = member.rsplit('.').next().unwrap_or(member);
+                            if !member_names.insert(*member_name) {
+                                fail(&format!("terminal {name}: memberName {member_name} twice"));
+                            }
                             let m = vec![
                                 attr("variableName", &v.name),
-                                attr("memberName", short),
+                                attr("memberName", member_name),
                                 attr("variableKind", "signal"),
                             ];
                             element(w, "TerminalMemberVariable", &m).write_empty()?;
@@ -461,7 +560,14 @@ fn write_terminals(w: &mut Writer<Vec<u8>>, vars: &[Var3]) -> std::io::Result<()
 
 /// The Rust map of the 3.0 variables, appended to `variables.rs`.
 pub fn rust_map(table: &Value, families: &[Family]) -> String {
-    let vars = variables(table, families);
+    // Both FMUs' variables: value references are unique across the table, and a variable of
+    // both FMUs is listed once.
+    let mut vars = variables(table, families, super::ENGINE);
+    for v in variables(table, families, super::BODY) {
+        if !vars.iter().any(|w| w.vr == v.vr) {
+            vars.push(v);
+        }
+    }
     let max = modes_max(&vars);
     let mut r = String::new();
     let _ = writeln!(

@@ -19,7 +19,7 @@
 use std::time::Instant;
 
 use engine_mount_chassis::cosim::{
-    BodyOptions, Counters, EffectSwitch, Inputs, SceneKind, Settings, Signal, Simulation,
+    BodyOptions, Counters, EffectSwitch, Inputs, RampInput, SceneKind, Settings, Simulation,
     RPM_TO_RAD_PER_S,
 };
 
@@ -45,17 +45,13 @@ struct Case {
 
 fn inputs_at(case: &Case, t: f64, interpolate: bool) -> Inputs {
     let rate = if interpolate { (case.rpm_rate)(t) } else { 0.0 };
-    Inputs {
-        crank_speed: Signal {
-            value: (case.rpm)(t) * RPM_TO_RAD_PER_S,
-            derivative: rate * RPM_TO_RAD_PER_S,
-            reference_time: t,
-        },
-        load_torque: Signal::constant(0.0),
-        stiffness_scale: [Signal::constant(1.0); 4],
-        damping_scale: [Signal::constant(1.0); 4],
-        ..Inputs::steady(0.0)
-    }
+    let mut inputs = Inputs::steady(0.0);
+    inputs.model.crank_speed = RampInput {
+        value: (case.rpm)(t) * RPM_TO_RAD_PER_S,
+        rate: rate * RPM_TO_RAD_PER_S,
+        since: t,
+    };
+    inputs
 }
 
 /// Runs a case with communication step `h`, recording every communication point in the window.

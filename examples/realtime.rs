@@ -62,7 +62,9 @@ fn unit_costs(model: &CoupledModel, t: f64, y: &[f64]) -> Result<[f64; 5], Probl
         m.rhs(t, y, &mut f).expect("rhs");
     });
     let outputs = time_per_call(|| {
-        std::hint::black_box(scene::outputs(model, t, y).expect("outputs"));
+        std::hint::black_box(
+            scene::outputs(model, scene::ComfortPoints::of(model), t, y).expect("outputs"),
+        );
     });
     let gamma = 1e-5;
     let mut b: Vec<f64> = f.iter().map(|v| v * 1e-6).collect();

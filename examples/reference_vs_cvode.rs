@@ -25,9 +25,7 @@ mod cvode {
     use std::time::Instant;
 
     use engine_mount_chassis::cosim::scene::{apply_inputs, build_model, outputs};
-    use engine_mount_chassis::cosim::{
-        BodyOptions, Inputs, Outputs, Settings, Signal, RPM_TO_RAD_PER_S,
-    };
+    use engine_mount_chassis::cosim::{BodyOptions, ComfortPoints, Inputs, Outputs, Settings};
     use engine_mount_chassis::model::CoupledModel as Scene;
     use engine_mount_chassis::ode::{Bdf, BdfOptions, OdeProblem, Tolerance};
     use faer::linalg::solvers::Solve;
@@ -47,13 +45,7 @@ mod cvode {
             },
             ..Settings::default()
         };
-        let inputs = Inputs {
-            crank_speed: Signal::constant(2000.0 * RPM_TO_RAD_PER_S),
-            load_torque: Signal::constant(0.0),
-            stiffness_scale: [Signal::constant(1.0); 4],
-            damping_scale: [Signal::constant(1.0); 4],
-            ..Inputs::steady(0.0)
-        };
+        let inputs = Inputs::steady(2000.0);
         let (mut s, _) = build_model(&settings).expect("scene");
         apply_inputs(&mut s, &inputs).expect("inputs");
         let y0 = s.static_equilibrium(0.0).expect("statics");
@@ -186,8 +178,8 @@ mod cvode {
             let (s, y0) = scene(number);
             let (ours, ours_steps, ours_t) = run_ours(s.clone(), &y0, RTOL, ATOL);
             let (theirs, cv_steps, cv_t) = run_cvode(s.clone(), &y0, RTOL, ATOL);
-            let a = forces(&outputs(&s, T_END, &ours).expect("outputs"));
-            let b = forces(&outputs(&s, T_END, &theirs).expect("outputs"));
+            let a = forces(&outputs(&s, ComfortPoints::of(&s), T_END, &ours).expect("outputs"));
+            let b = forces(&outputs(&s, ComfortPoints::of(&s), T_END, &theirs).expect("outputs"));
             let scale = b.iter().map(|x| x.abs()).fold(1e-30, f64::max);
             let diff = a
                 .iter()
@@ -233,10 +225,11 @@ mod cvode {
         for number in [1, 2] {
             let (s, y0) = scene(number);
             let (reference, _, _) = run_ours(s.clone(), &y0, RTOL, ATOL);
-            let reference = forces(&outputs(&s, T_END, &reference).expect("outputs"));
+            let reference =
+                forces(&outputs(&s, ComfortPoints::of(&s), T_END, &reference).expect("outputs"));
             let scale = reference.iter().map(|x| x.abs()).fold(1e-30, f64::max);
             let error = |y: &[f64]| {
-                let v = forces(&outputs(&s, T_END, y).expect("outputs"));
+                let v = forces(&outputs(&s, ComfortPoints::of(&s), T_END, y).expect("outputs"));
                 v.iter()
                     .zip(&reference)
                     .map(|(x, r)| (x - r).abs())

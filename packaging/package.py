@@ -14,8 +14,8 @@ Layout of <modelIdentifier>.fmu:
 (the body FMU's description and page are build.rs' body.modelDescription.xml and body.index.html;
 EngineInBody.ssp, the two FMUs connected mount by mount, is written beside them by emc.ssp)
 
-The FMI 3.0 FMU <modelIdentifier>-fmi3.fmu, from the same binaries, is written beside it
-(packaging/fmi3.py).
+The FMI 3.0 FMUs <modelIdentifier>-fmi3.fmu (engine and body), from the same binaries, are
+written beside them (packaging/fmi3.py).
 
 Usage: python packaging/package.py [--out DIR]   (default DIR: dist/)
 """
@@ -104,6 +104,7 @@ def main() -> None:
     print(engine)
     print(body)
     print(fmi3.write_fmu(out, out_dir, shipped_so, dll, engine.stem, ROOT))
+    print(fmi3.write_fmu(out, out_dir, shipped_so, dll, body.stem, ROOT, prefix="body."))
     # The two as one system (scene 2 split at the mounts) for tools that load SSP.
     sys.path.insert(0, str(ROOT / "python"))
     from emc.ssp import write_ssp

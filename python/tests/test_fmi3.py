@@ -33,6 +33,9 @@ COUNTERS = ["solver.steps", "solver.rhsEvaluations", "solver.jacobianEvaluations
 
 def test_fmpy_validates_the_fmi3_fmu_without_problems(fmu3_path):
     assert validate_fmu(str(fmu3_path)) == []
+    body3 = fmu3_path.parent / "EngineMountBody-fmi3.fmu"
+    assert validate_fmu(str(body3)) == []
+    assert read_model_description(str(body3)).coSimulation.modelIdentifier == "EngineMountBody"
     md = read_model_description(str(fmu3_path))
     assert md.fmiVersion == "3.0"
     assert md.coSimulation.modelIdentifier == "EngineMountChassis"
@@ -47,11 +50,12 @@ def test_arrays_units_and_descriptions_follow_the_2_0_variables(fmu3_path, fmu_p
     force = v3["mount.F"]
     assert [d.start for d in force.dimensions] == [4, 3]
     assert force.valueReference == v2["mount[1].F[1]"].valueReference
-    assert (force.unit, force.causality) == ("N", "output")
+    # 3.0 variables carry their units through declared types (as the Reference-FMUs do).
+    assert (force.declaredType.unit, force.causality) == ("N", "output")
     for name in ["steeringWheel.a", "seat.a", "powertrain.r"]:
         assert [d.start for d in v3[name].dimensions] == [3]
-        assert v3[name].unit == v2[f"{name}[1]"].unit
-        assert v3[name].displayUnit == v2[f"{name}[1]"].displayUnit
+        assert v3[name].declaredType.unit == v2[f"{name}[1]"].unit
+        assert v3[name].declaredType.displayUnit == v2[f"{name}[1]"].displayUnit
     size = v3["modes.size"]
     assert (size.type, size.causality, size.variability) == ("UInt64", "structuralParameter", "fixed")
     for name in ["mode.frequency", "mode.damping", "mode.powertrainShare"]:
@@ -61,7 +65,7 @@ def test_arrays_units_and_descriptions_follow_the_2_0_variables(fmu3_path, fmu_p
     elements = sum(int(np.prod([d.start if d.start is not None else int(slots) for d in v.dimensions]))
                    for n, v in v3.items() if n not in ("time", "modes.size"))
     assert elements == len(v2)
-    assert v3["rpm"].unit == "rpm" and v3["rpm"].start == v2["rpm"].start
+    assert v3["rpm"].declaredType.unit == "rpm" and v3["rpm"].start == v2["rpm"].start
 
 
 def test_terminals_name_existing_variables_and_match_the_schema(fmu3_path):

@@ -15,7 +15,7 @@ import pytest
 PYTHON = pathlib.Path(__file__).resolve().parents[1]
 ROOT = PYTHON.parent
 # Import name -> distribution name where they differ.
-DISTRIBUTION = {"yaml": "pyyaml"}
+DISTRIBUTION = {"yaml": "pyyaml", "mpl_toolkits": "matplotlib"}
 
 
 def requirement_name(spec: str) -> str:

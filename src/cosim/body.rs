@@ -4,12 +4,12 @@
 //! exactly, so it has no integrator settings; it starts in static equilibrium under the forces
 //! at the start time.
 
-use super::scene::{vehicle_config_with_replacements, SEAT_POINT, STEERING_WHEEL_POINT};
+use super::scene::{vehicle_config_with_replacements, ComfortPoints};
 use super::settings::Replaced;
 use super::{Counters, Error, Inputs, Outputs, Settings, StepFailure, FMU_MOUNTS};
 use crate::model::body_alone::BodyAlone;
 use crate::model::scene::build_body_alone;
-use crate::model::{Mode, ModeKind, RampInput};
+use crate::model::{Mode, ModeKind};
 
 /// The body alone with its state, ready to step.
 #[derive(Clone)]
@@ -21,6 +21,8 @@ pub struct BodySimulation {
     /// Modal coordinates, then their rates.
     state: Vec<f64>,
     inputs: Inputs,
+    /// Where the comfort outputs are among the body's output points.
+    comfort: ComfortPoints,
     initial_time: f64,
     initial_inputs: Inputs,
     steps: u64,
@@ -38,25 +40,12 @@ pub struct BodyState {
     steps: u64,
 }
 
-fn ramp(s: &super::Signal) -> RampInput {
-    RampInput {
-        value: s.value,
-        rate: s.derivative,
-        since: s.reference_time,
-    }
-}
-
-fn apply(model: &mut BodyAlone, inputs: &Inputs) -> Result<(), Error> {
-    let n = model.mount_points().len();
-    let forces: Vec<[RampInput; 3]> = (0..n)
-        .map(|i| {
-            inputs
-                .body_force
-                .get(i)
-                .map_or([RampInput::ZERO; 3], |f| f.each_ref().map(ramp))
-        })
-        .collect();
-    model.set_forces(&forces).map_err(|e| Error::Model(e.0))
+/// Applies the forces of `inputs`, sized to the model's mounts (checked by the model; on error
+/// nothing changes), and returns the inputs as applied.
+fn apply(model: &mut BodyAlone, inputs: &Inputs) -> Result<Inputs, Error> {
+    let sized = inputs.sized(model.mount_points().len());
+    model.set_forces(&sized.body_force)?;
+    Ok(sized)
 }
 
 impl BodySimulation {
@@ -71,7 +60,8 @@ impl BodySimulation {
             )));
         }
         let (mut model, note) = build_body_alone(&vehicle, &settings.chassis)?;
-        apply(&mut model, inputs)?;
+        let inputs = apply(&mut model, inputs)?;
+        let comfort = ComfortPoints::resolve(model.output_points().iter().map(|p| p.name.as_str()));
         let state = model.static_equilibrium(t0);
         let notes = vec![
             note,
@@ -88,9 +78,10 @@ impl BodySimulation {
             replaced,
             time: t0,
             state,
-            inputs: *inputs,
+            initial_inputs: inputs.clone(),
+            inputs,
+            comfort,
             initial_time: t0,
-            initial_inputs: *inputs,
             steps: 0,
         })
     }
@@ -120,11 +111,16 @@ impl BodySimulation {
         &self.inputs
     }
 
+    /// Whether the body accepts the forces of `inputs`, changing nothing.
+    pub fn check_inputs(&self, inputs: &Inputs) -> Result<(), Error> {
+        let sized = inputs.sized(self.model.mount_points().len());
+        Ok(self.model.check_forces(&sized.body_force)?)
+    }
+
     /// Applies the forces of `inputs` from the current time on. The exact propagation needs no
     /// restart, so nothing "jumps" for the integrator: returns `false`.
     pub fn set_inputs(&mut self, inputs: &Inputs) -> Result<bool, Error> {
-        apply(&mut self.model, inputs)?;
-        self.inputs = *inputs;
+        self.inputs = apply(&mut self.model, inputs)?;
         Ok(false)
     }
 
@@ -144,19 +140,19 @@ impl BodySimulation {
 
     /// Outputs at the communication time under the inputs in force.
     pub fn outputs(&self) -> Outputs {
-        Self::outputs_of(&self.model, self.time, &self.state)
+        Self::outputs_of(&self.model, self.comfort, self.time, &self.state)
     }
 
-    fn outputs_of(model: &BodyAlone, t: f64, y: &[f64]) -> Outputs {
+    fn outputs_of(model: &BodyAlone, comfort: ComfortPoints, t: f64, y: &[f64]) -> Outputs {
         let o = model.outputs(t, y);
         let mut out = Outputs::default();
         for (slot, m) in out.mount_point.iter_mut().zip(&o.mounts) {
             *slot = *m;
         }
-        if let Some(p) = o.point(STEERING_WHEEL_POINT) {
+        if let Some((_, p)) = comfort.steering_wheel.and_then(|k| o.points.get(k)) {
             out.steering_wheel_acceleration = p.acceleration;
         }
-        if let Some(p) = o.point(SEAT_POINT) {
+        if let Some((_, p)) = comfort.seat.and_then(|k| o.points.get(k)) {
             out.seat_acceleration = p.acceleration;
         }
         out
@@ -166,8 +162,13 @@ impl BodySimulation {
     /// accelerations respond at once to the forces.
     pub fn outputs_with(&self, interface: &Inputs) -> Result<Outputs, Error> {
         let mut model = self.model.clone();
-        apply(&mut model, interface)?;
-        Ok(Self::outputs_of(&model, self.time, &self.state))
+        apply(&mut model, &self.inputs.with_interface(interface))?;
+        Ok(Self::outputs_of(
+            &model,
+            self.comfort,
+            self.time,
+            &self.state,
+        ))
     }
 
     /// The outputs' response to the force increments in `seed.body_force` (values only), the
@@ -175,6 +176,7 @@ impl BodySimulation {
     pub fn input_sensitivities(&self, seed: &Inputs) -> Outputs {
         let mut out = Outputs::default();
         let points = self.model.mount_points();
+        let seed = seed.sized(points.len());
         let response = |p: usize| {
             let mut a = [0.0; 3];
             for (q, f) in points.iter().zip(&seed.body_force) {
@@ -191,10 +193,11 @@ impl BodySimulation {
                 slot.acceleration = response(*p);
             }
         }
-        if let Some(p) = self.model.output_point(STEERING_WHEEL_POINT) {
+        let body_point = |k: Option<usize>| k.map(|k| self.model.output_points()[k].point);
+        if let Some(p) = body_point(self.comfort.steering_wheel) {
             out.steering_wheel_acceleration = response(p);
         }
-        if let Some(p) = self.model.output_point(SEAT_POINT) {
+        if let Some(p) = body_point(self.comfort.seat) {
             out.seat_acceleration = response(p);
         }
         out
@@ -245,8 +248,8 @@ impl BodySimulation {
     pub fn dynamic_state(&self) -> BodyState {
         BodyState {
             initial_time: self.initial_time,
-            initial_inputs: self.initial_inputs,
-            inputs: self.inputs,
+            initial_inputs: self.initial_inputs.clone(),
+            inputs: self.inputs.clone(),
             time: self.time,
             state: self.state.clone(),
             steps: self.steps,

@@ -2,6 +2,8 @@
 //! parameter or input behind it in its own terms.
 
 use crate::model::scene::{BodyOption, SceneError};
+pub use crate::model::Input;
+use crate::model::InputError;
 
 /// An error of the co-simulation runtime.
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]
@@ -24,7 +26,7 @@ pub enum Error {
         /// Its value, in SI units.
         value: f64,
         /// The rule it breaks, as a sentence ending (e.g. "must be >= 0").
-        rule: &'static str,
+        rule: String,
     },
     /// The vehicle, the model or the integrator, in their own terms.
     #[error("{0}")]
@@ -60,26 +62,11 @@ impl From<Error> for String {
     }
 }
 
-/// One of the runtime's inputs ([`super::Inputs`]).
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
-pub enum Input {
-    /// Crank speed set-point, rad/s.
-    CrankSpeed,
-    /// Load torque, N m.
-    LoadTorque,
-    /// Stiffness scale of mount `i` (0-based).
-    StiffnessScale(usize),
-    /// Damping scale of mount `i` (0-based).
-    DampingScale(usize),
-}
-
-impl std::fmt::Display for Input {
-    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
-        match self {
-            Input::CrankSpeed => write!(f, "crank speed [rad/s]"),
-            Input::LoadTorque => write!(f, "load torque [N m]"),
-            Input::StiffnessScale(i) => write!(f, "stiffness scale of mount {i}"),
-            Input::DampingScale(i) => write!(f, "damping scale of mount {i}"),
+impl From<InputError> for Error {
+    fn from(e: InputError) -> Self {
+        match e {
+            InputError::Value { input, value, rule } => Error::Input { input, value, rule },
+            InputError::Other(m) => Error::Model(m),
         }
     }
 }

@@ -9,22 +9,23 @@
 pub mod body;
 pub mod error;
 pub mod export;
+mod inputs;
 pub mod periodic;
 pub mod runtime;
 pub mod scene;
 pub mod settings;
-mod signals;
 
 pub use crate::cms::CacheSetting;
 pub use crate::model::scene::{BodyOption, BodyOptions, SceneKind, AUTO_CUTOFF_MARGIN};
+pub use crate::model::RampInput;
 pub use crate::model::{EffectSwitch, Effects};
 pub use body::{BodySimulation, BodyState};
 pub use error::{Error, Input};
 pub use export::ExportRequest;
+pub use inputs::Inputs;
 pub use runtime::{FmuKind, Runtime, RuntimeState};
-pub use scene::FMU_MOUNTS;
+pub use scene::{ComfortPoints, FMU_MOUNTS};
 pub use settings::{EffectOverrides, Replaced, Settings, VehicleOverrides, VehicleSetting};
-pub use signals::{Inputs, Signal};
 
 pub use crate::model::body_alone::PointKinematics;
 use crate::model::CoupledModel;
@@ -107,7 +108,10 @@ pub struct Simulation {
     /// and interpolates, so its own time is usually a little ahead.
     time: f64,
     state: Vec<f64>,
+    /// The inputs in force, sized to the configuration's mounts.
     inputs: Inputs,
+    /// Where the comfort outputs are among the model's output points.
+    comfort: ComfortPoints,
     /// Where and under which inputs the static equilibrium was found: with the settings, this
     /// rebuilds the scene exactly (fade-in start, mount operating points).
     initial_time: f64,
@@ -133,7 +137,6 @@ impl Simulation {
         t0: f64,
         inputs: &Inputs,
     ) -> Result<Simulation, Error> {
-        inputs.validate()?;
         let mut options = BdfOptions {
             rtol: settings.rel_tol,
             max_order: settings.max_order,
@@ -150,7 +153,8 @@ impl Simulation {
             replaced,
             mut notes,
         } = scene::build_model(settings)?;
-        scene::apply_inputs(&mut scene, inputs)?;
+        let inputs = scene::apply_inputs(&mut scene, inputs)?;
+        let comfort = ComfortPoints::of(&scene);
         options.magnitude_cap = Some(scene.magnitude_caps());
         let y0 = scene.static_equilibrium(t0).map_err(|e| e.to_string())?;
         options.atol = scene.absolute_tolerance(settings.rel_tol, settings.abs_tol, t0, &y0)?;
@@ -166,9 +170,10 @@ impl Simulation {
             time: t0,
             equilibrium: y0.clone(),
             state: y0,
-            inputs: *inputs,
+            initial_inputs: inputs.clone(),
+            inputs,
+            comfort,
             initial_time: t0,
-            initial_inputs: *inputs,
             restarts: 0,
             interface_jumped: false,
         })
@@ -247,36 +252,39 @@ impl Simulation {
         self.time
     }
 
+    /// Whether the model accepts `inputs` ([`crate::model::ModelInputs::validate`]), changing
+    /// nothing.
+    pub fn check_inputs(&self, inputs: &Inputs) -> Result<(), Error> {
+        let mounts = self.scene.mounts().len();
+        Ok(inputs.sized(mounts).model.validate(mounts)?)
+    }
+
     /// Applies inputs valid from the current time on. Returns whether an input jumped, in which
     /// case the integrator restarted at order 1 from the state at the communication time (its
     /// history, and any step it took past that time, describe the old inputs).
     pub fn set_inputs(&mut self, inputs: &Inputs) -> Result<bool, Error> {
-        inputs.validate()?;
         let t = self.time;
+        let previous = self.inputs.clone();
+        // Sized to the mounts and checked by the model; on refusal nothing changed.
+        let inputs = scene::apply_inputs(&mut self.scene, inputs)?;
         // With the speed follower the crank speed is a state: a set-point jump bends its
         // trajectory but does not break it. It only needs a restart when the kink it puts into
         // the crank acceleration would fail the error test of the next step anyway.
-        let mut compared = *inputs;
+        let mut compared = inputs.model.clone();
         let mut sharp_kink = false;
         if self.scene.layout().has_follower() {
-            compared.crank_speed = self.inputs.crank_speed;
-            sharp_kink = self.follower_kink_is_sharp(inputs, t);
+            compared.crank_speed = previous.model.crank_speed;
+            sharp_kink = self.follower_kink_is_sharp(&inputs, t);
         }
-        let jumped = sharp_kink || !self.inputs.continue_into(&compared, t);
-        let interface_jumped = !self
-            .inputs
-            .interface()
-            .zip(inputs.interface())
-            .all(|(a, b)| a.continues_into(b, t));
-        let previous = self.inputs;
-        scene::apply_inputs(&mut self.scene, inputs)?;
+        let jumped = sharp_kink || !previous.model.continue_into(&compared, t);
+        let interface_jumped = !previous.interface_continues_into(&inputs, t);
         // An external body may move a mount beyond its characteristic: refuse the inputs
         // (naming the mount) rather than extrapolate a curve the mount does not have.
         if let Err(e) = self.interface_in_range() {
             scene::apply_inputs(&mut self.scene, &previous)?;
             return Err(e);
         }
-        self.inputs = *inputs;
+        self.inputs = inputs;
         self.interface_jumped = interface_jumped && !jumped;
         if jumped {
             if let Err(e) = self.integrator.restart_at(&mut self.scene, t, &self.state) {
@@ -299,9 +307,9 @@ impl Simulation {
             return false;
         };
         let tau = self.scene.follower().time_constant;
-        let (old, new) = (&self.inputs.crank_speed, &inputs.crank_speed);
-        let kink = (new.at(t) - old.at(t)).abs() / (tau * tau)
-            + 2.0 * (new.derivative - old.derivative).abs() / tau;
+        let (old, new) = (&self.inputs.model.crank_speed, &inputs.model.crank_speed);
+        let kink =
+            (new.at(t) - old.at(t)).abs() / (tau * tau) + 2.0 * (new.rate - old.rate).abs() / tau;
         let options = self.integrator.options();
         let weight = options.atol.get(acceleration) + options.rtol * self.state[acceleration].abs();
         kink * self.integrator.stats().h_next > weight
@@ -347,7 +355,7 @@ impl Simulation {
     /// Outputs at the communication time, with accelerations from one evaluation of the
     /// equations of motion.
     pub fn outputs(&mut self) -> Result<Outputs, Error> {
-        scene::outputs(&self.scene, self.time, &self.state)
+        scene::outputs(&self.scene, self.comfort, self.time, &self.state)
     }
 
     /// The inputs in force.
@@ -355,26 +363,15 @@ impl Simulation {
         &self.inputs
     }
 
-    /// The inputs in force with the interface signals (attachment motion, forces on a body)
-    /// of `interface`.
-    fn with_interface(&self, interface: &Inputs) -> Inputs {
-        Inputs {
-            body_displacement: interface.body_displacement,
-            body_velocity: interface.body_velocity,
-            body_force: interface.body_force,
-            ..self.inputs
-        }
-    }
-
     /// Outputs at the communication time, the state held, with the interface signals of
     /// `interface`: the mount forces and the powertrain acceleration respond at once to the
     /// external body's motion (scene 3).
     pub fn outputs_with(&mut self, interface: &Inputs) -> Result<Outputs, Error> {
-        let trial = self.with_interface(interface);
+        let trial = self.inputs.with_interface(interface);
         scene::apply_inputs(&mut self.scene, &trial)?;
         let outputs = self
             .interface_in_range()
-            .and_then(|()| scene::outputs(&self.scene, self.time, &self.state));
+            .and_then(|()| scene::outputs(&self.scene, self.comfort, self.time, &self.state));
         scene::apply_inputs(&mut self.scene, &self.inputs)?;
         outputs
     }
@@ -399,7 +396,7 @@ impl Simulation {
     /// increments in `seed` (values only), the state held, at the interface signals of `at`:
     /// the exact derivatives of [`Self::outputs_with`] (zero outside scene 3).
     pub fn input_sensitivities(&mut self, at: &Inputs, seed: &Inputs) -> Result<Outputs, Error> {
-        let trial = self.with_interface(at);
+        let trial = self.inputs.with_interface(at);
         scene::apply_inputs(&mut self.scene, &trial)?;
         let sensitivities = self
             .scene
@@ -407,10 +404,12 @@ impl Simulation {
             .map_err(|e| Error::Model(format!("{e:?}")));
         scene::apply_inputs(&mut self.scene, &self.inputs)?;
         let mut out = Outputs::default();
+        let seed = seed.sized(self.inputs.model.body_motion.len());
         for (i, s) in sensitivities?.iter().enumerate().take(FMU_MOUNTS) {
             let Some(s) = s else { continue };
-            let u = nalgebra::Vector3::from(seed.body_displacement[i].map(|x| x.value));
-            let v = nalgebra::Vector3::from(seed.body_velocity[i].map(|x| x.value));
+            let motion = &seed.model.body_motion[i];
+            let u = nalgebra::Vector3::from(motion.displacement.map(|x| x.value));
+            let v = nalgebra::Vector3::from(motion.velocity.map(|x| x.value));
             let force = s.force_per_displacement * u + s.force_per_velocity * v;
             let acceleration = s.housing_acceleration_per_force * force;
             out.mount_force[i] = force.into();
@@ -444,8 +443,8 @@ impl Simulation {
                 .map(|(y, d)| y + sign * eps * d)
                 .collect()
         };
-        let plus = scene::outputs(&self.scene, self.time + eps, &along(1.0))?;
-        let minus = scene::outputs(&self.scene, self.time - eps, &along(-1.0))?;
+        let plus = scene::outputs(&self.scene, self.comfort, self.time + eps, &along(1.0))?;
+        let minus = scene::outputs(&self.scene, self.comfort, self.time - eps, &along(-1.0))?;
         let d = |a: f64, b: f64| (a - b) / (2.0 * eps);
         let d3 = |a: [f64; 3], b: [f64; 3]| [d(a[0], b[0]), d(a[1], b[1]), d(a[2], b[2])];
         let mut mount_force = [[0.0; 3]; 4];
@@ -491,9 +490,9 @@ impl Simulation {
     pub fn dynamic_state(&self) -> SimulationState {
         SimulationState {
             initial_time: self.initial_time,
-            initial_inputs: self.initial_inputs,
+            initial_inputs: self.initial_inputs.clone(),
             fade_start: self.scene.fade_start(),
-            inputs: self.inputs,
+            inputs: self.inputs.clone(),
             time: self.time,
             state: self.state.clone(),
             integrator: self.integrator.snapshot(),
@@ -509,8 +508,6 @@ impl Simulation {
                 "simulation state holds a non-finite time or state".into(),
             ));
         }
-        saved.initial_inputs.validate()?;
-        saved.inputs.validate()?;
         let mut sim =
             Simulation::at_static_equilibrium(settings, saved.initial_time, &saved.initial_inputs)?;
         sim.scene
@@ -526,8 +523,7 @@ impl Simulation {
         sim.integrator
             .restore(&saved.integrator)
             .map_err(|e| e.to_string())?;
-        scene::apply_inputs(&mut sim.scene, &saved.inputs)?;
-        sim.inputs = saved.inputs;
+        sim.inputs = scene::apply_inputs(&mut sim.scene, &saved.inputs)?;
         sim.time = saved.time;
         sim.state.copy_from_slice(&saved.state);
         Ok(sim)

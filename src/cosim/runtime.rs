@@ -142,6 +142,14 @@ impl Runtime {
         }
     }
 
+    /// Whether the model accepts `inputs` (the model's one check), changing nothing.
+    pub fn check_inputs(&self, inputs: &Inputs) -> Result<(), Error> {
+        match self {
+            Runtime::Engine(s) => s.check_inputs(inputs),
+            Runtime::Body(s) => s.check_inputs(inputs),
+        }
+    }
+
     /// Applies inputs from the current time on; whether the integrator restarted.
     pub fn set_inputs(&mut self, inputs: &Inputs) -> Result<bool, Error> {
         match self {

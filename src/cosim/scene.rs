@@ -3,9 +3,8 @@
 
 use super::settings::Replaced;
 use super::{Error, Inputs, Outputs, Settings};
-use crate::model::inputs::AttachmentMotion;
 use crate::model::scene::build;
-use crate::model::{CoupledModel, RampInput, VehicleConfig};
+use crate::model::{CoupledModel, VehicleConfig};
 
 /// Number of mounts the FMU's variables expose (`mount[1..4]`).
 pub const FMU_MOUNTS: usize = 4;
@@ -72,33 +71,49 @@ pub fn build_model(settings: &Settings) -> Result<BuiltModel, Error> {
     })
 }
 
-fn ramp(s: &super::Signal) -> RampInput {
-    RampInput {
-        value: s.value,
-        rate: s.derivative,
-        since: s.reference_time,
+/// Applies the inputs, sized to the model's mounts, to the model (checked by the model as a
+/// whole; on error nothing changes), and returns them as applied.
+pub fn apply_inputs(model: &mut CoupledModel, inputs: &Inputs) -> Result<Inputs, Error> {
+    let sized = inputs.sized(model.mounts().len());
+    model.set_inputs(&sized.model)?;
+    Ok(sized)
+}
+
+/// Where the FMU's comfort outputs (`steeringWheel.a`, `seat.a`) are among a model's output
+/// points: resolved once when the model is built, not looked up by name at every output.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub struct ComfortPoints {
+    /// Position of [`STEERING_WHEEL_POINT`] among the output points, if the model has it.
+    pub steering_wheel: Option<usize>,
+    /// Position of [`SEAT_POINT`].
+    pub seat: Option<usize>,
+}
+
+impl ComfortPoints {
+    /// The comfort points of `model`'s output points.
+    pub fn of(model: &CoupledModel) -> ComfortPoints {
+        ComfortPoints::resolve(model.output_points().iter().map(|p| p.name.as_str()))
+    }
+
+    /// The positions of the comfort points among output points named `names`, in order.
+    pub fn resolve<'a>(names: impl Iterator<Item = &'a str> + Clone) -> ComfortPoints {
+        let position = |wanted: &str| names.clone().position(|n| n == wanted);
+        ComfortPoints {
+            steering_wheel: position(STEERING_WHEEL_POINT),
+            seat: position(SEAT_POINT),
+        }
     }
 }
 
-/// Applies the FMU inputs to the model (validated as a whole; on error nothing changes).
-pub fn apply_inputs(model: &mut CoupledModel, inputs: &Inputs) -> Result<(), Error> {
-    let mut m = model.inputs().clone();
-    m.crank_speed = ramp(&inputs.crank_speed);
-    m.load_torque = ramp(&inputs.load_torque);
-    for i in 0..m.stiffness_scale.len().min(FMU_MOUNTS) {
-        m.stiffness_scale[i] = ramp(&inputs.stiffness_scale[i]);
-        m.damping_scale[i] = ramp(&inputs.damping_scale[i]);
-        m.body_motion[i] = AttachmentMotion {
-            displacement: inputs.body_displacement[i].each_ref().map(ramp),
-            velocity: inputs.body_velocity[i].each_ref().map(ramp),
-        };
-    }
-    model.set_inputs(&m).map_err(|e| Error::Model(e.0))
-}
-
-/// The FMU outputs at `(t, y)`. Outputs without a component in this scene (the steering wheel
-/// and seat on rigid ground, a mount the configuration does not have) stay zero.
-pub fn outputs(model: &CoupledModel, t: f64, y: &[f64]) -> Result<Outputs, Error> {
+/// The FMU outputs at `(t, y)`, the comfort points at `comfort`. Outputs without a component
+/// in this scene (the steering wheel and seat on rigid ground, a mount the configuration does
+/// not have) stay zero.
+pub fn outputs(
+    model: &CoupledModel,
+    comfort: ComfortPoints,
+    t: f64,
+    y: &[f64],
+) -> Result<Outputs, Error> {
     let o = model
         .outputs(t, y)
         .map_err(|e| Error::Model(format!("{e:?}")))?;
@@ -112,10 +127,10 @@ pub fn outputs(model: &CoupledModel, t: f64, y: &[f64]) -> Result<Outputs, Error
     for (slot, f) in out.mount_force.iter_mut().zip(&o.mount_forces) {
         *slot = *f;
     }
-    if let Some(p) = o.point(STEERING_WHEEL_POINT) {
+    if let Some(p) = comfort.steering_wheel.and_then(|k| o.points.get(k)) {
         out.steering_wheel_acceleration = p.acceleration;
     }
-    if let Some(p) = o.point(SEAT_POINT) {
+    if let Some(p) = comfort.seat.and_then(|k| o.points.get(k)) {
         out.seat_acceleration = p.acceleration;
     }
     Ok(out)

@@ -31,7 +31,7 @@ use crate::variables::LogCategory;
 pub static ABI: Abi = Abi {
     // Marks a live instance of fmi3InstantiateCoSimulation (another value than FMI 2.0's).
     live: 0x454d_4346_4d55_0003,
-    kinds: &[FmuKind::Engine],
+    kinds: &[FmuKind::Engine, FmuKind::Body],
     token: "instantiation token",
     resources: "resource path",
     errors_enter_error_state: true,
@@ -58,9 +58,10 @@ const _: fmi3GetVersionTYPE = Some(fmi3GetVersion);
 
 /// Creates a co-simulation instance and returns it, or null after logging why through
 /// `logMessage`: a missing `instanceName`, an instantiation token that is not this FMU's, a
-/// resource path that is not a directory, `eventModeUsed` (the FMU has no event mode) or
-/// required intermediate variables (it provides no intermediate update). `earlyReturnAllowed`
-/// is accepted; fmi3DoStep never returns early.
+/// resource path that is not a directory, or `eventModeUsed` (the FMU has no event mode).
+/// `earlyReturnAllowed` is accepted (fmi3DoStep never returns early), and so are required
+/// intermediate variables, ignored as the Reference-FMUs do: the FMU provides no intermediate
+/// update, so nothing asks for them.
 #[no_mangle]
 pub extern "C" fn fmi3InstantiateCoSimulation(
     instanceName: fmi3String,
@@ -71,7 +72,7 @@ pub extern "C" fn fmi3InstantiateCoSimulation(
     eventModeUsed: fmi3Boolean,
     _earlyReturnAllowed: fmi3Boolean,
     _requiredIntermediateVariables: *const fmi3ValueReference,
-    nRequiredIntermediateVariables: usize,
+    _nRequiredIntermediateVariables: usize,
     instanceEnvironment: fmi3InstanceEnvironment,
     logMessage: fmi3LogMessageCallback,
     _intermediateUpdate: fmi3IntermediateUpdateCallback,
@@ -82,13 +83,10 @@ pub extern "C" fn fmi3InstantiateCoSimulation(
         resources: resourcePath,
         resource_dir,
     };
-    let refusal = if eventModeUsed {
-        Some("eventModeUsed: this FMU has no event mode (hasEventMode=false)")
-    } else if nRequiredIntermediateVariables > 0 {
-        Some("required intermediate variables: this FMU provides no intermediate update")
-    } else {
-        None
-    };
+    // Required intermediate variables are ignored, as the Reference-FMUs do: without
+    // intermediate update (providesIntermediateUpdate=false) no callback asks for them.
+    let refusal =
+        eventModeUsed.then_some("eventModeUsed: this FMU has no event mode (hasEventMode=false)");
     guard::instantiate(
         &ABI,
         request,
@@ -823,16 +821,68 @@ refused!(fmi3GetVariableDependencies, fmi3GetVariableDependenciesTYPE,
     (dependent: fmi3ValueReference, elementIndicesOfDependent: *mut usize,
      independents: *mut fmi3ValueReference, elementIndicesOfIndependents: *mut usize,
      dependencyKinds: *mut fmi3DependencyKind, nDependencies: usize));
-refused!(fmi3GetDirectionalDerivative, fmi3GetDirectionalDerivativeTYPE,
-    "not provided (providesDirectionalDerivative=false)",
-    (unknowns: *const fmi3ValueReference, nUnknowns: usize, knowns: *const fmi3ValueReference,
-     nKnowns: usize, seed: *const fmi3Float64, nSeed: usize, sensitivity: *mut fmi3Float64,
-     nSensitivity: usize));
 refused!(fmi3GetAdjointDerivative, fmi3GetAdjointDerivativeTYPE,
     "not provided (providesAdjointDerivatives=false)",
     (unknowns: *const fmi3ValueReference, nUnknowns: usize, knowns: *const fmi3ValueReference,
      nKnowns: usize, seed: *const fmi3Float64, nSeed: usize, sensitivity: *mut fmi3Float64,
      nSensitivity: usize));
+
+/// Directional derivatives of Float64 outputs with respect to Float64 inputs at the current
+/// communication point, the state held (`providesDirectionalDerivatives="true"`, as FMI 2.0's
+/// fmi2GetDirectionalDerivative): `sensitivity[i] = Σ_k ∂unknown_i/∂known_k · seed[k]`, arrays
+/// standing for their elements (row-major). Non-zero only through the interface inputs the
+/// model structure declares as direct dependencies; exact (the mounts' tangent stiffness and
+/// damping, the body's modal shapes).
+#[no_mangle]
+pub extern "C" fn fmi3GetDirectionalDerivative(
+    instance: fmi3Instance,
+    unknowns: *const fmi3ValueReference,
+    nUnknowns: usize,
+    knowns: *const fmi3ValueReference,
+    nKnowns: usize,
+    seed: *const fmi3Float64,
+    nSeed: usize,
+    sensitivity: *mut fmi3Float64,
+    nSensitivity: usize,
+) -> fmi3Status {
+    ABI.entry(
+        instance,
+        "fmi3GetDirectionalDerivative",
+        state::DIRECTIONAL_DERIVATIVE,
+        |h| {
+            // SAFETY: FMI passes nUnknowns and nKnowns value references, nSeed seeds and room
+            // for nSensitivity results.
+            let (unknowns, knowns, seed, out) = unsafe {
+                (
+                    array(unknowns, nUnknowns, "unknowns")?,
+                    array(knowns, nKnowns, "knowns")?,
+                    array(seed, nSeed, "seed")?,
+                    array_mut(sensitivity, nSensitivity, "sensitivity")?,
+                )
+            };
+            let size = h.instance.modes_size;
+            let unknowns = elements(&resolve::<f64>(unknowns, size, nSensitivity)?)?;
+            let knowns = elements(&resolve::<f64>(knowns, size, nSeed)?)?;
+            let values = h
+                .instance
+                .directional_derivative(&unknowns, &knowns, seed)?;
+            out.copy_from_slice(&values);
+            Ok(Status::Ok)
+        },
+    )
+}
+const _: fmi3GetDirectionalDerivativeTYPE = Some(fmi3GetDirectionalDerivative);
+
+/// The variables' elements behind `slots`; `time` is neither an input nor an output.
+fn elements(slots: &[Slot]) -> Result<Vec<usize>, String> {
+    slots
+        .iter()
+        .map(|s| {
+            s.element()
+                .ok_or_else(|| "time is neither an input nor an output".to_owned())
+        })
+        .collect()
+}
 
 /// The first time derivatives (order 1, `maxOutputDerivativeOrder="1"`) of continuous Float64
 /// outputs at the current communication point, along the trajectory the integrator follows
@@ -867,14 +917,8 @@ pub extern "C" fn fmi3GetOutputDerivatives(
                     "derivative order {order} is not provided (maxOutputDerivativeOrder=1)"
                 ));
             }
-            let mut elements = Vec::with_capacity(nValues);
-            for s in resolve::<f64>(vrs, h.instance.modes_size, nValues)? {
-                match s {
-                    Slot::Element(i) => elements.push(i),
-                    Slot::Time => return Err("time is not an output".into()),
-                }
-            }
-            let derivatives = h.instance.output_derivatives(&elements)?;
+            let outputs = elements(&resolve::<f64>(vrs, h.instance.modes_size, nValues)?)?;
+            let derivatives = h.instance.output_derivatives(&outputs)?;
             out.copy_from_slice(&derivatives);
             Ok(Status::Ok)
         },

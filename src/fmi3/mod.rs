@@ -23,3 +23,11 @@ pub const MODEL_DESCRIPTION_XML: &str =
 /// The FMU's `terminalsAndIcons/terminalsAndIcons.xml`.
 pub const TERMINALS_AND_ICONS_XML: &str =
     include_str!(concat!(env!("OUT_DIR"), "/fmi3/terminalsAndIcons.xml"));
+
+/// The body FMU's FMI 3.0 `modelDescription.xml`.
+pub const BODY_MODEL_DESCRIPTION_XML: &str =
+    include_str!(concat!(env!("OUT_DIR"), "/fmi3/body.modelDescription.xml"));
+
+/// The body FMU's `terminalsAndIcons/terminalsAndIcons.xml`.
+pub const BODY_TERMINALS_AND_ICONS_XML: &str =
+    include_str!(concat!(env!("OUT_DIR"), "/fmi3/body.terminalsAndIcons.xml"));

@@ -159,6 +159,8 @@ pub struct Instance {
     pub resource_dir: Option<PathBuf>,
     /// Everything an FMU state captures; replaced as a whole when one is restored.
     pub core: Core,
+    /// Whether the warning on body-point inputs outside scene 3 was given (once per instance).
+    warned_unused_body_point: bool,
 }
 
 impl Instance {
@@ -178,6 +180,7 @@ impl Instance {
             logger,
             resource_dir,
             core: Core::fresh(),
+            warned_unused_body_point: false,
         }
     }
 
@@ -305,7 +308,34 @@ impl Instance {
     pub fn exit_initialization(&mut self) -> Outcome {
         self.ensure_simulation()?;
         self.core.phase = Phase::StepComplete;
-        Ok(Status::Ok)
+        let reals = &self.core.values.reals;
+        let set: Vec<usize> = (0..REALS.len())
+            .filter(|&i| parameters::is_body_point_input(i) && reals.set_by_master(i as u32))
+            .collect();
+        Ok(self.warn_unused_body_point(&set))
+    }
+
+    /// Warns, once per instance, when the engine FMU gets body-point inputs (`mount[i].body.*`)
+    /// in a scene without an external body, which ignores them (an SSP whose scene binding was
+    /// lost would otherwise run uncoupled with no sign).
+    fn warn_unused_body_point(&mut self, indices: &[usize]) -> Status {
+        if self.warned_unused_body_point || self.kind != FmuKind::Engine {
+            return Status::Ok;
+        }
+        let Some(&first) = indices
+            .iter()
+            .find(|&&i| parameters::is_body_point_input(i))
+        else {
+            return Status::Ok;
+        };
+        match parameters::unused_body_point_input(&self.core.values, first) {
+            Some(warning) => {
+                self.warned_unused_body_point = true;
+                self.log_warning(&warning);
+                Status::Warning
+            }
+            None => Status::Ok,
+        }
     }
 
     /// Terminates.
@@ -494,11 +524,18 @@ impl Instance {
             }
         }
         if phase != Phase::StepComplete {
-            // Parameters or initial inputs changed before the model started: rebuild lazily.
+            // Parameters or initial inputs changed before the model started: rebuild lazily
+            // (the scene is only fixed when initialisation ends, where unused body-point inputs
+            // are warned about).
             self.core.simulation = None;
             self.core.setup_failure = None;
+            return Ok(Status::Ok);
         }
-        Ok(Status::Ok)
+        Ok(if T::TYPE_INDEX == <f64 as VarType>::TYPE_INDEX {
+            self.warn_unused_body_point(indices)
+        } else {
+            Status::Ok
+        })
     }
 
     /// Recomputes the outputs with direct feedthrough from the interface inputs just set (the
@@ -582,11 +619,20 @@ impl Instance {
                 tracks[i].set_value(self.core.values.reals.as_slice()[i]);
             }
         }
-        parameters::inputs_from(&tracks, self.core.time)
-            .validate()
-            .map_err(|e| parameters::message(&e))?;
+        self.check_inputs(&tracks)?;
         self.core.inputs = tracks;
         Ok(())
+    }
+
+    /// Whether the model accepts the inputs the signals `tracks` give from now on (a model not
+    /// built yet checks them when it is built).
+    fn check_inputs(&self, tracks: &[InputTrack]) -> Result<(), String> {
+        let Some(runtime) = &self.core.simulation else {
+            return Ok(());
+        };
+        runtime
+            .check_inputs(&parameters::inputs_from(tracks, self.core.time))
+            .map_err(|e| parameters::message(&e))
     }
 
     /// First time derivatives of the Real inputs at `indices` (fmi2SetRealInputDerivatives).
@@ -614,9 +660,7 @@ impl Instance {
             }
             candidate[i].set_slope(*value);
         }
-        parameters::inputs_from(&candidate, self.core.time)
-            .validate()
-            .map_err(|e| parameters::message(&e))?;
+        self.check_inputs(&candidate)?;
         self.core.inputs = candidate;
         self.core.setup_failure = None;
         Ok(Status::Ok)

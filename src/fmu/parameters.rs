@@ -13,6 +13,8 @@ use crate::cosim::{
     self, BodyOption, BodyOptions, EffectSwitch, Input, Replaced, SceneKind, Settings,
     VehicleOverrides, VehicleSetting,
 };
+use crate::model::inputs::AttachmentMotion;
+use crate::model::{ModelInputs, RampInput};
 use crate::variables::{
     boolean, integer, real, string, Parameters, BOOLEANS, INTEGERS, REALS, STRINGS,
 };
@@ -240,14 +242,15 @@ pub fn calculated(vr: u32) -> Calculated {
     }
 }
 
-/// The runtime's inputs from the Real input signals, from `time` on (SI units).
+/// The runtime's inputs from the Real input signals, from `time` on (SI units), one entry per
+/// mount of the FMU's variables (the runtime sizes them to the configuration).
 pub fn inputs_from(tracks: &[InputTrack], time: f64) -> cosim::Inputs {
     inputs_by(|index, scale| {
         let (value, derivative) = tracks[index as usize].preview(time);
-        cosim::Signal {
+        RampInput {
             value: value * scale,
-            derivative: derivative * scale,
-            reference_time: time,
+            rate: derivative * scale,
+            since: time,
         }
     })
 }
@@ -255,20 +258,30 @@ pub fn inputs_from(tracks: &[InputTrack], time: f64) -> cosim::Inputs {
 /// Input increments as runtime inputs (SI units, values only), from increments `seeds` of the
 /// Reals indexed like [`REALS`]: the seed of a directional derivative.
 pub fn input_increments(seeds: &[f64]) -> cosim::Inputs {
-    inputs_by(|index, scale| cosim::Signal::constant(seeds[index as usize] * scale))
+    inputs_by(|index, scale| RampInput::constant(seeds[index as usize] * scale))
 }
 
-/// The runtime's inputs with each signal from `signal(real index, factor to SI)`: the one place
-/// that knows which Real input feeds which runtime input.
-fn inputs_by(signal: impl Fn(u32, f64) -> cosim::Signal) -> cosim::Inputs {
+/// The runtime's inputs with each ramp from `ramp(real index, factor to SI)`: the one place
+/// that knows which Real input feeds which runtime input (and [`input_variable`] the way back).
+fn inputs_by(ramp: impl Fn(u32, f64) -> RampInput) -> cosim::Inputs {
+    let per_mount = |indices: &[u32]| indices.iter().map(|&i| ramp(i, 1.0)).collect();
+    let axes = |indices: &[u32; 3]| indices.map(|i| ramp(i, 1.0));
+    let mut model = ModelInputs::new(0);
+    model.crank_speed = ramp(real::RPM, RPM);
+    model.load_torque = ramp(real::LOAD_TORQUE, 1.0);
+    model.stiffness_scale = per_mount(&real::MOUNT_STIFFNESS_SCALE);
+    model.damping_scale = per_mount(&real::MOUNT_DAMPING_SCALE);
+    model.body_motion = real::MOUNT_BODY_R
+        .iter()
+        .zip(&real::MOUNT_BODY_V)
+        .map(|(r, v)| AttachmentMotion {
+            displacement: axes(r),
+            velocity: axes(v),
+        })
+        .collect();
     cosim::Inputs {
-        crank_speed: signal(real::RPM, RPM),
-        load_torque: signal(real::LOAD_TORQUE, 1.0),
-        stiffness_scale: real::MOUNT_STIFFNESS_SCALE.map(|i| signal(i, 1.0)),
-        damping_scale: real::MOUNT_DAMPING_SCALE.map(|i| signal(i, 1.0)),
-        body_displacement: real::MOUNT_BODY_R.map(|m| m.map(|i| signal(i, 1.0))),
-        body_velocity: real::MOUNT_BODY_V.map(|m| m.map(|i| signal(i, 1.0))),
-        body_force: real::BODY_MOUNT_F.map(|m| m.map(|i| signal(i, 1.0))),
+        model,
+        body_force: real::BODY_MOUNT_F.iter().map(axes).collect(),
     }
 }
 
@@ -306,13 +319,48 @@ pub fn is_interface_input(index: usize) -> bool {
         .any(|&i| i as usize == index)
 }
 
-/// The Real input behind a runtime input, and the factor from SI units to the input's unit.
-fn input_variable(input: Input) -> (u32, f64) {
+/// Whether Real `index` is the motion of an external body's point at a mount (`mount[i].body.*`),
+/// which only scene 3 uses.
+pub fn is_body_point_input(index: usize) -> bool {
+    [real::MOUNT_BODY_R, real::MOUNT_BODY_V]
+        .iter()
+        .flatten()
+        .flatten()
+        .any(|&i| i as usize == index)
+}
+
+/// The warning for body-point inputs set while `scene` is not the one with an external body,
+/// naming the first input set (`None` if the scene uses them).
+pub fn unused_body_point_input(values: &Values, index: usize) -> Option<String> {
+    let scene = *values.integers.get(integer::SCENE);
+    if scene == SceneKind::ExternalBody.number() {
+        return None;
+    }
+    Some(format!(
+        "{} is the motion of an external body's point at a mount, used in {} = {} only; \
+         {} = {scene} ignores it (said once per instance)",
+        REALS[index].name,
+        INTEGERS[integer::SCENE as usize].name,
+        SceneKind::ExternalBody.number(),
+        INTEGERS[integer::SCENE as usize].name,
+    ))
+}
+
+/// The Real input behind a runtime input, and the factor from SI units to the input's unit
+/// (`None` for a mount the FMU's variables do not have).
+fn input_variable(input: Input) -> Option<(u32, f64)> {
+    let mount = |family: &[u32], i: usize| family.get(i).map(|&k| (k, 1.0));
+    let axis = |family: &[[u32; 3]], i: usize, j: usize| {
+        family.get(i).and_then(|m| m.get(j)).map(|&k| (k, 1.0))
+    };
     match input {
-        Input::CrankSpeed => (real::RPM, 1.0 / RPM),
-        Input::LoadTorque => (real::LOAD_TORQUE, 1.0),
-        Input::StiffnessScale(i) => (real::MOUNT_STIFFNESS_SCALE[i], 1.0),
-        Input::DampingScale(i) => (real::MOUNT_DAMPING_SCALE[i], 1.0),
+        Input::CrankSpeed => Some((real::RPM, 1.0 / RPM)),
+        Input::LoadTorque => Some((real::LOAD_TORQUE, 1.0)),
+        Input::StiffnessScale(i) => mount(&real::MOUNT_STIFFNESS_SCALE, i),
+        Input::DampingScale(i) => mount(&real::MOUNT_DAMPING_SCALE, i),
+        Input::BodyDisplacement(i, j) => axis(&real::MOUNT_BODY_R, i, j),
+        Input::BodyVelocity(i, j) => axis(&real::MOUNT_BODY_V, i, j),
+        Input::BodyForce(i, j) => axis(&real::BODY_MOUNT_F, i, j),
     }
 }
 
@@ -354,14 +402,14 @@ pub fn message(error: &cosim::Error) -> String {
             value,
             rule,
         } => format!("{} = {value} {rule}", body_option_name(*option)),
-        cosim::Error::Input { input, value, rule } => {
-            let (index, scale) = input_variable(*input);
-            format!(
+        cosim::Error::Input { input, value, rule } => match input_variable(*input) {
+            Some((index, scale)) => format!(
                 "{} = {} {rule}",
                 REALS[index as usize].name,
                 super::values::Num(value * scale)
-            )
-        }
+            ),
+            None => error.to_string(),
+        },
         cosim::Error::Model(m) => m.clone(),
     }
 }
@@ -443,7 +491,7 @@ mod tests {
         let e = cosim::Error::Input {
             input: Input::CrankSpeed,
             value: -100.0 * RPM,
-            rule: "is negative",
+            rule: "is negative".into(),
         };
         let m = message(&e);
         assert!(
@@ -453,7 +501,7 @@ mod tests {
         let e = cosim::Error::Input {
             input: Input::StiffnessScale(2),
             value: -1.0,
-            rule: "must be >= 0",
+            rule: "must be >= 0".into(),
         };
         assert_eq!(message(&e), "mount[3].stiffnessScale = -1 must be >= 0");
         let e: cosim::Error = BodyOptions {

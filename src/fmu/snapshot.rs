@@ -14,9 +14,9 @@ use crate::cosim::{Runtime, RuntimeState};
 use crate::saved_state;
 
 const MAGIC: &[u8; 8] = b"EMCSTATE";
-/// 4: values with the variables the master set; 3: postcard; 1 and 2 were hand-written byte
-/// layouts.
-const FORMAT_VERSION: u32 = 5;
+/// 6: the runtime's inputs as ramps, one list per mount; 4: values with the variables the master
+/// set; 3: postcard; 1 and 2 were hand-written byte layouts.
+const FORMAT_VERSION: u32 = 6;
 
 /// What a serialized state holds: the co-simulation state machine, every variable value, the
 /// input signals and the simulation's dynamic state.

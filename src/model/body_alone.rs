@@ -13,7 +13,7 @@
 use nalgebra::{Matrix2, Vector2, Vector3};
 
 use super::coupled::{output_points, point_index, ModelError, OutputPoint, MOUNT_MATCH_TOLERANCE};
-use super::inputs::{InputError, RampInput};
+use super::inputs::{validate_body_forces, InputError, RampInput};
 use super::mount::MountConfig;
 use crate::cms::ReducedChassis;
 
@@ -53,16 +53,20 @@ pub struct BodyAlone {
     outputs: Vec<OutputPoint>,
     /// Per configured mount: the force on the body, N, per vehicle axis.
     forces: Vec<[RampInput; 3]>,
+    /// The largest force accepted at a mount, N ([`validate_body_forces`]).
+    force_limit: f64,
 }
 
 impl BodyAlone {
     /// The body with a force input at the body node of every active mount of `mounts` and the
-    /// named `outputs`. Every mode must have a positive frequency: a body that is free in some
-    /// direction has no static equilibrium under the engine's weight.
+    /// named `outputs`, accepting forces up to `force_limit` (N) at a mount. Every mode must
+    /// have a positive frequency: a body that is free in some direction has no static
+    /// equilibrium under the engine's weight.
     pub fn new(
         body: ReducedChassis,
         mounts: &[MountConfig],
         outputs: &[String],
+        force_limit: f64,
     ) -> Result<Self, ModelError> {
         if body.zeta.len() != body.n_modes() {
             return Err(ModelError::Body(format!(
@@ -86,15 +90,16 @@ impl BodyAlone {
                 continue;
             }
             let node = m.body_node.as_deref().ok_or_else(|| {
-                ModelError::Body(format!("mount {i} ('{}') names no body node", m.name))
+                ModelError::Body(format!("mount {} ('{}') names no body node", i + 1, m.name))
             })?;
             let p = point_index(&body, node, &format!("mount '{}'", m.name))?;
             let at = Vector3::from(body.points[p].position);
             let gap = (at - Vector3::from(m.bracket)).norm();
             if gap > MOUNT_MATCH_TOLERANCE {
                 return Err(ModelError::Body(format!(
-                    "mount {i} ('{}'): its body node '{node}' is {:.1} mm from its bracket \
+                    "mount {} ('{}'): its body node '{node}' is {:.1} mm from its bracket \
                      (limit {:.1} mm)",
+                    i + 1,
                     m.name,
                     gap * 1e3,
                     MOUNT_MATCH_TOLERANCE * 1e3
@@ -105,6 +110,7 @@ impl BodyAlone {
         let outputs = output_points(&body, outputs)?;
         Ok(Self {
             forces: vec![[RampInput::ZERO; 3]; mounts.len()],
+            force_limit,
             body,
             mount_points,
             outputs,
@@ -126,26 +132,22 @@ impl BodyAlone {
         &self.mount_points
     }
 
-    /// Sets the force on the body at each mount (configuration order), as ramps; validated as a
-    /// whole, on error nothing changes.
-    pub fn set_forces(&mut self, forces: &[[RampInput; 3]]) -> Result<(), InputError> {
+    /// Whether `forces` (one per configured mount) are admissible ([`validate_body_forces`]).
+    pub fn check_forces(&self, forces: &[[RampInput; 3]]) -> Result<(), InputError> {
         if forces.len() != self.forces.len() {
-            return Err(InputError(format!(
+            return Err(InputError::Other(format!(
                 "{} mount forces for {} mounts",
                 forces.len(),
                 self.forces.len()
             )));
         }
-        for (i, f) in forces.iter().enumerate() {
-            if f.iter()
-                .any(|r| !(r.value.is_finite() && r.rate.is_finite() && r.since.is_finite()))
-            {
-                return Err(InputError(format!(
-                    "the force at mount {} is not finite",
-                    i + 1
-                )));
-            }
-        }
+        validate_body_forces(forces, self.force_limit)
+    }
+
+    /// Sets the force on the body at each mount (configuration order), as ramps; validated as a
+    /// whole ([`Self::check_forces`]), on error nothing changes.
+    pub fn set_forces(&mut self, forces: &[[RampInput; 3]]) -> Result<(), InputError> {
+        self.check_forces(forces)?;
         self.forces.copy_from_slice(forces);
         Ok(())
     }
@@ -260,6 +262,11 @@ impl BodyAlone {
         out
     }
 
+    /// The output points, in the order of [`BodyOutputs::points`].
+    pub fn output_points(&self) -> &[OutputPoint] {
+        &self.outputs
+    }
+
     /// The body point of output `name`, if reported.
     pub fn output_point(&self, name: &str) -> Option<usize> {
         self.outputs
@@ -293,6 +300,7 @@ mod tests {
             mount_points: vec![Some(0)],
             outputs: Vec::new(),
             forces: vec![[RampInput::ZERO; 3]],
+            force_limit: 1e9,
         }
     }
 

@@ -1,14 +1,38 @@
-//! Inputs of the coupled model, settable at any time (FMI: at communication points, with
-//! derivatives for `canInterpolateInputs`). Every input is a ramp, `value + rate · (t − since)`.
+//! Inputs of the coupled model and of the body alone, settable at any time (FMI: at
+//! communication points, with derivatives for `canInterpolateInputs`). Every input is a ramp,
+//! `value + rate · (t − since)`, the one signal type from the FMU's input tracks down to the
+//! equations of motion.
+//!
+//! The model checks its inputs here, once: what is outside an input's domain is refused with a
+//! typed [`InputError`] naming the [`Input`], which the FMU turns into its variable's name. Mounts
+//! and axes are counted from 1 in every message, as the FMU's variables count them.
 
 use serde::{Deserialize, Serialize};
+
+/// The fastest an external body's point at a mount may move, m/s: a car body's points vibrate
+/// at mm/s to a few m/s; a displacement ramp or a velocity beyond this is a master's error
+/// (a wrong unit, a lost connection), refused naming the input rather than integrated.
+pub const ATTACHMENT_SPEED_LIMIT: f64 = 100.0;
+
+/// The largest acceleration of an external body's point at a mount, m/s² (about 1000 g): the
+/// bound on a velocity ramp's rate, for the same reason as [`ATTACHMENT_SPEED_LIMIT`].
+pub const ATTACHMENT_ACCELERATION_LIMIT: f64 = 1e4;
+
+/// The body alone refuses a force at a mount larger than this many times the powertrain's
+/// weight (so at least that many times the largest static mount force): 100 × m g is about
+/// 190 kN for the built-in engine, far beyond a mount's bump stop.
+pub const BODY_FORCE_LIMIT_WEIGHTS: f64 = 100.0;
+
+/// A body force may change by at most its bound within this time (s): its rate is refused
+/// beyond `bound / BODY_FORCE_RISE_TIME`.
+pub const BODY_FORCE_RISE_TIME: f64 = 1e-3;
 
 /// A real input that varies linearly between settings: `value + rate · (t − since)`.
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
 pub struct RampInput {
-    /// Value at `since`.
+    /// Value at `since`, in the input's SI unit.
     pub value: f64,
-    /// Slope (per second).
+    /// Slope (the input's unit per second).
     pub rate: f64,
     /// Time at which the ramp has `value` (s).
     pub since: f64,
@@ -31,17 +55,109 @@ impl RampInput {
         }
     }
 
-    /// The ramp's value at time `t`.
+    /// The ramp's value at time `t`; also before `since`, on the same line.
     pub fn at(&self, t: f64) -> f64 {
         self.value + self.rate * (t - self.since)
     }
 
-    fn is_finite(&self) -> bool {
+    /// Whether value, rate and reference time are finite.
+    pub fn is_finite(&self) -> bool {
         self.value.is_finite() && self.rate.is_finite() && self.since.is_finite()
+    }
+
+    /// Whether `next`, valid from `t` on, continues this ramp without a jump at `t`.
+    pub fn continues_into(&self, next: &RampInput, t: f64) -> bool {
+        let before = self.at(t);
+        let after = next.at(t);
+        (before - after).abs() <= 1e-12 * before.abs().max(after.abs()).max(1.0)
     }
 }
 
-/// All inputs of the coupled model.
+/// One input of the model, mounts and axes indexed from 0 (displayed from 1).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Input {
+    /// Crank speed set-point, rad/s.
+    CrankSpeed,
+    /// Load torque, N m.
+    LoadTorque,
+    /// Stiffness scale of a mount.
+    StiffnessScale(usize),
+    /// Damping scale of a mount.
+    DampingScale(usize),
+    /// Displacement of an external body's point at a mount along a vehicle axis, m.
+    BodyDisplacement(usize, usize),
+    /// Velocity of an external body's point at a mount along a vehicle axis, m/s.
+    BodyVelocity(usize, usize),
+    /// The body alone: the force on the body at a mount along a vehicle axis, N.
+    BodyForce(usize, usize),
+}
+
+const AXES: [&str; 3] = ["x", "y", "z"];
+
+impl std::fmt::Display for Input {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        match *self {
+            Input::CrankSpeed => write!(f, "crank speed [rad/s]"),
+            Input::LoadTorque => write!(f, "load torque [N m]"),
+            Input::StiffnessScale(i) => write!(f, "stiffness scale of mount {}", i + 1),
+            Input::DampingScale(i) => write!(f, "damping scale of mount {}", i + 1),
+            Input::BodyDisplacement(i, j) => {
+                write!(
+                    f,
+                    "body displacement at mount {} along {} [m]",
+                    i + 1,
+                    AXES[j]
+                )
+            }
+            Input::BodyVelocity(i, j) => {
+                write!(
+                    f,
+                    "body velocity at mount {} along {} [m/s]",
+                    i + 1,
+                    AXES[j]
+                )
+            }
+            Input::BodyForce(i, j) => {
+                write!(
+                    f,
+                    "force on the body at mount {} along {} [N]",
+                    i + 1,
+                    AXES[j]
+                )
+            }
+        }
+    }
+}
+
+/// An input the model refuses.
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+pub enum InputError {
+    /// An input outside its domain.
+    #[error("{input} = {value} {rule}")]
+    Value {
+        /// The input at fault.
+        input: Input,
+        /// Its value at its reference time, in SI units.
+        value: f64,
+        /// The rule it breaks, as a sentence ending ("must be >= 0", …).
+        rule: String,
+    },
+    /// Anything else, in the model's terms.
+    #[error("{0}")]
+    Other(String),
+}
+
+impl InputError {
+    fn value(input: Input, ramp: &RampInput, rule: impl Into<String>) -> Self {
+        InputError::Value {
+            input,
+            value: ramp.value,
+            rule: rule.into(),
+        }
+    }
+}
+
+/// All inputs of the coupled model, one per configured mount where per mount.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct ModelInputs {
     /// Crank speed set-point (rad/s, the crank's spin about its axis in inertial space) and its
@@ -84,11 +200,53 @@ impl AttachmentMotion {
         )
     }
 
-    fn is_finite(&self) -> bool {
-        self.displacement
-            .iter()
-            .chain(&self.velocity)
-            .all(RampInput::is_finite)
+    /// Finite ramps within [`ATTACHMENT_SPEED_LIMIT`] and [`ATTACHMENT_ACCELERATION_LIMIT`];
+    /// the error names mount `i`'s input.
+    fn validate(&self, i: usize) -> Result<(), InputError> {
+        for j in 0..3 {
+            let (r, v) = (&self.displacement[j], &self.velocity[j]);
+            let (r_input, v_input) = (Input::BodyDisplacement(i, j), Input::BodyVelocity(i, j));
+            for (input, ramp) in [(r_input, r), (v_input, v)] {
+                if !ramp.is_finite() {
+                    return Err(InputError::value(
+                        input,
+                        ramp,
+                        format!("(rate {}) is not finite", ramp.rate),
+                    ));
+                }
+            }
+            let speed = ATTACHMENT_SPEED_LIMIT;
+            if r.rate.abs() > speed {
+                return Err(InputError::value(
+                    r_input,
+                    r,
+                    format!(
+                        "changes at {} m/s, beyond the {speed} m/s a point of a car body can move",
+                        r.rate
+                    ),
+                ));
+            }
+            if v.value.abs() > speed {
+                return Err(InputError::value(
+                    v_input,
+                    v,
+                    format!("is beyond the {speed} m/s a point of a car body can move"),
+                ));
+            }
+            let acceleration = ATTACHMENT_ACCELERATION_LIMIT;
+            if v.rate.abs() > acceleration {
+                return Err(InputError::value(
+                    v_input,
+                    v,
+                    format!(
+                        "changes at {} m/s², beyond the {acceleration} m/s² a point of a car body \
+                         can accelerate",
+                        v.rate
+                    ),
+                ));
+            }
+        }
+        Ok(())
     }
 }
 
@@ -112,36 +270,37 @@ impl ModelInputs {
         )
     }
 
-    /// Finite values, non-negative mount scales, one scale pair per configured mount.
+    /// The one check of the model's inputs: one entry per configured mount, finite ramps, a
+    /// crank speed and mount scales >= 0, an external body's motion within what a car body can
+    /// do.
     pub fn validate(&self, mounts: usize) -> Result<(), InputError> {
-        for (name, r) in [
-            ("crank speed", &self.crank_speed),
-            ("load torque", &self.load_torque),
+        let lengths = [
+            self.stiffness_scale.len(),
+            self.damping_scale.len(),
+            self.body_motion.len(),
+        ];
+        if lengths.iter().any(|&n| n != mounts) {
+            return Err(InputError::Other(format!(
+                "{} stiffness scales, {} damping scales and {} attachment motions for {mounts} \
+                 mounts",
+                lengths[0], lengths[1], lengths[2]
+            )));
+        }
+        for (input, r) in [
+            (Input::CrankSpeed, &self.crank_speed),
+            (Input::LoadTorque, &self.load_torque),
         ] {
             if !r.is_finite() {
-                return Err(InputError(format!(
-                    "{name} {} (rate {}, since {}) must be finite",
-                    r.value, r.rate, r.since
-                )));
+                let rule = format!("(rate {}) must be finite", r.rate);
+                return Err(InputError::value(input, r, rule));
             }
         }
-        if self.stiffness_scale.len() != mounts || self.damping_scale.len() != mounts {
-            return Err(InputError(format!(
-                "{} stiffness and {} damping scales for {mounts} mounts",
-                self.stiffness_scale.len(),
-                self.damping_scale.len()
-            )));
-        }
-        if self.body_motion.len() != mounts {
-            return Err(InputError(format!(
-                "{} attachment motions for {mounts} mounts",
-                self.body_motion.len()
-            )));
-        }
-        if let Some(i) = self.body_motion.iter().position(|m| !m.is_finite()) {
-            return Err(InputError(format!(
-                "mounts[{i}] attachment displacement and velocity must be finite"
-            )));
+        if self.crank_speed.value < 0.0 {
+            return Err(InputError::value(
+                Input::CrankSpeed,
+                &self.crank_speed,
+                "is negative",
+            ));
         }
         for (i, (k, c)) in self
             .stiffness_scale
@@ -149,20 +308,177 @@ impl ModelInputs {
             .zip(&self.damping_scale)
             .enumerate()
         {
-            for (what, r) in [("stiffness", k), ("damping", c)] {
-                if !(r.is_finite() && r.value >= 0.0) {
-                    return Err(InputError(format!(
-                        "mounts[{i}] {what} scale {} (rate {}) must be finite and >= 0",
-                        r.value, r.rate
-                    )));
+            let rules = [
+                (
+                    Input::StiffnessScale(i),
+                    k,
+                    "must be >= 0 (0: no stiffness; the mount keeps its preload)",
+                ),
+                (Input::DampingScale(i), c, "must be >= 0"),
+            ];
+            for (input, r, rule) in rules {
+                if !r.is_finite() {
+                    let rule = format!("(rate {}) must be finite", r.rate);
+                    return Err(InputError::value(input, r, rule));
+                }
+                if r.value < 0.0 {
+                    return Err(InputError::value(input, r, rule));
                 }
             }
         }
+        for (i, m) in self.body_motion.iter().enumerate() {
+            m.validate(i)?;
+        }
         Ok(())
+    }
+
+    /// Whether `next` continues the engine's inputs (speed, load torque, mount scales) without a
+    /// jump at time `t`. The external body's motion is not compared: a coupling master sets it
+    /// every communication step from the other model's outputs, where it never exactly continues
+    /// the ramp before; its small jumps bend the trajectory less than an integrator restart at
+    /// each step would cost, and the error control sees them.
+    pub fn continue_into(&self, next: &ModelInputs, t: f64) -> bool {
+        let ramps = |m: &ModelInputs| -> Vec<RampInput> {
+            [m.crank_speed, m.load_torque]
+                .into_iter()
+                .chain(m.stiffness_scale.iter().copied())
+                .chain(m.damping_scale.iter().copied())
+                .collect()
+        };
+        let (a, b) = (ramps(self), ramps(next));
+        a.len() == b.len() && a.iter().zip(&b).all(|(a, b)| a.continues_into(b, t))
+    }
+
+    /// Whether the external body's motion in `next` continues this one's at `t`.
+    pub fn body_motion_continues_into(&self, next: &ModelInputs, t: f64) -> bool {
+        let ramps = |m: &ModelInputs| -> Vec<RampInput> {
+            m.body_motion
+                .iter()
+                .flat_map(|a| a.displacement.iter().chain(&a.velocity).copied())
+                .collect()
+        };
+        let (a, b) = (ramps(self), ramps(next));
+        a.len() == b.len() && a.iter().zip(&b).all(|(a, b)| a.continues_into(b, t))
     }
 }
 
-/// An input value the model rejects.
-#[derive(Debug, Clone, PartialEq, thiserror::Error)]
-#[error("{0}")]
-pub struct InputError(pub String);
+/// The one check of the body alone's mount forces: finite ramps, each force within `limit` (N)
+/// and changing at most by `limit` within [`BODY_FORCE_RISE_TIME`].
+pub fn validate_body_forces(forces: &[[RampInput; 3]], limit: f64) -> Result<(), InputError> {
+    for (i, f) in forces.iter().enumerate() {
+        for (j, r) in f.iter().enumerate() {
+            let input = Input::BodyForce(i, j);
+            if !r.is_finite() {
+                let rule = format!("(rate {}) is not finite", r.rate);
+                return Err(InputError::value(input, r, rule));
+            }
+            let bound =
+                format!("{limit:.4e} N ({BODY_FORCE_LIMIT_WEIGHTS} times the powertrain's weight)");
+            if r.value.abs() > limit {
+                return Err(InputError::value(
+                    input,
+                    r,
+                    format!("is beyond the plausible bound {bound}"),
+                ));
+            }
+            let rate_limit = limit / BODY_FORCE_RISE_TIME;
+            if r.rate.abs() > rate_limit {
+                return Err(InputError::value(
+                    input,
+                    r,
+                    format!(
+                        "changes at {} N/s: beyond the plausible bound {bound} within \
+                         {BODY_FORCE_RISE_TIME} s",
+                        r.rate
+                    ),
+                ));
+            }
+        }
+    }
+    Ok(())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn a_ramp_continued_at_its_end_is_not_a_jump() {
+        let a = RampInput {
+            value: 100.0,
+            rate: 10.0,
+            since: 1.0,
+        };
+        let mut b = RampInput {
+            value: 110.0,
+            rate: 10.0,
+            since: 2.0,
+        };
+        assert!(a.continues_into(&b, 2.0));
+        b.value = 120.0;
+        assert!(!a.continues_into(&b, 2.0));
+    }
+
+    #[test]
+    fn refusals_name_the_input_counting_mounts_and_axes_from_1() {
+        let good = ModelInputs::new(3);
+        assert!(good.validate(3).is_ok());
+        let mut bad = good.clone();
+        bad.stiffness_scale[2].value = -1.0;
+        let e = bad.validate(3).unwrap_err();
+        assert!(matches!(
+            e,
+            InputError::Value {
+                input: Input::StiffnessScale(2),
+                ..
+            }
+        ));
+        assert!(
+            e.to_string().starts_with("stiffness scale of mount 3 = -1"),
+            "{e}"
+        );
+        let mut bad = good.clone();
+        bad.body_motion[1].displacement[2].rate = 1e300;
+        let e = bad.validate(3).unwrap_err();
+        assert!(
+            matches!(
+                e,
+                InputError::Value {
+                    input: Input::BodyDisplacement(1, 2),
+                    ..
+                }
+            ),
+            "{e}"
+        );
+        assert!(e.to_string().contains("mount 2 along z"), "{e}");
+        let mut bad = good;
+        bad.body_motion[0].velocity[0].rate = 2.0 * ATTACHMENT_ACCELERATION_LIMIT;
+        assert!(bad.validate(3).is_err());
+    }
+
+    #[test]
+    fn body_forces_beyond_the_bound_are_refused() {
+        let limit = 1e5;
+        let mut f = vec![[RampInput::ZERO; 3]; 2];
+        f[1][2] = RampInput::constant(0.99 * limit);
+        assert!(validate_body_forces(&f, limit).is_ok());
+        f[1][2] = RampInput::constant(1e300);
+        let e = validate_body_forces(&f, limit).unwrap_err();
+        assert!(
+            matches!(
+                e,
+                InputError::Value {
+                    input: Input::BodyForce(1, 2),
+                    ..
+                }
+            ),
+            "{e}"
+        );
+        f[1][2] = RampInput {
+            value: 0.0,
+            rate: 2.0 * limit / BODY_FORCE_RISE_TIME,
+            since: 0.0,
+        };
+        assert!(validate_body_forces(&f, limit).is_err());
+    }
+}

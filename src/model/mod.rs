@@ -53,7 +53,7 @@ pub use coupled::{
 };
 pub use effects::{EffectSwitch, Effects};
 pub use follower::SpeedFollower;
-pub use inputs::{InputError, ModelInputs, RampInput};
+pub use inputs::{Input, InputError, ModelInputs, RampInput};
 pub use mount::{MountConfig, MountCurve};
 pub use powertrain::config::EngineConfig;
 pub use powertrain::defaults::{POWERTRAIN_CG, POWERTRAIN_MASS};

@@ -306,8 +306,17 @@ pub fn build_body_alone(
 ) -> Result<(BodyAlone, String), SceneError> {
     vehicle.validate().map_err(|e| e.to_string())?;
     let (reduced, note) = body(vehicle, options)?;
-    let model =
-        BodyAlone::new(reduced, &vehicle.mounts, &vehicle.outputs).map_err(|e| e.to_string())?;
+    let weight = crate::model::powertrain::Powertrain::new(
+        vehicle.engine.clone(),
+        vehicle.effects,
+        vehicle.gravity,
+    )
+    .map_err(|e| e.to_string())?
+    .mass()
+        * vehicle.gravity.abs();
+    let force_limit = crate::model::inputs::BODY_FORCE_LIMIT_WEIGHTS * weight;
+    let model = BodyAlone::new(reduced, &vehicle.mounts, &vehicle.outputs, force_limit)
+        .map_err(|e| e.to_string())?;
     Ok((model, note))
 }
 

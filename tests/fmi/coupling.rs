@@ -272,7 +272,7 @@ fn bad_body_motion_is_refused_naming_the_mount_and_changes_nothing() {
     assert!(
         s.logs()
             .iter()
-            .any(|l| l.contains("external body") && l.contains("mount 0")),
+            .any(|l| l.contains("external body") && l.contains("mount 1 ")),
         "{:?}",
         s.logs()
     );
@@ -280,4 +280,109 @@ fn bad_body_motion_is_refused_naming_the_mount_and_changes_nothing() {
     assert_eq!(s.reals(&watched), before);
     assert_eq!(s.do_step(0.02, 1e-3), OK, "{:?}", s.logs());
     assert!(s.reals(&watched).iter().all(|x| x.is_finite()));
+}
+
+/// The trial of the coupling ports: a force far beyond any a mount carries (1e300 N gave outputs
+/// near 1e297 with fmi2OK) is refused naming the input, its derivative too, and nothing changes.
+/// The bound is 100 times the powertrain's weight: 100 × 180 kg × 9.81 m/s² = 176.6 kN for the
+/// built-in vehicle (at least 100 times the largest static mount force, which is a share of it).
+#[test]
+fn body_forces_beyond_the_plausible_bound_are_refused_naming_the_input() {
+    let fmu = Fmu::load();
+    let s = body(&fmu, "body-force-bound");
+    let watched = reals_of(Causality::Output, 2);
+    let before = s.reals(&watched);
+    let input = [real::BODY_MOUNT_F[1][2]];
+    for f in [1e300, -1e300, 1.8e5] {
+        assert_eq!(s.set_real(&input, &[f]), ERROR, "{f}");
+        assert!(
+            s.logs()
+                .iter()
+                .any(|l| l.contains("mount[2].F[3]") && l.contains("plausible bound")),
+            "{f}: {:?}",
+            s.logs()
+        );
+    }
+    assert_eq!(s.set_input_derivatives(&input, &[1e300]), ERROR);
+    assert!(
+        s.logs()
+            .iter()
+            .any(|l| l.contains("mount[2].F[3]") && l.contains("N/s")),
+        "{:?}",
+        s.logs()
+    );
+    assert_eq!(s.reals(&watched), before);
+    // A bump stop's 10 kN is a force a mount carries.
+    assert_eq!(s.set_real(&input, &[-1e4]), OK, "{:?}", s.logs());
+    assert_eq!(s.do_step(0.02, 1e-3), OK, "{:?}", s.logs());
+    assert!(s.reals(&watched).iter().all(|x| x.is_finite()));
+}
+
+/// The trial: a derivative of 1e300 m/s on a body-point input failed the next step with "Newton
+/// convergence failures"; it is refused when set, naming the input, as is any speed beyond
+/// what a point of a car body does (100 m/s) and any acceleration beyond 1e4 m/s².
+#[test]
+fn a_huge_derivative_of_a_body_point_input_is_refused_naming_the_input() {
+    let fmu = Fmu::load();
+    let s = scene_3(&fmu, "huge-body-derivative");
+    let watched: Vec<u32> = real::MOUNT_F.iter().flatten().copied().collect();
+    let before = s.reals(&watched);
+    for (input, rate, name) in [
+        (real::MOUNT_BODY_R[0][2], 1e300, "mount[1].body.r[3]"),
+        (real::MOUNT_BODY_R[3][0], 1e6, "mount[4].body.r[1]"),
+        (real::MOUNT_BODY_V[1][1], 1e300, "mount[2].body.v[2]"),
+    ] {
+        assert_eq!(s.set_input_derivatives(&[input], &[rate]), ERROR, "{name}");
+        assert!(
+            s.logs()
+                .iter()
+                .any(|l| l.contains(name) && l.contains("a point of a car body")),
+            "{name}: {:?}",
+            s.logs()
+        );
+    }
+    assert_eq!(s.set_real(&[real::MOUNT_BODY_V[2][2]], &[1e3]), ERROR);
+    assert_eq!(s.reals(&watched), before);
+    assert_eq!(s.do_step(0.02, 1e-3), OK, "{:?}", s.logs());
+}
+
+/// The trial: body-point inputs set in scenes without an external body were accepted and
+/// ignored (an SSP whose scene binding was lost ran uncoupled with no sign). They are answered
+/// with a warning, once per instance: at the end of initialisation if set before, else when set.
+#[test]
+fn body_point_inputs_outside_scene_3_are_answered_with_a_warning_once() {
+    let fmu = Fmu::load();
+    let warned = |s: &Slave| {
+        s.logs()
+            .iter()
+            .filter(|l| l.contains("used in scene = 3 only"))
+            .count()
+    };
+    let a = fmu.instantiate("unused-body-point-a");
+    assert_eq!(a.setup(0.0, None), OK);
+    assert_eq!(a.enter_init(), OK);
+    assert_eq!(a.set_real(&[real::MOUNT_BODY_R[0][2]], &[1e-3]), OK);
+    assert_eq!(a.exit_init(), WARNING, "{:?}", a.logs());
+    assert!(
+        a.logs()
+            .iter()
+            .any(|l| l.contains("mount[1].body.r[3]") && l.contains("scene = 1 ignores it")),
+        "{:?}",
+        a.logs()
+    );
+    assert_eq!(a.do_step(0.0, 1e-3), OK);
+    assert_eq!(a.set_real(&[real::MOUNT_BODY_V[1][0]], &[0.1]), OK);
+    assert_eq!(warned(&a), 1);
+
+    let b = fmu.instantiate("unused-body-point-b");
+    b.initialize();
+    assert_eq!(b.do_step(0.0, 1e-3), OK);
+    assert_eq!(b.set_real(&[real::RPM], &[900.0]), OK);
+    assert_eq!(b.set_real(&[real::MOUNT_BODY_V[1][0]], &[0.1]), WARNING);
+    assert_eq!(b.set_real(&[real::MOUNT_BODY_V[1][0]], &[0.2]), OK);
+    assert_eq!(warned(&b), 1);
+    // In scene 3 they are the scene's inputs: no warning.
+    let c = scene_3(&fmu, "used-body-point");
+    assert_eq!(c.set_real(&[real::MOUNT_BODY_R[0][2]], &[1e-4]), OK);
+    assert_eq!(warned(&c), 0);
 }

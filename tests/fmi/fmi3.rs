@@ -11,8 +11,9 @@ use std::sync::Mutex;
 use fmi_sys::fmi3::*;
 use libloading::Library;
 
-use crate::common::{self, integer, real, GUID};
+use crate::common::{self, integer, real, Fmu, GUID};
 use engine_mount_chassis::variables::fmi3::{MODES_SIZE, MODES_SIZE_MAX, TIME};
+use engine_mount_chassis::variables::BODY_GUID;
 
 const OK: fmi3Status = fmi3Status_fmi3OK;
 const ERROR: fmi3Status = fmi3Status_fmi3Error;
@@ -83,6 +84,8 @@ symbols! {
     fmi3Reset: fmi3ResetTYPE,
     fmi3GetFloat64: fmi3GetFloat64TYPE,
     fmi3SetFloat64: fmi3SetFloat64TYPE,
+    fmi3SetInt32: fmi3SetInt32TYPE,
+    fmi3GetDirectionalDerivative: fmi3GetDirectionalDerivativeTYPE,
     fmi3GetFloat32: fmi3GetFloat32TYPE,
     fmi3GetInt32: fmi3GetInt32TYPE,
     fmi3GetUInt64: fmi3GetUInt64TYPE,
@@ -103,6 +106,16 @@ struct Instance<'a> {
 
 impl F3 {
     fn try_instantiate(&self, token: &str, event_mode: bool) -> Option<Instance<'_>> {
+        self.try_instantiate_with(token, event_mode, &[])
+    }
+
+    /// As [`F3::try_instantiate`], with the master's required intermediate variables.
+    fn try_instantiate_with(
+        &self,
+        token: &str,
+        event_mode: bool,
+        intermediate: &[u32],
+    ) -> Option<Instance<'_>> {
         let name = CString::new("three").unwrap();
         let token = CString::new(token).unwrap();
         let resources = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("resources");
@@ -116,9 +129,9 @@ impl F3 {
                 false,
                 false,
                 event_mode,
-                false,
-                std::ptr::null(),
-                0,
+                !intermediate.is_empty(),
+                intermediate.as_ptr(),
+                intermediate.len(),
                 std::ptr::null_mut(),
                 Some(log_message),
                 None,
@@ -167,6 +180,24 @@ impl Instance<'_> {
             )
         }
     }
+    fn derivative(&self, unknowns: &[u32], n: usize, knowns: &[u32], seed: &[f64]) -> Vec<f64> {
+        let mut out = vec![0.0; n];
+        let s = unsafe {
+            (self.f.fmi3GetDirectionalDerivative)(
+                self.i,
+                unknowns.as_ptr(),
+                unknowns.len(),
+                knowns.as_ptr(),
+                knowns.len(),
+                seed.as_ptr(),
+                seed.len(),
+                out.as_mut_ptr(),
+                n,
+            )
+        };
+        assert_eq!(s, OK, "fmi3GetDirectionalDerivative");
+        out
+    }
     fn get_state(&self) -> (fmi3Status, fmi3FMUState) {
         let mut state = std::ptr::null_mut();
         let s = unsafe { (self.f.fmi3GetFMUState)(self.i, &mut state) };
@@ -203,6 +234,20 @@ fn instantiation_refuses_event_mode_a_foreign_token_and_model_exchange() {
     };
     assert!(me.is_null());
     assert!(f.try_instantiate(GUID, false).is_some());
+}
+
+/// `fmusim --early-return-allowed --record-intermediate-values` lists required intermediate
+/// variables; the FMU provides no intermediate update, so it ignores the list, as the
+/// Reference-FMUs do, instead of refusing to instantiate.
+#[test]
+fn required_intermediate_variables_are_ignored_as_the_reference_fmus_do() {
+    let f = F3::load();
+    let a = f
+        .try_instantiate_with(GUID, false, &[real::CRANK_ANGLE, real::MOUNT_F[0][2]])
+        .expect("instantiated with required intermediate variables");
+    assert_eq!(a.init(), OK);
+    let (s, flags, _) = a.step(0.0, 1e-3);
+    assert_eq!((s, flags), (OK, [false, false, false]));
 }
 
 #[test]
@@ -452,4 +497,186 @@ fn output_derivatives_are_the_slopes_of_the_trajectories_and_change_nothing() {
     println!("output derivatives vs central differences: {worst:.1e} of the largest derivative");
     // An input is not an output.
     assert_eq!(a.derivatives(&[real::RPM], 1).0, ERROR);
+}
+
+/// The body's static forces at its mounts, N, vertical (row-major 4 × 3 as `mount.F`).
+fn static_forces() -> Vec<f64> {
+    let fz = [-600.0, -450.0, -400.0, -315.0];
+    (0..12)
+        .map(|k| if k % 3 == 2 { fz[k / 3] } else { 0.0 })
+        .collect()
+}
+
+/// The 3.0 body FMU of the same library, initialised under the static forces.
+fn body3(f: &F3) -> Instance<'_> {
+    let b = f
+        .try_instantiate(BODY_GUID, false)
+        .expect("the library instantiates the FMI 3.0 body FMU");
+    let s = unsafe { (f.fmi3EnterInitializationMode)(b.i, false, 0.0, 0.0, false, 0.0) };
+    assert_eq!(s, OK);
+    assert_eq!(b.set(&[real::BODY_MOUNT_F[0][0]], &static_forces()), OK);
+    assert_eq!(unsafe { (f.fmi3ExitInitializationMode)(b.i) }, OK);
+    b
+}
+
+/// The body's outputs as 3.0 arrays (value references of the first elements) and the 2.0
+/// scalars they stand for, row-major.
+fn body_outputs() -> (Vec<u32>, Vec<u32>) {
+    let arrays = vec![
+        real::BODY_MOUNT_R[0][0],
+        real::BODY_MOUNT_V[0][0],
+        real::BODY_MOUNT_A[0][0],
+        real::STEERING_WHEEL_A[0],
+        real::SEAT_A[0],
+    ];
+    let mut scalars: Vec<u32> = [real::BODY_MOUNT_R, real::BODY_MOUNT_V, real::BODY_MOUNT_A]
+        .iter()
+        .flatten()
+        .flatten()
+        .copied()
+        .collect();
+    scalars.extend(real::STEERING_WHEEL_A);
+    scalars.extend(real::SEAT_A);
+    (arrays, scalars)
+}
+
+/// The body FMU as FMI 3.0: the same library, instance and numbers as the 2.0 body under the
+/// same varying mount forces (to 1e-12 of each output's size).
+#[test]
+fn the_3_0_body_gives_the_numbers_of_the_2_0_body() {
+    let f = F3::load();
+    let b3 = body3(&f);
+    let fmu = Fmu::load();
+    let b2 = fmu
+        .instantiate_with("body2", BODY_GUID, Some(&common::resources_uri()))
+        .expect("2.0 body");
+    let forces2: Vec<u32> = real::BODY_MOUNT_F.iter().flatten().copied().collect();
+    assert_eq!(b2.setup(0.0, None), OK);
+    assert_eq!(b2.enter_init(), OK);
+    assert_eq!(b2.set_real(&forces2, &static_forces()), OK);
+    assert_eq!(b2.exit_init(), OK);
+    let (arrays, scalars) = body_outputs();
+    let h = 1e-3;
+    let mut largest = 0.0f64;
+    for k in 0..60 {
+        let t = k as f64 * h;
+        let forces: Vec<f64> = static_forces()
+            .iter()
+            .enumerate()
+            .map(|(c, f0)| f0 + 80.0 * (2.0 * std::f64::consts::PI * (31.0 + c as f64) * t).sin())
+            .collect();
+        assert_eq!(b3.set(&[real::BODY_MOUNT_F[0][0]], &forces), OK);
+        assert_eq!(b2.set_real(&forces2, &forces), OK);
+        assert_eq!(b3.step(t, h).0, OK);
+        assert_eq!(b2.do_step(t, h), OK);
+        let (s, three) = b3.get(&arrays, scalars.len());
+        assert_eq!(s, OK);
+        let two = b2.reals(&scalars);
+        for (x, y) in three.iter().zip(&two) {
+            assert!(x.is_finite());
+            let d = (x - y).abs() / y.abs().max(1e-12);
+            largest = largest.max(d);
+            assert!(
+                (x - y).abs() <= 1e-12 * y.abs().max(1e-9),
+                "t = {t}: 3.0 {x} vs 2.0 {y}"
+            );
+        }
+    }
+    eprintln!("3.0 body vs 2.0 body: largest relative difference {largest:e}");
+}
+
+/// Central difference of the `n` elements of the arrays `outputs` with respect to element `k`
+/// of the array input `input` (all `values` set at once, as FMI 3.0 sets arrays).
+fn central3(
+    i: &Instance,
+    outputs: &[u32],
+    n: usize,
+    input: u32,
+    values: &[f64],
+    k: usize,
+    h: f64,
+) -> Vec<f64> {
+    let mut x = values.to_vec();
+    x[k] = values[k] + h;
+    assert_eq!(i.set(&[input], &x), OK);
+    let plus = i.get(outputs, n).1;
+    x[k] = values[k] - h;
+    assert_eq!(i.set(&[input], &x), OK);
+    let minus = i.get(outputs, n).1;
+    assert_eq!(i.set(&[input], values), OK);
+    plus.iter()
+        .zip(&minus)
+        .map(|(p, m)| (p - m) / (2.0 * h))
+        .collect()
+}
+
+fn assert_close3(analytic: &[f64], difference: &[f64], what: &str) {
+    let scale = analytic.iter().fold(1e-6f64, |m, x| m.max(x.abs()));
+    for (a, d) in analytic.iter().zip(difference) {
+        assert!(
+            (a - d).abs() <= 1e-6 * scale,
+            "{what}: directional derivative {a:e} vs central difference {d:e} (scale {scale:e})"
+        );
+    }
+}
+
+/// fmi3GetDirectionalDerivative in both 3.0 FMUs, arrays for their elements, against central
+/// differences of the outputs as the 2.0 ones are checked (tests/fmi/coupling.rs): the body's
+/// accelerations with respect to the mount forces, and in scene 3 the engine's mount forces and
+/// powertrain acceleration with respect to the body's motion at the mounts.
+#[test]
+fn directional_derivatives_of_the_3_0_fmus_match_central_differences() {
+    let f = F3::load();
+    let b = body3(&f);
+    assert_eq!(b.step(0.0, 1e-3).0, OK);
+    let unknowns = [
+        real::BODY_MOUNT_A[0][0],
+        real::STEERING_WHEEL_A[0],
+        real::SEAT_A[0],
+    ];
+    let forces = static_forces();
+    for k in 0..12 {
+        let mut seed = vec![0.0; 12];
+        seed[k] = 1.0;
+        let analytic = b.derivative(&unknowns, 18, &[real::BODY_MOUNT_F[0][0]], &seed);
+        let difference = central3(&b, &unknowns, 18, real::BODY_MOUNT_F[0][0], &forces, k, 1.0);
+        assert_close3(
+            &analytic,
+            &difference,
+            &format!("body, mount.F element {k}"),
+        );
+    }
+
+    let e = f.instantiate();
+    let scene = common::value_references(1, &[integer::SCENE]);
+    let s = unsafe { (f.fmi3EnterInitializationMode)(e.i, false, 0.0, 0.0, false, 0.0) };
+    assert_eq!(s, OK);
+    assert_eq!(
+        unsafe { (f.fmi3SetInt32)(e.i, scene.as_ptr(), 1, [3].as_ptr(), 1) },
+        OK
+    );
+    assert_eq!(unsafe { (f.fmi3ExitInitializationMode)(e.i) }, OK);
+    for k in 0..10 {
+        assert_eq!(e.step(k as f64 * 1e-3, 1e-3).0, OK);
+    }
+    // A displaced, moving body so that the mounts are off their operating point.
+    let (r, v) = (real::MOUNT_BODY_R[0][0], real::MOUNT_BODY_V[0][0]);
+    let offsets: Vec<f64> = (0..12).map(|k| 1e-4 * ((k % 5) as f64 - 2.0)).collect();
+    let speeds: Vec<f64> = offsets.iter().map(|x| 30.0 * x).collect();
+    assert_eq!(e.set(&[r], &offsets), OK);
+    assert_eq!(e.set(&[v], &speeds), OK);
+    let unknowns = [real::MOUNT_F[0][0], real::POWERTRAIN_A[0]];
+    for (input, values, h) in [(r, &offsets, 1e-7), (v, &speeds, 1e-6)] {
+        for k in 0..12 {
+            let mut seed = vec![0.0; 12];
+            seed[k] = 1.0;
+            let analytic = e.derivative(&unknowns, 15, &[input], &seed);
+            let difference = central3(&e, &unknowns, 15, input, values, k, h);
+            assert_close3(
+                &analytic,
+                &difference,
+                &format!("engine, input {input} element {k}"),
+            );
+        }
+    }
 }

@@ -10,3 +10,4 @@ mod model_structure;
 mod natural_modes;
 mod precedence;
 mod properties;
+mod schema;

@@ -319,7 +319,7 @@ fn mounts_must_meet_their_body_nodes_and_removed_mounts_carry_nothing() {
         .unwrap_err()
         .to_string();
     assert!(
-        err.contains(&format!("mount 1 ('{}')", cfg.mounts[1].name)) && err.contains("2.0 mm"),
+        err.contains(&format!("mount 2 ('{}')", cfg.mounts[1].name)) && err.contains("2.0 mm"),
         "{err}"
     );
 

@@ -3,8 +3,9 @@
 //! master in between.
 
 use engine_mount_chassis::cosim::{
-    BodySimulation, CacheSetting, Inputs, Outputs, SceneKind, Settings, Signal, Simulation,
+    BodySimulation, CacheSetting, Inputs, Outputs, RampInput, SceneKind, Settings, Simulation,
 };
+use engine_mount_chassis::model::inputs::AttachmentMotion;
 use engine_mount_chassis::model::orders::order_amplitude;
 
 fn settings(scene: SceneKind, cache: &std::path::Path) -> Settings {
@@ -62,20 +63,22 @@ fn scene_3_with_the_body_at_rest_is_scene_1() {
 /// The interface of the engine side from the body's outputs: displacement ramps continued with
 /// the velocity, velocity ramps with the acceleration.
 fn engine_interface(inputs: &mut Inputs, body: &Outputs, t: f64) {
-    for (i, p) in body.mount_point.iter().enumerate() {
-        for j in 0..3 {
-            inputs.body_displacement[i][j] = Signal {
+    inputs.model.body_motion = body
+        .mount_point
+        .iter()
+        .map(|p| AttachmentMotion {
+            displacement: std::array::from_fn(|j| RampInput {
                 value: p.displacement[j],
-                derivative: p.velocity[j],
-                reference_time: t,
-            };
-            inputs.body_velocity[i][j] = Signal {
+                rate: p.velocity[j],
+                since: t,
+            }),
+            velocity: std::array::from_fn(|j| RampInput {
                 value: p.velocity[j],
-                derivative: p.acceleration[j],
-                reference_time: t,
-            };
-        }
-    }
+                rate: p.acceleration[j],
+                since: t,
+            }),
+        })
+        .collect();
 }
 
 /// Engine first on the body motion extrapolated over the step, then the body under the forces
@@ -101,7 +104,7 @@ impl Split {
         let mut body = BodySimulation::new(&body_settings, 0.0, &body_inputs).unwrap();
         for _ in 0..6 {
             let f = engine.outputs().unwrap().mount_force;
-            body_inputs.body_force = f.map(|m| m.map(Signal::constant));
+            body_inputs.body_force = f.iter().map(|m| m.map(RampInput::constant)).collect();
             body = BodySimulation::new(&body_settings, 0.0, &body_inputs).unwrap();
             engine_interface(&mut engine_inputs, &body.outputs(), 0.0);
             engine = Simulation::new(&engine_settings, 0.0, &engine_inputs).unwrap();
@@ -118,7 +121,7 @@ impl Split {
         let before = self.engine.outputs().unwrap().mount_force;
         self.engine.advance_to(t + self.h).unwrap();
         let after = self.engine.outputs().unwrap();
-        let mut body_inputs = *self.body.inputs();
+        let mut body_inputs = self.body.inputs().clone();
         for ((slot, b), a) in body_inputs
             .body_force
             .iter_mut()
@@ -126,10 +129,10 @@ impl Split {
             .zip(before.iter().flatten())
             .zip(after.mount_force.iter().flatten())
         {
-            *slot = Signal {
+            *slot = RampInput {
                 value: *b,
-                derivative: (a - b) / self.h,
-                reference_time: t,
+                rate: (a - b) / self.h,
+                since: t,
             };
         }
         self.body.set_inputs(&body_inputs).unwrap();

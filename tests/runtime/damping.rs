@@ -5,7 +5,7 @@
 
 use engine_mount_chassis::cms::{RecoveryPoint, ReducedChassis};
 use engine_mount_chassis::cosim::{
-    BodyOptions, BodySimulation, Inputs, SceneKind, Settings, Signal, Simulation, RPM_TO_RAD_PER_S,
+    BodyOptions, BodySimulation, Inputs, RampInput, SceneKind, Settings, Simulation,
 };
 use engine_mount_chassis::model::VehicleConfig;
 
@@ -90,8 +90,8 @@ fn a_single_mode_body_decays_with_the_configured_ratio() {
     };
     let rest = Inputs::steady(0.0);
     let mut body = BodySimulation::new(&settings, 0.0, &rest).expect("body alone");
-    let mut step = rest;
-    step.body_force[0][2] = Signal::constant(100.0);
+    let mut step = rest.sized(4);
+    step.body_force[0][2] = RampInput::constant(100.0);
     body.set_inputs(&step).unwrap();
     let h = 1.0 / (hz * 400.0);
     let samples: Vec<f64> = (1..=400 * 12)
@@ -125,10 +125,7 @@ fn scene_with_damping(dir: &std::path::Path, name: &str, damping: &str) -> Setti
 }
 
 fn inputs(rpm: f64) -> Inputs {
-    Inputs {
-        crank_speed: Signal::constant(rpm * RPM_TO_RAD_PER_S),
-        ..Inputs::steady(0.0)
-    }
+    Inputs::steady(rpm)
 }
 
 /// The largest steering-wheel acceleration over 0.4 s at 1500 rpm; every output finite.

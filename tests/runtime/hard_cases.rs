@@ -3,7 +3,7 @@
 //! All through the co-simulation runtime the FMU uses (`cosim::Simulation`).
 
 use engine_mount_chassis::cosim::{
-    Inputs, Outputs, SceneKind, Settings, Signal, Simulation, VehicleOverrides, RPM_TO_RAD_PER_S,
+    Inputs, Outputs, RampInput, SceneKind, Settings, Simulation, VehicleOverrides, RPM_TO_RAD_PER_S,
 };
 
 /// DESIGN §8: the default powertrain weighs 180 kg; the default configuration's gravity.
@@ -12,18 +12,16 @@ fn weight() -> f64 {
 }
 
 fn inputs(rpm: f64, torque: f64, stiffness: f64) -> Inputs {
-    Inputs {
-        crank_speed: Signal::constant(rpm * RPM_TO_RAD_PER_S),
-        load_torque: Signal::constant(torque),
-        stiffness_scale: [Signal::constant(stiffness); 4],
-        damping_scale: [Signal::constant(1.0); 4],
-        ..Inputs::steady(0.0)
-    }
+    let mut i = Inputs::steady(rpm);
+    i.model.load_torque = RampInput::constant(torque);
+    i.model.stiffness_scale = vec![RampInput::constant(stiffness); 4];
+    i.model.damping_scale = vec![RampInput::constant(1.0); 4];
+    i
 }
 
 fn at(mut i: Inputs, t: f64) -> Inputs {
-    i.crank_speed.reference_time = t;
-    i.load_torque.reference_time = t;
+    i.model.crank_speed.since = t;
+    i.model.load_torque.since = t;
     i
 }
 

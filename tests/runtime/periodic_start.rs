@@ -148,7 +148,7 @@ fn a_periodic_start_needs_a_running_engine_and_constant_inputs() {
         .expect("no orbit at standstill");
     assert!(err.to_string().contains("running engine"), "{err}");
     let mut ramp = Inputs::steady(1000.0);
-    ramp.crank_speed.derivative = 50.0;
+    ramp.model.crank_speed.rate = 50.0;
     let err = Simulation::new(&settings(1, true), 0.0, &ramp)
         .err()
         .expect("no orbit during a run-up");

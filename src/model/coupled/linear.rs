@@ -153,7 +153,7 @@ impl CoupledModel {
             let mut model = self.clone();
             model
                 .set_load_torque(self.fade_start, value, 0.0)
-                .map_err(|e| format!("linearisation: {}", e.0))?;
+                .map_err(|e| format!("linearisation: {}", e))?;
             let mut f = vec![0.0; dim];
             model
                 .rhs_at_rest(y_eq, &mut f)

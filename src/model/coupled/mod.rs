@@ -265,7 +265,8 @@ impl CoupledModel {
                 let gap = (at - v3(&m.bracket)).norm();
                 if gap > MOUNT_MATCH_TOLERANCE {
                     return Err(ModelError::Body(format!(
-                        "mount {i} ('{}') has its bracket at ({:.4}, {:.4}, {:.4}) m; its body node '{node}' is {:.1} mm away (limit {:.1} mm)",
+                        "mount {} ('{}') has its bracket at ({:.4}, {:.4}, {:.4}) m; its body node '{node}' is {:.1} mm away (limit {:.1} mm)",
+                        i + 1,
                         m.name,
                         m.bracket[0],
                         m.bracket[1],
@@ -427,7 +428,7 @@ impl CoupledModel {
     pub fn set_crank_speed(&mut self, since: f64, value: f64, rate: f64) -> Result<(), InputError> {
         let r = RampInput { value, rate, since };
         if !(value.is_finite() && rate.is_finite() && since.is_finite()) {
-            return Err(InputError(format!(
+            return Err(InputError::Other(format!(
                 "crank speed {value} rad/s, rate {rate} rad/s² must be finite"
             )));
         }
@@ -438,7 +439,7 @@ impl CoupledModel {
     /// Load torque on the housing about +y (N m) and its time derivative.
     pub fn set_load_torque(&mut self, since: f64, value: f64, rate: f64) -> Result<(), InputError> {
         if !(value.is_finite() && rate.is_finite() && since.is_finite()) {
-            return Err(InputError(format!(
+            return Err(InputError::Other(format!(
                 "load torque {value} N m, rate {rate} N m/s must be finite"
             )));
         }
@@ -469,8 +470,9 @@ impl CoupledModel {
     ) -> Result<(), InputError> {
         let n = self.mounts.len();
         if index >= n {
-            return Err(InputError(format!(
-                "mount index {index} out of range (0..{n})"
+            return Err(InputError::Other(format!(
+                "mount {} does not exist (the model has {n} mounts)",
+                index + 1
             )));
         }
         let mut trial = self.inputs.clone();
@@ -501,7 +503,7 @@ impl CoupledModel {
     /// Time from which the excitation fades in (set by [`Self::static_equilibrium`]).
     pub fn set_fade_start(&mut self, t: f64) -> Result<(), InputError> {
         if !t.is_finite() {
-            return Err(InputError(format!(
+            return Err(InputError::Other(format!(
                 "excitation fade-in start {t} s must be finite"
             )));
         }

@@ -35,7 +35,7 @@ impl CoupledModel {
     pub fn restore(&mut self, s: &ModelSnapshot) -> Result<(), InputError> {
         let n = self.mounts.len();
         if s.operating_points.len() != n {
-            return Err(InputError(format!(
+            return Err(InputError::Other(format!(
                 "snapshot is for {} mounts, the model has {n}",
                 s.operating_points.len()
             )));
@@ -46,8 +46,9 @@ impl CoupledModel {
             .enumerate()
             .find(|(_, p)| p.iter().any(|x| !x.is_finite()))
         {
-            return Err(InputError(format!(
-                "mount {i} operating point {p:?} must be finite"
+            return Err(InputError::Other(format!(
+                "mount {} operating point {p:?} must be finite",
+                i + 1
             )));
         }
         let mut trial = self.clone();

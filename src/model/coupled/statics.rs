@@ -130,7 +130,8 @@ impl CoupledModel {
     /// Fails with a message when Newton does not converge or a mount is pressed beyond its curve
     /// (mounts too soft to carry the weight).
     pub fn static_equilibrium(&mut self, t0: f64) -> Result<Vec<f64>, StaticsError> {
-        self.set_fade_start(t0).map_err(|e| StaticsError(e.0))?;
+        self.set_fade_start(t0)
+            .map_err(|e| StaticsError(e.to_string()))?;
         let l = self.layout;
         let nq = l.positions().len();
         let n = nq + l.modes();
@@ -220,9 +221,11 @@ impl CoupledModel {
                 let (lo, hi) = mount.curves[k].range();
                 if d[k] < lo || d[k] > hi {
                     return Err(StaticsError(format!(
-                        "mount {i} ({}) deflects {:.1} mm along its axis {k}, beyond its curve [{:.1}, {:.1}] mm",
+                        "mount {} ({}) deflects {:.1} mm along its axis {}, beyond its curve [{:.1}, {:.1}] mm",
+                        i + 1,
                         mount.name,
                         d[k] * 1e3,
+                        k + 1,
                         lo * 1e3,
                         hi * 1e3
                     )));

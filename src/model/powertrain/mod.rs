@@ -349,11 +349,13 @@ impl Powertrain {
     /// Ignored (Ok) when gas forces are off; an error for a user pressure table.
     pub fn set_gas_load(&mut self, load: f64) -> Result<(), InputError> {
         if !(load.is_finite() && (0.0..=1.0).contains(&load)) {
-            return Err(InputError(format!("gas load {load} must lie in [0, 1]")));
+            return Err(InputError::Other(format!(
+                "gas load {load} must lie in [0, 1]"
+            )));
         }
         if let Some(gas) = &mut self.gas {
             let Some(points) = &gas.load_points else {
-                return Err(InputError(
+                return Err(InputError::Other(
                     "the gas pressure comes from a user table; its load cannot change".into(),
                 ));
             };
