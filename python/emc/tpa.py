@@ -199,31 +199,47 @@ def plot_ranked(table: pd.DataFrame, rpm: float, order: float, response: str, pa
 def plot_over_speed(table: pd.DataFrame, order: float, response: str, path: str,
                     names: dict | None = None, case: str = "", top: int = 6):
     """The largest path contributions of one order over engine speed, with their sum and the
-    simulated response."""
+    simulated response. A table with the bounds of a damping band (``bound``: low, nominal,
+    high) draws each path and the sum as its band with the nominal line over it."""
     plt = _pyplot()
     data = table[(table.case == case) & (table.response == response) & (table.order == order)]
+    banded = "bound" in data and data.bound.nunique() > 1
+    if banded:
+        from .band import draw_band, wide
+
+        data = wide(data, ["rpm", "path", "mount", "direction"], ["amplitude"]).rename(
+            columns={"amplitude_nominal": "amplitude"})
+
+    def curve(d: pd.DataFrame, **style):
+        if banded:
+            draw_band(ax, d.rpm, d.amplitude_low, d.amplitude, d.amplitude_high, **style)
+        else:
+            ax.plot(d.rpm, d.amplitude, **style)
+
     paths = data[~data.path.isin(["sum", "simulated"])]
     biggest = paths.groupby("path").amplitude.max().sort_values(ascending=False).head(top).index
     fig, ax = plt.subplots(figsize=(9, 5.5))
     for k, p in enumerate(biggest):
         d = paths[paths.path == p].sort_values("rpm")
         m, direction = int(d.mount.iloc[0]), d.direction.iloc[0]
-        ax.plot(d.rpm, d.amplitude, color=f"C{k}", marker="o" if len(d) < 60 else None, ms=3,
-                lw=1.2, label=path_label(m, AXES.index(direction) + 1, names))
+        curve(d, color=f"C{k}", marker="o" if len(d) < 60 else None, ms=3, lw=1.2,
+              label=path_label(m, AXES.index(direction) + 1, names))
+    curve(data[data.path == "sum"].sort_values("rpm"), color="k", lw=2.2,
+          label="sum of the 12 paths")
     total = data[data.path == "sum"].sort_values("rpm")
-    ax.plot(total.rpm, total.amplitude, color="k", lw=2.2, label="sum of the 12 paths")
     if "quasi_static_amplitude" in total:
         ax.plot(total.rpm, total.quasi_static_amplitude, color="0.45", lw=1.0, ls=":",
                 label="sum of force × transfer function (quasi-stationary)")
     simulated = data[data.path == "simulated"].sort_values("rpm")
-    if len(simulated):
+    if len(simulated) and not banded:
         ax.plot(simulated.rpm, simulated.amplitude, color="w", ls="--", lw=1.0,
                 label="simulated (dashed over the sum)")
     ax.set_yscale("log")
     ax.set_xlabel("engine speed [rpm]")
     ax.set_ylabel(f"{response}, order {order:g} [m/s²]")
     ax.set_title(f"Path contributions of order {order:g} to {response}"
-                 f"{': ' + case if case else ''}", fontsize=10)
+                 + (", damping band shaded" if banded else "")
+                 + f"{': ' + case if case else ''}", fontsize=10)
     ax.grid(True, which="both", alpha=0.3)
     ax.legend(fontsize=8)
     fig.tight_layout()
@@ -258,35 +274,3 @@ def plot_cases(table: pd.DataFrame, order: float, response: str, path_name: str,
     fig.savefig(path, dpi=120)
     plt.close(fig)
 
-
-def plot_over_speed_band(table: pd.DataFrame, order: float, response: str, path: str,
-                         names: dict | None = None, case: str = "", top: int = 4):
-    """The largest path contributions of one order over speed and their sum, each with its
-    damping band (``bound`` column: low, nominal, high), the nominal line over the band."""
-    from .band import draw_band, wide
-
-    plt = _pyplot()
-    data = table[(table.case == case) & (table.response == response) & (table.order == order)]
-    curves = wide(data, ["rpm", "path", "mount", "direction"], ["amplitude"])
-    paths = curves[~curves.path.isin(["sum", "simulated"])]
-    biggest = (paths.groupby("path").amplitude_nominal.max().sort_values(ascending=False)
-               .head(top).index)
-    fig, ax = plt.subplots(figsize=(9, 5.5))
-    for k, p in enumerate(biggest):
-        d = paths[paths.path == p].sort_values("rpm")
-        m, direction = int(d.mount.iloc[0]), d.direction.iloc[0]
-        draw_band(ax, d.rpm, d.amplitude_low, d.amplitude_nominal, d.amplitude_high,
-                  label=path_label(m, AXES.index(direction) + 1, names), color=f"C{k}", lw=1.2)
-    total = curves[curves.path == "sum"].sort_values("rpm")
-    draw_band(ax, total.rpm, total.amplitude_low, total.amplitude_nominal, total.amplitude_high,
-              label="sum of the 12 paths", color="k", lw=2.0)
-    ax.set_yscale("log")
-    ax.set_xlabel("engine speed [rpm]")
-    ax.set_ylabel(f"{response}, order {order:g} [m/s²]")
-    ax.set_title(f"Path contributions of order {order:g} to {response} with the damping band "
-                 f"(nominal line, band shaded){': ' + case if case else ''}", fontsize=10)
-    ax.grid(True, which="both", alpha=0.3)
-    ax.legend(fontsize=8)
-    fig.tight_layout()
-    fig.savefig(path, dpi=120)
-    plt.close(fig)

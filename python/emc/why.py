@@ -226,8 +226,8 @@ def report_band(table: pd.DataFrame, names: dict, responses: list[str], labels: 
             at = at_of(label)
             suffix = f"_{cli.safe_name(label)}" if label else ""
             if table[table.case == label].rpm.nunique() > 1:
-                tpa.plot_over_speed_band(table, order, r, str(
-                    out / f"tpa_band_{cli.safe_name(r)}{suffix}.png"), names, case=label)
+                tpa.plot_over_speed(table, order, r, str(
+                    out / f"tpa_band_{cli.safe_name(r)}{suffix}.png"), names, case=label, top=4)
             dominant = summary[r][label]["dominant_path"]
             record = {}
             for bound in bands.BOUNDS:
