@@ -716,15 +716,7 @@ def add_parsers(sub) -> None:
     common(u)
     u.add_argument("--rpm", nargs=2, type=float, default=[800.0, 2500.0],
                    metavar=("FROM", "TO"), help="speed range, rpm (default 800 2500)")
-    u.add_argument("--duration", type=float, default=20.0, help="s, FROM to TO (default 20)")
-    u.add_argument("--step", type=float, default=2e-4,
-                   help="communication step, s: the outputs' sampling (default 2e-4)")
-    u.add_argument("--block-revolutions", type=int, default=4,
-                   help="revolutions per order-tracking block (even; default 4)")
-    u.add_argument("--start", choices=("periodic", "fade-in"), default="periodic",
-                   help="periodic (default): on the periodic steady state at FROM; fade-in: "
-                        "from the static equilibrium, the excitation faded in")
-    u.add_argument("--load-torque", type=float, default=0.0, help="N·m, constant")
+    _cli().runup_options(u)
     u.add_argument("--at", type=float, default=None,
                    help="speed of the ranked contributions, rpm: the block nearest it "
                         "(default FROM)")
