@@ -36,7 +36,7 @@ from . import band as bands
 from . import plots
 from .comfort import comfort_table
 from .runner import PointFailed, Runner
-from .sweep import run_sweep, save, speed_points
+from .sweep import DEFAULT_SIGNAL_PREFIXES, run_sweep, save, speed_points
 from .tracking import track_orders
 
 
@@ -374,7 +374,7 @@ def analysed_signals(args, variables: dict, default: list[str]) -> list[str]:
 def default_signals(variables: dict) -> list[str]:
     """What a sweep records without --signal: the mount forces and the comfort points."""
     return [n for n in output_names(variables) if variables[n].type == "Real"
-            and n.startswith(("mount[", "steeringWheel.a", "seat.a"))]
+            and n.startswith(DEFAULT_SIGNAL_PREFIXES)]
 
 
 def check_config_file(fmu: str, parameters: dict, remote: bool = False):
