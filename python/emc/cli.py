@@ -786,6 +786,21 @@ def cmd_bench_realtime(args) -> int:
     return 0
 
 
+def runup_options(parser):
+    """The run-up's options (``emc runup``, ``emc tpa-runup``): duration, sampling, blocks,
+    start and load."""
+    parser.add_argument("--duration", type=float, default=20.0,
+                        help="s, FROM to TO (default 20)")
+    parser.add_argument("--step", type=float, default=2e-4,
+                        help="communication step, s: the outputs' sampling (default 2e-4)")
+    parser.add_argument("--block-revolutions", type=int, default=4,
+                        help="revolutions per order-tracking block (even; default 4)")
+    parser.add_argument("--start", choices=("periodic", "fade-in"), default="periodic",
+                        help="periodic (default): start on the periodic steady state at FROM; "
+                             "fade-in: from the static equilibrium, the excitation faded in")
+    parser.add_argument("--load-torque", type=float, default=0.0, help="N·m, constant")
+
+
 def build_parser() -> argparse.ArgumentParser:
     parser = argparse.ArgumentParser(prog="emc", description=__doc__,
                                      formatter_class=argparse.RawDescriptionHelpFormatter)
@@ -838,15 +853,7 @@ def build_parser() -> argparse.ArgumentParser:
                                      "order-tracked in the crank-angle domain")
     common(r)
     case_option(r)
-    r.add_argument("--duration", type=float, default=20.0, help="s, FROM to TO (default 20)")
-    r.add_argument("--step", type=float, default=2e-4,
-                   help="communication step, s: the outputs' sampling (default 2e-4)")
-    r.add_argument("--block-revolutions", type=int, default=4,
-                   help="revolutions per order-tracking block (even; default 4)")
-    r.add_argument("--start", choices=("periodic", "fade-in"), default="periodic",
-                   help="periodic (default): start on the periodic steady state at FROM; "
-                        "fade-in: from the static equilibrium, the excitation faded in")
-    r.add_argument("--load-torque", type=float, default=0.0, help="N·m, constant")
+    runup_options(r)
     r.add_argument("--plot", action="append",
                    help="analysed signal to plot (repeatable; default: every --signal)")
     bands.add_options(r)
