@@ -36,7 +36,7 @@ from . import band as bands
 from . import plots
 from .comfort import comfort_table
 from .runner import PointFailed, Runner
-from .sweep import run_sweep, save, speed_points
+from .sweep import DEFAULT_SIGNAL_PREFIXES, run_sweep, save, speed_points
 from .tracking import track_orders
 
 
@@ -375,7 +375,7 @@ def analysed_signals(args, variables: dict, default: list[str]) -> list[str]:
 def default_signals(variables: dict) -> list[str]:
     """What a sweep records without --signal: the mount forces and the comfort points."""
     return [n for n in output_names(variables) if variables[n].type == "Real"
-            and n.startswith(("mount[", "steeringWheel.a", "seat.a"))]
+            and n.startswith(DEFAULT_SIGNAL_PREFIXES)]
 
 
 def check_config_file(fmu: str, parameters: dict, remote: bool = False):
@@ -787,6 +787,21 @@ def cmd_bench_realtime(args) -> int:
     return 0
 
 
+def runup_options(parser):
+    """The run-up's options (``emc runup``, ``emc tpa-runup``): duration, sampling, blocks,
+    start and load."""
+    parser.add_argument("--duration", type=float, default=20.0,
+                        help="s, FROM to TO (default 20)")
+    parser.add_argument("--step", type=float, default=2e-4,
+                        help="communication step, s: the outputs' sampling (default 2e-4)")
+    parser.add_argument("--block-revolutions", type=int, default=4,
+                        help="revolutions per order-tracking block (even; default 4)")
+    parser.add_argument("--start", choices=("periodic", "fade-in"), default="periodic",
+                        help="periodic (default): start on the periodic steady state at FROM; "
+                             "fade-in: from the static equilibrium, the excitation faded in")
+    parser.add_argument("--load-torque", type=float, default=0.0, help="N·m, constant")
+
+
 def build_parser() -> argparse.ArgumentParser:
     parser = argparse.ArgumentParser(prog="emc", description=__doc__,
                                      formatter_class=argparse.RawDescriptionHelpFormatter)
@@ -839,15 +854,7 @@ def build_parser() -> argparse.ArgumentParser:
                                      "order-tracked in the crank-angle domain")
     common(r)
     case_option(r)
-    r.add_argument("--duration", type=float, default=20.0, help="s, FROM to TO (default 20)")
-    r.add_argument("--step", type=float, default=2e-4,
-                   help="communication step, s: the outputs' sampling (default 2e-4)")
-    r.add_argument("--block-revolutions", type=int, default=4,
-                   help="revolutions per order-tracking block (even; default 4)")
-    r.add_argument("--start", choices=("periodic", "fade-in"), default="periodic",
-                   help="periodic (default): start on the periodic steady state at FROM; "
-                        "fade-in: from the static equilibrium, the excitation faded in")
-    r.add_argument("--load-torque", type=float, default=0.0, help="N·m, constant")
+    runup_options(r)
     r.add_argument("--plot", action="append",
                    help="analysed signal to plot (repeatable; default: every --signal)")
     bands.add_options(r)

@@ -53,6 +53,7 @@ from fmpy.fmi2 import FMU2Slave
 from .runner import (logging_callbacks, mount_count, release_logging, set_value,
                      variable_names)
 from .spectra import ORDERS, order_amplitudes
+from .synthesis import HeldForces
 
 ALGORITHMS = ("jacobi", "gauss_seidel", "interface_jacobian")
 AXES = 3
@@ -170,6 +171,9 @@ class Run:
     wall: float          # s, the stepping loop only
     status: str          # "ok", "diverged at t = … s" or "error at t = … s: …"
     t_reached: float
+    # The forces the body was driven with (coupled runs): per output sample interval the ramp's
+    # start and end values and the force in effect when the outputs were read (t = 0 first).
+    body_forces: HeldForces | None = None
 
     @property
     def ok(self) -> bool:
@@ -216,6 +220,9 @@ class CoupledPair:
             if previous is not None:
                 self.init_change.append(float(np.max(np.abs(F - previous))))
             previous = F
+        # The body rests in static equilibrium under the forces it had when it left
+        # initialisation: its state at t = 0.
+        self.F_static = previous
         e.slave.exitInitializationMode()
         b.slave.exitInitializationMode()
         self.F = np.array(e.slave.getReal(self.vr["F"]))
@@ -317,6 +324,11 @@ class CoupledPair:
         n_steps = int(round(self.t_end / H))
         e, b, vr, nf = self.engine, self.body, self.vr, self.n
         samples = np.full((n_steps * m, len(self.signals)), np.nan)
+        ramp_start = np.full((n_steps * m, nf), np.nan)
+        ramp_end = np.full((n_steps * m, nf), np.nan)
+        read = np.full((n_steps * m + 1, nf), np.nan)
+        read[0] = self.F
+        fractions = np.arange(m + 1)[:, None] / m
         zeros = [0.0] * nf
         ones = [1] * nf
         r = np.array(b.slave.getReal(vr["r"]))
@@ -347,12 +359,14 @@ class CoupledPair:
                     b.slave.setRealInputDerivatives(vr["Fb"], ones, zeros)
                     self._advance(e, t, H, m, rec_engine)
                     self._advance(b, t, H, m, rec_body)
+                    increment = np.zeros(nf)
                 elif algorithm == "gauss_seidel":
                     e.slave.setRealInputDerivatives(vr["re"], ones, zeros)
                     e.slave.setRealInputDerivatives(vr["ve"], ones, zeros)
                     self._advance(e, t, H, m, rec_engine)
                     F_end = np.array(e.slave.getReal(vr["F"]))
-                    b.slave.setRealInputDerivatives(vr["Fb"], ones, list((F_end - self.F) / H))
+                    increment = F_end - self.F
+                    b.slave.setRealInputDerivatives(vr["Fb"], ones, list(increment / H))
                     self._advance(b, t, H, m, rec_body)
                 else:
                     # The body motion for the guessed ramp (exact for that ramp: the body is
@@ -379,8 +393,14 @@ class CoupledPair:
                     b.slave.setReal(vr["Fb"], list(self.F))
                     b.slave.setRealInputDerivatives(vr["Fb"], ones, list(dF / H))
                     self._advance(b, t, H, m, rec_body)
+                    increment = dF
                     dF = dF_next
+                ramp = self.F + fractions * increment  # the body's input over the step
+                ramp_start[base:base + m] = ramp[:-1]
+                ramp_end[base:base + m] = ramp[1:]
+                read[base + 1:base + m] = ramp[1:-1]
                 r, v = self._exchange()
+                read[base + m] = self.F
                 row += m
                 samples[row - 1, :nf] = self.F
                 samples[row - 1, nf:] = b.slave.getReal(vr["sw"])
@@ -394,8 +414,11 @@ class CoupledPair:
             cause = e.errors() or b.errors() or str(error)
             status = f"error at t = {t_reached:.4g} s: {cause}"
         wall = time.perf_counter() - begin
+        done = int(round(t_reached / h_out))
+        held = HeldForces(dt=h_out, start=ramp_start[:done], end=ramp_end[:done],
+                          read=read[:done + 1])
         return Run(h=h_out, signals=dict(zip(self.signals, samples.T)), wall=wall, status=status,
-                   t_reached=t_reached)
+                   t_reached=t_reached, body_forces=held)
 
 
 def coupled(engine_fmu, body_fmu, rpm: float, algorithm: str, H: float, t_end: float = 1.0,

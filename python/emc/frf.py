@@ -140,13 +140,16 @@ def sine_response(fmu: str, parameters: dict, input_name: str, outputs: list[str
 def plot(table: pd.DataFrame, path: str, unit: str, title: str, top: int | None = None,
          checks: pd.DataFrame | None = None, marks: dict | None = None):
     """Magnitude (log) and phase over frequency, one line per input (the ``top`` largest at
-    their peak if given); ``checks`` (frequency, input, amplitude, phase_deg) from the sine
+    their peak if given; a table with a ``bound`` column: the magnitude's damping band shaded
+    around the nominal line, the nominal phase); ``checks`` (frequency, input, amplitude, phase_deg) from the sine
     excitation as points; ``marks`` {label: Hz} as vertical lines (e.g. an order at a speed)."""
     import matplotlib
 
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
 
+    banded = "bound" in table
+    full, table = table, table[table.bound == "nominal"] if banded else table
     inputs = list(dict.fromkeys(table.input))
     if top is not None:
         peaks = table.groupby("input").amplitude.max().sort_values(ascending=False)
@@ -156,7 +159,14 @@ def plot(table: pd.DataFrame, path: str, unit: str, title: str, top: int | None 
     for k, name in enumerate(inputs):
         d = table[table.input == name].sort_values("frequency")
         label = d.path.iloc[0]
-        ax.plot(d.frequency, d.amplitude, color=f"C{k % 10}", lw=1.3, label=label)
+        if banded:
+            from .band import draw_band, wide
+
+            w = wide(full[full.input == name], ["frequency"], ["amplitude"])
+            draw_band(ax, w.frequency, w.amplitude_low, w.amplitude_nominal, w.amplitude_high,
+                      label=label, color=f"C{k % 10}", lw=1.3)
+        else:
+            ax.plot(d.frequency, d.amplitude, color=f"C{k % 10}", lw=1.3, label=label)
         ax_phase.plot(d.frequency, d.phase_deg, color=f"C{k % 10}", lw=1.0)
         if checks is not None:
             c = checks[checks.input == name]

@@ -285,8 +285,9 @@ class Runner:
                step: float = 2e-4, start_values: dict | None = None, progress=None,
                case: str = "") -> dict:
         """A slow linear run-up, the speed given continuously by input derivatives; the crank
-        angle is recorded beside ``signals`` for order tracking. ``progress(seconds)`` is
-        called with the simulated time reached, every 1 % of the run."""
+        angle is recorded beside ``signals`` for order tracking (``samples`` after each step,
+        ``initial`` the signals at the start). ``progress(seconds)`` is called with the
+        simulated time reached, every 1 % of the run."""
         self.log.clear()
         try:
             return self._run_up(rpm_from, rpm_to, duration, signals, step, start_values,
@@ -302,6 +303,7 @@ class Runner:
         vrs = [self.vr[s] for s in signals] + [self.vr["crankAngle"]]
         samples = np.empty((n, len(vrs)))
         rpm = np.empty(n)
+        initial = np.array(self.slave.getReal(vrs))
         t = 0.0
         tick = max(1, n // 100)
         for k in range(n):
@@ -316,7 +318,8 @@ class Runner:
         if not np.all(np.isfinite(samples)):
             raise RuntimeError("non-finite outputs in the run-up")
         return {"dt": step, "rpm": rpm, "signals": signals, "samples": samples[:, :-1],
-                "crank_angle": samples[:, -1], "warnings": self.warnings()}
+                "crank_angle": samples[:, -1], "initial": initial[:-1],
+                "warnings": self.warnings()}
 
 
 def fmu_from_content(content: bytes, sha256: str) -> str:

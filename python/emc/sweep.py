@@ -18,9 +18,12 @@ from .runner import OperatingPoint, Runner
 from .spectra import ORDERS, amplitude_spectrum, order_amplitudes
 
 
+# What a sweep records without --signal: the mount forces and the comfort points.
+DEFAULT_SIGNAL_PREFIXES = ("mount[", "steeringWheel.a", "seat.a")
+
+
 def default_signals(runner: Runner) -> list[str]:
-    names = [n for n in runner.outputs() if n.startswith(("mount[", "steeringWheel.a", "seat.a"))]
-    return names
+    return [n for n in runner.outputs() if n.startswith(DEFAULT_SIGNAL_PREFIXES)]
 
 
 @dataclasses.dataclass

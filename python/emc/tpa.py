@@ -52,31 +52,44 @@ def contributions(export: Export, response: str, samples: dict, revolutions: int
     f = order_components(forces, revolutions, orders)                       # (orders, paths)
     frequencies = np.asarray(orders, float) * rpm / 60.0
     h = export.body.accelerance(point, dof, [(p, j - 1) for _, j, p in paths], frequencies)
-    c = h * f
-    total = c.sum(axis=1)
     simulated = (order_components(samples[response], revolutions, orders)
                  if response in samples else None)
+    return expand_complex(pd.DataFrame(order_rows(paths, orders, frequencies, h * f, f, h,
+                                                  simulated, case=case, rpm=rpm,
+                                                  response=response)))
+
+
+def order_rows(paths, orders, frequencies, c, f, h, simulated=None, quasi_static=None,
+               **labels) -> list[dict]:
+    """Table rows of one speed and response: per order, each path's contribution ``c``, force
+    ``f`` and transfer function ``h`` (orders × paths, complex), then the row ``sum`` and, if
+    given, ``simulated`` (per order); ``quasi_static`` (orders × paths): each path's force
+    times its transfer function where ``c`` is something else (a run-up's contribution),
+    summed in the row ``sum`` alike. ``labels``: the columns every row carries (case, rpm,
+    response)."""
     rows = []
     for o, order in enumerate(orders):
-        base = {"case": case, "rpm": rpm, "response": response, "order": float(order),
-                "frequency": frequencies[o]}
-        for (i, j, p), value, force, transfer in zip(paths, c[o], f[o], h[o]):
-            rows.append({**base, "path": path_label(i, j), "mount": i, "direction": AXES[j - 1],
-                         "body_point": p, "value": value, "force": force, "transfer": transfer})
-        rows.append({**base, "path": "sum", "mount": 0, "direction": "", "body_point": "",
-                     "value": total[o], "force": np.nan, "transfer": np.nan})
+        base = {**labels, "order": float(order), "frequency": frequencies[o]}
+        for k, (i, j, p) in enumerate(paths):
+            row = {**base, "path": path_label(i, j), "mount": i, "direction": AXES[j - 1],
+                   "body_point": p, "value": c[o, k], "force": f[o, k], "transfer": h[o, k]}
+            if quasi_static is not None:
+                row["quasi_static"] = quasi_static[o, k]
+            rows.append(row)
+        none = {"mount": 0, "direction": "", "body_point": "", "force": np.nan,
+                "transfer": np.nan}
+        total = {} if quasi_static is None else {"quasi_static": quasi_static[o].sum()}
+        rows.append({**base, "path": "sum", **none, "value": c[o].sum(), **total})
         if simulated is not None:
-            rows.append({**base, "path": "simulated", "mount": 0, "direction": "",
-                         "body_point": "", "value": simulated[o], "force": np.nan,
-                         "transfer": np.nan})
-    table = pd.DataFrame(rows)
-    return expand_complex(table)
+            missing = {} if quasi_static is None else {"quasi_static": np.nan}
+            rows.append({**base, "path": "simulated", **none, "value": simulated[o], **missing})
+    return rows
 
 
 def expand_complex(table: pd.DataFrame) -> pd.DataFrame:
     """Complex columns as amplitude, phase (deg), real and imaginary parts (CSV-friendly)."""
     out = table.copy()
-    for column in ("value", "force", "transfer"):
+    for column in [c for c in ("value", "force", "transfer", "quasi_static") if c in out]:
         z = out.pop(column).to_numpy(dtype=complex)
         prefix = "" if column == "value" else f"{column}_"
         out[f"{prefix}amplitude"] = np.abs(z)
@@ -90,17 +103,18 @@ def complex_values(table: pd.DataFrame, prefix: str = "") -> np.ndarray:
     return table[f"{prefix}re"].to_numpy() + 1j * table[f"{prefix}im"].to_numpy()
 
 
-def closure(table: pd.DataFrame, significant: float = 0.01) -> pd.DataFrame:
+def closure(table: pd.DataFrame, significant: float = 0.01, prefix: str = "") -> pd.DataFrame:
     """Per case, rpm, response and order: the simulated amplitude, the sum of the paths and
     their difference relative to the simulated order, for the orders above ``significant`` of
-    the response's largest order at that speed."""
+    the response's largest order at that speed (``prefix`` ``quasi_static_``: the sum of the
+    products of force and transfer function instead of the contributions)."""
     keys = ["case", "rpm", "response", "order"]
     sim = table[table.path == "simulated"].set_index(keys)
     total = table[table.path == "sum"].set_index(keys)
     if sim.empty:
         raise ValueError("the response was not simulated: no closure to check")
     z_sim = complex_values(sim)
-    z_sum = complex_values(total.loc[sim.index])
+    z_sum = complex_values(total.loc[sim.index], prefix)
     out = pd.DataFrame({"simulated": np.abs(z_sim), "sum_of_paths": np.abs(z_sum),
                         "relative_error": np.abs(z_sum - z_sim) / np.maximum(np.abs(z_sim), 1e-300)},
                        index=sim.index).reset_index()
@@ -185,28 +199,47 @@ def plot_ranked(table: pd.DataFrame, rpm: float, order: float, response: str, pa
 def plot_over_speed(table: pd.DataFrame, order: float, response: str, path: str,
                     names: dict | None = None, case: str = "", top: int = 6):
     """The largest path contributions of one order over engine speed, with their sum and the
-    simulated response."""
+    simulated response. A table with the bounds of a damping band (``bound``: low, nominal,
+    high) draws each path and the sum as its band with the nominal line over it."""
     plt = _pyplot()
     data = table[(table.case == case) & (table.response == response) & (table.order == order)]
+    banded = "bound" in data and data.bound.nunique() > 1
+    if banded:
+        from .band import draw_band, wide
+
+        data = wide(data, ["rpm", "path", "mount", "direction"], ["amplitude"]).rename(
+            columns={"amplitude_nominal": "amplitude"})
+
+    def curve(d: pd.DataFrame, **style):
+        if banded:
+            draw_band(ax, d.rpm, d.amplitude_low, d.amplitude, d.amplitude_high, **style)
+        else:
+            ax.plot(d.rpm, d.amplitude, **style)
+
     paths = data[~data.path.isin(["sum", "simulated"])]
     biggest = paths.groupby("path").amplitude.max().sort_values(ascending=False).head(top).index
     fig, ax = plt.subplots(figsize=(9, 5.5))
     for k, p in enumerate(biggest):
         d = paths[paths.path == p].sort_values("rpm")
         m, direction = int(d.mount.iloc[0]), d.direction.iloc[0]
-        ax.plot(d.rpm, d.amplitude, color=f"C{k}", marker="o", ms=3, lw=1.2,
-                label=path_label(m, AXES.index(direction) + 1, names))
+        curve(d, color=f"C{k}", marker="o" if len(d) < 60 else None, ms=3, lw=1.2,
+              label=path_label(m, AXES.index(direction) + 1, names))
+    curve(data[data.path == "sum"].sort_values("rpm"), color="k", lw=2.2,
+          label="sum of the 12 paths")
     total = data[data.path == "sum"].sort_values("rpm")
-    ax.plot(total.rpm, total.amplitude, color="k", lw=2.2, label="sum of the 12 paths")
+    if "quasi_static_amplitude" in total:
+        ax.plot(total.rpm, total.quasi_static_amplitude, color="0.45", lw=1.0, ls=":",
+                label="sum of force × transfer function (quasi-stationary)")
     simulated = data[data.path == "simulated"].sort_values("rpm")
-    if len(simulated):
+    if len(simulated) and not banded:
         ax.plot(simulated.rpm, simulated.amplitude, color="w", ls="--", lw=1.0,
                 label="simulated (dashed over the sum)")
     ax.set_yscale("log")
     ax.set_xlabel("engine speed [rpm]")
     ax.set_ylabel(f"{response}, order {order:g} [m/s²]")
     ax.set_title(f"Path contributions of order {order:g} to {response}"
-                 f"{': ' + case if case else ''}", fontsize=10)
+                 + (", damping band shaded" if banded else "")
+                 + f"{': ' + case if case else ''}", fontsize=10)
     ax.grid(True, which="both", alpha=0.3)
     ax.legend(fontsize=8)
     fig.tight_layout()
@@ -240,3 +273,4 @@ def plot_cases(table: pd.DataFrame, order: float, response: str, path_name: str,
     fig.tight_layout()
     fig.savefig(path, dpi=120)
     plt.close(fig)
+

@@ -12,7 +12,7 @@ from __future__ import annotations
 import numpy as np
 import pandas as pd
 
-from .spectra import ORDERS, order_amplitudes
+from .spectra import ORDERS, order_components
 
 
 def resample_by_angle(crank_angle: np.ndarray, values: np.ndarray, samples_per_revolution: int):
@@ -30,25 +30,40 @@ def resample_by_angle(crank_angle: np.ndarray, values: np.ndarray, samples_per_r
                                   for j in range(values.shape[1])])
 
 
+def tracked_blocks(crank_angle, rpm, samples: np.ndarray, revolutions_per_block: int = 4,
+                   samples_per_revolution: int = 64, orders=ORDERS):
+    """The complex order components of each signal per block of ``revolutions_per_block``
+    revolutions in the crank-angle domain: (mean speed of each block, array (blocks, orders,
+    signals)); the phase of a block refers to its first crank angle."""
+    if revolutions_per_block < 2 or revolutions_per_block % 2:
+        raise ValueError("blocks must hold an even number of revolutions (half orders on bins)")
+    if samples_per_revolution < 2 * max(orders) + 2:
+        raise ValueError("too few samples per revolution for the highest order")
+    samples = np.asarray(samples, dtype=float)
+    if samples.ndim == 1:
+        samples = samples[:, None]
+    grid, resampled = resample_by_angle(crank_angle, np.column_stack([samples, rpm]),
+                                        samples_per_revolution)
+    n = revolutions_per_block * samples_per_revolution
+    starts = range(0, len(grid) - n + 1, n)
+    speeds = np.array([np.mean(resampled[s:s + n, -1]) for s in starts])
+    components = np.array([order_components(resampled[s:s + n, :-1], revolutions_per_block,
+                                            orders) for s in starts])
+    return speeds, components.reshape(len(speeds), len(orders), samples.shape[1])
+
+
 def track_orders(crank_angle, rpm, samples: np.ndarray, signals: list[str],
                  revolutions_per_block: int = 4, samples_per_revolution: int = 64,
                  orders=ORDERS, case: str = "runup") -> pd.DataFrame:
     """Order amplitudes (peak) of each signal per block of ``revolutions_per_block``
     revolutions, labelled with the block's mean speed: a table like a stationary sweep's."""
-    if revolutions_per_block < 2 or revolutions_per_block % 2:
-        raise ValueError("blocks must hold an even number of revolutions (half orders on bins)")
-    if samples_per_revolution < 2 * max(orders) + 2:
-        raise ValueError("too few samples per revolution for the highest order")
-    grid, resampled = resample_by_angle(crank_angle, np.column_stack([samples, rpm]),
-                                        samples_per_revolution)
-    n = revolutions_per_block * samples_per_revolution
+    speeds, components = tracked_blocks(crank_angle, rpm, samples, revolutions_per_block,
+                                        samples_per_revolution, orders)
     rows = []
-    for start in range(0, len(grid) - n + 1, n):
-        block = resampled[start:start + n]
-        speed = float(np.mean(block[:, -1]))
+    for speed, block in zip(speeds, np.abs(components)):
         for j, signal in enumerate(signals):
-            amplitudes = order_amplitudes(block[:, j], revolutions_per_block, orders)
-            for order, amplitude in amplitudes.items():
-                rows.append({"case": case, "rpm": speed, "signal": signal, "order": order,
-                             "frequency": order * speed / 60.0, "amplitude": amplitude})
+            for order, amplitude in zip(orders, block[:, j]):
+                rows.append({"case": case, "rpm": float(speed), "signal": signal,
+                             "order": float(order), "frequency": order * speed / 60.0,
+                             "amplitude": float(amplitude)})
     return pd.DataFrame(rows)

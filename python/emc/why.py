@@ -15,9 +15,10 @@ import time
 import numpy as np
 import pandas as pd
 
-from . import decoupling, frf, ods, tpa
+from . import band as bands
+from . import decoupling, frf, ods, tpa, tpa_time
 from .modal import OUTPUT_POINTS, body_point_of, export_from_fmu
-from .runner import OperatingPoint, Runner
+from .runner import OperatingPoint, PointFailed, Runner
 
 TPA_ORDERS = tuple(k / 2 for k in range(1, 13))
 
@@ -100,6 +101,18 @@ def with_closing_tolerance(parameters: dict) -> dict:
     return {"solver.relTol": CLOSING_TOLERANCE, **parameters}
 
 
+def parse_responses(args) -> list[str]:
+    """``--response`` (default the steering wheel's vertical acceleration), each an
+    acceleration output."""
+    responses = args.response or ["steeringWheel.a[3]"]
+    for r in responses:
+        try:
+            body_point_of(r)
+        except ValueError as error:
+            raise _cli().UsageError(f"--response {r}: {error}") from None
+    return responses
+
+
 def check_order(order: float):
     if order not in TPA_ORDERS:
         raise _cli().UsageError(f"--order {order:g}: one of 0.5, 1, 1.5 … 6 (the half orders a "
@@ -124,6 +137,120 @@ def tpa_case(args, variables: dict, label: str, parameters: dict, speeds: list[f
     return table, export
 
 
+def report_paths(table: pd.DataFrame, names: dict, responses: list[str], labels: list[str],
+                 at_of, order: float, recorded: list[str], out: pathlib.Path) -> dict:
+    """What ``emc tpa`` and its run-up and coupled forms write and print from the table of path
+    contributions: closure.csv, the ranked paths at the speed ``at_of(case)`` and the paths over
+    speed per response and case, the cases compared; returns the summary for metadata.json."""
+    cli = _cli()
+    summary = {}
+    if recorded:
+        closure = tpa.closure(table[table.response.isin(recorded)])
+        cli.save(closure, str(out / "closure.csv"))
+        significant = closure[closure.significant]
+        summary["closure_max_relative_error"] = float(significant.relative_error.max())
+        if "quasi_static_re" in table:
+            quasi = tpa.closure(table[table.response.isin(recorded)], prefix="quasi_static_")
+            significant = quasi[quasi.significant]
+            summary["quasi_static_closure"] = {
+                "median_relative_error": float(significant.relative_error.median()),
+                "max_relative_error": float(significant.relative_error.max())}
+    for r in responses:
+        name = cli.safe_name(r)
+        for label in labels:
+            at = at_of(label)
+            suffix = f"_{cli.safe_name(label)}" if label else ""
+            tpa.plot_ranked(table, at, order, r, str(out / f"tpa_ranked_{name}{suffix}.png"),
+                            names, case=label)
+            if table[table.case == label].rpm.nunique() > 1:
+                tpa.plot_over_speed(table, order, r,
+                                    str(out / f"tpa_over_speed_{name}{suffix}.png"), names,
+                                    case=label)
+            ranked = tpa.ranked(table, at, order, r, case=label)
+            print(f"{r}, order {order:g} at {at:g} rpm ({order * at / 60:.1f} Hz)"
+                  f"{', case ' + repr(label) if label else ''}:")
+            shown = ranked[["amplitude", "phase_deg", "in_phase", "share"]].head(6).copy()
+            shown.insert(0, "path", [tpa.path_label(int(m), tpa.AXES.index(d) + 1, names)
+                                     for m, d in zip(ranked.mount[:6], ranked.direction[:6])])
+            print(shown.to_string(index=False, float_format=lambda v: f"{v:.4g}"))
+            dominant = tpa.dominant_path(table, at, order, r, case=label)
+            total = tpa.complex_values(table[(table.case == label) & (table.response == r)
+                                             & (table.order == order)
+                                             & np.isclose(table.rpm, at)
+                                             & (table.path == "sum")])[0]
+            summary.setdefault(r, {})[label] = {"at": at, "dominant_path": str(dominant.path),
+                                                "share": float(dominant.share),
+                                                "dominant_amplitude": float(dominant.amplitude),
+                                                "total_amplitude": float(abs(total))}
+        if len(labels) > 1:
+            first = summary[r][labels[0]]["dominant_path"]
+            tpa.plot_cases(table, order, r, first, labels,
+                           str(out / f"tpa_cases_{name}.png"), names, at=at_of(labels[0]))
+            print(f"{r}, order {order:g}, {first} and the total per case:")
+            for label in labels:
+                one = tpa.ranked(table, at_of(label), order, r, case=label).set_index("path")
+                print(f"  {label or 'model'} at {at_of(label):g} rpm: {first} "
+                      f"{one.amplitude[first]:.4g}, total "
+                      f"{summary[r][label]['total_amplitude']:.4g}")
+    if "closure_max_relative_error" in summary:
+        print(f"closure: the 12 paths add up to the simulated response within "
+              f"{summary['closure_max_relative_error']:.2e} (every order above 1 % of the "
+              "largest)")
+    if "quasi_static_closure" in summary:
+        q = summary["quasi_static_closure"]
+        print(f"force × transfer function (quasi-stationary) against the simulated response: "
+              f"median {q['median_relative_error']:.2e}, largest "
+              f"{q['max_relative_error']:.2e}")
+    return summary
+
+
+def per_bound(band, parameters: dict, analyse) -> tuple[pd.DataFrame, object]:
+    """``analyse(parameters)`` → (table, export) once, or at the band's three bounds with the
+    tables stacked (column ``bound``) and the nominal export."""
+    if band is None:
+        return analyse(parameters)
+    result = bands.run_band(lambda settings, _bound: analyse(settings), band, parameters)
+    return result.stack(part=0), result.nominal[1]
+
+
+def report_band(table: pd.DataFrame, names: dict, responses: list[str], labels: list[str],
+                at_of, order: float, out: pathlib.Path, summary: dict):
+    """The damping band of the path contributions: tpa_band.csv (every path's and the sum's
+    amplitude at the three bounds), the paths over speed with their bands, and at the speed
+    ``at_of(case)`` the dominant path and the total at each bound (into ``summary``)."""
+    cli = _cli()
+    keys = ["case", "response", "order", "rpm", "path"]
+    cli.save(bands.wide(table, keys, ["amplitude", "phase_deg"]), str(out / "tpa_band.csv"))
+    for r in responses:
+        for label in labels:
+            at = at_of(label)
+            suffix = f"_{cli.safe_name(label)}" if label else ""
+            if table[table.case == label].rpm.nunique() > 1:
+                tpa.plot_over_speed(table, order, r, str(
+                    out / f"tpa_band_{cli.safe_name(r)}{suffix}.png"), names, case=label, top=4)
+            dominant = summary[r][label]["dominant_path"]
+            record = {}
+            for bound in bands.BOUNDS:
+                ranked = tpa.ranked(table[table.bound == bound], at, order, r,
+                                    case=label).set_index("path")
+                total = ranked.in_phase.sum()
+                top = tpa.dominant_path(table[table.bound == bound], at, order, r, case=label)
+                record[bound] = {"total_amplitude": float(total),
+                                 "path_amplitude": float(ranked.amplitude[dominant]),
+                                 "path_share": float(ranked.share[dominant]),
+                                 "dominant_path": str(top.path)}
+            summary[r][label]["band"] = record
+            print(f"{r}, order {order:g} at {at:g} rpm{', case ' + repr(label) if label else ''}"
+                  f", damping band (low / nominal / high): total "
+                  + " / ".join(f"{record[b]['total_amplitude']:.3g}" for b in bands.BOUNDS)
+                  + f"; {dominant} "
+                  + " / ".join(f"{record[b]['path_amplitude']:.3g}" for b in bands.BOUNDS)
+                  + " (share " + " / ".join(f"{100 * record[b]['path_share']:.0f} %"
+                                             for b in bands.BOUNDS)
+                  + "); dominant path at each bound: "
+                  + ", ".join(dict.fromkeys(record[b]["dominant_path"] for b in bands.BOUNDS)))
+
+
 def cmd_tpa(args) -> int:
     cli = _cli()
     cli.check_range("--count", args.count, 1)
@@ -134,16 +261,12 @@ def cmd_tpa(args) -> int:
     variables, cases = cli.prepare(args)
     cli.check_speeds(args.rpm, increasing=args.count > 1, highest=cli.highest_speed(variables))
     cases = [(label, with_closing_tolerance(parameters)) for label, parameters in cases]
+    band = cli.band_of(args, variables, cases)
     at = args.at if args.at is not None else args.rpm[0]
     if not args.rpm[0] <= at <= args.rpm[1]:
         raise cli.UsageError(f"--at {at:g} rpm is outside the sweep --rpm {args.rpm[0]:g} "
                              f"{args.rpm[1]:g}")
-    responses = args.response or ["steeringWheel.a[3]"]
-    for r in responses:
-        try:
-            body_point_of(r)
-        except ValueError as error:
-            raise cli.UsageError(f"--response {r}: {error}") from None
+    responses = parse_responses(args)
     cli.reduction_notice(cases[0][1], variables)
     speeds = sorted(set(np.round(np.linspace(args.rpm[0], args.rpm[1], args.count), 6)) | {at})
     out = pathlib.Path(args.out)
@@ -151,64 +274,182 @@ def cmd_tpa(args) -> int:
     started = time.perf_counter()
     tables, exports = [], {}
     for label, parameters in cases:
-        table, exports[label] = tpa_case(args, variables, label, parameters, speeds, responses)
+        table, exports[label] = per_bound(
+            band, parameters, lambda settings, label=label: tpa_case(
+                args, variables, label, settings, speeds, responses))
         tables.append(table)
     table = pd.concat(tables, ignore_index=True)
     cli.save(table, str(out / "tpa.csv"))
+    nominal = table if band is None else table[table.bound == "nominal"]
     names = _mount_names(exports[cases[0][0]])
-    summary = {}
-    recorded = [r for r in responses if r in variables]
-    if recorded:
-        closure = tpa.closure(table[table.response.isin(recorded)])
-        cli.save(closure, str(out / "closure.csv"))
-        significant = closure[closure.significant]
-        summary["closure_max_relative_error"] = float(significant.relative_error.max())
     labels = [label for label, _ in cases]
-    for r in responses:
-        name = cli.safe_name(r)
-        for label in labels:
-            suffix = f"_{cli.safe_name(label)}" if label else ""
-            tpa.plot_ranked(table, at, args.order, r,
-                            str(out / f"tpa_ranked_{name}{suffix}.png"), names, case=label)
-            if len(speeds) > 1:
-                tpa.plot_over_speed(table, args.order, r,
-                                    str(out / f"tpa_over_speed_{name}{suffix}.png"), names,
-                                    case=label)
-            ranked = tpa.ranked(table, at, args.order, r, case=label)
-            print(f"{r}, order {args.order:g} at {at:g} rpm ({args.order * at / 60:.1f} Hz)"
-                  f"{', case ' + repr(label) if label else ''}:")
-            shown = ranked[["amplitude", "phase_deg", "in_phase", "share"]].head(6).copy()
-            shown.insert(0, "path", [tpa.path_label(int(m), tpa.AXES.index(d) + 1, names)
-                                     for m, d in zip(ranked.mount[:6], ranked.direction[:6])])
-            print(shown.to_string(index=False, float_format=lambda v: f"{v:.4g}"))
-            dominant = tpa.dominant_path(table, at, args.order, r, case=label)
-            total = tpa.complex_values(table[(table.case == label) & (table.response == r)
-                                             & (table.order == args.order)
-                                             & np.isclose(table.rpm, at)
-                                             & (table.path == "sum")])[0]
-            summary.setdefault(r, {})[label] = {"dominant_path": str(dominant.path),
-                                                "share": float(dominant.share),
-                                                "dominant_amplitude": float(dominant.amplitude),
-                                                "total_amplitude": float(abs(total))}
-        if len(cases) > 1:
-            first = summary[r][labels[0]]["dominant_path"]
-            tpa.plot_cases(table, args.order, r, first, labels,
-                           str(out / f"tpa_cases_{name}.png"), names, at=at)
-            print(f"{r}, order {args.order:g} at {at:g} rpm, {first} and the total per case:")
-            for label in labels:
-                one = tpa.ranked(table, at, args.order, r, case=label).set_index("path")
-                print(f"  {label or 'model'}: {first} {one.amplitude[first]:.4g}, total "
-                      f"{summary[r][label]['total_amplitude']:.4g}")
+    summary = report_paths(nominal, names, responses, labels, lambda label: at, args.order,
+                           [r for r in responses if r in variables], out)
+    if band is not None:
+        report_band(table, names, responses, labels, lambda label: at, args.order, out,
+                    summary)
     cli.write_metadata(out, args, variables, cases,
                        {"tpa": {"speeds": speeds, "at": at, "order": args.order,
                                 "responses": responses, "revolutions": args.revolutions,
                                 "steps_per_revolution": args.steps_per_rev, **summary},
-                        "export": exports[cases[0][0]].manifest})
-    if "closure_max_relative_error" in summary:
-        print(f"closure: the 12 paths add up to the simulated response within "
-              f"{summary['closure_max_relative_error']:.2e} (every order above 1 % of the "
-              "largest)")
-    print(f"{len(cases) * len(speeds)} points in {time.perf_counter() - started:.1f} s -> {out}")
+                        "export": exports[cases[0][0]].manifest, **cli.band_metadata(band)})
+    runs = len(cases) * len(speeds) * (1 if band is None else len(bands.BOUNDS))
+    print(f"{runs} points in {time.perf_counter() - started:.1f} s -> {out}")
+    return 0
+
+
+# ----- emc tpa-runup ---------------------------------------------------------------------------
+
+def start_cycle(args, parameters: dict, export, initial: np.ndarray) -> tuple[np.ndarray, float]:
+    """One working cycle of the mount forces on the periodic steady state at the run-up's start
+    speed, from the start's crank angle on (the run-up's modal state at its start), checked
+    against the run-up's first forces."""
+    rpm = args.rpm[0]
+    point = OperatingPoint(rpm=rpm, revolutions=2,
+                           steps_per_revolution=tpa_time.CYCLE_STEPS_PER_REVOLUTION,
+                           load_torque=args.load_torque, parameters=tuple(parameters.items()))
+    with Runner(args.fmu) as runner:
+        samples = runner.run_point(point, tpa.force_signals(export))["samples"]
+    cycle = np.roll(samples, 1, axis=0)  # the last sample closes the cycle: t = 0
+    mismatch = np.max(np.abs(cycle[0] - initial[:cycle.shape[1]]))
+    if mismatch > 1e-4 * np.max(np.abs(cycle)):
+        print(f"warning: the run-up's start is {mismatch:.3g} N off the periodic cycle at "
+              f"{rpm:g} rpm: its paths start with a transient", file=sys.stderr)
+    return cycle, 2 * 60.0 / rpm
+
+
+def cmd_tpa_runup(args) -> int:
+    cli = _cli()
+    cli.check_range("--duration", args.duration, 0.0, strict_low=True)
+    cli.check_range("--step", args.step, 0.0, 0.01, strict_low=True)
+    if args.block_revolutions < 2 or args.block_revolutions % 2:
+        raise cli.UsageError(f"--block-revolutions must be even and >= 2 (half orders on "
+                             f"bins), got {args.block_revolutions}")
+    check_order(args.order)
+    variables, cases = cli.prepare(args)
+    cli.check_speeds(args.rpm, increasing=True, highest=cli.highest_speed(variables))
+    revolutions = (args.rpm[0] + args.rpm[1]) / 2.0 / 60.0 * args.duration
+    if revolutions < 2 * args.block_revolutions:
+        raise cli.UsageError(f"a run-up of {args.duration:g} s turns the crank "
+                             f"{revolutions:.1f} times: too few for blocks of "
+                             f"{args.block_revolutions} revolutions (lengthen --duration)")
+    at = args.at if args.at is not None else args.rpm[0]
+    if not args.rpm[0] <= at <= args.rpm[1]:
+        raise cli.UsageError(f"--at {at:g} rpm is outside the run-up --rpm {args.rpm[0]:g} "
+                             f"{args.rpm[1]:g}")
+    responses = parse_responses(args)
+    periodic = args.start == "periodic"
+    cases = [(label, with_closing_tolerance(parameters)) for label, parameters in cases]
+    cli.reduction_notice(cases[0][1], variables)
+    out = pathlib.Path(args.out)
+    out.mkdir(parents=True, exist_ok=True)
+    started = time.perf_counter()
+    tables, exports, warnings = [], {}, []
+    band = cli.band_of(args, variables, cases)
+
+    def analyse(label: str, parameters: dict):
+        export = export_for(args, parameters)
+        if export.body is None:
+            raise cli.UsageError("transfer paths need the elastic body: --set scene=2")
+        check_responses(responses, export, variables)
+        recorded = [r for r in responses if r in variables]
+        start_values = {**parameters, "loadTorque": args.load_torque}
+        if periodic:
+            start_values["initialization.periodic"] = True
+        run = cli.run_up(args, tpa.force_signals(export) + recorded, start_values, label)
+        warnings.extend(run["warnings"])
+        cycle = start_cycle(args, parameters, export, run["initial"]) if periodic else None
+        return tpa_time.runup_paths(export, run, responses, cycle, args.block_revolutions,
+                                    case=label), export
+
+    for label, parameters in cases:
+        table, exports[label] = per_bound(
+            band, parameters, lambda settings, label=label: analyse(label, settings))
+        tables.append(table)
+    table = pd.concat(tables, ignore_index=True)
+    cli.fmu_warnings_summary(warnings)
+    cli.save(table, str(out / "tpa_runup.csv"))
+    labels = [label for label, _ in cases]
+    nominal = table if band is None else table[table.bound == "nominal"]
+    speeds = {label: np.sort(nominal[nominal.case == label].rpm.unique()) for label in labels}
+    at_of = {label: float(v[np.argmin(np.abs(v - at))]) for label, v in speeds.items()}
+    names = _mount_names(exports[labels[0]])
+    summary = report_paths(nominal, names, responses, labels, at_of.__getitem__, args.order,
+                           [r for r in responses if r in variables], out)
+    if band is not None:
+        report_band(table, names, responses, labels, at_of.__getitem__, args.order, out,
+                    summary)
+    cli.write_metadata(out, args, variables, cases,
+                       {"tpa_runup": {"from": args.rpm[0], "to": args.rpm[1],
+                                      "duration": args.duration, "step": args.step,
+                                      "block_revolutions": args.block_revolutions,
+                                      "start": args.start, "at": at, "order": args.order,
+                                      "responses": responses, **summary},
+                        "export": exports[labels[0]].manifest, **cli.band_metadata(band)},
+                       warnings)
+    print(f"{len(cases)} run-up(s), {sum(len(v) for v in speeds.values())} blocks in "
+          f"{time.perf_counter() - started:.1f} s -> {out}")
+    return 0
+
+
+# ----- emc tpa-coupled -------------------------------------------------------------------------
+
+def cmd_tpa_coupled(args) -> int:
+    from .coupling import ALGORITHMS, CoupledPair
+    from .synthesis import static_state
+
+    cli = _cli()
+    check_order(args.order)
+    if args.revolutions < 2 or args.revolutions % 2:
+        raise cli.UsageError(f"--revolutions must be even and >= 2, got {args.revolutions}")
+    cli.check_range("--settle", args.settle, 0.0)
+    cli.check_range("--coupling-step", args.coupling_step, 0.0, 0.05, strict_low=True)
+    if args.algorithm not in ALGORITHMS:
+        raise cli.UsageError(f"--algorithm: one of {', '.join(ALGORITHMS)}")
+    variables, cases = cli.prepare(args, cases_wanted=False)
+    cli.check_range("--rpm-point", args.rpm_point, 0.0, cli.highest_speed(variables),
+                    strict_low=True)
+    engine = {k: v for k, v in cases[0][1].items() if k != "scene"}  # the pair sets scene 3
+    if args.start == "periodic":
+        engine["initialization.periodic"] = True
+    try:
+        export = export_from_fmu(args.body_fmu, {})
+    except ValueError as error:
+        raise cli.UsageError(str(error)) from None
+    if export.body is None:
+        raise cli.UsageError(f"{args.body_fmu} exports no elastic body")
+    responses = parse_responses(args)
+    check_responses(responses, export, variables)
+    window = args.revolutions * 60.0 / args.rpm_point
+    out = pathlib.Path(args.out)
+    out.mkdir(parents=True, exist_ok=True)
+    started = time.perf_counter()
+    if not args.quiet:
+        print(f"coupling the engine and the body at {args.rpm_point:g} rpm for "
+              f"{args.settle + window:.3g} s ({args.algorithm}, step {args.coupling_step:g} s)",
+              file=sys.stderr)
+    with CoupledPair(args.fmu, args.body_fmu, args.rpm_point, args.settle + window,
+                     engine_parameters=engine) as pair:
+        initial = static_state(export.body, pair.F_static)
+        run = pair.run(args.algorithm, args.coupling_step)
+    if not run.ok:
+        raise PointFailed(f"coupled run at {args.rpm_point:g} rpm: {run.status}")
+    recorded = {r: run.signals.get(r) for r in responses}
+    table = tpa_time.window_paths(export, run.body_forces, recorded, args.revolutions,
+                                  args.rpm_point, run.t_reached - window, initial)
+    cli.save(table, str(out / "tpa_coupled.csv"))
+    summary = report_paths(table, {}, responses, [""], lambda _label: args.rpm_point,
+                           args.order, [r for r in responses if recorded[r] is not None], out)
+    cli.write_metadata(out, args, variables, [("", engine)],
+                       {"tpa_coupled": {"rpm": args.rpm_point, "settle": args.settle,
+                                        "revolutions": args.revolutions,
+                                        "coupling_step": args.coupling_step,
+                                        "algorithm": args.algorithm, "start": args.start,
+                                        "order": args.order, "responses": responses,
+                                        "stepping_wall_s": run.wall, **summary},
+                        "export": export.manifest})
+    print(f"{args.settle + window:.3g} s coupled in {time.perf_counter() - started:.1f} s "
+          f"-> {out}")
     return 0
 
 
@@ -223,10 +464,22 @@ def cmd_frf(args) -> int:
         cli.check_range("--verify", f, 0.0, strict_low=True)
     variables, cases = cli.prepare(args, cases_wanted=False)
     parameters = cases[0][1]
+    band = cli.band_of(args, variables, cases)
     cli.reduction_notice(parameters, variables)
     export = export_for(args, parameters)
     if export.body is None:
         raise cli.UsageError("transfer functions need the elastic body: --set scene=2")
+    # At the band's bounds: the body and the linearised model exported with their damping.
+    exports = ({"nominal": export} if band is None else
+               {bound: export if bound == "nominal" else
+                export_for(args, band.applied(parameters, bound)) for bound in bands.BOUNDS})
+
+    def at_bounds(table_of) -> pd.DataFrame:
+        if band is None:
+            return table_of(export)
+        return pd.concat([bands.with_bound(table_of(e), b) for b, e in exports.items()],
+                         ignore_index=True)
+
     responses = check_responses(args.response or ["steeringWheel.a[3]"], export, variables)
     out = pathlib.Path(args.out)
     out.mkdir(parents=True, exist_ok=True)
@@ -236,8 +489,8 @@ def cmd_frf(args) -> int:
     summary = {}
     for r in responses:
         name = cli.safe_name(r)
-        body = frf.body_frf(export, r, freqs)
-        coupled = frf.coupled_frf(export, [r], freqs)
+        body = at_bounds(lambda e: frf.body_frf(e, r, freqs))
+        coupled = at_bounds(lambda e: frf.coupled_frf(e, [r], freqs))
         cli.save(body, str(out / f"frf_body_{name}.csv"))
         cli.save(coupled, str(out / f"frf_coupled_{name}.csv"))
         checks = None
@@ -256,7 +509,7 @@ def cmd_frf(args) -> int:
     cli.write_metadata(out, args, variables, cases,
                        {"frf": {"frequencies": [args.freq[0], args.freq[1], args.points],
                                 "responses": responses, "verify": args.verify or [], **summary},
-                        "export": export.manifest})
+                        "export": export.manifest, **cli.band_metadata(band)})
     print(f"transfer functions of {', '.join(responses)} -> {out}")
     return 0
 
@@ -290,28 +543,22 @@ def verify(args, parameters: dict, export, response: str) -> pd.DataFrame:
 
 # ----- emc ods ---------------------------------------------------------------------------------
 
-def cmd_ods(args) -> int:
-    cli = _cli()
-    check_order(args.order)
-    variables, cases = cli.prepare(args, cases_wanted=False)
-    cli.check_range("--rpm-point", args.rpm_point, 0.0, cli.highest_speed(variables),
-                    strict_low=True)
-    parameters = with_closing_tolerance(cases[0][1])
-    cli.reduction_notice(parameters, variables)
-    print("note: recovering the body's modes on every node (the reduction is run once more)",
-          file=sys.stderr)
+def operating_shape_at(args, parameters: dict, variables: dict):
+    """The export with the body's modes on every node, the speed point's samples and the
+    operating deflection shape of ``--order`` at ``--rpm-point``."""
     export = export_for(args, parameters, full_recovery=True)
     signals = ods.signals(export) + [s for s in args.compare if s in variables]
     check_responses(args.compare, export, variables)
-    out = pathlib.Path(args.out)
-    out.mkdir(parents=True, exist_ok=True)
     samples = run_points(args, parameters, [args.rpm_point], signals, args.revolutions,
                          args.steps_per_rev)[args.rpm_point]
-    shape = ods.operating_shape(export, samples, args.revolutions, args.rpm_point, args.order)
-    stem = f"ods_{args.rpm_point:g}rpm_order{args.order:g}"
-    ods.write_vtu(shape, str(out / f"{stem}.vtu"))
-    labels = {p: export.body.nodes[p] for p in export.body.shapes if not p.startswith("mount_")}
-    ods.plot(shape, str(out / f"{stem}.png"), point_labels=labels)
+    return export, samples, ods.operating_shape(export, samples, args.revolutions,
+                                                args.rpm_point, args.order)
+
+
+def compared_points(args, export, samples: dict, shape: dict) -> list[dict]:
+    """Per ``--compare`` output: the shape's displacement at its node and the simulated one."""
+    from .spectra import order_components
+
     rows = []
     w = 2 * np.pi * shape["frequency"]
     for r in args.compare:
@@ -321,12 +568,32 @@ def cmd_ods(args) -> int:
         row = {"response": r, "node": node, "ods_displacement": abs(u),
                "ods_phase_deg": np.degrees(np.angle(u))}
         if r in samples:
-            from .spectra import order_components
-
             a = order_components(samples[r], args.revolutions, [args.order])[0]
             row.update({"simulated_displacement": abs(a / -w**2),
                         "relative_difference": abs(u - a / -w**2) / abs(a / -w**2)})
         rows.append(row)
+    return rows
+
+
+def cmd_ods(args) -> int:
+    cli = _cli()
+    check_order(args.order)
+    variables, cases = cli.prepare(args, cases_wanted=False)
+    cli.check_range("--rpm-point", args.rpm_point, 0.0, cli.highest_speed(variables),
+                    strict_low=True)
+    parameters = with_closing_tolerance(cases[0][1])
+    band = cli.band_of(args, variables, [("", parameters)])
+    cli.reduction_notice(parameters, variables)
+    print("note: recovering the body's modes on every node (the reduction is run once more)",
+          file=sys.stderr)
+    export, samples, shape = operating_shape_at(args, parameters, variables)
+    out = pathlib.Path(args.out)
+    out.mkdir(parents=True, exist_ok=True)
+    stem = f"ods_{args.rpm_point:g}rpm_order{args.order:g}"
+    ods.write_vtu(shape, str(out / f"{stem}.vtu"))
+    labels = {p: export.body.nodes[p] for p in export.body.shapes if not p.startswith("mount_")}
+    ods.plot(shape, str(out / f"{stem}.png"), point_labels=labels)
+    rows = compared_points(args, export, samples, shape)
     for r in args.compare:
         point, dof = body_point_of(r)
         modes = ods.modal_contributions(shape, export, point, dof)
@@ -334,6 +601,17 @@ def cmd_ods(args) -> int:
         print(f"body modes carrying {r} (displacement, share in phase with the whole):")
         print(modes.to_string(index=False, float_format=lambda v: f"{v:.4g}"))
     points = pd.DataFrame(rows)
+    if band is not None and args.compare:
+        # The shape at the band's bounds, point by point (the file and the picture: nominal).
+        tables = [bands.with_bound(points, "nominal")]
+        for bound in ("low", "high"):
+            e, x, sh = operating_shape_at(args, band.applied(parameters, bound), variables)
+            tables.append(bands.with_bound(pd.DataFrame(compared_points(args, e, x, sh)),
+                                           bound))
+        stacked = pd.concat(tables, ignore_index=True)
+        points = bands.wide(stacked, ["response", "node"],
+                            [c for c in ("ods_displacement", "simulated_displacement",
+                                                   "relative_difference") if c in stacked])
     if len(points):
         cli.save(points, str(out / f"{stem}_points.csv"))
         print(points.to_string(index=False, float_format=lambda v: f"{v:.4g}"))
@@ -341,7 +619,7 @@ def cmd_ods(args) -> int:
                        {"ods": {"rpm": args.rpm_point, "order": args.order,
                                 "frequency": shape["frequency"], "nodes": len(shape["nodes"]),
                                 "revolutions": args.revolutions},
-                        "export": export.manifest})
+                        "export": export.manifest, **cli.band_metadata(band)})
     print(f"operating deflection shape, order {args.order:g} at {args.rpm_point:g} rpm "
           f"({shape['frequency']:.1f} Hz) -> {out / (stem + '.vtu')}")
     return 0
@@ -392,7 +670,8 @@ def cmd_decoupling(args) -> int:
 # ----- registration ----------------------------------------------------------------------------
 
 def add_parsers(sub) -> None:
-    """Registers ``emc tpa``, ``emc frf``, ``emc ods`` and ``emc decoupling``."""
+    """Registers ``emc tpa``, ``emc tpa-runup``, ``emc frf``, ``emc ods`` and
+    ``emc decoupling``."""
 
     def common(p):
         p.add_argument("--fmu", default="dist/EngineMountChassis.fmu",
@@ -429,7 +708,48 @@ def add_parsers(sub) -> None:
                    help="a case with its own settings on top of --set (repeatable): each case "
                         "is analysed and the first case's dominant path compared across them")
     window(t, 8, 72)
+    bands.add_options(t)
     t.set_defaults(func=cmd_tpa)
+
+    u = sub.add_parser("tpa-runup", help="transfer paths of a run-up: each mount and "
+                                         "direction's contribution per order, order-tracked")
+    common(u)
+    u.add_argument("--rpm", nargs=2, type=float, default=[800.0, 2500.0],
+                   metavar=("FROM", "TO"), help="speed range, rpm (default 800 2500)")
+    _cli().runup_options(u)
+    u.add_argument("--at", type=float, default=None,
+                   help="speed of the ranked contributions, rpm: the block nearest it "
+                        "(default FROM)")
+    u.add_argument("--order", type=float, default=1.5, help="order of the plots (default 1.5)")
+    u.add_argument("--response", action="append",
+                   help="acceleration to explain (repeatable; default steeringWheel.a[3])")
+    u.add_argument("--case", action="append", metavar="NAME[:NAME=VALUE,...]",
+                   help="a case with its own settings on top of --set (repeatable)")
+    bands.add_options(u)
+    u.set_defaults(func=cmd_tpa_runup)
+
+    c = sub.add_parser("tpa-coupled", help="transfer paths of the engine FMU (scene 3) on the "
+                                           "body FMU, coupled by emc.coupling, at one speed")
+    common(c)
+    c.add_argument("--body-fmu", default="dist/EngineMountBody.fmu",
+                   help="the body FMU (default dist/EngineMountBody.fmu); --set goes to the "
+                        "engine")
+    c.add_argument("--rpm-point", type=float, required=True, help="engine speed, rpm")
+    c.add_argument("--start", choices=("periodic", "static"), default="periodic",
+                   help="periodic (default): the engine on its periodic orbit on the body at "
+                        "rest; static: both at the static equilibrium, excitation faded in")
+    c.add_argument("--settle", type=float, default=1.0,
+                   help="s coupled before the analysed window (default 1)")
+    c.add_argument("--revolutions", type=int, default=8,
+                   help="analysed window, whole revolutions (even; default 8)")
+    c.add_argument("--coupling-step", type=float, default=1e-4,
+                   help="s (default 1e-4: the outputs are read every step)")
+    c.add_argument("--algorithm", default="interface_jacobian",
+                   help="jacobi, gauss_seidel or interface_jacobian (default)")
+    c.add_argument("--order", type=float, default=1.5, help="order of the plots (default 1.5)")
+    c.add_argument("--response", action="append",
+                   help="acceleration to explain (repeatable; default steeringWheel.a[3])")
+    c.set_defaults(func=cmd_tpa_coupled)
 
     f = sub.add_parser("frf", help="transfer functions: the body's accelerance from each mount "
                                    "point, and the coupled system's from the load torque")
@@ -449,6 +769,7 @@ def add_parsers(sub) -> None:
                    help="solver.relTol of the --verify runs (default 1e-6)")
     f.add_argument("--mark-rpm", type=float, help="mark the --mark-order frequencies at this speed")
     f.add_argument("--mark-order", type=float, action="append", help="order to mark (repeatable)")
+    bands.add_options(f)
     f.set_defaults(func=cmd_frf)
 
     o = sub.add_parser("ods", help="operating deflection shape of one order at one speed: the "
@@ -460,6 +781,7 @@ def add_parsers(sub) -> None:
                    help="an acceleration output whose point's shape is compared with the "
                         "simulation (repeatable, e.g. steeringWheel.a[3])")
     window(o, 8, 72)
+    bands.add_options(o)
     o.set_defaults(func=cmd_ods)
 
     d = sub.add_parser("decoupling", help="the mount decoupling table: rigid modes of the "

@@ -74,9 +74,10 @@ def test_stiff_mounts_at_1_ms_only_the_interface_jacobian_master_holds(fmus, cac
 
 
 def test_at_1_ms_the_interface_jacobian_master_is_within_2_percent(fmus, cache):
-    """Production mounts, 1100 rpm, coupling step 1 ms: Jacobi and Gauss-Seidel are off by more
-    than 5 % (measured 13 % and 8 %), the interface-Jacobian step within 2 % (measured 0.75 %),
-    orders above 1 % of their group's largest."""
+    """Production mounts, 1100 rpm, coupling step 1 ms, the default body damping: Jacobi off by
+    more than 3 % (measured 4.0 %), Gauss-Seidel between (1.5 %), the interface-Jacobian step the
+    closest and within 2 % (1.04 %), orders above 1 % of their group's largest. (With the body
+    damped by the Adams table: 13 %, 8 % and 0.75 %.)"""
     rpm = 1100.0
     reference = monolithic(fmus[0], rpm, 1e-4, 1.0, cache_dir=cache)
     deviations = {}
@@ -84,7 +85,8 @@ def test_at_1_ms_the_interface_jacobian_master_is_within_2_percent(fmus, cache):
         run = coupled(*fmus, rpm, algorithm, 1e-3, 1.0, cache_dir=cache)
         assert run.ok, f"{algorithm}: {run.status}"
         deviations[algorithm], _ = largest_deviation(reference, run, rpm, floor="group")
-    assert deviations["jacobi"] > 0.05 and deviations["gauss_seidel"] > 0.05, deviations
+    assert deviations["jacobi"] > 0.03, deviations
+    assert deviations["interface_jacobian"] < deviations["gauss_seidel"] < deviations["jacobi"]
     assert deviations["interface_jacobian"] < 0.02, deviations
 
 

@@ -267,3 +267,195 @@ def test_tpa_writes_tables_plots_and_metadata(capsys, tmp_path, fmu_path):
     for name in ("tpa.csv", "closure.csv", "tpa_ranked_steeringWheel.a3.png",
                  "tpa_over_speed_steeringWheel.a3.png"):
         assert (tmp_path / name).is_file(), name
+
+
+# --- transfer paths in the time domain (run-ups, the coupled pair) -----------------------------
+
+def test_the_path_synthesis_matches_an_independent_integration():
+    """emc.synthesis against scipy's DOP853 on the modal equations: forces held and ramped with
+    jumps between steps (what a master applies) from a static start, including a critically
+    damped mode; and the periodic state against the modal steady state of two harmonics."""
+    from scipy.integrate import solve_ivp
+
+    from emc.modal import Body
+    from emc.synthesis import HeldForces, path_responses, periodic_state, static_state
+
+    omega = 2 * np.pi * np.array([5.0, 30.0, 1300.0])
+    zeta = np.array([0.01, 0.05, 1.0])
+    phi_in, phi_out = np.array([1.0, 0.5, 1.0]), np.array([0.3, -2.0, 3.0])
+    rows = lambda v: np.column_stack([v, np.zeros((3, 5))])  # noqa: E731 - ux only
+    body = Body(omega=omega, zeta=zeta, shapes={"in": rows(phi_in), "out": rows(phi_out)},
+                nodes={}, positions={})
+    rng = np.random.default_rng(7)
+    dt, n = 1e-3, 300
+    start, end = rng.normal(size=n), rng.normal(size=n)
+    held = HeldForces(dt=dt, start=start[:, None], end=end[:, None],
+                      read=np.concatenate([start, [end[-1]]])[:, None])
+    ours = path_responses(body, held, [("out", 0)], [("in", 0)],
+                          static_state(body, np.array([0.7])))[:, 0, 0]
+
+    def rhs(t, y, k):
+        q = phi_in * (start[k] + (end[k] - start[k]) * (t / dt - k))
+        return np.concatenate([y[3:], q - 2 * zeta * omega * y[3:] - omega**2 * y[:3]])
+
+    y = np.concatenate([phi_in * 0.7 / omega**2, np.zeros(3)])
+    truth = []
+    for k in range(n):
+        q = phi_in * start[k]
+        truth.append(phi_out @ (q - 2 * zeta * omega * y[3:] - omega**2 * y[:3]))
+        y = solve_ivp(rhs, (k * dt, (k + 1) * dt), y, args=(k,), method="DOP853", rtol=1e-12,
+                      atol=1e-14).y[:, -1]
+    truth = np.array(truth)
+    assert np.max(np.abs(ours[:n] - truth)) < 1e-9 * np.max(np.abs(truth))
+
+    period = 0.15
+    harmonics = ((1.0, 3, -0.5 * np.pi), (0.2, 7, 0.3))
+    force = lambda t: sum(a * np.cos(2 * np.pi / period * h * t + p)  # noqa: E731
+                          for a, h, p in harmonics)
+    state = periodic_state(body, force(np.arange(1440) * period / 1440)[:, None], period)
+    w = 2 * np.pi / period * np.array([h for _, h, _ in harmonics])
+    z = np.array([a * np.exp(1j * p) for a, _, p in harmonics])
+    r = 1 / (omega[None, :] ** 2 - w[:, None] ** 2 + 2j * zeta[None, :] * omega[None, :] * w[:, None])
+    assert np.allclose(state[0, :, 0], (z[:, None] * r).sum(0).real, rtol=1e-10, atol=0)
+    assert np.allclose(state[1, :, 0], (1j * w[:, None] * z[:, None] * r).sum(0).real,
+                       rtol=1e-10, atol=0)
+
+
+RUNUP_RESPONSES = ["steeringWheel.a[3]", "seat.a[3]", "steeringWheel.a[2]"]
+
+
+def runup_table(fmu_path, export, rpm_from, rpm_to, duration, start):
+    from emc import tpa_time
+
+    params = {"scene": 2, "solver.relTol": 1e-7}
+    signals = tpa.force_signals(export) + RUNUP_RESPONSES
+    with Runner(str(fmu_path)) as runner:
+        values = {**params, **({"initialization.periodic": True} if start == "periodic" else {})}
+        run = runner.run_up(rpm_from, rpm_to, duration, signals, start_values=values)
+        cycle = None
+        if start == "periodic":
+            point = OperatingPoint(rpm=rpm_from, revolutions=2, steps_per_revolution=720,
+                                   parameters=tuple(params.items()))
+            samples = runner.run_point(point, tpa.force_signals(export))["samples"]
+            cycle = (np.roll(samples, 1, axis=0), 120.0 / rpm_from)
+    return tpa_time.runup_paths(export, run, RUNUP_RESPONSES, cycle)
+
+
+@pytest.mark.parametrize("start", ["periodic", "fade-in"])
+def test_the_paths_of_a_run_up_add_up_to_the_tracked_response(fmu_path, export, start):
+    """Through the 26.5 Hz body mode at 75 rpm/s, where the response lags its quasi-stationary
+    value by tens of per cent: the time-domain paths, order-tracked, still add up."""
+    table = runup_table(fmu_path, export, 1000.0, 1300.0, 4.0, start)
+    closure = tpa.closure(table)
+    significant = closure[closure.significant]
+    assert significant.groupby("response").size().min() >= 20
+    worst = significant.loc[significant.relative_error.idxmax()]
+    assert worst.relative_error < 1e-3, worst.to_dict()
+    quasi = tpa.closure(table, prefix="quasi_static_")
+    assert quasi[quasi.significant].relative_error.median() > 0.05  # not quasi-stationary
+
+
+def test_at_constant_speed_a_tracked_path_is_its_force_times_the_transfer_function(fmu_path,
+                                                                                    export):
+    """A run-up that does not change speed is a stationary window: each time-domain path's
+    tracked order equals the product of its force's order with the body's accelerance (the
+    frequency-domain TPA), path by path, for the engine's orders 1.5, 3 and 4.5."""
+    table = runup_table(fmu_path, export, 1100.0, 1100.0, 1.5, "periodic")
+    for order, tolerance in ((1.5, 1e-4), (3.0, 1e-3), (4.5, 1e-3)):
+        paths = table[~table.path.isin(["sum", "simulated"]) & (table.order == order)]
+        c = tpa.complex_values(paths)
+        q = tpa.complex_values(paths, "quasi_static_")
+        big = np.abs(c) > 0.01 * np.abs(c).max()
+        assert big.sum() >= 8
+        assert np.max(np.abs(c - q)[big] / np.abs(q)[big]) < tolerance, order
+
+
+def test_tpa_runup_writes_tables_plots_and_metadata(capsys, tmp_path, fmu_path):
+    common = ["--fmu", str(fmu_path), "--out", str(tmp_path), "--quiet"]
+    code, out = run(capsys, "tpa-runup", *common, "--rpm", "1000", "1300", "--at", "1400")
+    assert code == 2 and "--at 1400 rpm is outside the run-up" in out.err
+    code, out = run(capsys, "tpa-runup", *common, "--block-revolutions", "3")
+    assert code == 2 and "--block-revolutions must be even" in out.err
+    code, out = run(capsys, "tpa-runup", *common, "--rpm", "1000", "1200", "--duration", "2",
+                    "--at", "1100", "--response", "seat.a[3]")
+    assert code == 0, out.err
+    assert "mount[1] z" in out.out and "closure" in out.out and "quasi-stationary" in out.out
+    meta = json.loads((tmp_path / "metadata.json").read_text())
+    assert meta["fmu"]["sha256"] and meta["tpa_runup"]["start"] == "periodic"
+    assert meta["tpa_runup"]["closure_max_relative_error"] < 1e-3
+    assert abs(meta["tpa_runup"]["seat.a[3]"][""]["at"] - 1100.0) < 10.0
+    table = pd.read_csv(tmp_path / "tpa_runup.csv")
+    assert {"quasi_static_amplitude", "force_amplitude", "transfer_amplitude"} <= set(table)
+    for name in ("closure.csv", "tpa_ranked_seat.a3.png", "tpa_over_speed_seat.a3.png"):
+        assert (tmp_path / name).is_file(), name
+
+
+def test_the_engine_fmu_on_the_body_fmu_has_the_paths_of_the_single_fmu(capsys, tmp_path,
+                                                                          fmu_path,
+                                                                          body_fmu_path):
+    """Scene 3: the paths from the forces the master exchanged and the body FMU's exported modes
+    add up to the body FMU's response (the synthesis integrates the forces the body was given,
+    from the static state it started in), and after the settling second their order 1.5 is the
+    single FMU's (scene 2, a second method: one integrator, no master) path by path."""
+    code, out = run(capsys, "tpa-coupled", "--fmu", str(fmu_path), "--body-fmu",
+                    str(body_fmu_path), "--out", str(tmp_path / "coupled"), "--quiet",
+                    "--rpm-point", "1100")
+    assert code == 0, out.err
+    meta = json.loads((tmp_path / "coupled" / "metadata.json").read_text())["tpa_coupled"]
+    assert meta["closure_max_relative_error"] < 1e-8
+    assert meta["quasi_static_closure"]["max_relative_error"] < 2e-2
+    coupled = pd.read_csv(tmp_path / "coupled" / "tpa_coupled.csv")
+    code, out = run(capsys, "tpa", "--fmu", str(fmu_path), "--out", str(tmp_path / "single"),
+                    "--quiet", "--rpm", "1100", "1100", "--count", "1")
+    assert code == 0, out.err
+    single = pd.read_csv(tmp_path / "single" / "tpa.csv")
+    pick = lambda t: (t[(t.order == 1.5) & (t.response == "steeringWheel.a[3]")]  # noqa: E731
+                      .set_index("path").amplitude)
+    a, b = pick(coupled), pick(single)
+    big = b[b > 0.01 * b.max()].index
+    assert len(big) >= 5  # the four vertical paths and the sum
+    assert np.max(np.abs(a[big] / b[big] - 1)) < 1e-3, (a[big] / b[big]).to_dict()
+
+
+def test_the_paths_with_the_damping_band(capsys, tmp_path, fmu_path):
+    """At 1100 rpm the 1.5 order sits on the 26.5 Hz body mode: the least damped bound gives the
+    highest wheel level and every bound's paths close."""
+    code, out = run(capsys, "tpa", "--fmu", str(fmu_path), "--out", str(tmp_path), "--quiet",
+                    "--rpm", "1000", "1200", "--count", "2", "--at", "1100", "--band")
+    assert code == 0, out.err
+    table = pd.read_csv(tmp_path / "tpa.csv", dtype={"case": str}).fillna({"case": ""})
+    for bound in ("low", "nominal", "high"):
+        closure = tpa.closure(table[table.bound == bound])
+        assert closure[closure.significant].relative_error.max() < 1e-3, bound
+    meta = json.loads((tmp_path / "metadata.json").read_text())
+    assert meta["band"]["low"]["chassis.modalDampingScale"] == 0.6
+    band = meta["tpa"]["steeringWheel.a[3]"][""]["band"]
+    levels = [band[b]["total_amplitude"] for b in ("low", "nominal", "high")]
+    assert levels[0] > levels[1] > levels[2]
+    assert band["nominal"]["dominant_path"] == "mount[1] z"
+    wide = pd.read_csv(tmp_path / "tpa_band.csv")
+    assert {"amplitude_low", "amplitude_nominal", "amplitude_high"} <= set(wide)
+    assert (tmp_path / "tpa_band_steeringWheel.a3.png").is_file()
+
+
+def test_the_transfer_functions_and_the_shape_with_the_damping_band(capsys, tmp_path, fmu_path):
+    """A resonance peak's accelerance scales with 1 / damping: at the 26.5 Hz bending mode the
+    body's modal damping x0.6 and x1.4 give 1/0.6 and 1/1.4 of the nominal peak. The operating
+    shape at every bound holds the simulated wheel motion of that bound."""
+    code, out = run(capsys, "frf", "--fmu", str(fmu_path), "--out", str(tmp_path / "frf"),
+                    "--quiet", "--freq", "25", "28.5", "--points", "351", "--band")
+    assert code == 0, out.err
+    body = pd.read_csv(tmp_path / "frf" / "frf_body_steeringWheel.a3.csv")
+    peak = body[body.input == "mount[1].F[3]"].groupby("bound").amplitude.max()
+    assert abs(peak["low"] / peak["nominal"] * 0.6 - 1) < 0.03, peak.to_dict()
+    assert abs(peak["high"] / peak["nominal"] * 1.4 - 1) < 0.03, peak.to_dict()
+    coupled = pd.read_csv(tmp_path / "frf" / "frf_coupled_steeringWheel.a3.csv")
+    assert set(coupled.bound) == {"low", "nominal", "high"}
+    code, out = run(capsys, "ods", "--fmu", str(fmu_path), "--out", str(tmp_path / "ods"),
+                    "--quiet", "--rpm-point", "1100", "--compare", "steeringWheel.a[3]", "--band")
+    assert code == 0, out.err
+    points = pd.read_csv(tmp_path / "ods" / "ods_1100rpm_order1.5_points.csv")
+    for bound in ("low", "nominal", "high"):
+        assert points[f"relative_difference_{bound}"].max() < 1e-4, bound
+    shape = points.iloc[0]
+    assert shape.ods_displacement_low > shape.ods_displacement_nominal > shape.ods_displacement_high

@@ -3,7 +3,8 @@
 //! All through the co-simulation runtime the FMU uses (`cosim::Simulation`).
 
 use engine_mount_chassis::cosim::{
-    Inputs, Outputs, RampInput, SceneKind, Settings, Simulation, VehicleOverrides, RPM_TO_RAD_PER_S,
+    EffectSwitch, Inputs, Outputs, RampInput, SceneKind, Settings, Simulation, VehicleOverrides,
+    RPM_TO_RAD_PER_S,
 };
 
 /// DESIGN §8: the default powertrain weighs 180 kg; the default configuration's gravity.
@@ -239,6 +240,61 @@ fn impossible_cases_fail_with_a_clear_error() {
     // Negative engine speed and negative stiffness scale (0 is allowed: a mount switched off).
     assert!(Simulation::new(&Settings::default(), 0.0, &inputs(-10.0, 0.0, 1.0)).is_err());
     assert!(Simulation::new(&Settings::default(), 0.0, &inputs(800.0, 0.0, -0.5)).is_err());
+}
+
+/// The transfer-function check (`emc frf --verify`): the engine at rest, gas and mass forces off,
+/// a 45 Hz sine on the load torque given with its derivative at every communication step (50 per
+/// period). A tighter tolerance must cost steps, not refuse to run: at rtol 1e-7 both scenes
+/// used to fail their first communication step after 500,000 steps, because the absolute
+/// tolerances were scaled from the round-off left in an engine without excitation (1e-37 m).
+/// The runs at 1e-7 and 1e-9 agree to a small fraction of the powertrain's roll.
+#[test]
+fn a_sine_on_the_load_torque_at_rest_runs_at_tight_tolerances() {
+    let (frequency, amplitude) = (45.0, 20.0);
+    let w = 2.0 * std::f64::consts::PI * frequency;
+    let h = 1.0 / (50.0 * frequency);
+    let sine = |t: f64| {
+        let mut i = inputs(0.0, 0.0, 1.0);
+        i.model.load_torque = RampInput {
+            value: amplitude * (w * t).sin(),
+            rate: amplitude * w * (w * t).cos(),
+            since: t,
+        };
+        Some(i)
+    };
+    for scene in [SceneKind::Ground, SceneKind::Body] {
+        let run_at = |rel_tol: f64| {
+            let mut vehicle = VehicleOverrides::default();
+            vehicle.effects.set(EffectSwitch::GasForces, false);
+            vehicle.effects.set(EffectSwitch::MassForces, false);
+            let s = Settings {
+                scene,
+                rel_tol,
+                vehicle,
+                ..Settings::default()
+            };
+            run(&s, inputs(0.0, 0.0, 1.0), h, 50.0 * h, sine)
+                .unwrap_or_else(|e| panic!("{scene:?} at rtol {rel_tol:e}: {e}"))
+        };
+        let (loose, tight) = (run_at(1e-7), run_at(1e-9));
+        assert_finite_and_bounded(&tight, 2.0 * weight());
+        let roll = |o: &Outputs| o.powertrain_rotation[1];
+        let swing = tight.iter().map(|(_, o)| roll(o)).fold(0.0, f64::max)
+            - tight.iter().map(|(_, o)| roll(o)).fold(0.0, f64::min);
+        assert!(
+            swing > 1e-6,
+            "{scene:?}: the powertrain rolls under the torque ({swing} rad)"
+        );
+        let difference = loose
+            .iter()
+            .zip(&tight)
+            .map(|((_, a), (_, b))| (roll(a) - roll(b)).abs())
+            .fold(0.0, f64::max);
+        assert!(
+            difference < 1e-4 * swing,
+            "{scene:?}: roll at rtol 1e-7 and 1e-9 differ by {difference:e} rad of {swing:e}"
+        );
+    }
 }
 
 #[test]
