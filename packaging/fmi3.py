@@ -10,6 +10,9 @@ Layout of <modelIdentifier>-fmi3.fmu:
     terminalsAndIcons/terminalsAndIcons.xml        terminals: engine inputs, mounts, powertrain, comfort
     resources/                                     as in the 2.0 FMU
     documentation/index.html                       as in the 2.0 FMU (the variables by their 2.0 names)
+    documentation/fmi-ls-ref.html, extra/org.fmi-standard.fmi-ls-ref/
+                                                   the 2.0 FMU's reference experiments with the 3.0
+                                                   array variables, added by references.py
 """
 
 import pathlib

@@ -17,7 +17,7 @@ EngineInBody.ssp, the two FMUs connected mount by mount, is written beside them 
 cross-check/, the FMUs in the fmi-cross-check tree, by references.py)
 
 The FMI 3.0 FMUs <modelIdentifier>-fmi3.fmu (engine and body), from the same binaries, are
-written beside them (packaging/fmi3.py).
+written beside them (packaging/fmi3.py), with the same reference experiments (references.py).
 
 Usage: python packaging/package.py [--out DIR]   (default DIR: dist/)
 """
@@ -109,14 +109,16 @@ def main() -> None:
     cross_check = out / "cross-check"
     shutil.rmtree(cross_check, ignore_errors=True)
     version = tomllib.loads((ROOT / "Cargo.toml").read_text())["package"]["version"]
-    for fmu in (engine, body):
-        experiments = references.add_references(fmu)
+    engine3 = fmi3.write_fmu(out, out_dir, shipped_so, dll, engine.stem, ROOT)
+    body3 = fmi3.write_fmu(out, out_dir, shipped_so, dll, body.stem, ROOT, prefix="body.")
+    for fmu, fmu3 in ((engine, engine3), (body, body3)):
+        experiments = references.add_references(fmu, fmu3)
         references.write_cross_check(fmu, experiments[0], cross_check, version)
     print(engine)
     print(body)
     print(cross_check)
-    print(fmi3.write_fmu(out, out_dir, shipped_so, dll, engine.stem, ROOT))
-    print(fmi3.write_fmu(out, out_dir, shipped_so, dll, body.stem, ROOT, prefix="body."))
+    print(engine3)
+    print(body3)
     # The two as one system (scene 2 split at the mounts) for tools that load SSP.
     sys.path.insert(0, str(ROOT / "python"))
     from emc.ssp import write_ssp

@@ -1,20 +1,26 @@
 """The reference experiments the FMUs carry and the fmi-cross-check tree, written by package.py.
 
 Each FMU gets its experiments as FMI-LS-REF files (python/emc/references.py describes the
-layout): the stimulus, the parameter values, the expected outputs computed by the FMU itself at
-rtol 1e-9 (the experiments run at 1e-6), and the comparison tolerance. The first experiment of
-each FMU also goes into the directory tree of the FMI cross-check
+layout): the stimulus, the parameter values, the expected outputs computed by the 2.0 FMU at
+rtol 1e-9 (the experiments run at 1e-6), and the comparison tolerance. The FMI 3.0 FMU of the
+same model carries the same experiments, their columns gathered into its array variables
+(``emc.references.as_fmi3``): the references of both come from one run of the 2.0 FMU that
+records every element of the arrays the 3.0 outputs are. The first experiment of each 2.0 FMU
+also goes into the directory tree of the FMI cross-check
 (github.com/modelica/fmi-cross-check, rules 4.1):
 
     cross-check/fmus/2.0/cs/<platform>/engine_mount_chassis/<version>/<model>/
         <model>.fmu  <model>_ref.csv  <model>_ref.opt  <model>_in.csv
 
 for linux64 and win64 (the same FMU carries both binaries), which
-``fmpy.cross_check.validate_vendor_repo`` checks (sizes, model description, options, CSVs).
+``fmpy.cross_check.validate_vendor_repo`` checks (sizes, model description, options, CSVs). The
+3.0 FMUs have no cross-check tree: ``validate_vendor_repo`` (fmpy 0.3.32) skips any folder below
+``fmus/`` whose FMI version is not 1.0 or 2.0, so it would check nothing.
 """
 
 from __future__ import annotations
 
+import dataclasses
 import html
 import pathlib
 import shutil
@@ -26,7 +32,8 @@ import numpy as np
 
 sys.path.insert(0, str(pathlib.Path(__file__).resolve().parent.parent / "python"))
 from emc.references import (ANNOTATION, EXPERIMENTS, EXPERIMENTS_TYPE, LS_DIR, LS_NAME,  # noqa: E402
-                            LS_NS, LS_VERSION, MANIFEST, Experiment, csv_text, sha3, simulate)
+                            LS_NS, LS_VERSION, MANIFEST, Experiment, as_fmi3, csv_text,
+                            fmi3_arrays, fmi3_element, sha3, simulate)
 from emc.ssp import parameter_set  # noqa: E402
 
 TOOL = "engine_mount_chassis"
@@ -127,7 +134,7 @@ def experiments_xml(experiments: list[Experiment]) -> str:
     return "\n".join(lines) + "\n"
 
 
-def files_of(experiments: list[Experiment]) -> dict[str, tuple[bytes, str, str, str]]:
+def files_of(experiments: list[Experiment], computed_by: str) -> dict[str, tuple[bytes, str, str, str]]:
     """Every file of the layered standard's folder: name -> (content, MIME type, role, description)."""
     files = {EXPERIMENTS: (experiments_xml(experiments).encode(), EXPERIMENTS_TYPE,
                            "experiment/validation", "Reference experiments of this FMU")}
@@ -140,8 +147,8 @@ def files_of(experiments: list[Experiment]) -> dict[str, tuple[bytes, str, str, 
             files[f"{e.name}_in.csv"] = (csv_text(e.stimuli).encode(), "text/csv", "testcase",
                                          f"Stimulus of the experiment {e.name}")
         files[f"{e.name}_ref.csv"] = (csv_text(e.references).encode(), "text/csv", "result",
-                                      f"Expected outputs of the experiment {e.name} (rtol "
-                                      f"{REFERENCE_TOLERANCE:g})")
+                                      f"Expected outputs of the experiment {e.name} ("
+                                      f"{computed_by})")
     return files
 
 
@@ -157,7 +164,7 @@ def manifest_xml(files: dict[str, tuple[bytes, str, str, str]]) -> str:
     return "\n".join(lines) + "\n"
 
 
-def documentation(fmu: pathlib.Path, experiments: list[Experiment]) -> str:
+def documentation(fmu: pathlib.Path, experiments: list[Experiment], computed_by: str) -> str:
     rows = "\n".join(
         f"<tr><td>{html.escape(e.name)}</td><td>{html.escape(e.description)}</td>"
         f"<td>{e.stop:g} s every {e.step * 1e3:g} ms, rtol {e.tolerance:g}</td>"
@@ -172,8 +179,10 @@ the files with their SHA3-256 checksums, <code>{EXPERIMENTS}</code> the experime
 its start to its stop time with the communication step and solver tolerance it gives, the
 parameter values of its <code>.ssv</code> file, and the inputs of its <code>_in.csv</code>
 (linear between rows); every output of its <code>_ref.csv</code> must then stay within the
-tolerance below at every sample. The references were computed by this FMU at rtol
-{REFERENCE_TOLERANCE:g}; a master that reproduces them drives the FMU correctly.</p>
+tolerance below at every sample (each element of an array against the range of its own
+reference). An array variable's elements share one CSV cell, separated by spaces, in row-major
+order. The references were computed {computed_by}; a master that reproduces them drives the FMU
+correctly.</p>
 <table border="1"><tr><th>experiment</th><th>what</th><th>run</th><th>outputs compared</th><th>tolerance</th></tr>
 {rows}
 </table>
@@ -182,18 +191,50 @@ tolerance below at every sample. The references were computed by this FMU at rto
 """
 
 
-def add_references(fmu: pathlib.Path) -> list[Experiment]:
-    """Computes the references of ``fmu`` and adds the layered standard's files to it."""
-    experiments = experiments_of(fmu)
+def add_references(fmu: pathlib.Path, fmu3: pathlib.Path) -> list[Experiment]:
+    """Computes the references of the 2.0 FMU ``fmu`` and adds the layered standard's files to
+    it and, with the columns as its array variables, to its 3.0 twin ``fmu3``."""
+    from fmpy import read_model_description
+
+    arrays = fmi3_arrays([v.name for v in read_model_description(str(fmu)).modelVariables])
+    check_arrays(arrays, fmu3)
+    experiments, experiments3 = experiments_of(fmu), []
     for e in experiments:
-        e.references = simulate(fmu, e, tolerance=REFERENCE_TOLERANCE)
-    files = files_of(experiments)
-    with zipfile.ZipFile(fmu, "a", compression=zipfile.ZIP_DEFLATED) as z:
-        for name, (data, *_rest) in files.items():
-            z.writestr(f"{LS_DIR}/{name}", data)
-        z.writestr(MANIFEST, manifest_xml(files))
-        z.writestr("documentation/fmi-ls-ref.html", documentation(fmu, experiments))
+        outputs3 = list(dict.fromkeys(fmi3_element(name)[0] for name in e.outputs))
+        recorded = [name for name3 in outputs3 for name in arrays[name3]]
+        wide = simulate(fmu, dataclasses.replace(e, outputs=recorded), tolerance=REFERENCE_TOLERANCE)
+        e.references = wide[["time", *e.outputs]]
+        if any(fmi3_element(name)[1] for name in e.parameters):
+            raise ValueError(f"{e.name}: an array element as a parameter has no 3.0 SSV name")
+        experiments3.append(dataclasses.replace(
+            e, outputs=outputs3, references=as_fmi3(wide, arrays),
+            stimuli=None if e.stimuli is None else as_fmi3(e.stimuli, arrays)))
+    by = f"by this FMU at rtol {REFERENCE_TOLERANCE:g}"
+    by3 = (f"by the FMI 2.0 FMU of this model ({fmu.name}, the same binary) at rtol "
+           f"{REFERENCE_TOLERANCE:g}")
+    for target, carried, computed_by in [(fmu, experiments, by), (fmu3, experiments3, by3)]:
+        files = files_of(carried, computed_by)
+        with zipfile.ZipFile(target, "a", compression=zipfile.ZIP_DEFLATED) as z:
+            for name, (data, *_rest) in files.items():
+                z.writestr(f"{LS_DIR}/{name}", data)
+            z.writestr(MANIFEST, manifest_xml(files))
+            z.writestr("documentation/fmi-ls-ref.html", documentation(target, carried, computed_by))
     return experiments
+
+
+def check_arrays(arrays: dict[str, list[str]], fmu3: pathlib.Path) -> None:
+    """Every 3.0 variable named by the mapping of 2.0 names exists with as many elements."""
+    from fmpy import read_model_description
+
+    variables = {v.name: v for v in read_model_description(str(fmu3)).modelVariables}
+    for name3, members in arrays.items():
+        v = variables.get(name3)
+        if v is None:
+            raise ValueError(f"{fmu3.name} has no variable {name3} (from {members[0]})")
+        if all(d.start is not None for d in v.dimensions):
+            size = int(np.prod([int(d.start) for d in v.dimensions]))
+            if size != len(members):
+                raise ValueError(f"{fmu3.name}: {name3} has {size} elements, the 2.0 FMU {len(members)}")
 
 
 def write_cross_check(fmu: pathlib.Path, experiment: Experiment, root: pathlib.Path, version: str) -> list[pathlib.Path]:

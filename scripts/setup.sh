@@ -105,8 +105,8 @@ stamp="$venv/.requirements.sha256"
 want=$(cat "$root/python/requirements.txt" "$root/python/pyproject.toml" | sha256sum | cut -d' ' -f1)
 if [ ! -f "$stamp" ] || [ "$(cat "$stamp")" != "$want" ]; then
   echo "setup: installing Python requirements and the emc tool"
-  "$venv/bin/pip" install -q --disable-pip-version-check -r "$root/python/requirements.txt"
-  "$venv/bin/pip" install -q --disable-pip-version-check --no-deps -e "$root/python"
+  "$venv/bin/python" -m pip install -q --disable-pip-version-check -r "$root/python/requirements.txt"
+  "$venv/bin/python" -m pip install -q --disable-pip-version-check --no-deps -e "$root/python"
   echo "$want" >"$stamp"
 fi
 
@@ -117,7 +117,7 @@ stamp="$venv/.requirements-test.sha256"
 want=$(sha256sum <"$root/python/requirements-test.txt" | cut -d' ' -f1)
 if [ ! -f "$stamp" ] || [ "$(cat "$stamp")" != "$want" ]; then
   echo "setup: installing the Python test requirements (pytest)"
-  "$venv/bin/pip" install -q --disable-pip-version-check -r "$root/python/requirements-test.txt"
+  "$venv/bin/python" -m pip install -q --disable-pip-version-check -r "$root/python/requirements-test.txt"
   echo "$want" >"$stamp"
 fi
 
@@ -142,6 +142,6 @@ fi
 want=$(sha256sum <"$nastran_req" | cut -d' ' -f1)
 if [ ! -f "$nastran_stamp" ] || [ "$(cat "$nastran_stamp")" != "$want" ]; then
   echo "setup: installing pyNastran (a venv of its own: it needs numpy < 2)"
-  "$nastran_venv/bin/pip" install -q --disable-pip-version-check -r "$nastran_req"
+  "$nastran_venv/bin/python" -m pip install -q --disable-pip-version-check -r "$nastran_req"
   echo "$want" >"$nastran_stamp"
 fi
