@@ -64,11 +64,12 @@ def model_variables(fmu: str) -> dict:
     return {v.name: v for v in read_model_description(fmu).modelVariables}
 
 
-def typed_value(variable, text: str):
-    """``text`` as a value of ``variable``, checked against its type and declared range."""
+def typed_value(variable, text: str, controlled: dict = CONTROLLED):
+    """``text`` as a value of ``variable``, checked against its type and declared range
+    (``controlled``: names the caller sets itself, refused)."""
     name = variable.name
-    if name in CONTROLLED:
-        raise UsageError(f"--set {name}: emc sets it for every point; use {CONTROLLED[name]}")
+    if name in controlled:
+        raise UsageError(f"--set {name}: emc sets it for every point; use {controlled[name]}")
     if variable.causality not in ("parameter", "input"):
         article = "an" if variable.causality[0] in "aeiou" else "a"
         raise UsageError(f"--set {name}: only parameters and inputs can be set, this is "

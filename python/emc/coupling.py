@@ -41,17 +41,14 @@ from __future__ import annotations
 import argparse
 import dataclasses
 import pathlib
-import shutil
 import sys
 import tempfile
 import time
 
 import numpy as np
-from fmpy import extract, read_model_description
-from fmpy.fmi2 import FMU2Slave
+from fmpy import read_model_description
 
-from .runner import (logging_callbacks, mount_count, release_logging, set_value,
-                     variable_names)
+from .runner import Runner, mount_count, variable_names
 from .spectra import ORDERS, order_amplitudes
 from .synthesis import HeldForces
 
@@ -83,20 +80,12 @@ class Diverged(RuntimeError):
     :data:`FORCE_LIMIT`."""
 
 
-class Fmu:
-    """One FMU instance on fmpy's low-level API, addressed by variable name."""
+class Fmu(Runner):
+    """One FMU instance on fmpy's low-level API, addressed by variable name: the sweeps'
+    :class:`Runner`, started by the coupling master itself."""
 
     def __init__(self, path, name: str):
-        self.md = read_model_description(str(path))
-        self.unzipdir = extract(str(path))
-        self.vr = {v.name: v.valueReference for v in self.md.modelVariables}
-        self.kind = {v.name: v.type for v in self.md.modelVariables}
-        self.slave = FMU2Slave(guid=self.md.guid, unzipDirectory=self.unzipdir,
-                               modelIdentifier=self.md.coSimulation.modelIdentifier,
-                               instanceName=name)
-        self.log: list[str] = []
-        self.callbacks = logging_callbacks(self.log)
-        self.slave.instantiate(callbacks=self.callbacks)
+        super().__init__(str(path), name)
 
     def refs(self, names):
         return [self.vr[n] for n in names]
@@ -105,20 +94,11 @@ class Fmu:
         # No stop time declared: the master may probe a step past t_end (body_response).
         self.slave.setupExperiment(startTime=0.0)
         for name, value in values.items():
-            set_value(self.slave, self.kind[name], self.vr[name], value)
+            self._set(name, value)
 
     def errors(self) -> str:
         lines = [line for line in self.log if line.startswith(("[error]", "[fatal]"))]
         return "; ".join(lines[-3:])
-
-    def close(self):
-        try:
-            self.slave.terminate()
-        except Exception:  # noqa: BLE001 - a failed run leaves the instance in an error state
-            pass
-        self.slave.freeInstance()
-        release_logging(self.callbacks)
-        shutil.rmtree(self.unzipdir, ignore_errors=True)
 
 
 def dependency_groups(fmu: Fmu, outputs: list[str],

@@ -7,8 +7,10 @@ import sys
 
 import pytest
 from fmpy import read_model_description
+from fmpy.ssp.ssd import read_ssd
 
 from emc.split import largest_deviation, scene_2, split_in_libcosim
+from emc.runner import mount_count
 from emc.ssp import connections, write_ssp
 
 ROOT = pathlib.Path(__file__).resolve().parents[2]
@@ -22,11 +24,70 @@ def body_fmu_path(fmu_path) -> pathlib.Path:
     return path
 
 
+def test_the_shipped_ssp_is_valid_against_the_ssp_1_0_schemas(body_fmu_path):
+    # fmpy validates SystemStructure.ssd against SSP 1.0's SystemStructureDescription.xsd and each
+    # parameter set it binds by source against SystemStructureParameterValues.xsd.
+    ssd = read_ssd(str(ROOT / "dist" / "EngineInBody.ssp"), validate=True)
+    engine = next(e for e in ssd.system.elements if e.name == "engine")
+    values = {p.name: (p.type, p.value) for b in engine.parameterBindings for s in b.parameterValues
+              for p in s.parameters}
+    assert values == {"scene": ("Integer", "3")}
+
+
+def test_parameters_of_every_type_make_a_valid_ssp(fmu_path, body_fmu_path, tmp_path):
+    ssp = write_ssp(fmu_path, body_fmu_path, tmp_path / "typed.ssp",
+                    engine_parameters={"rpm": 1500.0, "solver.maxOrder": 3,
+                                       "effects.balanceShaft": False, "chassis.cacheDir": "a&b<c>"},
+                    body_parameters={"chassis.stiffeningBar": True})
+    ssd = read_ssd(str(ssp), validate=True)
+    got = {e.name: {p.name: (p.type, p.value) for b in e.parameterBindings for s in b.parameterValues
+                    for p in s.parameters} for e in ssd.system.elements}
+    assert got == {"engine": {"rpm": ("Real", "1500.0"), "solver.maxOrder": ("Integer", "3"),
+                              "effects.balanceShaft": ("Boolean", "false"),
+                              "chassis.cacheDir": ("String", "a&b<c>"), "scene": ("Integer", "3")},
+                   "body": {"chassis.stiffeningBar": ("Boolean", "true")}}
+
+
+@pytest.mark.parametrize("parameters, message", [
+    ({"solver.relTol": 5.0}, "solver.relTol=5.0: outside the declared range [1e-12, 0.1]"),
+    ({"solver.maxOrder": 2.5}, "solver.maxOrder=2.5: not an Integer"),
+    ({"mount[1].F[3]": 1.0}, "mount[1].F[3]: only parameters and inputs can be set, this is an output"),
+    ({"solver.reltol": 1e-6}, "no variable named solver.reltol"),
+])
+def test_a_value_the_fmu_would_refuse_never_reaches_the_ssp(fmu_path, body_fmu_path, tmp_path,
+                                                             parameters, message):
+    # libcosim 0.11 aborts the whole process when an FMU refuses a parameter value of an SSP.
+    out = tmp_path / "refused.ssp"
+    with pytest.raises(ValueError) as refused:
+        write_ssp(fmu_path, body_fmu_path, out, engine_parameters=parameters)
+    assert str(refused.value) == f"EngineMountChassis.fmu: {message}"
+    assert not out.exists()
+
+
+def test_libcosim_takes_the_parameter_sets_and_the_step_from_the_ssp(fmu_path, body_fmu_path, tmp_path):
+    from libcosimpy.CosimExecution import CosimExecution
+    from libcosimpy.CosimObserver import CosimObserver
+
+    cache = tmp_path / "cache"
+    ssp = write_ssp(fmu_path, body_fmu_path, tmp_path / "EngineInBody.ssp",
+                    engine_parameters={"chassis.cacheDir": str(cache), "solver.relTol": 1e-7},
+                    body_parameters={"chassis.cacheDir": str(cache)}, step_size=2e-4)
+    execution = CosimExecution.from_ssp_file(str(ssp))  # no step given: the SSD's annotation
+    observer = CosimObserver.create_last_value()
+    execution.add_observer(observer)
+    engine = execution.slave_index_from_instance_name("engine")
+    vr = {v.name.decode(): v.reference for v in execution.slave_variables(engine)}
+    assert execution.step()
+    assert execution.status().current_time == 200_000  # ns
+    assert observer.last_integer_values(engine, [vr["scene"]]) == [3]
+    assert observer.last_real_values(engine, [vr["solver.relTol"]]) == [1e-7]
+
+
 def test_the_ssp_connects_every_mount_both_ways(fmu_path, body_fmu_path):
     engine = {v.name: v for v in read_model_description(str(fmu_path)).modelVariables}
     body = {v.name: v for v in read_model_description(str(body_fmu_path)).modelVariables}
     models = {"engine": engine, "body": body}
-    links = connections()
+    links = connections(mount_count(engine))
     assert len(links) == 36
     for a, ca, b, cb in links:
         assert models[a][ca].causality == "output" and models[b][cb].causality == "input"

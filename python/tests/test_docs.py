@@ -215,3 +215,60 @@ def test_the_commands_the_guide_names_exist():
     assert {"sweep", "runup", "campbell", "study-mounts", "bench-realtime"} <= commands
     for command in commands:
         assert command in subcommands, f"emc {command}"
+
+
+def _generator():
+    sys.path.insert(0, str(ROOT / "docs"))
+    try:
+        import generate
+    finally:
+        sys.path.pop(0)
+    return generate
+
+
+def test_generated_sections_are_current(fmu_path, fmu3_path):
+    # The variable tables, the FMI 3.0 terminals and the card table are generated from the model
+    # descriptions and the deck reader (docs/generate.py); a page whose section differs is stale.
+    generate = _generator()
+    assert len(generate.pages()) >= 2
+    stale = [p.relative_to(ROOT).as_posix() for p in generate.stale_pages()]
+    assert not stale, f"stale generated sections in {stale}: regenerate with `{generate.COMMAND}`"
+
+
+def test_a_stale_generated_section_is_found(fmu_path, fmu3_path):
+    generate = _generator()
+    page = BOOK_SRC / "fmu" / "variables.md"
+    text = page.read_text()
+    assert generate.regenerate(text, page, {}) == text
+    stale = text.replace("| `rpm` | input |", "| `rpm` | output |", 1)
+    assert stale != text and generate.regenerate(stale, page, {}) == text
+
+
+# Phrases that tell the story of how the guide came to be instead of what holds now: the history
+# belongs in CHANGELOG.md and git, evidence pages give what was measured, the command, the date
+# and the machine.
+HISTORY = re.compile(r"|".join([
+    r"\bissue \d+", r"\b(first|second|third|last|this|that|previous|earlier|same) (session|sitting)s?\b",
+    r"\bthe day before\b", r"\bthe same morning\b", r"\bthis morning\b", r"\byesterday\b",
+    r"\b(before|after|since) the (fix|speed-ups?|change)\b", r"\bre-?run since\b",
+    r"\bthe former\b", r"\bformerly\b", r"\bof that day\b", r"\buntil now\b",
+    r"\bprevious(ly)? (version|release|code|solver)\b", r"\bearlier (runs|measurements|version|code)\b",
+    r"\b(has|have) not been re-?(run|measured)\b",
+]), re.I)
+
+
+def history_phrases(text: str) -> list[str]:
+    return [f"line {text.count(chr(10), 0, m.start()) + 1}: '{m.group(0)}'"
+            for m in HISTORY.finditer(text)]
+
+
+def test_the_guide_has_no_history_phrases():
+    found = {p.relative_to(ROOT).as_posix(): history_phrases(p.read_text()) for p in pages()}
+    found = {page: hits for page, hits in found.items() if hits}
+    assert not found, found
+
+
+def test_the_history_check_finds_history():
+    text = "Fast.\n607.9 s the day before (issue 27, first sitting); measured before the fix.\n"
+    assert len(history_phrases(text)) == 4
+    assert history_phrases("The solver holds the order down for a while.") == []

@@ -82,3 +82,25 @@ def test_no_build_artefacts_in_the_repository():
                              text=True, check=True).stdout.splitlines()
     assert tracked, "git lists the python folder"
     assert not [f for f in tracked if ".egg-info/" in f or "__pycache__" in f]
+
+
+def test_one_version_everywhere(project, fmu_path, fmu3_path):
+    # Cargo.toml's version is the release: pyproject.toml, the variable table (the FMUs' version
+    # attribute), every packaged FMU and a dated changelog section below "Unreleased" say the same.
+    import json
+    import xml.etree.ElementTree as ET
+    import zipfile
+
+    version = tomllib.loads((ROOT / "Cargo.toml").read_text())["package"]["version"]
+    assert project["version"] == version
+    assert json.loads((ROOT / "modelDescription" / "variables.json").read_text())["version"] == version
+    fmus = sorted((ROOT / "dist").glob("*.fmu"))
+    assert len(fmus) >= 2
+    for fmu in fmus:
+        with zipfile.ZipFile(fmu) as z:
+            attribute = ET.fromstring(z.read("modelDescription.xml")).get("version")
+        assert attribute == version, f"{fmu.name} says version {attribute}: run bash packaging/package.sh"
+    changelog = (ROOT / "CHANGELOG.md").read_text()
+    section = re.search(rf"^## \[{re.escape(version)}\] - (\d{{4}}-\d{{2}}-\d{{2}})$", changelog, re.M)
+    assert section, f"CHANGELOG.md has no dated section for {version}"
+    assert changelog.index("## [Unreleased]") < section.start()

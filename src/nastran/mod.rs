@@ -116,7 +116,8 @@
 //!   set in the file.
 //! - PARAM WTMASS (scales all mass), PARAM POST/GRDPNT/… (output only) and EIGRL/EIGR
 //!   (extraction requests) are accepted; any other card is an error naming card and line and
-//!   listing the supported cards (one table, which the card dispatch uses).
+//!   listing the supported cards (one table, [`card_table::CARD_TABLE`], which the card dispatch
+//!   uses and the user guide's card table is generated from).
 //! - GRIDs that no element, spring, damper, bush, mass or link references (coordinate
 //!   definition grids, leftovers) get no DOFs: all six are constrained, as Nastran's AUTOSPC
 //!   does, and [`NastranBody::unused_grids`] and a note in [`NastranBody::notes`] name them.
@@ -132,6 +133,7 @@
 //! Reduced bodies: [`read_dmig_file`] / [`write_dmig_file`] read and write Craig-Bampton
 //! matrices as Nastran punches them (`DMIG`, see the `dmig` module).
 
+pub mod card_table;
 mod cards;
 mod dmig;
 mod lexer;

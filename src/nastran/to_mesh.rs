@@ -5,6 +5,7 @@ use std::collections::{BTreeMap, BTreeSet};
 
 use nalgebra::{Matrix3, Vector3};
 
+use super::card_table;
 use super::cards::{self, Orientation, Reader, ScalarValue, SystemKind};
 use super::lexer::{CardSink, Loc, RawCard, Value};
 use super::reader::DeckInfo;
@@ -18,26 +19,12 @@ use crate::fe::mesh::{
 
 mod shell_cards;
 
-/// Every bulk data card the reader accepts: the dispatch in `Cards::add` takes exactly these
-/// (a test feeds each one), and the refusal of any other card lists them.
-pub(crate) const SUPPORTED_CARDS: [&str; 36] = [
-    "GRID", "CORD2R", "CORD2C", "CORD2S", "MAT1", "MAT2", "MAT8", "PSHELL", "PBAR", "PBEAM",
-    "PELAS", "PDAMP", "PBUSH", "PSOLID", "CQUAD4", "CTRIA3", "CBAR", "CBEAM", "CTETRA", "CPENTA",
-    "CHEXA", "CONM1", "CONM2", "CBUSH", "CELAS1", "CELAS2", "CDAMP1", "CDAMP2", "RBE2", "RBE3",
-    "SPC", "SPC1", "PARAM", "EIGRL", "EIGR", "TABDMP1",
-];
-
-/// Parameters that only steer output or solution bookkeeping: accepted and ignored.
-const IGNORED_PARAMS: [&str; 8] = [
-    "POST", "GRDPNT", "AUTOSPC", "PRGPST", "MAXRATIO", "OGEOM", "NOCOMPS", "BAILOUT",
-];
-
 fn unsupported(card: &str, line: &Loc) -> FeError {
     mesh_error(
         line,
         format!(
             "card {card} is not supported (supported: {})",
-            SUPPORTED_CARDS.join(", ")
+            card_table::supported_list()
         ),
     )
 }
@@ -113,7 +100,7 @@ impl Cards {
         {
             let r = Reader::new(raw);
             let line = raw.loc();
-            let Some(&name) = SUPPORTED_CARDS.iter().find(|c| **c == raw.name) else {
+            let Some(name) = card_table::supported_card(&raw.name) else {
                 return Err(unsupported(&raw.name, &line));
             };
             match name {
@@ -274,13 +261,13 @@ impl Cards {
             }
             self.mass_scale = w;
             Ok(())
-        } else if IGNORED_PARAMS.contains(&name.as_str()) {
+        } else if card_table::IGNORED_PARAMS.contains(&name.as_str()) {
             Ok(())
         } else {
             Err(r.card_error(format!(
                 "PARAM {name} is not supported (it may change K or M); supported: WTMASS, and \
                  ignored as output-only: {}",
-                IGNORED_PARAMS.join(", ")
+                card_table::IGNORED_PARAMS.join(", ")
             )))
         }
     }
@@ -1216,7 +1203,7 @@ mod tests {
     /// own parser, never as unsupported), and any other name is refused listing them all.
     #[test]
     fn the_supported_card_table_is_the_dispatch() {
-        for card in SUPPORTED_CARDS {
+        for card in card_table::supported_cards() {
             let mut collector = Collector::new();
             let raw = crate::nastran::lex(&format!("{card},1\n"))
                 .unwrap()
@@ -1231,6 +1218,24 @@ mod tests {
         }
         let raw = crate::nastran::lex("CTRIA6,1\n").unwrap().cards.remove(0);
         let err = Collector::new().card(raw).err().unwrap().to_string();
-        assert!(err.contains(&SUPPORTED_CARDS.join(", ")), "{err}");
+        assert!(err.contains(&card_table::supported_list()), "{err}");
+    }
+
+    /// The cards the table lists as refused are refused by the dispatch, as unsupported.
+    #[test]
+    fn the_cards_listed_as_refused_are_refused() {
+        for (cards, _) in card_table::REFUSED_CARDS {
+            for card in cards.split(", ") {
+                let raw = crate::nastran::lex(&format!("{card},1\n"))
+                    .unwrap()
+                    .cards
+                    .remove(0);
+                let err = Collector::new().card(raw).err().unwrap().to_string();
+                assert!(
+                    err.contains(&format!("card {card} is not supported")),
+                    "{card}: {err}"
+                );
+            }
+        }
     }
 }

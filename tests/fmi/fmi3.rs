@@ -46,9 +46,9 @@ fn logged(part: &str) -> bool {
 macro_rules! symbols {
     ($($name:ident : $ty:ident),* $(,)?) => {
         #[allow(non_snake_case)]
-        struct F3 { _lib: Library, $($name: <$ty as Inner>::F,)* }
+        pub(crate) struct F3 { _lib: Library, $(pub(crate) $name: <$ty as Inner>::F,)* }
         impl F3 {
-            fn load() -> F3 {
+            pub(crate) fn load() -> F3 {
                 let path = common::library_path();
                 // SAFETY: our own cdylib; the symbols have the signatures of fmi-sys' fmi3
                 // typedefs, and the copied pointers live no longer than the library in F3.
@@ -64,7 +64,7 @@ macro_rules! symbols {
     };
 }
 
-trait Inner {
+pub(crate) trait Inner {
     type F: Copy;
 }
 impl<F: Copy> Inner for Option<F> {
@@ -99,13 +99,13 @@ symbols! {
     fmi3DoStep: fmi3DoStepTYPE,
 }
 
-struct Instance<'a> {
-    f: &'a F3,
-    i: fmi3Instance,
+pub(crate) struct Instance<'a> {
+    pub(crate) f: &'a F3,
+    pub(crate) i: fmi3Instance,
 }
 
 impl F3 {
-    fn try_instantiate(&self, token: &str, event_mode: bool) -> Option<Instance<'_>> {
+    pub(crate) fn try_instantiate(&self, token: &str, event_mode: bool) -> Option<Instance<'_>> {
         self.try_instantiate_with(token, event_mode, &[])
     }
 
@@ -140,7 +140,7 @@ impl F3 {
         (!i.is_null()).then_some(Instance { f: self, i })
     }
 
-    fn instantiate(&self) -> Instance<'_> {
+    pub(crate) fn instantiate(&self) -> Instance<'_> {
         self.try_instantiate(GUID, false).expect("instantiate")
     }
 }
@@ -148,7 +148,7 @@ impl F3 {
 // SAFETY (all methods): `i` is a live instance of this library, the slices are valid for the
 // lengths passed, and out-pointers point to locals.
 impl Instance<'_> {
-    fn init(&self) -> fmi3Status {
+    pub(crate) fn init(&self) -> fmi3Status {
         let s =
             unsafe { (self.f.fmi3EnterInitializationMode)(self.i, false, 0.0, 0.0, false, 0.0) };
         if s != OK {
@@ -156,20 +156,20 @@ impl Instance<'_> {
         }
         unsafe { (self.f.fmi3ExitInitializationMode)(self.i) }
     }
-    fn step(&self, t: f64, h: f64) -> (fmi3Status, [bool; 3], f64) {
+    pub(crate) fn step(&self, t: f64, h: f64) -> (fmi3Status, [bool; 3], f64) {
         let (mut e, mut term, mut early, mut last) = (true, true, true, -1.0);
         let s = unsafe {
             (self.f.fmi3DoStep)(self.i, t, h, true, &mut e, &mut term, &mut early, &mut last)
         };
         (s, [e, term, early], last)
     }
-    fn get(&self, vrs: &[u32], n: usize) -> (fmi3Status, Vec<f64>) {
+    pub(crate) fn get(&self, vrs: &[u32], n: usize) -> (fmi3Status, Vec<f64>) {
         let mut v = vec![0.0; n];
         let s =
             unsafe { (self.f.fmi3GetFloat64)(self.i, vrs.as_ptr(), vrs.len(), v.as_mut_ptr(), n) };
         (s, v)
     }
-    fn set(&self, vrs: &[u32], values: &[f64]) -> fmi3Status {
+    pub(crate) fn set(&self, vrs: &[u32], values: &[f64]) -> fmi3Status {
         unsafe {
             (self.f.fmi3SetFloat64)(
                 self.i,
@@ -180,7 +180,13 @@ impl Instance<'_> {
             )
         }
     }
-    fn derivative(&self, unknowns: &[u32], n: usize, knowns: &[u32], seed: &[f64]) -> Vec<f64> {
+    pub(crate) fn derivative(
+        &self,
+        unknowns: &[u32],
+        n: usize,
+        knowns: &[u32],
+        seed: &[f64],
+    ) -> Vec<f64> {
         let mut out = vec![0.0; n];
         let s = unsafe {
             (self.f.fmi3GetDirectionalDerivative)(
@@ -198,7 +204,7 @@ impl Instance<'_> {
         assert_eq!(s, OK, "fmi3GetDirectionalDerivative");
         out
     }
-    fn get_state(&self) -> (fmi3Status, fmi3FMUState) {
+    pub(crate) fn get_state(&self) -> (fmi3Status, fmi3FMUState) {
         let mut state = std::ptr::null_mut();
         let s = unsafe { (self.f.fmi3GetFMUState)(self.i, &mut state) };
         (s, state)

@@ -5,9 +5,12 @@ mod bad_inputs;
 mod common;
 mod coupling;
 mod fmi3;
+mod fmi3_coupling;
 mod inputs;
 mod model_structure;
 mod natural_modes;
+#[path = "../common/order_deviation.rs"]
+mod order_deviation;
 mod precedence;
 mod properties;
 mod schema;

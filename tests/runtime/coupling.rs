@@ -2,11 +2,11 @@
 //! the monolithic scene 2 — the split a vehicle co-simulation makes, checked without an FMI
 //! master in between.
 
+use crate::order_deviation::{assert_within, order_deviations};
 use engine_mount_chassis::cosim::{
     BodySimulation, CacheSetting, Inputs, Outputs, RampInput, SceneKind, Settings, Simulation,
 };
 use engine_mount_chassis::model::inputs::AttachmentMotion;
-use engine_mount_chassis::model::orders::order_amplitude;
 
 fn settings(scene: SceneKind, cache: &std::path::Path) -> Settings {
     let mut s = Settings {
@@ -146,22 +146,6 @@ impl Split {
     }
 }
 
-/// Per signal (12 mount-force components, 3 steering-wheel components) the amplitudes of the
-/// half orders 0.5..6 over the last `revolutions` of `samples` (one per `h`, a whole number per
-/// revolution).
-fn orders(samples: &[Vec<f64>], per_rev: usize, revolutions: usize) -> Vec<Vec<f64>> {
-    let n = per_rev * revolutions;
-    let tail = &samples[samples.len() - n..];
-    (0..tail[0].len())
-        .map(|c| {
-            let x: Vec<f64> = tail.iter().map(|s| s[c]).collect();
-            (1..=12)
-                .map(|k| order_amplitude(&x, per_rev, k as f64 * 0.5).unwrap())
-                .collect()
-        })
-        .collect()
-}
-
 fn signals(o: &Outputs) -> Vec<f64> {
     let mut v: Vec<f64> = o.mount_force.iter().flatten().copied().collect();
     v.extend(o.steering_wheel_acceleration);
@@ -189,24 +173,11 @@ fn engine_and_body_coupled_mount_by_mount_reproduce_scene_2() {
             a.push(signals(&mono.outputs().unwrap()));
             b.push(signals(&split.step(t)));
         }
-        let (oa, ob) = (orders(&a, per_rev, 8), orders(&b, per_rev, 8));
-        let mut worst = 0.0f64;
-        for (c, (xa, xb)) in oa.iter().zip(&ob).enumerate() {
-            let largest = xa.iter().fold(0.0f64, |m, x| m.max(*x));
-            for (k, (ya, yb)) in xa.iter().zip(xb).enumerate() {
-                if *ya < 0.01 * largest {
-                    continue;
-                }
-                let rel = (yb - ya).abs() / ya;
-                worst = worst.max(rel);
-                assert!(
-                    rel < 0.02,
-                    "{rpm} rpm, signal {c}, order {}: split {yb:.5e} vs scene 2 {ya:.5e} ({:.2} %)",
-                    (k + 1) as f64 * 0.5,
-                    rel * 100.0
-                );
-            }
-        }
+        let worst = assert_within(
+            &order_deviations(&a, &b, per_rev, 8),
+            0.02,
+            &format!("{rpm} rpm"),
+        );
         eprintln!(
             "{rpm} rpm: largest order-amplitude deviation split vs scene 2 {:.3} %",
             worst * 100.0

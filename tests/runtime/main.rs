@@ -4,4 +4,6 @@ mod coupling;
 mod damping;
 mod hard_cases;
 mod hybrid_cosim;
+#[path = "../common/order_deviation.rs"]
+mod order_deviation;
 mod periodic_start;

@@ -1,0 +1,339 @@
+"""Writes the guide's generated sections from where their truth is: the variable tables from the
+model descriptions that build.rs writes from modelDescription/variables.json (with the family
+names and descriptions of variables.json itself), the FMI 3.0 terminals from the 3.0 FMUs'
+terminalsAndIcons.xml, the supported bulk-data cards from the deck reader's dispatch table.
+
+A generated section sits in a page between two markers:
+
+    <!-- generated: NAME -->
+    ...
+    <!-- end generated: NAME -->
+
+Usage (after `bash packaging/package.sh`, which writes the FMUs this reads):
+
+    .venv/bin/python docs/generate.py           # rewrite every generated section
+    .venv/bin/python docs/generate.py --check   # list stale pages, exit 1 if any
+
+python/tests/test_docs.py runs the check: a page whose generated section is stale fails it.
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import pathlib
+import re
+import subprocess
+import sys
+import xml.etree.ElementTree as ET
+import zipfile
+
+ROOT = pathlib.Path(__file__).resolve().parent.parent
+PAGES = ROOT / "docs" / "src"
+DIST = ROOT / "dist"
+TABLE = ROOT / "modelDescription" / "variables.json"
+COMMAND = ".venv/bin/python docs/generate.py"
+
+BEGIN = re.compile(r"<!-- generated: ([\w-]+) -->\n")
+END = "<!-- end generated: {} -->"
+INDICES = ["i", "j", "k"]
+CAUSALITY_ORDER = ["input", "output", "parameter", "calculatedParameter", "structuralParameter",
+                   "local", "independent"]
+
+
+# ---------------------------------------------------------------------------------------------
+# Variables: the FMI 2.0 model descriptions, families named as in variables.json
+
+
+def fmu_text(fmu: pathlib.Path, member: str) -> str:
+    if not fmu.is_file():
+        sys.exit(f"generate: {fmu.relative_to(ROOT)} is missing: run bash packaging/package.sh first")
+    with zipfile.ZipFile(fmu) as z:
+        return z.read(member).decode("utf-8")
+
+
+class Family:
+    """Scalars that share a name template of variables.json (``mount[{i}].F[{j}]``), or a scalar
+    that no template names."""
+
+    def __init__(self, name: str, description: str, dims: list[int], pattern: re.Pattern | None):
+        self.name, self.description, self.dims, self.pattern = name, description, dims, pattern
+        self.scalars: list[tuple[dict, tuple[int, ...]]] = []  # (attributes, indices)
+
+    def display(self) -> str:
+        return self.name.format(**dict(zip(INDICES, INDICES)))
+
+    def text(self) -> str:
+        return self.description.format(**dict(zip(INDICES, INDICES)))
+
+
+def templates(fmu_key: str) -> list[Family]:
+    """The families variables.json declares for the FMU ``fmu_key`` (engine or body)."""
+    out = []
+    for v in json.loads(TABLE.read_text())["variables"]:
+        if fmu_key not in v.get("fmus", ["engine"]):
+            continue
+        pattern = re.escape(v["name"])
+        for index in INDICES:
+            pattern = pattern.replace(re.escape("{" + index + "}"), r"(\d+)")
+        out.append(Family(v["name"], v["description"], v.get("dims", []), re.compile(pattern + "$")))
+    return out
+
+
+def fmu_key(model_name: str) -> str:
+    table = json.loads(TABLE.read_text())
+    if model_name == table["modelName"]:
+        return "engine"
+    if model_name == table.get("bodyModel", {}).get("modelName"):
+        return "body"
+    sys.exit(f"generate: {model_name} is neither model of {TABLE.relative_to(ROOT)}")
+
+
+def read_variables(fmu: pathlib.Path) -> tuple[ET.Element, list[dict], dict[int, list[int] | None]]:
+    """The model description root, its scalar variables (attributes, the type element's attributes
+    as ``type`` and ``kind``), and each output's direct dependencies (indices into the list,
+    0-based; None where the attribute is absent: dependent on every input)."""
+    root = ET.fromstring(fmu_text(fmu, "modelDescription.xml"))
+    scalars = []
+    for sv in root.iter("ScalarVariable"):
+        typed = next(iter(sv))
+        scalars.append({**sv.attrib, "kind": typed.tag, "type": dict(typed.attrib)})
+    dependencies: dict[int, list[int] | None] = {}
+    outputs = root.find("ModelStructure/Outputs")
+    for unknown in ([] if outputs is None else outputs.iter("Unknown")):
+        deps = unknown.get("dependencies")
+        dependencies[int(unknown.get("index")) - 1] = (
+            None if deps is None else [int(d) - 1 for d in deps.split()])
+    return root, scalars, dependencies
+
+
+def families_of(scalars: list[dict], key: str) -> tuple[list[Family], dict[int, tuple[Family, tuple]]]:
+    families = templates(key)
+    where: dict[int, tuple[Family, tuple]] = {}
+    for n, s in enumerate(scalars):
+        for f in families:
+            m = f.pattern.match(s["name"])
+            if m:
+                indices = tuple(int(g) for g in m.groups())
+                break
+        else:
+            f = Family(s["name"].replace("{", "{{").replace("}", "}}"),
+                       s.get("description", "").replace("{", "{{").replace("}", "}}"), [], None)
+            families.append(f)
+            indices = ()
+        f.scalars.append((s, indices))
+        where[n] = (f, indices)
+    return [f for f in families if f.scalars], where
+
+
+def number(text: str | None) -> str:
+    if text is None:
+        return ""
+    try:
+        v = float(text)
+    except ValueError:
+        return text
+    return f"{v:g}"
+
+
+def unit_text(f: Family) -> str:
+    t = f.scalars[0][0]["type"]
+    unit = t.get("unit", "")
+    display = t.get("displayUnit")
+    if unit and display and display != unit:
+        return f"{unit} ({display})"
+    return unit
+
+
+def range_text(f: Family) -> str:
+    t = f.scalars[0][0]["type"]
+    lo, hi = number(t.get("min")), number(t.get("max"))
+    if lo and hi:
+        return f"{lo} … {hi}"
+    if lo:
+        return f"≥ {lo}"
+    if hi:
+        return f"≤ {hi}"
+    return ""
+
+
+def start_text(f: Family) -> str:
+    s, _ = f.scalars[0]
+    start = s["type"].get("start")
+    if start is None:
+        return ""
+    if s["kind"] == "String":
+        return f'`"{start}"`'
+    return number(start) if s["kind"] in ("Real", "Integer") else start
+
+
+def dependencies_text(f: Family, scalars: list[dict], dependencies: dict, where: dict) -> str:
+    """The inputs an output responds to at once (its direct dependencies in <ModelStructure>)."""
+    if f.scalars[0][0].get("causality") != "output":
+        return ""
+    index_of = {id(s): n for n, s in enumerate(scalars)}
+    inputs: dict[int, tuple[Family, set]] = {}  # by id(family): (family, the elements named)
+    same_first_index = True
+    for s, indices in f.scalars:
+        deps = dependencies.get(index_of[id(s)], None)
+        if deps is None:
+            return "every input"
+        for d in deps:
+            dep_family, dep_indices = where[d]
+            inputs.setdefault(id(dep_family), (dep_family, set()))[1].add(dep_indices)
+            if not (indices and dep_indices and dep_indices[0] == indices[0]):
+                same_first_index = False
+    if not inputs:
+        return "none"
+    names = ", ".join(f"`{g.display()}`" for g, _ in inputs.values())
+    if same_first_index:
+        return f"{names} with the same {INDICES[0]}"
+    if all(len(named) == len(g.scalars) for g, named in inputs.values()):
+        return f"all of {names}" if any(g.scalars[0][1] for g, _ in inputs.values()) else names
+    return names + " (some elements)"
+
+
+def cell(text: str) -> str:
+    return text.replace("|", "\\|").replace("\n", " ")
+
+
+def variables_table(fmu: pathlib.Path) -> str:
+    root, scalars, dependencies = read_variables(fmu)
+    key = fmu_key(root.get("modelName"))
+    families, where = families_of(scalars, key)
+    families.sort(key=lambda f: CAUSALITY_ORDER.index(f.scalars[0][0].get("causality", "local")))
+    rows = ["| variable | causality | type | unit (display) | range | start | responds at once to | description |",
+            "|---|---|---|---|---|---|---|---|"]
+    for f in families:
+        s, indices = f.scalars[0]
+        counts = [max(ix[n] for _, ix in f.scalars) for n in range(len(indices))]
+        name = f"`{f.display()}`"
+        if counts:
+            name += " " + ", ".join(f"{INDICES[n]} = 1…{c}" for n, c in enumerate(counts))
+        causality = s.get("causality", "local")
+        if s.get("variability") == "tunable":
+            causality += " (tunable)"
+        rows.append("| " + " | ".join(cell(c) for c in [
+            name, causality, s["kind"], unit_text(f), range_text(f), start_text(f),
+            dependencies_text(f, scalars, dependencies, where), f.text()]) + " |")
+    head = (f"`{fmu.name}`, {len(scalars)} scalar variables (FMI {root.get('fmiVersion')}, "
+            f"`{root.find('CoSimulation').get('modelIdentifier')}`):")
+    return head + "\n\n" + "\n".join(rows)
+
+
+def engine_variables() -> str:
+    return variables_table(DIST / "EngineMountChassis.fmu")
+
+
+def body_variables() -> str:
+    return variables_table(DIST / "EngineMountBody.fmu")
+
+
+# ---------------------------------------------------------------------------------------------
+# FMI 3.0 terminals
+
+
+def terminal_rows(terminal: ET.Element, prefix: str = "") -> list[str]:
+    name = prefix + terminal.get("name")
+    members = []
+    for m in terminal.findall("TerminalMemberVariable"):
+        text = f"`{m.get('variableName')}`"
+        if m.get("memberName") and m.get("memberName") != m.get("variableName"):
+            text += f" as `{m.get('memberName')}`"
+        members.append(text)
+    rows = ["| " + " | ".join(cell(c) for c in [
+        f"`{name}`", terminal.get("matchingRule", ""),
+        ", ".join(members), terminal.get("description", "")]) + " |"]
+    for child in terminal.findall("Terminal"):
+        rows += terminal_rows(child, name + ".")
+    return rows
+
+
+def fmi3_terminals() -> str:
+    parts = []
+    for fmu in sorted(DIST.glob("*-fmi3.fmu")):
+        with zipfile.ZipFile(fmu) as z:
+            if "terminalsAndIcons/terminalsAndIcons.xml" not in z.namelist():
+                parts.append(f"`{fmu.name}` declares no terminals.")
+                continue
+        root = ET.fromstring(fmu_text(fmu, "terminalsAndIcons/terminalsAndIcons.xml"))
+        rows = ["| terminal | matching rule | members | description |", "|---|---|---|---|"]
+        terminals = root.find("Terminals")
+        for t in ([] if terminals is None else terminals.findall("Terminal")):
+            rows += terminal_rows(t)
+        parts.append(f"`{fmu.name}`:\n\n" + "\n".join(rows))
+    if not parts:
+        sys.exit(f"generate: no FMI 3.0 FMU in {DIST} (run bash packaging/package.sh)")
+    return "\n\n".join(parts)
+
+
+# ---------------------------------------------------------------------------------------------
+# Supported bulk-data cards: the deck reader's table, printed by an example
+
+
+def supported_cards() -> str:
+    run = subprocess.run(["cargo", "run", "--release", "--quiet", "--example", "supported_cards"],
+                         cwd=ROOT, capture_output=True, text=True)
+    if run.returncode != 0:
+        sys.exit(f"generate: cargo run --example supported_cards failed:\n{run.stderr}")
+    return run.stdout
+
+
+# ---------------------------------------------------------------------------------------------
+# Pages
+
+SECTIONS = {
+    "engine-variables": engine_variables,
+    "body-variables": body_variables,
+    "fmi3-terminals": fmi3_terminals,
+    "supported-cards": supported_cards,
+}
+
+
+def regenerate(text: str, page: pathlib.Path, cache: dict[str, str]) -> str:
+    out, pos = [], 0
+    for m in BEGIN.finditer(text):
+        name = m.group(1)
+        if name not in SECTIONS:
+            sys.exit(f"generate: {page.relative_to(ROOT)} asks for an unknown section '{name}'")
+        end = text.find(END.format(name), m.end())
+        if end < 0:
+            sys.exit(f"generate: {page.relative_to(ROOT)}: '{END.format(name)}' is missing")
+        if name not in cache:
+            cache[name] = SECTIONS[name]().rstrip("\n")
+        out += [text[pos:m.end()], "\n", cache[name], "\n\n"]
+        pos = end
+    out.append(text[pos:])
+    return "".join(out)
+
+
+def pages() -> list[pathlib.Path]:
+    return sorted(p for p in PAGES.rglob("*.md") if BEGIN.search(p.read_text()))
+
+
+def stale_pages() -> list[pathlib.Path]:
+    """The pages whose generated sections differ from what this script writes now."""
+    cache: dict[str, str] = {}
+    return [p for p in pages() if regenerate(p.read_text(), p, cache) != p.read_text()]
+
+
+def main(argv: list[str] | None = None) -> None:
+    parser = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
+    parser.add_argument("--check", action="store_true", help="only list stale pages; exit 1 if any")
+    args = parser.parse_args(argv)
+    if args.check:
+        stale = stale_pages()
+        for p in stale:
+            print(f"stale: {p.relative_to(ROOT)} (regenerate with `{COMMAND}`)")
+        sys.exit(1 if stale else 0)
+    cache: dict[str, str] = {}
+    for p in pages():
+        text = p.read_text()
+        new = regenerate(text, p, cache)
+        if new != text:
+            p.write_text(new)
+            print(f"wrote {p.relative_to(ROOT)}")
+
+
+if __name__ == "__main__":
+    main()
