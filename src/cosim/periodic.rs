@@ -15,9 +15,10 @@
 //!
 //! The cycle map carries the integration error of one cycle, tens of error weights at the run's
 //! tolerance (the error of a cycle is a global error). The iteration therefore switches to a
-//! 1000× tighter tolerance once it reaches that floor, and accepts the orbit when one cycle
-//! returns to within one error weight of the run's tolerance: the start is on the orbit to
-//! better than the run can resolve.
+//! 1000× tighter tolerance once it reaches that floor, its acceleration restarting there (the
+//! two cycle maps differ by that error), and accepts the orbit when one cycle returns to within
+//! one error weight of the run's tolerance: the start is on the orbit to better than the run can
+//! resolve.
 
 use faer::Mat;
 use nalgebra::DMatrix;
@@ -159,13 +160,21 @@ pub fn periodic_start(
         }
         // The run's tolerance has done what it can when the residual nears its error floor or
         // stops falling fast.
-        if !tight && (residual <= COARSE_FLOOR || residual > previous / 4.0) {
-            tight = true;
-            anderson.clear();
-        }
+        let switching = !tight && (residual <= COARSE_FLOOR || residual > previous / 4.0);
         previous = residual;
         let step = chord.solve(&r);
-        x = anderson.next(&x, &step, &w);
+        x = if switching {
+            // Anderson combines the steps of one cycle map. The tight map differs from the
+            // coarse one by the coarse map's integration error (tens of error weights, more than
+            // the residual at the switch): a coarse step kept in the history reads as the
+            // response to the iterates' differences and is cancelled, holding the state still.
+            // The first tight iterate is the plain chord step; the history starts after it.
+            tight = true;
+            anderson.clear();
+            x.iter().zip(&step).map(|(xi, si)| xi + si).collect()
+        } else {
+            anderson.next(&x, &step, &w)
+        };
     }
     unreachable!("the loop returns on its last iteration")
 }
