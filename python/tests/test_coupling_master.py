@@ -9,7 +9,7 @@ import sys
 import numpy as np
 import pytest
 
-from emc.coupling import (ALGORITHMS, CoupledPair, coupled, growth, largest_deviation,
+from emc.coupling import (ALGORITHMS, CoupledPair, Run, coupled, growth, largest_deviation,
                           monolithic)
 
 ROOT = pathlib.Path(__file__).resolve().parents[2]
@@ -100,3 +100,38 @@ def test_at_0_1_ms_all_three_reproduce_scene_2(fmus, cache):
         assert run.ok, f"{algorithm}: {run.status}"
         deviation, where = largest_deviation(reference, run, rpm)
         assert deviation < 0.02, f"{algorithm}, {where}: {deviation * 100:.2f} %"
+
+
+def test_values_only_the_order_of_the_exchange_decides(fmus, cache):
+    """Values only (no input derivatives: the FMUs continue them by their first-order hold),
+    0.1 ms, 2000 rpm, 1 s from the coupled equilibrium. The engine's forces depend directly on the
+    body motion it is given: setting the body's motion first and then reading the forces stays
+    within 2 % of scene 2 (measured 0.75 %, like the FMI 3.0 pair); reading the forces first, as
+    libcosim's fixed-step master does, passes forces of the engine's extrapolated motion (measured
+    2.89 %, libcosim's own 2.82 %)."""
+    rpm, H, t_end = 2000.0, 1e-4, 1.0
+    reference = monolithic(fmus[0], rpm, H, t_end, cache_dir=cache)
+    deviation = {}
+    for motion_first in (True, False):
+        with CoupledPair(*fmus, rpm, t_end=t_end, cache_dir=cache) as pair:
+            e, b, vr, nf = pair.engine.slave, pair.body.slave, pair.vr, pair.n
+            steps = int(round(t_end / H))
+            samples = np.full((steps, len(pair.signals)), np.nan)
+            for k in range(steps):
+                e.doStep(k * H, H)
+                b.doStep(k * H, H)
+                if not motion_first:
+                    forces = e.getReal(vr["F"])
+                e.setReal(vr["re"], b.getReal(vr["r"]))
+                e.setReal(vr["ve"], b.getReal(vr["v"]))
+                if motion_first:
+                    forces = e.getReal(vr["F"])
+                b.setReal(vr["Fb"], list(forces))
+                samples[k, :nf] = forces
+                samples[k, nf:] = b.getReal(vr["sw"])
+        run = Run(h=H, signals=dict(zip(pair.signals, samples.T)), wall=0.0, status="ok",
+                  t_reached=t_end)
+        deviation[motion_first], _ = largest_deviation(reference, run, rpm)
+    print(f"motion first {deviation[True] * 100:.2f} %, forces first {deviation[False] * 100:.2f} %")
+    assert deviation[True] < 0.02, deviation
+    assert deviation[False] > 2 * deviation[True], deviation
