@@ -691,22 +691,25 @@ def add_parsers(sub) -> None:
                        help=f"samples per revolution (default {steps})")
         p.add_argument("--load-torque", type=float, default=0.0, help="N·m, every point")
 
+    def paths(p, at_help: str, case_help: str):
+        """The options of both path analyses (``tpa``, ``tpa-runup``)."""
+        p.add_argument("--rpm", nargs=2, type=float, default=[800.0, 2500.0],
+                       metavar=("FROM", "TO"), help="speed range, rpm (default 800 2500)")
+        p.add_argument("--at", type=float, default=None, help=at_help)
+        p.add_argument("--order", type=float, default=1.5, help="order of the plots (default 1.5)")
+        p.add_argument("--response", action="append",
+                       help="acceleration to explain: steeringWheel.a[1..3], seat.a[1..3] or "
+                            "<body point>.a[1..3] (repeatable; default steeringWheel.a[3])")
+        p.add_argument("--case", action="append", metavar="NAME[:NAME=VALUE,...]", help=case_help)
+
     t = sub.add_parser("tpa", help="transfer path analysis per order: each mount and "
                                    "direction's contribution to a body point over speed")
     common(t)
-    t.add_argument("--rpm", nargs=2, type=float, default=[800.0, 2500.0],
-                   metavar=("FROM", "TO"), help="speed range, rpm (default 800 2500)")
+    paths(t, at_help="speed of the ranked contributions, rpm, within the range (added to the "
+                     "points; default FROM)",
+          case_help="a case with its own settings on top of --set (repeatable): each case is "
+                    "analysed and the first case's dominant path compared across them")
     t.add_argument("--count", type=int, default=18, help="speed points (default 18)")
-    t.add_argument("--at", type=float, default=None,
-                   help="speed of the ranked contributions, rpm, within the range (added to "
-                        "the points; default FROM)")
-    t.add_argument("--order", type=float, default=1.5, help="order of the plots (default 1.5)")
-    t.add_argument("--response", action="append",
-                   help="acceleration to explain: steeringWheel.a[1..3], seat.a[1..3] or "
-                        "<body point>.a[1..3] (repeatable; default steeringWheel.a[3])")
-    t.add_argument("--case", action="append", metavar="NAME[:NAME=VALUE,...]",
-                   help="a case with its own settings on top of --set (repeatable): each case "
-                        "is analysed and the first case's dominant path compared across them")
     window(t, 8, 72)
     bands.add_options(t)
     t.set_defaults(func=cmd_tpa)
@@ -714,17 +717,10 @@ def add_parsers(sub) -> None:
     u = sub.add_parser("tpa-runup", help="transfer paths of a run-up: each mount and "
                                          "direction's contribution per order, order-tracked")
     common(u)
-    u.add_argument("--rpm", nargs=2, type=float, default=[800.0, 2500.0],
-                   metavar=("FROM", "TO"), help="speed range, rpm (default 800 2500)")
+    paths(u, at_help="speed of the ranked contributions, rpm: the block nearest it (default "
+                     "FROM)",
+          case_help="a case with its own settings on top of --set (repeatable)")
     _cli().runup_options(u)
-    u.add_argument("--at", type=float, default=None,
-                   help="speed of the ranked contributions, rpm: the block nearest it "
-                        "(default FROM)")
-    u.add_argument("--order", type=float, default=1.5, help="order of the plots (default 1.5)")
-    u.add_argument("--response", action="append",
-                   help="acceleration to explain (repeatable; default steeringWheel.a[3])")
-    u.add_argument("--case", action="append", metavar="NAME[:NAME=VALUE,...]",
-                   help="a case with its own settings on top of --set (repeatable)")
     bands.add_options(u)
     u.set_defaults(func=cmd_tpa_runup)
 
