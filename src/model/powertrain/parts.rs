@@ -122,6 +122,7 @@ pub(super) enum MovingPart {
 
 /// Sine and cosine of `ratio · φ` from those of `φ`: exact identities for the ratios engines use
 /// (±1, ±2), a fresh `sin_cos` otherwise.
+#[inline]
 pub(super) fn multiple_angle(ratio: f64, phi: f64, sin: f64, cos: f64) -> (f64, f64) {
     if ratio == 1.0 {
         (sin, cos)
@@ -188,6 +189,7 @@ impl MovingPart {
     }
 
     /// `(ρ, ρ', ρ'')` at crank angle `phi` with `(sin φ, cos φ)` given.
+    #[inline]
     pub(super) fn path(&self, phi: f64, sin: f64, cos: f64) -> [Vector3<f64>; 3] {
         match self {
             MovingPart::Piston {
