@@ -1,14 +1,21 @@
 #!/usr/bin/env bash
 # The scaling benchmark on a machine without network: the wheels of scripts/bench-wheels.sh are
 # unpacked into a temporary directory (those in fallback/ only where the interpreter lacks the
-# package), then `python -m emc.bench scaling` runs with the remaining arguments.
+# package), then `python -m emc.bench scaling` (or `scheduling`, named after WHEELDIR) runs with
+# the remaining arguments.
 #
 #   bash scripts/bench-scaling.sh WHEELDIR --fmu dist/EngineMountChassis.fmu --points 192 \
-#       --workers 1 4 16 --csv scaling.csv
+#       --workers 1 4 16 --batching guided equal --csv scaling.csv
+#   bash scripts/bench-scaling.sh WHEELDIR scheduling --points 192 --workers 16
 set -euo pipefail
 root=$(cd "$(dirname "$0")/.." && pwd)
 wheels=$1
 shift
+benchmark=scaling
+if [[ ${1:-} == scaling || ${1:-} == scheduling ]]; then
+  benchmark=$1
+  shift
+fi
 python=${PYTHON:-$(command -v python3.12 || command -v python3)}
 site=$(mktemp -d)
 trap 'rm -rf "$site"' EXIT
@@ -22,4 +29,4 @@ for p in numpy pandas lxml dateutil; do
 done
 echo "$("$python" --version), $(nproc) CPUs; packages from $wheels"
 cd "$root"
-PYTHONPATH=$site:$root/python exec "$python" -m emc.bench scaling "$@"
+PYTHONPATH=$site:$root/python exec "$python" -m emc.bench "$benchmark" "$@"

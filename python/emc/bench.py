@@ -22,7 +22,7 @@ import time
 import numpy as np
 import pandas as pd
 
-from .runner import OperatingPoint, Runner
+from .runner import OperatingPoint, Runner, keep_freed_memory
 
 EFFECTS = ("gasForces", "massForces", "balanceShaft", "gyroscopic", "ringCarrier", "mountNonlinearity")
 
@@ -156,13 +156,16 @@ def _tree_cpu() -> float:
 
 
 def scaling_table(fmu_path: str, points: list, workers=(1, 2), repeat: int = 2,
-                  out=sys.stdout) -> pd.DataFrame:
-    """Serial against Dask pools of each worker count, on warm instances: the serial loop runs
+                  batchings=("guided",), out=sys.stdout) -> pd.DataFrame:
+    """Serial against Dask pools of each worker count and batching (``"guided"``: shrinking
+    batches; ``"equal"``: four equal batches per worker), on warm instances: the serial loop runs
     on an instance that has already run a point; each pool is started and its workers' instances
     warmed (one point each, the reduced body read from the cache) before the timed runs. The
     start and warm-up of each pool are reported beside, and the CPU time of each run: the serial
     process's, or that of this process and all its children (scheduler, nannies, workers),
-    which load does not change. Every run's
+    which load does not change. Of the pool runs also the CPU time of the evaluations alone
+    (the worker threads that ran them) and where the workers' time went
+    (:meth:`emc.distributed.MapRecord.anatomy`, the run with the shortest wall time). Every run's
     results are compared with the serial ones to the bit."""
     from .distributed import FmuPool
     from .sweep import sweep_point
@@ -177,23 +180,36 @@ def scaling_table(fmu_path: str, points: list, workers=(1, 2), repeat: int = 2,
               file=out, flush=True)
         times, cpus, serial = _timed(lambda: [evaluate(runner, p) for p in points], repeat,
                                      time.process_time)
-    rows.append({"workers": "serial", "start_s": 0.0, "warm_s": 0.0, "run_min_s": min(times),
-                 "run_max_s": max(times), "cpu_s": min(cpus), "identical": True})
+    rows.append({"workers": "serial", "batching": "", "start_s": 0.0, "warm_s": 0.0,
+                 "run_min_s": min(times), "run_max_s": max(times), "cpu_s": min(cpus),
+                 "task_cpu_s": min(cpus), "identical": True})
     print(f"serial: {min(times):.2f}-{max(times):.2f} s", file=out, flush=True)
     for w in workers:
-        started = time.perf_counter()
-        with FmuPool(fmu_path, workers=w) as pool:
-            start = time.perf_counter() - started
+        for batching in batchings:
             started = time.perf_counter()
-            pool.warm(evaluate, points[0])
-            warm = time.perf_counter() - started
-            times, cpus, results = _timed(lambda: pool.map(evaluate, points), repeat,
-                                          _tree_cpu)
-        rows.append({"workers": w, "start_s": start, "warm_s": warm, "run_min_s": min(times),
-                     "run_max_s": max(times), "cpu_s": min(cpus),
-                     "identical": same_results(results, serial)})
-        print(f"{w} workers: start {start:.1f} s, warm-up {warm:.1f} s, "
-              f"{min(times):.2f}-{max(times):.2f} s", file=out, flush=True)
+            with FmuPool(fmu_path, workers=w,
+                         batches_per_worker=4 if batching == "equal" else None) as pool:
+                start = time.perf_counter() - started
+                started = time.perf_counter()
+                pool.warm(evaluate, points[0])
+                warm = time.perf_counter() - started
+                anatomies = []
+
+                def run():
+                    results = pool.map(evaluate, points)
+                    anatomies.append(pool.last_map.anatomy(w))
+                    return results
+
+                times, cpus, results = _timed(run, repeat, _tree_cpu)
+            fastest = anatomies[times.index(min(times))]
+            rows.append({"workers": w, "batching": batching, "start_s": start, "warm_s": warm,
+                         "run_min_s": min(times), "run_max_s": max(times), "cpu_s": min(cpus),
+                         "task_cpu_s": min(a["cpu_s"] for a in anatomies),
+                         "batches": fastest["batches"], "busy": fastest["busy"],
+                         "first_s": fastest["first_s"], "tail_s": fastest["tail_s"],
+                         "identical": same_results(results, serial)})
+            print(f"{w} workers, {batching} batches: start {start:.1f} s, warm-up {warm:.1f} s, "
+                  f"{min(times):.2f}-{max(times):.2f} s", file=out, flush=True)
     table = pd.DataFrame(rows)
     best_serial = table.run_min_s.iloc[0]
     table["speedup"] = best_serial / table.run_min_s
@@ -201,9 +217,76 @@ def scaling_table(fmu_path: str, points: list, workers=(1, 2), repeat: int = 2,
     table["points_per_s"] = len(points) / table.run_min_s
     # CPU of a run relative to the serial loop's: what the pool (scheduler, nannies, workers,
     # this process) costs besides the simulations. On idle cores the speed-up approaches
-    # workers / cpu_ratio.
+    # workers × busy / task_cpu_ratio.
     table["cpu_ratio"] = table.cpu_s / table.cpu_s.iloc[0]
+    table["task_cpu_ratio"] = table.task_cpu_s / table.cpu_s.iloc[0]
     return table
+
+
+def wait_point(runner: Runner, seconds: float) -> float:
+    """A stand-in evaluation that holds its worker for a point's measured time without using a
+    core (see :func:`scheduling_table`)."""
+    time.sleep(seconds)
+    return seconds
+
+
+def point_costs(fmu_path: str, points: list) -> list[float]:
+    """The wall time of each point, serially on one warm instance (the best of two runs)."""
+    from .sweep import sweep_point
+
+    evaluate = functools.partial(sweep_point, signals=None, case="")
+    costs = [float("inf")] * len(points)
+    with Runner(fmu_path) as runner:
+        evaluate(runner, points[0])
+        for _ in range(2):
+            for i, point in enumerate(points):
+                started = time.perf_counter()
+                evaluate(runner, point)
+                costs[i] = min(costs[i], time.perf_counter() - started)
+    return costs
+
+
+def scheduling_table(fmu_path: str, costs: list[float], workers=(16,), repeat: int = 2,
+                     batchings=("guided", "equal"), out=sys.stdout) -> pd.DataFrame:
+    """What distribution alone costs at any worker count, on a machine with fewer cores: each
+    point is replaced by a wait of its measured time (:func:`wait_point`), so the workers hold
+    no core while they "compute" and only the pool's own work (scheduling, batching, the
+    results' way back, the idle tail) competes for the cores. The speed-up against the sum of
+    the waits is what the pool would give if the workers computed as fast as the serial loop;
+    a real run on that many cores adds whatever slows a worker's computing (the scaling
+    table's task_cpu_ratio)."""
+    from .distributed import FmuPool
+
+    total = sum(costs)
+    rows = []
+    for w in workers:
+        for batching in batchings:
+            started = time.perf_counter()
+            with FmuPool(fmu_path, workers=w,
+                         batches_per_worker=4 if batching == "equal" else None) as pool:
+                start = time.perf_counter() - started
+                pool.warm()
+                anatomies = []
+
+                def run():
+                    results = pool.map(wait_point, costs)
+                    anatomies.append(pool.last_map.anatomy(w))
+                    return results
+
+                times, cpus, results = _timed(run, repeat, _tree_cpu)
+            if results != costs:
+                raise RuntimeError("the pool returned the items out of order")
+            fastest = anatomies[times.index(min(times))]
+            rows.append({"workers": w, "batching": batching, "start_s": start,
+                         "run_min_s": min(times), "run_max_s": max(times),
+                         "ideal_s": total / w, "speedup": total / min(times),
+                         "speedup_low": total / max(times), "efficiency": total / w / min(times),
+                         "pool_cpu_s": min(cpus), "batches": fastest["batches"],
+                         "busy": fastest["busy"], "first_s": fastest["first_s"],
+                         "tail_s": fastest["tail_s"]})
+            print(f"{w} workers, {batching} batches: {min(times):.2f}-{max(times):.2f} s "
+                  f"(ideal {total / w:.2f} s)", file=out, flush=True)
+    return pd.DataFrame(rows)
 
 
 def machine_line() -> str:
@@ -218,23 +301,54 @@ def cmd_scaling(args) -> int:
     print(machine_line(), flush=True)
     print(f"{len(points)} points, {args.rpm[0]:g}-{args.rpm[1]:g} rpm, scene 2, periodic start, "
           f"8 revolutions at 72 steps each; {args.repeat} timed runs per row", flush=True)
-    table = scaling_table(args.fmu, points, args.workers, args.repeat)
+    table = scaling_table(args.fmu, points, args.workers, args.repeat, args.batching)
     load = os.getloadavg()
     print(f"load average after: {load[0]:.2f} / {load[1]:.2f} / {load[2]:.2f}")
     shown = table.copy()
     shown["run s (min-max)"] = [f"{a:.2f}-{b:.2f}" for a, b in zip(table.run_min_s, table.run_max_s)]
     shown["speed-up vs serial"] = [f"{a:.2f}x ({b:.2f}x)" for a, b in
                                    zip(table.speedup, table.speedup_low)]
-    print(shown[["workers", "start_s", "warm_s", "run s (min-max)", "speed-up vs serial",
-                 "points_per_s", "cpu_s", "cpu_ratio",
-                 "identical"]].to_string(
-        index=False, float_format=lambda v: f"{v:.2f}"))
+    print(shown[["workers", "batching", "start_s", "warm_s", "run s (min-max)",
+                 "speed-up vs serial", "points_per_s", "cpu_s", "cpu_ratio", "task_cpu_ratio",
+                 "batches", "busy", "first_s", "tail_s", "identical"]].to_string(
+        index=False, na_rep="", float_format=lambda v: f"{v:.2f}"))
+    print("cpu_ratio: the CPU time of every process against the serial loop's; task_cpu_ratio: "
+          "that of the evaluations alone (worker threads); busy: the share of workers x wall "
+          "time spent in batches; first_s / tail_s: a worker's mean wait for its first batch / "
+          "idle time after its last (fastest run)")
     if args.csv:
         table.insert(0, "machine", machine_line())
         table.insert(1, "points", len(points))
         table.to_csv(args.csv, index=False)
         print(f"-> {args.csv}")
     return 0 if table.identical.all() else 1
+
+
+def cmd_scheduling(args) -> int:
+    points = scaling_points(args.points, *args.rpm)
+    print(machine_line(), flush=True)
+    costs = point_costs(args.fmu, points)
+    scaled = [c * args.scale for c in costs]
+    print(f"{len(points)} points, {args.rpm[0]:g}-{args.rpm[1]:g} rpm, scene 2, periodic start: "
+          f"measured serially {sum(costs):.2f} s ({min(costs) * 1e3:.0f}-{max(costs) * 1e3:.0f} "
+          f"ms a point); waits of {args.scale:g} x that, {sum(scaled):.2f} s in all; "
+          f"{args.repeat} timed runs per row", flush=True)
+    table = scheduling_table(args.fmu, scaled, args.workers, args.repeat, args.batching)
+    shown = table.copy()
+    shown["run s (min-max)"] = [f"{a:.2f}-{b:.2f}" for a, b in zip(table.run_min_s, table.run_max_s)]
+    shown["speed-up"] = [f"{a:.2f}x ({b:.2f}x)" for a, b in zip(table.speedup, table.speedup_low)]
+    print(shown[["workers", "batching", "start_s", "run s (min-max)", "ideal_s", "speed-up",
+                 "efficiency", "pool_cpu_s", "batches", "busy", "first_s", "tail_s"]].to_string(
+        index=False, float_format=lambda v: f"{v:.2f}"))
+    print("speed-up: the sum of the waits over the run's wall time (best; worst); efficiency: "
+          "of the ideal sum / workers; pool_cpu_s: CPU time of every process during the run "
+          "(the pool's own work, the waits use none)")
+    if args.csv:
+        table.insert(0, "machine", machine_line())
+        table.insert(1, "points", len(points))
+        table.to_csv(args.csv, index=False)
+        print(f"-> {args.csv}")
+    return 0
 
 
 def main(argv: list[str] | None = None) -> int:
@@ -248,9 +362,31 @@ def main(argv: list[str] | None = None) -> int:
     s.add_argument("--rpm", type=float, nargs=2, default=[800.0, 4000.0], metavar=("FROM", "TO"))
     s.add_argument("--workers", type=int, nargs="+", default=[2], help="worker counts (default 2)")
     s.add_argument("--repeat", type=int, default=2, help="timed runs per row (default 2)")
+    s.add_argument("--batching", nargs="+", choices=("guided", "equal"), default=["guided"],
+                   help="how a pool batches the points: shrinking batches (guided, the default) "
+                        "and/or four equal batches per worker (equal); both to compare them in "
+                        "one run")
     s.add_argument("--csv", help="also write the table here")
     s.set_defaults(func=cmd_scaling)
+    d = sub.add_parser("scheduling", help="what distribution alone costs at many workers, on few "
+                                          "cores: each point replaced by a wait of its measured "
+                                          "time")
+    d.add_argument("--fmu", default="dist/EngineMountChassis.fmu")
+    d.add_argument("--points", type=int, default=192, help="speed points (default 192)")
+    d.add_argument("--rpm", type=float, nargs=2, default=[800.0, 4000.0], metavar=("FROM", "TO"))
+    d.add_argument("--workers", type=int, nargs="+", default=[16],
+                   help="worker counts (default 16)")
+    d.add_argument("--scale", type=float, default=1.0,
+                   help="each wait is this times the point's measured time (to stand in for a "
+                        "slower machine; default 1)")
+    d.add_argument("--repeat", type=int, default=2, help="timed runs per row (default 2)")
+    d.add_argument("--batching", nargs="+", choices=("guided", "equal"),
+                   default=["guided", "equal"], help="batchings to compare (default both)")
+    d.add_argument("--csv", help="also write the table here")
+    d.set_defaults(func=cmd_scheduling)
     args = parser.parse_args(argv)
+    # The serial loop at its best, with the malloc settings the workers get.
+    keep_freed_memory()
     return args.func(args)
 
 

@@ -35,7 +35,7 @@ import pandas as pd
 from . import band as bands
 from . import plots
 from .comfort import comfort_table
-from .runner import PointFailed, Runner
+from .runner import PointFailed, Runner, keep_freed_memory
 from .sweep import DEFAULT_SIGNAL_PREFIXES, run_sweep, save, speed_points
 from .tracking import track_orders
 
@@ -920,6 +920,7 @@ def main(argv: list[str] | None = None) -> int:
     on stderr and a non-zero exit code, without a Python traceback."""
     args = build_parser().parse_args(argv)
     args.command_line = ["emc"] + list(sys.argv[1:] if argv is None else argv)
+    keep_freed_memory()
     if args.command == "bench-effects" and args.scene is None:
         args.scene = [DEFAULT_PARAMETERS["scene"]]
     try:

@@ -11,9 +11,13 @@ thousands of times. What each evaluation may cost besides its own simulation is 
   both cost well under a millisecond against 100–400 ms for a point (most of it the periodic
   start), so the plain reset is kept: there is no state to hold.
 - **Evaluations go in batches**, several per task, so that scheduling is a small part of each
-  task. The batches interleave the items (batch ``b`` holds items ``b, b + B, b + 2B, …``): a
-  sweep's slow low-speed points spread over all batches. There are a few batches per worker, so a
-  worker slowed by another job on its core does not hold the study back by more than a batch.
+  task. By default the batches shrink as the study goes (guided self-scheduling): the first
+  round gives each worker a batch of a ``2 × workers``-th of the items, each later round a
+  ``2 × workers``-th of what is left, down to single items. Big batches at the start keep the
+  scheduling cost small; single items at the end leave a worker idle for at most about one
+  evaluation while the others finish. Each batch spreads over the items (a sweep's slow
+  low-speed points over all batches). ``batches_per_worker=B`` gives the older scheme instead:
+  ``B × workers`` equal interleaved batches.
 - **Results come back in the order of the items**, and every evaluation starts from the reset
   instance: a study gives the same numbers to the bit, serially or on any number of workers.
 
@@ -29,28 +33,31 @@ from __future__ import annotations
 
 import hashlib
 import logging
+import math
 import os
 import sys
+import time
+from dataclasses import dataclass, field
 from typing import Callable, Iterable
 
 import dask
 from distributed.diagnostics.plugin import WorkerPlugin
 
-from .runner import PointFailed, Runner, extracted, fmu_from_content
+from .runner import MALLOC_SETTINGS, PointFailed, Runner, extracted, fmu_from_content
 
 # Local workers: Dask's nanny starts them with MALLOC_TRIM_THRESHOLD_=65536 so that they hand
 # memory back to the system; glibc then trims the FMU's short-lived allocations at every free, and
 # a worker needed 15-20 % more CPU time per point than the same loop in the caller (thread CPU
-# time of 8 scene-2 points, 0.63-0.69 s against 0.54-0.58 s). With a large trim threshold and top
-# pad it needs the same. Without the sampling profiler a worker runs only the study. Dask's
+# time of 8 scene-2 points, 0.63-0.69 s against 0.54-0.58 s). With the large trim threshold and
+# top pad of emc.runner.MALLOC_SETTINGS (which the command-line tools set in their own process
+# too) it needs the same. Without the sampling profiler a worker runs only the study. Dask's
 # periodic housekeeping (an event-loop tick every 20 ms, system and memory monitors every
 # 0.5 s and 0.1 s, work stealing every 0.1 s) cost the caller 4 % and each worker 2 % of a core
 # while a study runs; at 1-5 s they cost a tenth of that (2 workers, 48 scene-2 points: all
 # processes together within 1-4 % of the serial loop's CPU time instead of 22 % above it).
 WORKER_CONFIG = {
     "distributed.nanny.pre-spawn-environ": {
-        "MALLOC_TRIM_THRESHOLD_": 1 << 28, "MALLOC_TOP_PAD_": 1 << 26,
-        "OMP_NUM_THREADS": 1, "MKL_NUM_THREADS": 1, "OPENBLAS_NUM_THREADS": 1},
+        **MALLOC_SETTINGS, "OMP_NUM_THREADS": 1, "MKL_NUM_THREADS": 1, "OPENBLAS_NUM_THREADS": 1},
     "distributed.worker.profile.enabled": False,
     "distributed.admin.tick.interval": "1s",
     "distributed.admin.system-monitor.interval": "5s",
@@ -96,24 +103,112 @@ def worker_runner(sha256: str) -> Runner:
     return runner
 
 
-def evaluate_batch(sha256: str, evaluate: Callable, items: list) -> tuple[list, PointFailed | None]:
+@dataclass(frozen=True)
+class BatchRecord:
+    """Where and when a batch ran: the worker's process, its wall-clock start and end
+    (``time.time()``, comparable between the processes of one machine) and the CPU time of the
+    worker thread that ran it (the evaluations alone, without the worker's housekeeping)."""
+    pid: int
+    items: int
+    start: float
+    end: float
+    cpu: float
+
+
+def evaluate_batch(sha256: str, evaluate: Callable,
+                   items: list) -> tuple[list, PointFailed | None, BatchRecord]:
     """A task: ``evaluate(runner, item)`` for each item on this worker's warm instance. A failure
     comes back as a value with the results before it, so the worker logs nothing of its own and
     the caller reports the FMU's cause."""
+    start, cpu = time.time(), time.thread_time()
     runner = worker_runner(sha256)
-    results = []
+    results: list = []
+    failure = None
     for item in items:
         try:
             results.append(evaluate(runner, item))
-        except PointFailed as failure:
-            return results, failure
-    return results, None
+        except PointFailed as failed:
+            failure = failed
+            break
+    record = BatchRecord(os.getpid(), len(items), start, time.time(), time.thread_time() - cpu)
+    return results, failure, record
+
+
+def _quiet_teardown():
+    """Run on a local pool's workers before it closes: errors while closing are not logged."""
+    logging.getLogger("distributed").setLevel(logging.CRITICAL)
 
 
 def interleaved_batches(count: int, batches: int) -> list[list[int]]:
-    """Item indices ``0 … count-1`` in ``batches`` interleaved batches (none empty)."""
+    """Item indices ``0 … count-1`` in ``batches`` equal interleaved batches (none empty):
+    batch ``b`` holds items ``b, b + B, b + 2B, …``."""
     batches = max(1, min(batches, count))
-    return [list(range(b, count, batches)) for b in range(batches)]
+    return spread_batches([count // batches + (b < count % batches) for b in range(batches)])
+
+
+def spread_batches(sizes: list[int]) -> list[list[int]]:
+    """Item indices ``0 … sum(sizes)-1`` in batches of these sizes, each spread evenly over the
+    index range: item ``i`` goes to the batch furthest behind its share ``size × (i+1) / n``
+    (the first such batch on a tie). Equal sizes give :func:`interleaved_batches`."""
+    count = sum(sizes)
+    assigned = [0] * len(sizes)
+    batches: list[list[int]] = [[] for _ in sizes]
+    for i in range(count):
+        # The shortfalls times ``count``: integers, so ties are exact.
+        deficits = [size * (i + 1) - done * count for size, done in zip(sizes, assigned)]
+        b = deficits.index(max(deficits))
+        assigned[b] += 1
+        batches[b].append(i)
+    return batches
+
+
+def guided_sizes(count: int, workers: int) -> list[int]:
+    """Batch sizes of guided self-scheduling: rounds of ``workers`` batches, each of a
+    ``2 × workers``-th of the items still left (rounded up), the last rounds single items."""
+    sizes: list[int] = []
+    left = count
+    while left > 0:
+        size = max(1, math.ceil(left / (2 * workers)))
+        for _ in range(workers):
+            take = min(size, left)
+            if take == 0:
+                break
+            sizes.append(take)
+            left -= take
+    return sizes
+
+
+def guided_batches(count: int, workers: int) -> list[list[int]]:
+    """Item indices ``0 … count-1`` in shrinking batches (:func:`guided_sizes`), each spread over
+    the items, the largest first."""
+    return spread_batches(guided_sizes(count, workers))
+
+
+@dataclass
+class MapRecord:
+    """A :meth:`FmuPool.map`: its wall-clock start and end (``time.time()``) and every batch."""
+    start: float
+    end: float = 0.0
+    batches: list[BatchRecord] = field(default_factory=list)
+
+    def anatomy(self, workers: int) -> dict:
+        """Where the workers' time went: ``busy``, the share of ``workers × wall time`` spent in
+        batches; ``first_s``, how long a worker waited for its first batch (mean); ``tail_s``,
+        how long a worker sat idle between its last batch and the map's end (mean); ``cpu_s``,
+        the CPU time of the evaluations alone (the worker threads that ran them)."""
+        wall = self.end - self.start
+        by_worker: dict[int, list[BatchRecord]] = {}
+        for batch in self.batches:
+            by_worker.setdefault(batch.pid, []).append(batch)
+        # Workers that got no batch wait the whole map.
+        idle = max(0, workers - len(by_worker))
+        first = [min(b.start for b in runs) - self.start for runs in by_worker.values()]
+        tail = [self.end - max(b.end for b in runs) for runs in by_worker.values()]
+        return {"busy": sum(b.end - b.start for b in self.batches) / (workers * wall),
+                "first_s": (sum(first) + idle * wall) / workers,
+                "tail_s": (sum(tail) + idle * wall) / workers,
+                "cpu_s": sum(b.cpu for b in self.batches),
+                "batches": len(self.batches)}
 
 
 class FmuPool:
@@ -121,17 +216,20 @@ class FmuPool:
 
     ``scheduler``: the address of a running Dask scheduler (its workers get the FMU by content:
     they need not share the caller's file system); else a local cluster of ``workers`` processes
-    with one thread each (the FMU runs single-threaded).
+    with one thread each (the FMU runs single-threaded). ``batches_per_worker``: ``None`` for
+    shrinking (guided) batches, a number for that many equal batches per worker.
     """
 
     def __init__(self, fmu_path: str, workers: int = 2, scheduler: str | None = None,
-                 batches_per_worker: int = 4):
+                 batches_per_worker: int | None = None):
         from dask.distributed import Client, LocalCluster
 
         with open(fmu_path, "rb") as f:
             self.content = f.read()
         self.sha256 = hashlib.sha256(self.content).hexdigest()
         self.batches_per_worker = batches_per_worker
+        # The last map's timings (see MapRecord.anatomy).
+        self.last_map: MapRecord | None = None
         self.cluster = None
         if scheduler:
             self.client = Client(scheduler)
@@ -166,20 +264,27 @@ class FmuPool:
     def map(self, evaluate: Callable, items: Iterable, progress: Callable[[int], None] | None = None,
             batches: int | None = None) -> list:
         """``evaluate(runner, item)`` for every item on the workers; the results in the order of
-        ``items``. ``progress(n)`` is called with the number of items each finished batch held."""
+        ``items``. ``progress(n)`` is called with the number of items each finished batch held.
+        ``batches``: that many equal batches for this map (else as the pool was made)."""
         from dask.distributed import as_completed
 
         items = list(items)
         if not items:
             return []
-        count = batches or self.batches_per_worker * self.workers
-        groups = interleaved_batches(len(items), count)
+        record = MapRecord(time.time())
+        workers = self.workers
+        if batches or self.batches_per_worker:
+            groups = interleaved_batches(len(items), batches or self.batches_per_worker * workers)
+        else:
+            groups = guided_batches(len(items), workers)
+        # Submitted largest first: the scheduler hands out tasks in the order they came.
         futures = {self.client.submit(evaluate_batch, self.sha256, evaluate,
                                       [items[i] for i in group], pure=False): group
                    for group in groups}
         results: list = [None] * len(items)
         for future in as_completed(futures):
-            values, failure = future.result()
+            values, failure, batch = future.result()
+            record.batches.append(batch)
             if failure is not None:
                 self.client.cancel(list(futures))
                 raise failure
@@ -187,9 +292,19 @@ class FmuPool:
                 results[i] = value
             if progress is not None:
                 progress(len(values))
+        record.end = time.time()
+        self.last_map = record
         return results
 
     def close(self):
+        if self.cluster is not None:
+            # A worker whose heartbeat meets the closing scheduler logs the closed connection as
+            # an error with its traceback (seen with 16 workers on 2 cores): noise after the
+            # study's results, not a failure of it.
+            try:
+                self.client.run(_quiet_teardown)
+            except Exception:  # noqa: BLE001 - a worker already gone needs no quieting
+                pass
         self.client.close()
         if self.cluster is not None:
             self.cluster.close()

@@ -315,10 +315,11 @@ def test_fmu_content_is_written_once_under_its_checksum(fmu_path, tmp_path):
     plugin.setup(worker=None)
     try:
         evaluate = functools.partial(sweep_point, signals=["mount[1].F[3]"], case="")
-        results, failure = evaluate_batch(digest, evaluate, points)
+        results, failure, batch = evaluate_batch(digest, evaluate, points)
     finally:
         plugin.teardown(worker=None)
     assert failure is None and results[0][0].order_amplitude.size, "orders of the point"
+    assert batch.items == 1 and batch.end > batch.start and batch.cpu > 0
 
 
 def test_a_relative_fmu_works_on_workers_with_another_working_directory(fmu_path, tmp_path,

@@ -64,6 +64,39 @@ def test_batches_interleave_the_items_and_cover_each_once():
     assert sorted(i for g in groups for i in g) == list(range(48))
 
 
+def test_guided_batches_shrink_to_single_items_and_spread_over_the_items():
+    from emc.distributed import guided_batches, guided_sizes
+
+    assert guided_sizes(48, 2) == [12, 12, 6, 6, 3, 3, 2, 2, 1, 1]
+    sizes = guided_sizes(192, 16)
+    assert sum(sizes) == 192 and sizes == sorted(sizes, reverse=True)
+    assert sizes[:16] == [6] * 16 and sizes[-16:] == [1] * 16, "the last round: single items"
+    assert guided_sizes(5, 8) == [1] * 5 and guided_sizes(1, 1) == [1]
+    for count, workers in ((48, 2), (192, 16), (7, 3), (1000, 5)):
+        batches = guided_batches(count, workers)
+        assert [len(b) for b in batches] == guided_sizes(count, workers)
+        assert sorted(i for b in batches for i in b) == list(range(count))
+        # The j-th of a batch's k items lies within 1.5 places of the j-th k-th of the range:
+        # every batch holds slow and fast points alike.
+        for batch in batches:
+            k = len(batch)
+            assert all(abs(j - k * i / count) < 1.5 for j, i in enumerate(batch)), (count, batch)
+
+
+def test_a_maps_anatomy_splits_the_workers_time():
+    from emc.distributed import BatchRecord, MapRecord
+
+    # Two workers over 10 s: one busy 1-9 s in two batches, the other 2-6 s; a third never used.
+    record = MapRecord(100.0, 110.0, [BatchRecord(1, 2, 101.0, 105.0, 3.5),
+                                      BatchRecord(1, 1, 105.0, 109.0, 4.0),
+                                      BatchRecord(2, 3, 102.0, 106.0, 3.0)])
+    anatomy = record.anatomy(workers=3)
+    assert anatomy["busy"] == 12.0 / 30.0
+    assert anatomy["first_s"] == (1.0 + 2.0 + 10.0) / 3
+    assert anatomy["tail_s"] == (1.0 + 4.0 + 10.0) / 3
+    assert anatomy["cpu_s"] == 10.5 and anatomy["batches"] == 3
+
+
 def test_study_engines_compares_the_inline_three_with_the_inline_four(fmu_path, tmp_path):
     """emc study-engines: in the same body, the inline-3's mount force carries the 1.5 order, the
     inline-4's the 2nd and 4th; every case gets its side-by-side plots."""
@@ -149,3 +182,40 @@ def test_instances_log_to_their_own_sink_and_outlive_each_other(fmu_path):
         assert any(line.startswith("[error]") for line in first.log)
     finally:
         first.close()
+
+
+def test_the_scaling_benchmark_checks_each_pool_run_and_splits_its_time(fmu_path):
+    """The benchmark's plumbing, not its timings: every pool run is compared with the serial run
+    to the bit, and a pool's time is accounted for (a share in batches, the evaluations' CPU)."""
+    import io
+
+    from emc.bench import scaling_points, scaling_table, scheduling_table
+
+    points = scaling_points(3)
+    table = scaling_table(str(fmu_path), points, workers=(2,), repeat=1,
+                          batchings=("guided", "equal"), out=io.StringIO())
+    assert list(table.workers) == ["serial", 2, 2] and table.identical.all()
+    pools = table.iloc[1:]
+    assert (pools.batches == 3).all() and ((pools.busy > 0) & (pools.busy <= 1)).all()
+    assert (pools.task_cpu_s > 0).all() and (pools.tail_s >= 0).all()
+    # Waits cannot overlap more than the workers do: the speed-up is at most their number.
+    waits = [0.05] * 8
+    scheduled = scheduling_table(str(fmu_path), waits, workers=(2,), repeat=1,
+                                 batchings=("guided",), out=io.StringIO())
+    assert 0 < scheduled.speedup.iloc[0] <= 2.0 and scheduled.ideal_s.iloc[0] == sum(waits) / 2
+
+
+def test_the_command_line_keeps_freed_memory_for_reuse(monkeypatch):
+    import platform
+
+    from emc.runner import MALLOC_SETTINGS, keep_freed_memory
+
+    if platform.system() != "Linux" or platform.libc_ver()[0] != "glibc":
+        assert keep_freed_memory() == []
+        return
+    monkeypatch.delenv("MALLOC_TRIM_THRESHOLD_", raising=False)
+    monkeypatch.setenv("MALLOC_TOP_PAD_", "0")
+    # A setting the environment gives is the user's: left alone.
+    assert keep_freed_memory() == ["MALLOC_TRIM_THRESHOLD_"]
+    monkeypatch.delenv("MALLOC_TOP_PAD_")
+    assert keep_freed_memory() == list(MALLOC_SETTINGS)
