@@ -139,6 +139,36 @@ def same_results(a: list, b: list) -> bool:
     return len(a) == len(b) and all(same(x, y) and wx == wy for (x, wx), (y, wy) in zip(a, b))
 
 
+def timed_pool_runs(fmu_path: str, workers: int, batching: str, evaluate, items: list,
+                    repeat: int, warm_with=None) -> dict:
+    """A pool of ``workers`` (``batching``: "guided" or "equal") started, its instances warmed
+    (and ``evaluate(runner, warm_with)`` run once on each, if given), then ``repeat`` timed maps
+    of ``evaluate`` over ``items``: the start and warm-up times, each run's wall and CPU time
+    (every process), the last run's results, the evaluations' least CPU time and the fastest
+    run's anatomy (:meth:`emc.distributed.MapRecord.anatomy`)."""
+    from .distributed import FmuPool
+
+    started = time.perf_counter()
+    with FmuPool(fmu_path, workers=workers,
+                 batches_per_worker=4 if batching == "equal" else None) as pool:
+        start = time.perf_counter() - started
+        started = time.perf_counter()
+        pool.warm(evaluate if warm_with is not None else None, warm_with)
+        warm = time.perf_counter() - started
+        anatomies = []
+
+        def run():
+            results = pool.map(evaluate, items)
+            anatomies.append(pool.last_map.anatomy(workers))
+            return results
+
+        times, cpus, results = _timed(run, repeat, _tree_cpu)
+    fastest = anatomies[times.index(min(times))]
+    return {"start_s": start, "warm_s": warm, "times": times, "cpus": cpus, "results": results,
+            "task_cpu_s": min(a["cpu_s"] for a in anatomies),
+            **{k: fastest[k] for k in ("batches", "busy", "first_s", "tail_s")}}
+
+
 def _tree_cpu() -> float:
     """CPU seconds used so far by this process and all its descendants alive (a local pool's
     scheduler, nannies and workers)."""
@@ -167,7 +197,6 @@ def scaling_table(fmu_path: str, points: list, workers=(1, 2), repeat: int = 2,
     (the worker threads that ran them) and where the workers' time went
     (:meth:`emc.distributed.MapRecord.anatomy`, the run with the shortest wall time). Every run's
     results are compared with the serial ones to the bit."""
-    from .distributed import FmuPool
     from .sweep import sweep_point
 
     evaluate = functools.partial(sweep_point, signals=None, case="")
@@ -186,29 +215,17 @@ def scaling_table(fmu_path: str, points: list, workers=(1, 2), repeat: int = 2,
     print(f"serial: {min(times):.2f}-{max(times):.2f} s", file=out, flush=True)
     for w in workers:
         for batching in batchings:
-            started = time.perf_counter()
-            with FmuPool(fmu_path, workers=w,
-                         batches_per_worker=4 if batching == "equal" else None) as pool:
-                start = time.perf_counter() - started
-                started = time.perf_counter()
-                pool.warm(evaluate, points[0])
-                warm = time.perf_counter() - started
-                anatomies = []
-
-                def run():
-                    results = pool.map(evaluate, points)
-                    anatomies.append(pool.last_map.anatomy(w))
-                    return results
-
-                times, cpus, results = _timed(run, repeat, _tree_cpu)
-            fastest = anatomies[times.index(min(times))]
-            rows.append({"workers": w, "batching": batching, "start_s": start, "warm_s": warm,
-                         "run_min_s": min(times), "run_max_s": max(times), "cpu_s": min(cpus),
-                         "task_cpu_s": min(a["cpu_s"] for a in anatomies),
-                         "batches": fastest["batches"], "busy": fastest["busy"],
-                         "first_s": fastest["first_s"], "tail_s": fastest["tail_s"],
-                         "identical": same_results(results, serial)})
-            print(f"{w} workers, {batching} batches: start {start:.1f} s, warm-up {warm:.1f} s, "
+            run = timed_pool_runs(fmu_path, w, batching, evaluate, points, repeat,
+                                  warm_with=points[0])
+            rows.append({"workers": w, "batching": batching, "start_s": run["start_s"],
+                         "warm_s": run["warm_s"], "run_min_s": min(run["times"]),
+                         "run_max_s": max(run["times"]), "cpu_s": min(run["cpus"]),
+                         "task_cpu_s": run["task_cpu_s"], "batches": run["batches"],
+                         "busy": run["busy"], "first_s": run["first_s"], "tail_s": run["tail_s"],
+                         "identical": same_results(run["results"], serial)})
+            times = run["times"]
+            print(f"{w} workers, {batching} batches: start {run['start_s']:.1f} s, "
+                  f"warm-up {run['warm_s']:.1f} s, "
                   f"{min(times):.2f}-{max(times):.2f} s", file=out, flush=True)
     table = pd.DataFrame(rows)
     best_serial = table.run_min_s.iloc[0]
@@ -255,35 +272,20 @@ def scheduling_table(fmu_path: str, costs: list[float], workers=(16,), repeat: i
     the waits is what the pool would give if the workers computed as fast as the serial loop;
     a real run on that many cores adds whatever slows a worker's computing (the scaling
     table's task_cpu_ratio)."""
-    from .distributed import FmuPool
-
     total = sum(costs)
     rows = []
     for w in workers:
         for batching in batchings:
-            started = time.perf_counter()
-            with FmuPool(fmu_path, workers=w,
-                         batches_per_worker=4 if batching == "equal" else None) as pool:
-                start = time.perf_counter() - started
-                pool.warm()
-                anatomies = []
-
-                def run():
-                    results = pool.map(wait_point, costs)
-                    anatomies.append(pool.last_map.anatomy(w))
-                    return results
-
-                times, cpus, results = _timed(run, repeat, _tree_cpu)
-            if results != costs:
+            run = timed_pool_runs(fmu_path, w, batching, wait_point, costs, repeat)
+            if run["results"] != costs:
                 raise RuntimeError("the pool returned the items out of order")
-            fastest = anatomies[times.index(min(times))]
-            rows.append({"workers": w, "batching": batching, "start_s": start,
+            times = run["times"]
+            rows.append({"workers": w, "batching": batching, "start_s": run["start_s"],
                          "run_min_s": min(times), "run_max_s": max(times),
                          "ideal_s": total / w, "speedup": total / min(times),
                          "speedup_low": total / max(times), "efficiency": total / w / min(times),
-                         "pool_cpu_s": min(cpus), "batches": fastest["batches"],
-                         "busy": fastest["busy"], "first_s": fastest["first_s"],
-                         "tail_s": fastest["tail_s"]})
+                         "pool_cpu_s": min(run["cpus"]), "batches": run["batches"],
+                         "busy": run["busy"], "first_s": run["first_s"], "tail_s": run["tail_s"]})
             print(f"{w} workers, {batching} batches: {min(times):.2f}-{max(times):.2f} s "
                   f"(ideal {total / w:.2f} s)", file=out, flush=True)
     return pd.DataFrame(rows)
@@ -296,6 +298,22 @@ def machine_line() -> str:
             f"{datetime.datetime.now().astimezone().isoformat(timespec='seconds')}")
 
 
+def show_table(table: pd.DataFrame, columns: list[str], legend: str, csv: str | None,
+               points: int) -> None:
+    """Prints a benchmark table (run times as ranges, speed-ups best and worst) with its legend,
+    and writes it to ``csv`` if given, with the machine and the number of points."""
+    shown = table.copy()
+    shown["run s (min-max)"] = [f"{a:.2f}-{b:.2f}" for a, b in zip(table.run_min_s, table.run_max_s)]
+    shown["speed-up"] = [f"{a:.2f}x ({b:.2f}x)" for a, b in zip(table.speedup, table.speedup_low)]
+    print(shown[columns].to_string(index=False, na_rep="", float_format=lambda v: f"{v:.2f}"))
+    print(legend)
+    if csv:
+        table.insert(0, "machine", machine_line())
+        table.insert(1, "points", points)
+        table.to_csv(csv, index=False)
+        print(f"-> {csv}")
+
+
 def cmd_scaling(args) -> int:
     points = scaling_points(args.points, *args.rpm)
     print(machine_line(), flush=True)
@@ -304,23 +322,14 @@ def cmd_scaling(args) -> int:
     table = scaling_table(args.fmu, points, args.workers, args.repeat, args.batching)
     load = os.getloadavg()
     print(f"load average after: {load[0]:.2f} / {load[1]:.2f} / {load[2]:.2f}")
-    shown = table.copy()
-    shown["run s (min-max)"] = [f"{a:.2f}-{b:.2f}" for a, b in zip(table.run_min_s, table.run_max_s)]
-    shown["speed-up vs serial"] = [f"{a:.2f}x ({b:.2f}x)" for a, b in
-                                   zip(table.speedup, table.speedup_low)]
-    print(shown[["workers", "batching", "start_s", "warm_s", "run s (min-max)",
-                 "speed-up vs serial", "points_per_s", "cpu_s", "cpu_ratio", "task_cpu_ratio",
-                 "batches", "busy", "first_s", "tail_s", "identical"]].to_string(
-        index=False, na_rep="", float_format=lambda v: f"{v:.2f}"))
-    print("cpu_ratio: the CPU time of every process against the serial loop's; task_cpu_ratio: "
-          "that of the evaluations alone (worker threads); busy: the share of workers x wall "
-          "time spent in batches; first_s / tail_s: a worker's mean wait for its first batch / "
-          "idle time after its last (fastest run)")
-    if args.csv:
-        table.insert(0, "machine", machine_line())
-        table.insert(1, "points", len(points))
-        table.to_csv(args.csv, index=False)
-        print(f"-> {args.csv}")
+    show_table(table, ["workers", "batching", "start_s", "warm_s", "run s (min-max)",
+                       "speed-up", "points_per_s", "cpu_s", "cpu_ratio", "task_cpu_ratio",
+                       "batches", "busy", "first_s", "tail_s", "identical"],
+               "speed-up: against the serial loop (best; worst); cpu_ratio: the CPU time of every "
+               "process against the serial loop's; task_cpu_ratio: that of the evaluations alone "
+               "(worker threads); busy: the share of workers x wall time spent in batches; "
+               "first_s / tail_s: a worker's mean wait for its first batch / idle time after its "
+               "last (fastest run)", args.csv, len(points))
     return 0 if table.identical.all() else 1
 
 
@@ -334,20 +343,11 @@ def cmd_scheduling(args) -> int:
           f"ms a point); waits of {args.scale:g} x that, {sum(scaled):.2f} s in all; "
           f"{args.repeat} timed runs per row", flush=True)
     table = scheduling_table(args.fmu, scaled, args.workers, args.repeat, args.batching)
-    shown = table.copy()
-    shown["run s (min-max)"] = [f"{a:.2f}-{b:.2f}" for a, b in zip(table.run_min_s, table.run_max_s)]
-    shown["speed-up"] = [f"{a:.2f}x ({b:.2f}x)" for a, b in zip(table.speedup, table.speedup_low)]
-    print(shown[["workers", "batching", "start_s", "run s (min-max)", "ideal_s", "speed-up",
-                 "efficiency", "pool_cpu_s", "batches", "busy", "first_s", "tail_s"]].to_string(
-        index=False, float_format=lambda v: f"{v:.2f}"))
-    print("speed-up: the sum of the waits over the run's wall time (best; worst); efficiency: "
-          "of the ideal sum / workers; pool_cpu_s: CPU time of every process during the run "
-          "(the pool's own work, the waits use none)")
-    if args.csv:
-        table.insert(0, "machine", machine_line())
-        table.insert(1, "points", len(points))
-        table.to_csv(args.csv, index=False)
-        print(f"-> {args.csv}")
+    show_table(table, ["workers", "batching", "start_s", "run s (min-max)", "ideal_s", "speed-up",
+                       "efficiency", "pool_cpu_s", "batches", "busy", "first_s", "tail_s"],
+               "speed-up: the sum of the waits over the run's wall time (best; worst); "
+               "efficiency: of the ideal sum / workers; pool_cpu_s: CPU time of every process "
+               "during the run (the pool's own work, the waits use none)", args.csv, len(points))
     return 0
 
 
