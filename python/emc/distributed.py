@@ -148,16 +148,13 @@ def interleaved_batches(count: int, batches: int) -> list[list[int]]:
 
 def spread_batches(sizes: list[int]) -> list[list[int]]:
     """Item indices ``0 … sum(sizes)-1`` in batches of these sizes, each spread evenly over the
-    index range: item ``i`` goes to the batch furthest behind its share ``size × (i+1) / n``
-    (the first such batch on a tie). Equal sizes give :func:`interleaved_batches`."""
-    count = sum(sizes)
-    assigned = [0] * len(sizes)
+    index range: the ``j``-th of a batch's ``k`` slots belongs at the middle of the ``j``-th
+    ``k``-th of the range, and the slots of all batches, sorted by that place (the first batch on
+    a tie), take the items in order. Equal sizes give :func:`interleaved_batches`."""
+    slots = sorted(((2 * j + 1) / (2 * size), b) for b, size in enumerate(sizes)
+                   for j in range(size))
     batches: list[list[int]] = [[] for _ in sizes]
-    for i in range(count):
-        # The shortfalls times ``count``: integers, so ties are exact.
-        deficits = [size * (i + 1) - done * count for size, done in zip(sizes, assigned)]
-        b = deficits.index(max(deficits))
-        assigned[b] += 1
+    for i, (_, b) in enumerate(slots):
         batches[b].append(i)
     return batches
 
