@@ -8,7 +8,6 @@ use std::ffi::CString;
 use std::sync::{Mutex, OnceLock};
 
 use super::*;
-use crate::fmu::guard::Handle;
 use crate::variables::GUID;
 use crate::variables::{boolean, integer, real, string, BOOLEANS, INTEGERS, REALS, STRINGS};
 
@@ -136,7 +135,7 @@ fn instance_in(name: &str, phase: Phase) -> fmi2Component {
         Phase::Terminated => ok(fmi2Terminate(c)),
         Phase::StepFailed | Phase::Error => {
             // SAFETY: c is a live instance from fmi2Instantiate, used by this thread alone.
-            let handle = unsafe { &mut *(c as *mut Handle) };
+            let handle = unsafe { guard::handle_mut(c) };
             handle.instance.core.phase = phase;
         }
         _ => {}
@@ -159,7 +158,7 @@ impl Prepared {
         let mut state: fmi2FMUstate = std::ptr::null_mut();
         assert_eq!(fmi2GetFMUstate(c, &mut state), fmi2Status_fmi2OK);
         // SAFETY: c is a live instance from fmi2Instantiate, used by this thread alone.
-        let time = unsafe { &*(c as *const Handle) }.instance.core.time;
+        let time = unsafe { guard::handle_mut(c) }.instance.core.time;
         let mut size = 0;
         assert_eq!(
             fmi2SerializedFMUstateSize(c, state, &mut size),
@@ -337,7 +336,7 @@ fn a_fatal_instance_answers_fatal_to_everything_but_free() {
         let c = instance_in(&name, Phase::StepComplete);
         let prepared = Prepared::of(c);
         // SAFETY: c is a live instance from fmi2Instantiate, used by this thread alone.
-        unsafe { &mut *(c as *mut Handle) }.instance.core.phase = Phase::Fatal;
+        unsafe { guard::handle_mut(c) }.instance.core.phase = Phase::Fatal;
         assert_eq!(call(c, prepared), fmi2Status_fmi2Fatal, "{function}");
         fmi2FreeInstance(c);
     }
@@ -353,4 +352,249 @@ fn a_null_or_freed_instance_is_an_error_not_a_crash() {
         );
     }
     fmi2FreeInstance(std::ptr::null_mut());
+}
+
+#[test]
+fn every_entry_point_on_a_busy_instance_is_refused_and_changes_nothing() {
+    let calls = calls();
+    let name = "busy";
+    let c = instance_in(name, Phase::StepComplete);
+    let prepared = Prepared::of(c);
+    for (function, call) in &calls {
+        let before = logs(name).len();
+        // SAFETY: c is live and outlives the guard; no call is inside it.
+        let held = unsafe { guard::hold(c) };
+        let status = call(c, prepared);
+        drop(held);
+        let said = logs(name)[before..].to_vec();
+        assert_eq!(
+            status, fmi2Status_fmi2Error,
+            "{function} on a busy instance"
+        );
+        assert!(
+            said.iter()
+                .any(|l| l.contains(&format!("{function}: the instance is busy"))),
+            "{function}: {said:?}"
+        );
+    }
+    // The refusals changed nothing: the instance is where it was and goes on.
+    // SAFETY: c is live and no call is inside it.
+    let handle = unsafe { guard::handle_mut(c) };
+    assert_eq!(handle.instance.core.phase, Phase::StepComplete);
+    assert_eq!(handle.instance.core.time, prepared.time);
+    assert_eq!(fmi2DoStep(c, prepared.time, 1e-3, 1), fmi2Status_fmi2OK);
+    // Freeing a busy instance is refused too (it would free memory another call is using).
+    // SAFETY: as above.
+    let held = unsafe { guard::hold(c) };
+    fmi2FreeInstance(c);
+    drop(held);
+    assert!(logs(name)
+        .iter()
+        .any(|l| l.contains("fmi2FreeInstance: the instance is busy")));
+    assert_eq!(
+        fmi2DoStep(c, prepared.time + 1e-3, 1e-3, 1),
+        fmi2Status_fmi2OK
+    );
+    fmi2FreeInstance(c);
+}
+
+/// An instance pointer handed to a second thread: exactly what FMI forbids and these tests do.
+#[derive(Clone, Copy)]
+struct Shared(fmi2Component);
+// SAFETY: the point of the tests below; the guard makes the concurrent calls safe.
+unsafe impl Send for Shared {}
+
+impl Shared {
+    /// The pointer (a method, so that a closure captures the whole `Shared`, not its field).
+    fn ptr(self) -> fmi2Component {
+        self.0
+    }
+}
+// SAFETY: as above.
+unsafe impl Sync for Shared {}
+// SAFETY: an FMU state of an instance the race tests share; as above.
+unsafe impl Send for Prepared {}
+// SAFETY: as above.
+unsafe impl Sync for Prepared {}
+
+/// Value references of the outputs the race tests compare.
+fn compared_outputs() -> Vec<fmi2ValueReference> {
+    let mut vrs: Vec<_> = real::MOUNT_F
+        .iter()
+        .flatten()
+        .map(|&i| REALS[i as usize].vr)
+        .collect();
+    vrs.extend(real::STEERING_WHEEL_A.map(|i| REALS[i as usize].vr));
+    vrs
+}
+
+/// `call` until it is not refused as busy (another thread is inside the instance); panics on
+/// any other status than OK.
+fn until_not_busy(function: &str, mut call: impl FnMut() -> fmi2Status) -> usize {
+    for refusals in 0..10_000_000 {
+        match call() {
+            s if s == fmi2Status_fmi2OK => return refusals,
+            s if s == fmi2Status_fmi2Error => std::hint::spin_loop(),
+            s => panic!("{function} answered {s} under a concurrent caller"),
+        }
+    }
+    panic!("{function} refused ten million times");
+}
+
+/// Scene 1 at 2000 rpm from the start, `steps` steps of 1 ms, the compared outputs after each,
+/// every call repeated while refused as busy; returns them and the number of refusals.
+fn stepped_outputs(c: fmi2Component, steps: usize) -> (Vec<f64>, usize) {
+    let vrs = compared_outputs();
+    let rpm = REALS[real::RPM as usize].vr;
+    let mut refusals = 0;
+    refusals += until_not_busy("fmi2SetupExperiment", || {
+        fmi2SetupExperiment(c, 0, 0.0, 0.0, 0, 0.0)
+    });
+    refusals += until_not_busy("fmi2SetReal", || fmi2SetReal(c, &rpm, 1, &2000.0));
+    refusals += until_not_busy("fmi2EnterInitializationMode", || {
+        fmi2EnterInitializationMode(c)
+    });
+    refusals += until_not_busy("fmi2ExitInitializationMode", || {
+        fmi2ExitInitializationMode(c)
+    });
+    let mut outputs = Vec::with_capacity(steps * vrs.len());
+    let mut values = vec![0.0; vrs.len()];
+    for k in 0..steps {
+        refusals += until_not_busy("fmi2DoStep", || fmi2DoStep(c, k as f64 * 1e-3, 1e-3, 1));
+        refusals += until_not_busy("fmi2GetReal", || {
+            fmi2GetReal(c, vrs.as_ptr(), vrs.len(), values.as_mut_ptr())
+        });
+        outputs.extend_from_slice(&values);
+    }
+    (outputs, refusals)
+}
+
+#[test]
+fn a_second_thread_reading_a_stepping_instance_gets_refusals_or_right_values_never_a_crash() {
+    const STEPS: usize = 400;
+    let reference = instance_in("race-reference", Phase::Instantiated);
+    let (expected, none) = stepped_outputs(reference, STEPS);
+    assert_eq!(none, 0);
+    fmi2FreeInstance(reference);
+
+    // Raced until the guard has refused at least once (nearly always the first time).
+    for attempt in 0..5 {
+        let name = format!("race-readers-{attempt}");
+        let c = Shared(instance_in(&name, Phase::Instantiated));
+        let (outputs, refused, reads) = race_with_reader(c, STEPS);
+        // Identical to the bit: a refused call did nothing, an admitted one ran alone.
+        assert_eq!(outputs, expected);
+        let busy = logs(&name)
+            .iter()
+            .filter(|l| l.contains(": the instance is busy"))
+            .count();
+        assert!(busy >= refused);
+        eprintln!("race with a reader: {reads} reads, {busy} calls refused as busy ({refused} of the stepper's)");
+        fmi2FreeInstance(c.ptr());
+        if busy > 0 {
+            return;
+        }
+    }
+    panic!("the two threads never met inside the instance in five runs");
+}
+
+/// Steps `c` as [`stepped_outputs`] while a second thread reads it as fast as it can; returns
+/// the outputs, the stepper's refused calls and the reader's calls.
+fn race_with_reader(c: Shared, steps: usize) -> (Vec<f64>, usize, usize) {
+    let done = std::sync::atomic::AtomicBool::new(false);
+    let vrs = compared_outputs();
+    std::thread::scope(|scope| {
+        let stepper = scope.spawn(|| {
+            let result = stepped_outputs(c.ptr(), steps);
+            done.store(true, std::sync::atomic::Ordering::Release);
+            result
+        });
+        let reader = scope.spawn(|| {
+            let mut reads = 0usize;
+            let mut values = vec![0.0; vrs.len()];
+            let mut status = 0;
+            while !done.load(std::sync::atomic::Ordering::Acquire) {
+                // Read-only calls: whatever they return, they must not change the stepper's
+                // run; refused as busy, or in initialisation for not being allowed there.
+                let s = match reads % 3 {
+                    0 => fmi2GetReal(c.ptr(), vrs.as_ptr(), vrs.len(), values.as_mut_ptr()),
+                    1 => fmi2GetStatus(c.ptr(), fmi2StatusKind_fmi2DoStepStatus, &mut status),
+                    _ => {
+                        let mut t = 0.0;
+                        fmi2GetRealStatus(c.ptr(), fmi2StatusKind_fmi2LastSuccessfulTime, &mut t)
+                    }
+                };
+                assert!(
+                    s == fmi2Status_fmi2OK || s == fmi2Status_fmi2Error,
+                    "status {s}"
+                );
+                if s == fmi2Status_fmi2OK {
+                    assert!(values.iter().all(|v| v.is_finite()));
+                }
+                reads += 1;
+            }
+            reads
+        });
+        let (outputs, refused) = stepper.join().unwrap();
+        (outputs, refused, reader.join().unwrap())
+    })
+}
+
+#[test]
+fn a_second_thread_calling_every_entry_point_never_crashes_or_corrupts_the_instance() {
+    let calls = calls();
+    let c = Shared(instance_in("race-all", Phase::StepComplete));
+    let prepared = Prepared::of(c.ptr());
+    let done = std::sync::atomic::AtomicBool::new(false);
+    std::thread::scope(|scope| {
+        // The first thread runs, and starts again whenever the second has reset, terminated
+        // or failed it: every status but fatal is fair under such a caller.
+        scope.spawn(|| {
+            let start = std::time::Instant::now();
+            let mut t = prepared.time;
+            while start.elapsed() < std::time::Duration::from_millis(1500) {
+                let s = fmi2DoStep(c.ptr(), t, 1e-3, 1);
+                assert_ne!(s, fmi2Status_fmi2Fatal, "{:?}", logs("race-all"));
+                if s == fmi2Status_fmi2OK {
+                    t += 1e-3;
+                } else {
+                    fmi2Reset(c.ptr());
+                    fmi2SetupExperiment(c.ptr(), 0, 0.0, 0.0, 0, 0.0);
+                    fmi2EnterInitializationMode(c.ptr());
+                    fmi2ExitInitializationMode(c.ptr());
+                    let mut now = 0.0;
+                    if fmi2GetRealStatus(c.ptr(), fmi2StatusKind_fmi2LastSuccessfulTime, &mut now)
+                        == fmi2Status_fmi2OK
+                    {
+                        t = now;
+                    }
+                }
+            }
+            done.store(true, std::sync::atomic::Ordering::Release);
+        });
+        scope.spawn(|| {
+            let mut k = 0;
+            while !done.load(std::sync::atomic::Ordering::Acquire) {
+                let (function, call) = &calls[k % calls.len()];
+                let s = call(c.ptr(), prepared);
+                assert_ne!(
+                    s,
+                    fmi2Status_fmi2Fatal,
+                    "{function}: {:?}",
+                    logs("race-all")
+                );
+                k += 1;
+            }
+        });
+    });
+    // Not corrupted: reset, the instance runs the reference case to the bit.
+    assert_eq!(fmi2Reset(c.ptr()), fmi2Status_fmi2OK);
+    let (outputs, _) = stepped_outputs(c.ptr(), 50);
+    let reference = instance_in("race-all-reference", Phase::Instantiated);
+    assert_eq!(outputs, stepped_outputs(reference, 50).0);
+    assert!(logs("race-all")
+        .iter()
+        .any(|l| l.contains(": the instance is busy")));
+    fmi2FreeInstance(reference);
+    fmi2FreeInstance(c.ptr());
 }

@@ -1098,3 +1098,7 @@ pub extern "C" fn fmi3DoStep(
     })
 }
 const _: fmi3DoStepTYPE = Some(fmi3DoStep);
+
+#[cfg(test)]
+#[path = "abi_concurrency.rs"]
+mod concurrency;

@@ -8,9 +8,11 @@
 //! functions, and whether every refusal leads to the error state (FMI 3.0) or leaves the phase
 //! as it was (FMI 2.0).
 
+use std::cell::UnsafeCell;
 use std::ffi::{c_char, c_void, CString};
 use std::panic::{catch_unwind, AssertUnwindSafe};
 use std::path::PathBuf;
+use std::sync::atomic::{AtomicBool, AtomicU64, Ordering};
 
 use super::c_args::{array, array_mut, place, text};
 use super::fmu_states::FmuStates;
@@ -65,9 +67,92 @@ pub struct Abi {
     pub names: FunctionNames,
 }
 
-/// An instance as the master holds it: the pointer both ABIs hand out.
+/// What the pointer both ABIs hand out points to: the instance's handle behind a flag that
+/// admits one call at a time.
+///
+/// FMI forbids a master to call one instance from two threads at once (FMI 2.0 §2.1.4, FMI 3.0
+/// §2.2.2), but a master that does (a Dask worker with several threads sharing one instance,
+/// say) must get an error, not a corrupted instance. So everything a call may touch before it
+/// owns the instance is atomic or immutable after instantiation: the live marker, the busy flag
+/// and a copy of the logger to refuse with. The handle itself is reached only through
+/// [`Shell::enter`], which takes the busy flag first.
+struct Shell {
+    /// Marks a live instance of one standard ([`Abi::live`]); zero once freed.
+    live: AtomicU64,
+    /// Taken by the one call inside the instance, for the length of that call.
+    busy: AtomicBool,
+    /// The instance's logger as it was at instantiation; a refused concurrent call logs through
+    /// it (errors always reach the environment, so later debug-logging settings do not matter).
+    alarm: Logger,
+    handle: UnsafeCell<Handle>,
+}
+
+/// A call inside a [`Shell`]: it holds the busy flag, and with it the only access to the
+/// handle, until it drops.
+struct Entered<'a>(&'a Shell);
+
+impl std::ops::Deref for Entered<'_> {
+    type Target = Handle;
+    fn deref(&self) -> &Handle {
+        // SAFETY: this call holds the busy flag (taken in `Shell::enter`), and every access to
+        // the handle goes through an `Entered`, so no other reference to it exists meanwhile.
+        unsafe { &*self.0.handle.get() }
+    }
+}
+
+impl std::ops::DerefMut for Entered<'_> {
+    fn deref_mut(&mut self) -> &mut Handle {
+        // SAFETY: as in `deref`; `&mut self` makes this the only reference through this guard.
+        unsafe { &mut *self.0.handle.get() }
+    }
+}
+
+impl Drop for Entered<'_> {
+    fn drop(&mut self) {
+        self.0.busy.store(false, Ordering::Release);
+    }
+}
+
+impl Shell {
+    /// The shell behind an instance pointer of `abi`, if it is live.
+    ///
+    /// A shared reference is all a call may hold before [`Shell::enter`]: two threads may hold
+    /// one at once, and what it reaches outside the cell is atomic or never written again.
+    fn of<'a>(ptr: *mut c_void, abi: &Abi) -> Option<&'a Shell> {
+        if ptr.is_null() {
+            return None;
+        }
+        // SAFETY: a non-null instance pointer is, per FMI 2.0 and 3.0, the pointer instantiation
+        // returned (a boxed Shell), not freed since; a shared reference aliases safely, as the
+        // only fields written after instantiation are atomics and the UnsafeCell's content.
+        let shell = unsafe { &*(ptr as *const Shell) };
+        (shell.live.load(Ordering::Acquire) == abi.live).then_some(shell)
+    }
+
+    /// The handle for the calling thread alone, or `None` while another call is inside it.
+    fn enter(&self) -> Option<Entered<'_>> {
+        self.busy
+            .compare_exchange(false, true, Ordering::Acquire, Ordering::Relaxed)
+            .ok()
+            .map(|_| Entered(self))
+    }
+
+    /// Logs that `function` was refused because another call is inside the instance.
+    fn refuse_busy(&self, function: &str) {
+        self.alarm.log(
+            Level::Error,
+            LogCategory::StatusError,
+            &format!(
+                "{function}: the instance is busy: another thread is inside a call on it; an \
+                 instance takes one call at a time (a master must not use it from two threads \
+                 at once), so this call did nothing"
+            ),
+        );
+    }
+}
+
+/// An instance as the master holds it.
 pub struct Handle {
-    live: u64,
     /// The instance.
     pub instance: Instance,
     /// Strings returned by a string getter stay valid until the next such call on this instance.
@@ -93,9 +178,10 @@ impl Abi {
 
 /// The guard of every entry point with an instance: runs `body` on the instance behind `ptr`
 /// if `function` may be called in its phase (`mask`). A null or stale pointer, or one of the
-/// other standard, gives an error; a refusal is logged as "`function`: reason" and gives an
-/// error (and, for FMI 3.0, the error state); a panic gives a fatal status (the instance is then
-/// unusable); in the fatal phase only freeing the instance is allowed.
+/// other standard, gives an error; so does a call while another thread's call is inside the
+/// instance (logged as busy, nothing done); a refusal is logged as "`function`: reason" and
+/// gives an error (and, for FMI 3.0, the error state); a panic gives a fatal status (the instance
+/// is then unusable); in the fatal phase only freeing the instance is allowed.
 fn entry(
     ptr: *mut c_void,
     abi: &Abi,
@@ -103,17 +189,15 @@ fn entry(
     mask: Mask,
     body: impl FnOnce(&mut Handle) -> Outcome,
 ) -> Status {
-    if ptr.is_null() {
+    let Some(shell) = Shell::of(ptr, abi) else {
         return Status::Error;
-    }
-    let ptr = ptr as *mut Handle;
-    // SAFETY: a non-null instance pointer is, per FMI 2.0 and 3.0, the pointer instantiation
-    // returned, not freed since; the caller must not use one instance from two threads at once
-    // (FMI 2.0 §2.1.4, FMI 3.0 §2.2.2), so this is the only live reference.
-    let handle = unsafe { &mut *ptr };
-    if handle.live != abi.live {
+    };
+    // A refused concurrent call changes nothing, not even the phase: the call inside owns it.
+    let Some(mut entered) = shell.enter() else {
+        shell.refuse_busy(function);
         return Status::Error;
-    }
+    };
+    let handle: &mut Handle = &mut entered;
     let result = catch_unwind(AssertUnwindSafe(|| {
         let inst = &handle.instance;
         inst.logger.log(Level::Info, LogCategory::Calls, function);
@@ -246,13 +330,17 @@ pub fn instantiate(
                 ),
             );
         }
-        let handle = Box::new(Handle {
-            live: abi.live,
-            instance: Instance::new(&name, kind, abi, logger, resource_dir),
-            returned_strings: Vec::new(),
-            states: FmuStates::default(),
+        let shell = Box::new(Shell {
+            live: AtomicU64::new(abi.live),
+            busy: AtomicBool::new(false),
+            alarm: logger.clone(),
+            handle: UnsafeCell::new(Handle {
+                instance: Instance::new(&name, kind, abi, logger, resource_dir),
+                returned_strings: Vec::new(),
+                states: FmuStates::default(),
+            }),
         });
-        Box::into_raw(handle) as *mut c_void
+        Box::into_raw(shell) as *mut c_void
     }));
     result.unwrap_or(std::ptr::null_mut())
 }
@@ -274,22 +362,53 @@ pub fn model_identifier(kind: FmuKind) -> &'static str {
 }
 
 /// Frees the instance behind `ptr` and every FMU state it handed out. A null or already freed
-/// pointer, or one of the other standard, is ignored; allowed in every phase.
+/// pointer, or one of the other standard, is ignored; allowed in every phase. While another
+/// thread's call is inside the instance it is not freed (that call would go on in freed memory):
+/// the refusal is logged, and the master may free it once the call has returned.
 pub fn free(ptr: *mut c_void, abi: &Abi) {
-    if ptr.is_null() {
+    let Some(shell) = Shell::of(ptr, abi) else {
         return;
+    };
+    let Some(entered) = shell.enter() else {
+        shell.refuse_busy(abi.names.free_instance);
+        return;
+    };
+    // The live marker catches the common double free, and a pointer of the other standard,
+    // before ownership is taken back; only the thread that clears it frees.
+    let freed_here = shell
+        .live
+        .compare_exchange(abi.live, 0, Ordering::AcqRel, Ordering::Acquire)
+        .is_ok();
+    drop(entered);
+    if freed_here {
+        // SAFETY: ptr came from `instantiate` (Box::into_raw of a Shell); this thread cleared
+        // its live marker while holding its busy flag, so no call is inside it and no later
+        // call or free gets past `Shell::of`; it is freed exactly once.
+        drop(unsafe { Box::from_raw(ptr as *mut Shell) });
     }
-    let ptr = ptr as *mut Handle;
-    // SAFETY: ptr came from `instantiate` (Box::into_raw) and is freed at most once by contract;
-    // the live marker catches the common double free, and a pointer of the other standard,
-    // before we take ownership back.
-    unsafe {
-        if (*ptr).live != abi.live {
-            return;
-        }
-        (*ptr).live = 0;
-        drop(Box::from_raw(ptr));
-    }
+}
+
+/// The handle behind a live instance pointer, for tests that put an instance into a state the
+/// entry points do not lead to.
+///
+/// # Safety
+/// `ptr` is a live instance of this library and no call is inside it.
+#[cfg(test)]
+pub(crate) unsafe fn handle_mut<'a>(ptr: *mut c_void) -> &'a mut Handle {
+    // SAFETY: the caller's contract.
+    unsafe { &mut *(*(ptr as *const Shell)).handle.get() }
+}
+
+/// Keeps the instance behind `ptr` busy until the returned guard drops, as a call from
+/// another thread would; for tests of the refusal.
+///
+/// # Safety
+/// `ptr` is a live instance of this library, outliving the guard.
+#[cfg(test)]
+pub(crate) unsafe fn hold(ptr: *mut c_void) -> impl Drop {
+    // SAFETY: the caller's contract.
+    let shell: &'static Shell = unsafe { &*(ptr as *const Shell) };
+    shell.enter().expect("the instance is not busy")
 }
 
 impl Handle {

@@ -41,6 +41,7 @@ impl Callback {
 }
 
 /// The environment's logger and which categories it asked for.
+#[derive(Clone)]
 pub struct Logger {
     callback: Callback,
     environment: fmi2ComponentEnvironment,
