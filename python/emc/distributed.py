@@ -5,8 +5,11 @@ thousands of times. What each evaluation may cost besides its own simulation is 
 
 - **The FMU's bytes reach each worker once**, in a worker plugin (workers that join the cluster
   later get it too); the worker writes them to its temporary directory under their checksum.
-- **Each worker keeps one instance** (:class:`emc.runner.Runner`) for its life and reuses it from
-  evaluation to evaluation: ``fmi2Reset`` brings it back to the instantiated state. Restoring an
+- **Each worker keeps one instance per task it runs at once** (:class:`emc.runner.Runner`) for its
+  life and reuses it from evaluation to evaluation: ``fmi2Reset`` brings it back to the
+  instantiated state. A worker started with several threads (Dask's default: one per core) runs
+  that many tasks at once; each task takes an instance no other task holds (FMI allows one call
+  at a time per instance), so the threads compute in parallel (the FMU releases the GIL). Restoring an
   FMU state saved right after instantiation does the same and gives the same numbers to the bit;
   both cost well under a millisecond against 100–400 ms for a point (most of it the periodic
   start), so the plain reset is kept: there is no state to hold.
@@ -31,11 +34,13 @@ the FMU's log.
 
 from __future__ import annotations
 
+import contextlib
 import hashlib
 import logging
 import math
 import os
 import sys
+import threading
 import time
 from dataclasses import dataclass, field
 from typing import Callable, Iterable
@@ -65,9 +70,13 @@ WORKER_CONFIG = {
     "distributed.scheduler.work-stealing-interval": "1s",
 }
 
-# The warm instances of this worker process, by the FMU's checksum (one process per worker, one
-# thread: never used concurrently).
-_RUNNERS: dict[str, Runner] = {}
+# The warm instances of this worker process that no task holds now, by the FMU's checksum. A
+# worker with several threads runs several tasks at once: each takes an idle instance (or makes
+# one) and gives it back when done, so no instance is ever called from two threads at once and a
+# worker holds as many instances as it ran tasks at once. Every evaluation starts from a reset, so
+# which instance runs which item does not change a number.
+_IDLE_RUNNERS: dict[str, list[Runner]] = {}
+_RUNNERS_LOCK = threading.Lock()
 # The FMU files the plugin wrote on this worker, by checksum.
 _FMU_FILES: dict[str, str] = {}
 
@@ -84,31 +93,44 @@ class FmuPlugin(WorkerPlugin):
         _FMU_FILES[self.sha256] = fmu_from_content(self.content, self.sha256)
 
     def teardown(self, worker):
-        # The instance is dropped, not freed: a task may still be stepping it in the worker's
-        # thread (a study interrupted), and freeing it under that step corrupts the heap. The
-        # worker process ends next and takes it along; its files stay extracted for the next
-        # pool on this machine.
-        _RUNNERS.pop(self.sha256, None)
+        # Idle instances are dropped, not freed: freeing is cheap to skip, the worker process
+        # ends next and takes them along; an instance a task still holds (a study interrupted)
+        # must not be freed under its step. The files stay extracted for the next pool here.
+        with _RUNNERS_LOCK:
+            _IDLE_RUNNERS.pop(self.sha256, None)
 
 
-def worker_runner(sha256: str) -> Runner:
-    """This worker's instance of the FMU with this checksum, created at its first use."""
-    runner = _RUNNERS.get(sha256)
+def _new_runner(sha256: str) -> Runner:
+    path = _FMU_FILES.get(sha256)
+    if path is None:
+        raise RuntimeError(f"the FMU {sha256[:12]}… never reached this worker")
+    name = f"emc-worker-{os.getpid()}-{threading.get_ident()}"
+    return Runner(path, instance_name=name, unzipdir=extracted(path, sha256))
+
+
+@contextlib.contextmanager
+def worker_runner(sha256: str):
+    """An instance of the FMU with this checksum that no other task of this worker holds, for
+    the length of the ``with`` block: an idle one, else a new one."""
+    with _RUNNERS_LOCK:
+        idle = _IDLE_RUNNERS.get(sha256)
+        runner = idle.pop() if idle else None
     if runner is None:
-        path = _FMU_FILES.get(sha256)
-        if path is None:
-            raise RuntimeError(f"the FMU {sha256[:12]}… never reached this worker")
-        runner = _RUNNERS[sha256] = Runner(path, instance_name=f"emc-worker-{os.getpid()}",
-                                           unzipdir=extracted(path, sha256))
-    return runner
+        runner = _new_runner(sha256)
+    try:
+        yield runner
+    finally:
+        with _RUNNERS_LOCK:
+            _IDLE_RUNNERS.setdefault(sha256, []).append(runner)
 
 
 @dataclass(frozen=True)
 class BatchRecord:
-    """Where and when a batch ran: the worker's process, its wall-clock start and end
+    """Where and when a batch ran: the worker's process and thread, its wall-clock start and end
     (``time.time()``, comparable between the processes of one machine) and the CPU time of the
     worker thread that ran it (the evaluations alone, without the worker's housekeeping)."""
     pid: int
+    thread: int
     items: int
     start: float
     end: float
@@ -121,17 +143,32 @@ def evaluate_batch(sha256: str, evaluate: Callable,
     comes back as a value with the results before it, so the worker logs nothing of its own and
     the caller reports the FMU's cause."""
     start, cpu = time.time(), time.thread_time()
-    runner = worker_runner(sha256)
     results: list = []
     failure = None
-    for item in items:
-        try:
-            results.append(evaluate(runner, item))
-        except PointFailed as failed:
-            failure = failed
-            break
-    record = BatchRecord(os.getpid(), len(items), start, time.time(), time.thread_time() - cpu)
+    with worker_runner(sha256) as runner:
+        for item in items:
+            try:
+                results.append(evaluate(runner, item))
+            except PointFailed as failed:
+                failure = failed
+                break
+    record = BatchRecord(os.getpid(), threading.get_ident(), len(items), start, time.time(),
+                         time.thread_time() - cpu)
     return results, failure, record
+
+
+def _warm_up(sha256: str, evaluate: Callable | None, item, dask_worker=None):
+    """Run on each worker by :meth:`FmuPool.warm`: as many idle instances as the worker has
+    threads, each through ``evaluate(runner, item)`` once."""
+    threads = dask_worker.nthreads if dask_worker is not None else 1
+    with _RUNNERS_LOCK:
+        runners = _IDLE_RUNNERS.pop(sha256, [])
+    runners += [_new_runner(sha256) for _ in range(threads - len(runners))]
+    if evaluate is not None:
+        for runner in runners:
+            evaluate(runner, item)
+    with _RUNNERS_LOCK:
+        _IDLE_RUNNERS.setdefault(sha256, []).extend(runners)
 
 
 def _quiet_teardown():
@@ -189,14 +226,15 @@ class MapRecord:
     batches: list[BatchRecord] = field(default_factory=list)
 
     def anatomy(self, workers: int) -> dict:
-        """Where the workers' time went: ``busy``, the share of ``workers × wall time`` spent in
-        batches; ``first_s``, how long a worker waited for its first batch (mean); ``tail_s``,
-        how long a worker sat idle between its last batch and the map's end (mean); ``cpu_s``,
-        the CPU time of the evaluations alone (the worker threads that ran them)."""
+        """Where the workers' time went (``workers``: the task slots, the threads of all
+        workers): ``busy``, the share of ``workers × wall time`` spent in batches; ``first_s``,
+        how long a slot waited for its first batch (mean); ``tail_s``, how long a slot sat idle
+        between its last batch and the map's end (mean); ``cpu_s``, the CPU time of the
+        evaluations alone (the worker threads that ran them)."""
         wall = self.end - self.start
-        by_worker: dict[int, list[BatchRecord]] = {}
+        by_worker: dict[tuple[int, int], list[BatchRecord]] = {}
         for batch in self.batches:
-            by_worker.setdefault(batch.pid, []).append(batch)
+            by_worker.setdefault((batch.pid, batch.thread), []).append(batch)
         # Workers that got no batch wait the whole map.
         idle = max(0, workers - len(by_worker))
         first = [min(b.start for b in runs) - self.start for runs in by_worker.values()]
@@ -212,8 +250,9 @@ class FmuPool:
     """A Dask cluster whose workers each hold a warm instance of one FMU.
 
     ``scheduler``: the address of a running Dask scheduler (its workers get the FMU by content:
-    they need not share the caller's file system); else a local cluster of ``workers`` processes
-    with one thread each (the FMU runs single-threaded). ``batches_per_worker``: ``None`` for
+    they need not share the caller's file system, and may have any number of threads: each
+    running task has an instance of its own); else a local cluster of ``workers`` processes with
+    one thread each (the FMU runs single-threaded; processes keep the instances' memory apart). ``batches_per_worker``: ``None`` for
     shrinking (guided) batches, a number for that many equal batches per worker.
     """
 
@@ -245,18 +284,15 @@ class FmuPool:
 
     @property
     def workers(self) -> int:
-        return max(1, len(self.client.scheduler_info()["workers"]))
+        """The task slots: the threads of all workers (each runs one evaluation at a time)."""
+        workers = self.client.scheduler_info()["workers"].values()
+        return max(1, sum(w.get("nthreads", 1) for w in workers))
 
     def warm(self, evaluate: Callable | None = None, item=None):
-        """Creates every worker's instance now (and runs ``evaluate(runner, item)`` once on each,
-        e.g. a point that reads the reduced body from the cache), so that a timed study that
-        follows pays for neither."""
-        def warm_up(sha256, evaluate, item):
-            runner = worker_runner(sha256)
-            if evaluate is not None:
-                evaluate(runner, item)
-
-        self.client.run(warm_up, self.sha256, evaluate, item)
+        """Creates every worker's instances now, one per thread (and runs ``evaluate(runner,
+        item)`` once on each, e.g. a point that reads the reduced body from the cache), so that a
+        timed study that follows pays for neither."""
+        self.client.run(_warm_up, self.sha256, evaluate, item)
 
     def map(self, evaluate: Callable, items: Iterable, progress: Callable[[int], None] | None = None,
             batches: int | None = None) -> list:

@@ -87,9 +87,9 @@ def test_a_maps_anatomy_splits_the_workers_time():
     from emc.distributed import BatchRecord, MapRecord
 
     # Two workers over 10 s: one busy 1-9 s in two batches, the other 2-6 s; a third never used.
-    record = MapRecord(100.0, 110.0, [BatchRecord(1, 2, 101.0, 105.0, 3.5),
-                                      BatchRecord(1, 1, 105.0, 109.0, 4.0),
-                                      BatchRecord(2, 3, 102.0, 106.0, 3.0)])
+    record = MapRecord(100.0, 110.0, [BatchRecord(1, 7, 2, 101.0, 105.0, 3.5),
+                                      BatchRecord(1, 7, 1, 105.0, 109.0, 4.0),
+                                      BatchRecord(2, 7, 3, 102.0, 106.0, 3.0)])
     anatomy = record.anatomy(workers=3)
     assert anatomy["busy"] == 12.0 / 30.0
     assert anatomy["first_s"] == (1.0 + 2.0 + 10.0) / 3

@@ -9,6 +9,13 @@
 //! replaced. Entries are written to a temporary file in the same directory and renamed into
 //! place, so concurrent processes see either no entry or a complete one; a failed write never
 //! fails the reduction.
+//!
+//! A reduction about to be built takes an exclusive lock on the entry's lock file
+//! (`cms-….lock` beside it) and looks for the entry again once it holds it. So processes and
+//! threads that want the same body at the same time (the instances of a Dask worker with
+//! several threads, the workers of one machine) reduce it once: the first builds and stores it,
+//! the others wait and read it. Where no lock can be taken (a read-only directory, a file
+//! system without locks) each reduces on its own, as before.
 
 use std::fs;
 use std::io::Write;
@@ -207,6 +214,20 @@ fn store(path: &Path, entry: &Entry) -> Result<(), String> {
     written.map_err(|e| format!("writing {}: {e}", path.display()))
 }
 
+/// An exclusive lock on `path` (created if missing), released when the file is dropped; `None`
+/// where none can be taken.
+fn lock(path: &Path) -> Option<fs::File> {
+    fs::create_dir_all(path.parent()?).ok()?;
+    let file = fs::OpenOptions::new()
+        .create(true)
+        .truncate(false)
+        .write(true)
+        .open(path)
+        .ok()?;
+    file.lock().ok()?;
+    Some(file)
+}
+
 /// [`reduce`](super::reduce::reduce) through the cache selected by `cache`.
 pub fn reduce_cached(
     spec: &ReductionSpec,
@@ -242,16 +263,33 @@ pub fn reduce_cached_with_notes(
             notes,
         ));
     };
-    let path = dir.join(format!("cms-{}.json", &sha256_hex(key.as_bytes())[..16]));
-    let rejected = if path.exists() {
-        match load(&path, &key) {
-            Ok((reduced, notes)) => return Ok((reduced, CacheOutcome::Hit(path), notes)),
-            Err(reason) => Some(reason),
+    let name = format!("cms-{}", &sha256_hex(key.as_bytes())[..16]);
+    let path = dir.join(format!("{name}.json"));
+    let look = |path: PathBuf| {
+        if !path.exists() {
+            return Err(None);
         }
-    } else {
-        None
+        match load(&path, &key) {
+            Ok((reduced, notes)) => Ok((reduced, CacheOutcome::Hit(path), notes)),
+            Err(reason) => Err(Some(reason)),
+        }
     };
-    let (reduced, notes) = reduce_with_notes(spec)?;
+    if let Ok(hit) = look(path.clone()) {
+        return Ok(hit);
+    }
+    // Held until this reduction is stored: whoever waited on it then finds the entry.
+    let lock_path = dir.join(format!("{name}.lock"));
+    let _lock = lock(&lock_path);
+    let rejected = match look(path.clone()) {
+        Ok(hit) => return Ok(hit),
+        Err(rejected) => rejected,
+    };
+    let (reduced, notes) = reduce_with_notes(spec).inspect_err(|_| {
+        // A spec that cannot be reduced leaves no file behind. A waiter still holding the
+        // removed file's lock may then reduce beside a newcomer: twice the work, never a
+        // wrong entry.
+        let _ = fs::remove_file(&lock_path);
+    })?;
     let entry = match Entry::new(key, reduced.clone(), notes.clone()) {
         Ok(entry) => entry,
         Err(reason) => return Ok((reduced, CacheOutcome::NotStored { reason }, notes)),

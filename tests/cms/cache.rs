@@ -1,6 +1,7 @@
 //! The reduction cache: hits return the identical reduction, any changed input misses, corrupt
 //! or foreign entries are rebuilt, unwritable directories do not fail the reduction, and
-//! concurrent writers leave one complete entry.
+//! concurrent callers reduce once (the others wait on the entry's lock) and leave one complete
+//! entry.
 
 use std::path::{Path, PathBuf};
 
@@ -159,9 +160,20 @@ fn concurrent_writers_leave_one_complete_entry() {
     for (r, _) in &results {
         assert_eq!(r, &results[0].0);
     }
+    // One built and stored it; the others waited on its lock and read it.
+    let stored = results
+        .iter()
+        .filter(|(_, o)| matches!(o, CacheOutcome::Stored(_)))
+        .count();
+    let hits = results
+        .iter()
+        .filter(|(_, o)| matches!(o, CacheOutcome::Hit(_)))
+        .count();
+    assert_eq!((stored, hits), (1, 2), "{results:?}");
     let files: Vec<_> = std::fs::read_dir(&dir)
         .unwrap()
-        .map(|e| e.unwrap().file_name())
+        .map(|e| e.unwrap().file_name().into_string().unwrap())
+        .filter(|name| !name.ends_with(".lock"))
         .collect();
     assert_eq!(files.len(), 1, "temporary files left behind: {files:?}");
     let (r, outcome) = reduce_cached(&spec(), &setting).unwrap();
