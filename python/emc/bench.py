@@ -14,6 +14,7 @@ from __future__ import annotations
 import argparse
 import datetime
 import functools
+import itertools
 import os
 import platform
 import sys
@@ -140,8 +141,9 @@ def same_results(a: list, b: list) -> bool:
 
 
 def timed_pool_runs(fmu_path: str, workers: int, batching: str, evaluate, items: list,
-                    repeat: int, warm_with=None) -> dict:
-    """A pool of ``workers`` (``batching``: "guided" or "equal") started, its instances warmed
+                    repeat: int, warm_with=None, threads: int = 1) -> dict:
+    """A pool of ``workers`` processes of ``threads`` threads each (``batching``: "guided" or
+    "equal") started, its instances warmed
     (and ``evaluate(runner, warm_with)`` run once on each, if given), then ``repeat`` timed maps
     of ``evaluate`` over ``items``: the start and warm-up times, each run's wall and CPU time
     (every process), the last run's results, the evaluations' least CPU time and the fastest
@@ -149,7 +151,7 @@ def timed_pool_runs(fmu_path: str, workers: int, batching: str, evaluate, items:
     from .distributed import FmuPool
 
     started = time.perf_counter()
-    with FmuPool(fmu_path, workers=workers,
+    with FmuPool(fmu_path, workers=workers, threads_per_worker=threads,
                  batches_per_worker=4 if batching == "equal" else None) as pool:
         start = time.perf_counter() - started
         started = time.perf_counter()
@@ -159,7 +161,7 @@ def timed_pool_runs(fmu_path: str, workers: int, batching: str, evaluate, items:
 
         def run():
             results = pool.map(evaluate, items)
-            anatomies.append(pool.last_map.anatomy(workers))
+            anatomies.append(pool.last_map.anatomy(pool.workers))
             return results
 
         times, cpus, results = _timed(run, repeat, _tree_cpu)
@@ -186,9 +188,10 @@ def _tree_cpu() -> float:
 
 
 def scaling_table(fmu_path: str, points: list, workers=(1, 2), repeat: int = 2,
-                  batchings=("guided",), out=sys.stdout) -> pd.DataFrame:
-    """Serial against Dask pools of each worker count and batching (``"guided"``: shrinking
-    batches; ``"equal"``: four equal batches per worker), on warm instances: the serial loop runs
+                  batchings=("guided",), out=sys.stdout, threads=(1,)) -> pd.DataFrame:
+    """Serial against Dask pools of each worker count, threads per worker and batching
+    (``"guided"``: shrinking batches; ``"equal"``: four equal batches per worker), on warm
+    instances: the serial loop runs
     on an instance that has already run a point; each pool is started and its workers' instances
     warmed (one point each, the reduced body read from the cache) before the timed runs. The
     start and warm-up of each pool are reported beside, and the CPU time of each run: the serial
@@ -209,24 +212,24 @@ def scaling_table(fmu_path: str, points: list, workers=(1, 2), repeat: int = 2,
               file=out, flush=True)
         times, cpus, serial = _timed(lambda: [evaluate(runner, p) for p in points], repeat,
                                      time.process_time)
-    rows.append({"workers": "serial", "batching": "", "start_s": 0.0, "warm_s": 0.0,
+    rows.append({"workers": "serial", "threads": "", "batching": "", "start_s": 0.0,
+                 "warm_s": 0.0,
                  "run_min_s": min(times), "run_max_s": max(times), "cpu_s": min(cpus),
                  "task_cpu_s": min(cpus), "identical": True})
     print(f"serial: {min(times):.2f}-{max(times):.2f} s", file=out, flush=True)
-    for w in workers:
-        for batching in batchings:
-            run = timed_pool_runs(fmu_path, w, batching, evaluate, points, repeat,
-                                  warm_with=points[0])
-            rows.append({"workers": w, "batching": batching, "start_s": run["start_s"],
-                         "warm_s": run["warm_s"], "run_min_s": min(run["times"]),
-                         "run_max_s": max(run["times"]), "cpu_s": min(run["cpus"]),
-                         "task_cpu_s": run["task_cpu_s"], "batches": run["batches"],
-                         "busy": run["busy"], "first_s": run["first_s"], "tail_s": run["tail_s"],
-                         "identical": same_results(run["results"], serial)})
-            times = run["times"]
-            print(f"{w} workers, {batching} batches: start {run['start_s']:.1f} s, "
-                  f"warm-up {run['warm_s']:.1f} s, "
-                  f"{min(times):.2f}-{max(times):.2f} s", file=out, flush=True)
+    for w, t, batching in itertools.product(workers, threads, batchings):
+        run = timed_pool_runs(fmu_path, w, batching, evaluate, points, repeat,
+                              warm_with=points[0], threads=t)
+        rows.append({"workers": w, "threads": t, "batching": batching, "start_s": run["start_s"],
+                     "warm_s": run["warm_s"], "run_min_s": min(run["times"]),
+                     "run_max_s": max(run["times"]), "cpu_s": min(run["cpus"]),
+                     "task_cpu_s": run["task_cpu_s"], "batches": run["batches"],
+                     "busy": run["busy"], "first_s": run["first_s"], "tail_s": run["tail_s"],
+                     "identical": same_results(run["results"], serial)})
+        times = run["times"]
+        print(f"{w} workers x {t} threads, {batching} batches: start {run['start_s']:.1f} s, "
+              f"warm-up {run['warm_s']:.1f} s, "
+              f"{min(times):.2f}-{max(times):.2f} s", file=out, flush=True)
     table = pd.DataFrame(rows)
     best_serial = table.run_min_s.iloc[0]
     table["speedup"] = best_serial / table.run_min_s
@@ -319,10 +322,11 @@ def cmd_scaling(args) -> int:
     print(machine_line(), flush=True)
     print(f"{len(points)} points, {args.rpm[0]:g}-{args.rpm[1]:g} rpm, scene 2, periodic start, "
           f"8 revolutions at 72 steps each; {args.repeat} timed runs per row", flush=True)
-    table = scaling_table(args.fmu, points, args.workers, args.repeat, args.batching)
+    table = scaling_table(args.fmu, points, args.workers, args.repeat, args.batching,
+                          threads=args.threads)
     load = os.getloadavg()
     print(f"load average after: {load[0]:.2f} / {load[1]:.2f} / {load[2]:.2f}")
-    show_table(table, ["workers", "batching", "start_s", "warm_s", "run s (min-max)",
+    show_table(table, ["workers", "threads", "batching", "start_s", "warm_s", "run s (min-max)",
                        "speed-up", "points_per_s", "cpu_s", "cpu_ratio", "task_cpu_ratio",
                        "batches", "busy", "first_s", "tail_s", "identical"],
                "speed-up: against the serial loop (best; worst); cpu_ratio: the CPU time of every "
@@ -361,6 +365,9 @@ def main(argv: list[str] | None = None) -> int:
     s.add_argument("--points", type=int, default=48, help="speed points (default 48)")
     s.add_argument("--rpm", type=float, nargs=2, default=[800.0, 4000.0], metavar=("FROM", "TO"))
     s.add_argument("--workers", type=int, nargs="+", default=[2], help="worker counts (default 2)")
+    s.add_argument("--threads", type=int, nargs="+", default=[1],
+                   help="threads per worker (default 1); a worker with several runs that many "
+                        "evaluations at once, each on an instance of its own")
     s.add_argument("--repeat", type=int, default=2, help="timed runs per row (default 2)")
     s.add_argument("--batching", nargs="+", choices=("guided", "equal"), default=["guided"],
                    help="how a pool batches the points: shrinking batches (guided, the default) "

@@ -35,6 +35,7 @@ import pandas as pd
 from . import band as bands
 from . import plots
 from .comfort import comfort_table
+from .distributed import ClusterMismatch
 from .runner import PointFailed, Runner, keep_freed_memory
 from .sweep import DEFAULT_SIGNAL_PREFIXES, run_sweep, save, speed_points
 from .tracking import track_orders
@@ -423,11 +424,12 @@ def sweep_cases(args, cases: list[tuple[str, dict]], signals: list[str], out: pa
     """Every case's speed points (serial or on Dask), at the band's three bounds if a band is
     given (a ``bound`` column then), the FMU's warnings summarised, the order and spectrum tables
     of all cases written; returns (orders, spectra, FMU warnings)."""
-    from .distributed import FmuPool
+    from .distributed import FmuPool, settings_files
 
     fmu_warnings = []
     # One pool for every case and bound: its workers start and load the FMU once.
-    pool = None if args.serial else FmuPool(args.fmu, args.workers, args.scheduler)
+    files = sorted({f for _, parameters in cases for f in settings_files(parameters)})
+    pool = None if args.serial else FmuPool(args.fmu, args.workers, args.scheduler, files=files)
 
     def run(_settings: dict, bound: str | None = None):
         tables = []
@@ -931,6 +933,9 @@ def main(argv: list[str] | None = None) -> int:
     except PointFailed as failure:
         print(failure.report(), file=sys.stderr)
         return 1
+    except ClusterMismatch as error:
+        print(f"error: {error}", file=sys.stderr)
+        return 2
     except KeyboardInterrupt:
         print("error: interrupted", file=sys.stderr)
         return 130

@@ -35,7 +35,9 @@ the FMU's log.
 from __future__ import annotations
 
 import contextlib
+import functools
 import hashlib
+import json
 import logging
 import math
 import os
@@ -157,10 +159,103 @@ def evaluate_batch(sha256: str, evaluate: Callable,
     return results, failure, record
 
 
+class ClusterMismatch(Exception):
+    """A worker cannot give the numbers this process would: another emc, fmpy or numpy, or
+    another copy (or none) of a file the settings name."""
+
+
+@functools.cache
+def software_identity() -> dict:
+    """What decides a worker's numbers besides the FMU (which travels by content): emc's version
+    and a checksum of its source files (two checkouts of one version differ there), fmpy's and
+    numpy's versions."""
+    from importlib import metadata
+
+    import fmpy
+    import numpy
+
+    package = os.path.dirname(os.path.abspath(__file__))
+    digest = hashlib.sha256()
+    for folder, dirs, files in sorted(os.walk(package)):
+        dirs[:] = sorted(d for d in dirs if d != "__pycache__")
+        for name in sorted(f for f in files if f.endswith(".py")):
+            path = os.path.join(folder, name)
+            digest.update(os.path.relpath(path, package).encode())
+            with open(path, "rb") as f:
+                digest.update(f.read())
+    try:
+        version = metadata.version("emc")
+    except metadata.PackageNotFoundError:
+        version = "unknown"
+    return {"emc": f"{version} (source {digest.hexdigest()[:12]})", "fmpy": fmpy.__version__,
+            "numpy": numpy.__version__}
+
+
+def describe_identity(identity: dict) -> str:
+    return ", ".join(f"{name} {value}" for name, value in identity.items())
+
+
+def identity_mismatches(local: dict, workers: dict[str, dict]) -> list[str]:
+    """One line per worker whose software differs from ``local``, naming both."""
+    return [f"worker {address} runs {describe_identity(theirs)}; this process runs "
+            f"{describe_identity(local)}"
+            for address, theirs in sorted(workers.items()) if theirs != local]
+
+
+def file_digest(path: str) -> str | None:
+    """The SHA-256 of the file at ``path``, None if there is none."""
+    try:
+        with open(path, "rb") as f:
+            return hashlib.sha256(f.read()).hexdigest()
+    except OSError:
+        return None
+
+
+def _file_digests(paths: list[str]) -> dict[str, str | None]:
+    return {path: file_digest(path) for path in paths}
+
+
+def settings_files(parameters: dict) -> list[str]:
+    """The files an absolute ``configFile`` among ``parameters`` makes the FMU read: the
+    configuration itself and the body file it names (a deck, a DMIG punch or a reduced body;
+    relative to the configuration's folder). INCLUDE files of a deck are not followed. A
+    configuration that does not read as JSON is left to the FMU's own message."""
+    name = str(parameters.get("configFile", "") or "")
+    if not name or not os.path.isabs(name):
+        return []
+    files = [name]
+    try:
+        with open(name, encoding="utf-8") as f:
+            body = json.load(f).get("body", {})
+        path = body.get("path") if isinstance(body, dict) else None
+    except (OSError, ValueError, AttributeError):
+        path = None
+    if isinstance(path, str) and path:
+        files.append(os.path.normpath(os.path.join(os.path.dirname(name), path)))
+    return files
+
+
+def file_mismatches(local: dict[str, str | None], workers: dict[str, dict]) -> list[str]:
+    """One line per file a worker lacks, or holds with other content than this process (where
+    this process has it) or than the other workers (where it does not)."""
+    lines = []
+    for path in sorted({p for digests in workers.values() for p in digests} | set(local)):
+        seen = {address: digests.get(path) for address, digests in sorted(workers.items())}
+        reference = local.get(path) or next((d for d in seen.values() if d), None)
+        for address, digest in seen.items():
+            if digest is None:
+                lines.append(f"{path} is missing on worker {address}")
+            elif reference is not None and digest != reference:
+                whose = "this process's" if local.get(path) else "another worker's"
+                lines.append(f"{path} differs on worker {address} (sha256 {digest[:12]}… "
+                             f"against {whose} {reference[:12]}…)")
+    return lines
+
+
 def _warm_up(sha256: str, evaluate: Callable | None, item, dask_worker=None):
     """Run on each worker by :meth:`FmuPool.warm`: as many idle instances as the worker has
     threads, each through ``evaluate(runner, item)`` once."""
-    threads = dask_worker.nthreads if dask_worker is not None else 1
+    threads = dask_worker.state.nthreads if dask_worker is not None else 1
     with _RUNNERS_LOCK:
         runners = _IDLE_RUNNERS.pop(sha256, [])
     runners += [_new_runner(sha256) for _ in range(threads - len(runners))]
@@ -257,7 +352,13 @@ class FmuPool:
     """
 
     def __init__(self, fmu_path: str, workers: int = 2, scheduler: str | None = None,
-                 batches_per_worker: int | None = None):
+                 batches_per_worker: int | None = None, files: Iterable[str] = (),
+                 threads_per_worker: int = 1):
+        """``threads_per_worker``: of a local cluster (one by default: processes keep the
+        instances' memory apart, and need not share the GIL). ``files``: files the settings make the FMU read by absolute path (see
+        :func:`settings_files`); every worker must see each with the same content as this
+        process, checked before anything runs like the workers' software
+        (:class:`ClusterMismatch`)."""
         from dask.distributed import Client, LocalCluster
 
         with open(fmu_path, "rb") as f:
@@ -272,15 +373,42 @@ class FmuPool:
         else:
             # Worker logs below ERROR (cancelled tasks after a failure, …) would bury the cause.
             with dask.config.set(WORKER_CONFIG):
-                self.cluster = LocalCluster(n_workers=workers, threads_per_worker=1,
+                self.cluster = LocalCluster(n_workers=workers,
+                                            threads_per_worker=threads_per_worker,
                                             processes=True, dashboard_address=None,
                                             silence_logs=logging.ERROR)
             self.client = Client(self.cluster)
         try:
+            self.check_workers(list(files))
             self.client.register_plugin(FmuPlugin(self.content, self.sha256))
         except BaseException:
             self.close()
             raise
+
+    def check_workers(self, files: list[str]):
+        """Refuses workers whose software differs from this process's, or that lack one of
+        ``files`` or hold another copy (:class:`ClusterMismatch`, one line per defect)."""
+        try:
+            identities = self.client.run(software_identity)
+        except (ImportError, AttributeError) as error:
+            # Its functions are sent by reference: a worker without this emc cannot run them.
+            raise ClusterMismatch(f"a worker cannot run emc's functions ({error}): install the "
+                                  "same emc on every worker (pip install ./python)") from None
+        software = identity_mismatches(software_identity(), identities)
+        files = file_mismatches(_file_digests(files), self.client.run(_file_digests, files)) \
+            if files else []
+        problems = software + files
+        if problems:
+            more = f" (and {len(problems) - 3} more)" if len(problems) > 3 else ""
+            remedy = []
+            if software:
+                remedy.append("install the same emc, fmpy and numpy on every worker as here "
+                              "(pip install the same ./python)")
+            if files:
+                remedy.append("a worker reads the files the settings name from its own file "
+                              "system: give it them at the same path with the same content (a "
+                              "shared file system or a copy)")
+            raise ClusterMismatch("; ".join(problems[:3]) + more + ": " + "; ".join(remedy))
 
     @property
     def workers(self) -> int:

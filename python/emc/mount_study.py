@@ -481,7 +481,7 @@ def open_study(args, problem: Problem, mounts: int):
     """(store, evaluator, pool or None, progress bar or None) for the command's options; the
     caller closes the evaluator and the pool."""
     from . import cli
-    from .distributed import FmuPool
+    from .distributed import FmuPool, settings_files
 
     with open(args.fmu, "rb") as f:
         digest = hashlib.sha256(f.read()).hexdigest()
@@ -492,7 +492,8 @@ def open_study(args, problem: Problem, mounts: int):
     if store.records:
         print(f"note: {len(store.records)} evaluations found in {store.path}: the study "
               "continues from them", file=sys.stderr)
-    pool = None if args.serial else FmuPool(args.fmu, args.workers, args.scheduler)
+    pool = None if args.serial else FmuPool(args.fmu, args.workers, args.scheduler,
+                                            files=settings_files(dict(problem.parameters)))
     evaluator = Evaluator(problem, args.fmu, store, mounts, pool)
     return store, evaluator, pool
 
