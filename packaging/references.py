@@ -4,7 +4,7 @@ Each FMU gets its experiments as FMI-LS-REF files (python/emc/references.py desc
 layout): the stimulus, the parameter values, the expected outputs computed by the 2.0 FMU at
 rtol 1e-9 (the experiments run at 1e-6), and the comparison tolerance. The FMI 3.0 FMU of the
 same model carries the same experiments, their columns gathered into its array variables
-(``emc.references.as_fmi3``): the references of both come from one run of the 2.0 FMU that
+(``emc.running.references.as_fmi3``): the references of both come from one run of the 2.0 FMU that
 records every element of the arrays the 3.0 outputs are. The first experiment of each 2.0 FMU
 also goes into the directory tree of the FMI cross-check
 (github.com/modelica/fmi-cross-check, rules 4.1):
@@ -31,10 +31,10 @@ from xml.sax.saxutils import quoteattr
 import numpy as np
 
 sys.path.insert(0, str(pathlib.Path(__file__).resolve().parent.parent / "python"))
-from emc.references import (ANNOTATION, EXPERIMENTS, EXPERIMENTS_TYPE, LS_DIR, LS_NAME,  # noqa: E402
+from emc.running.references import (ANNOTATION, EXPERIMENTS, EXPERIMENTS_TYPE, LS_DIR, LS_NAME,  # noqa: E402
                             LS_NS, LS_VERSION, MANIFEST, Experiment, as_fmi3, csv_text,
                             fmi3_arrays, fmi3_element, sha3, simulate)
-from emc.ssp import parameter_set  # noqa: E402
+from emc.running.ssp import parameter_set  # noqa: E402
 
 TOOL = "engine_mount_chassis"
 PLATFORMS = ["linux64", "win64"]
@@ -186,7 +186,7 @@ correctly.</p>
 <table border="1"><tr><th>experiment</th><th>what</th><th>run</th><th>outputs compared</th><th>tolerance</th></tr>
 {rows}
 </table>
-<p>With fmpy: <code>python -m emc.references {fmu.name}</code> (the emc tool of the project).</p>
+<p>With fmpy: <code>python -m emc.running.references {fmu.name}</code> (the emc tool of the project).</p>
 </body></html>
 """
 

@@ -10,8 +10,8 @@ Usage: PYTHONPATH=python .venv/bin/python scripts/tolerance_table.py dist/Engine
 """
 import sys
 
-from emc import accuracy
-from emc.runner import Runner
+from emc.studies import accuracy
+from emc.running.runner import Runner
 
 FORCES = [f"mount[{i}].F[{j}]" for i in range(1, 5) for j in range(1, 4)]
 WHEEL = [f"steeringWheel.a[{j}]" for j in range(1, 4)]

@@ -23,7 +23,15 @@ import time
 import numpy as np
 import pandas as pd
 
-from .runner import OperatingPoint, Runner, keep_freed_memory
+from .base import options
+from .base.checks import DEFAULT_PARAMETERS, check_range
+from .base.fmu import check_outputs, highest_speed, model_variables
+from .base.outputs import save
+from .running.runner import OperatingPoint, Runner, keep_freed_memory
+from .running.sweep import speed_points
+from .running.distributed import FmuPool
+import psutil
+from .running.sweep import sweep_point
 
 EFFECTS = ("gasForces", "massForces", "balanceShaft", "gyroscopic", "ringCarrier", "mountNonlinearity")
 
@@ -111,7 +119,6 @@ def scaling_points(count: int, rpm_from: float = 800.0, rpm_to: float = 4000.0) 
     """The points of the scaling benchmark: what ``emc sweep`` runs by default (scene 2, periodic
     start, 8 revolutions, 72 steps per revolution), ``count`` speeds from ``rpm_from`` to
     ``rpm_to``."""
-    from .sweep import speed_points
 
     return speed_points(rpm_from, rpm_to, count, revolutions=8, periodic=True,
                         parameters=(("scene", 2),))
@@ -147,8 +154,7 @@ def timed_pool_runs(fmu_path: str, workers: int, batching: str, evaluate, items:
     (and ``evaluate(runner, warm_with)`` run once on each, if given), then ``repeat`` timed maps
     of ``evaluate`` over ``items``: the start and warm-up times, each run's wall and CPU time
     (every process), the last run's results, the evaluations' least CPU time and the fastest
-    run's anatomy (:meth:`emc.distributed.MapRecord.anatomy`)."""
-    from .distributed import FmuPool
+    run's anatomy (:meth:`emc.running.distributed.MapRecord.anatomy`)."""
 
     started = time.perf_counter()
     with FmuPool(fmu_path, workers=workers, threads_per_worker=threads,
@@ -174,7 +180,6 @@ def timed_pool_runs(fmu_path: str, workers: int, batching: str, evaluate, items:
 def _tree_cpu() -> float:
     """CPU seconds used so far by this process and all its descendants alive (a local pool's
     scheduler, nannies and workers)."""
-    import psutil
 
     me = psutil.Process()
     total = 0.0
@@ -198,9 +203,8 @@ def scaling_table(fmu_path: str, points: list, workers=(1, 2), repeat: int = 2,
     process's, or that of this process and all its children (scheduler, nannies, workers),
     which load does not change. Of the pool runs also the CPU time of the evaluations alone
     (the worker threads that ran them) and where the workers' time went
-    (:meth:`emc.distributed.MapRecord.anatomy`, the run with the shortest wall time). Every run's
+    (:meth:`emc.running.distributed.MapRecord.anatomy`, the run with the shortest wall time). Every run's
     results are compared with the serial ones to the bit."""
-    from .sweep import sweep_point
 
     evaluate = functools.partial(sweep_point, signals=None, case="")
     rows = []
@@ -252,7 +256,6 @@ def wait_point(runner: Runner, seconds: float) -> float:
 
 def point_costs(fmu_path: str, points: list) -> list[float]:
     """The wall time of each point, serially on one warm instance (the best of two runs)."""
-    from .sweep import sweep_point
 
     evaluate = functools.partial(sweep_point, signals=None, case="")
     costs = [float("inf")] * len(points)
@@ -355,15 +358,46 @@ def cmd_scheduling(args) -> int:
     return 0
 
 
+# ----- emc bench-effects and emc bench-realtime ------------------------------------------------
+
+def cmd_bench_effects(args) -> int:
+    if args.scene is None:
+        args.scene = [DEFAULT_PARAMETERS["scene"]]
+    variables = model_variables(args.fmu)
+    scene = variables.get("scene")
+    for value in args.scene:
+        check_range("--scene", value, int(scene.min) if scene and scene.min else 1,
+                    int(scene.max) if scene and scene.max else 2)
+    check_range("--rpm-point", args.rpm_point, 0.0, highest_speed(variables), strict_low=True)
+    check_range("--seconds", args.seconds, 0.0, strict_low=True)
+    check_outputs("--signal-name", [args.signal_name], variables)
+
+    table = effects_table(args.fmu, scenes=args.scene, rpm=args.rpm_point, seconds=args.seconds,
+                          signal=args.signal_name)
+    with pd.option_context("display.width", 160, "display.max_columns", 20):
+        print(table.to_string(index=False, float_format=lambda v: f"{v:.4g}"))
+    if args.table:
+        save(table, args.table)
+    return 0
+
+
+def cmd_bench_realtime(args) -> int:
+    table = realtime_table(args.fmu, rpm=args.rpm_point, seconds=args.seconds, repeats=args.repeats)
+    with pd.option_context("display.width", 160, "display.max_columns", 20):
+        print(table.to_string(index=False, float_format=lambda v: f"{v:.3g}"))
+    return 0
+
+
+
 def main(argv: list[str] | None = None) -> int:
     parser = argparse.ArgumentParser(prog="python -m emc.bench", description=__doc__,
                                      formatter_class=argparse.RawDescriptionHelpFormatter)
     sub = parser.add_subparsers(dest="command", required=True)
     s = sub.add_parser("scaling", help="a sweep serial and on Dask pools of several worker counts "
                                        "(warm instances), with speed-ups and a bit-for-bit check")
-    s.add_argument("--fmu", default="dist/EngineMountChassis.fmu")
+    options.add_fmu(s)
     s.add_argument("--points", type=int, default=48, help="speed points (default 48)")
-    s.add_argument("--rpm", type=float, nargs=2, default=[800.0, 4000.0], metavar=("FROM", "TO"))
+    options.add_speed_range(s, (800.0, 4000.0))
     s.add_argument("--workers", type=int, nargs="+", default=[2], help="worker counts (default 2)")
     s.add_argument("--threads", type=int, nargs="+", default=[1],
                    help="threads per worker (default 1); a worker with several runs that many "
@@ -378,9 +412,9 @@ def main(argv: list[str] | None = None) -> int:
     d = sub.add_parser("scheduling", help="what distribution alone costs at many workers, on few "
                                           "cores: each point replaced by a wait of its measured "
                                           "time")
-    d.add_argument("--fmu", default="dist/EngineMountChassis.fmu")
+    options.add_fmu(d)
     d.add_argument("--points", type=int, default=192, help="speed points (default 192)")
-    d.add_argument("--rpm", type=float, nargs=2, default=[800.0, 4000.0], metavar=("FROM", "TO"))
+    options.add_speed_range(d, (800.0, 4000.0))
     d.add_argument("--workers", type=int, nargs="+", default=[16],
                    help="worker counts (default 16)")
     d.add_argument("--scale", type=float, default=1.0,

@@ -11,7 +11,10 @@ import pandas as pd
 import pytest
 from matplotlib.collections import PolyCollection
 
-from emc import band, cli
+from emc.figures import plots
+from emc.running import band
+
+from emc import cli
 
 
 def test_the_default_band_scales_body_and_mounts_to_the_ends_of_their_ranges():
@@ -64,7 +67,7 @@ def test_draw_band_fills_between_the_bounds_and_draws_the_nominal():
         [2.0, 2.0, 1.0])
     fig, ax = plt.subplots()
     try:
-        line = band.draw_band(ax, x, low, nominal, high, label="wheel")
+        line = plots.draw_band(ax, x, low, nominal, high, label="wheel")
         assert np.allclose(line.get_ydata(), nominal) and line.get_label() == "wheel"
         (fill,) = [c for c in ax.collections if isinstance(c, PolyCollection)]
         ys = fill.get_paths()[0].vertices[:, 1]
@@ -89,7 +92,7 @@ def synthetic_orders():
 
 
 def test_order_cuts_and_comfort_draw_a_band_per_case():
-    fig = band.order_cuts_figure(synthetic_orders(), "x", unit="m/s2")
+    fig = plots.order_cuts_figure(synthetic_orders(), "x", unit="m/s2")
     try:
         panels = [ax for ax in fig.axes if ax.get_visible()]
         assert len(panels) == 5
@@ -101,7 +104,7 @@ def test_order_cuts_and_comfort_draw_a_band_per_case():
     comfort = pd.DataFrame([{"case": "", "rpm": r, "bound": b, "wheel_ahv": s * r / 1000,
                              "seat_av_comfort": s} for r in (1000.0, 2000.0)
                             for b, s in (("low", 2.0), ("nominal", 1.0), ("high", 0.5))])
-    fig = band.comfort_figure(comfort)
+    fig = plots.comfort_figure(comfort)
     try:
         assert len(fig.axes) == 2
         for ax in fig.axes:

@@ -16,9 +16,12 @@ import pytest
 from fmpy import read_model_description
 
 from emc import cli
-from emc.runner import PointFailed, fmu_from_content
-from emc.sweep import run_sweep, speed_points, sweep_point
-from emc.tracking import track_orders
+from emc.base.checks import DEFAULT_PARAMETERS, parse_settings, sampling_warnings
+from emc.base.fmu import model_variables
+from emc.running.runner import cutoffs_in_use
+from emc.running.runner import PointFailed, fmu_from_content
+from emc.running.sweep import run_sweep, speed_points, sweep_point
+from emc.signals.tracking import track_orders
 
 TINY = ["--serial", "--quiet", "--count", "1", "--rpm", "1500", "1500", "--revolutions", "2",
         "--signal", "mount[1].F[3]"]
@@ -26,7 +29,7 @@ TINY = ["--serial", "--quiet", "--count", "1", "--rpm", "1500", "1500", "--revol
 
 @pytest.fixture(scope="module")
 def variables(fmu_path):
-    return cli.model_variables(str(fmu_path))
+    return model_variables(str(fmu_path))
 
 
 def run(capsys, *args):
@@ -40,7 +43,7 @@ def run(capsys, *args):
                                         ("ON", True), ("yes", True), ("true", True),
                                         ("False", False), (" on ", True)])
 def test_booleans_accept_the_usual_spellings(variables, text, value):
-    assert cli.parse_settings([f"effects.balanceShaft={text}"], variables) == {
+    assert parse_settings([f"effects.balanceShaft={text}"], variables) == {
         "effects.balanceShaft": value}
 
 
@@ -235,15 +238,15 @@ def test_default_scene_is_the_elastic_body_and_scene_1_still_works(fmu_path, tmp
     assert rigid.amplitude.max() == 0.0, "scene 1: no body, no steering wheel"
     assert json.loads((tmp_path / "a" / "metadata.json").read_text())["cases"][""] == {"scene": 2}
     assert cli.build_parser().parse_args(["bench-effects"]).scene is None  # main() fills in 2
-    assert cli.DEFAULT_PARAMETERS["scene"] == 2
+    assert DEFAULT_PARAMETERS["scene"] == 2
 
 
 # --- warnings and progress ---------------------------------------------------------------------
 
 def test_warnings_for_aliasing_and_speeds_beyond_the_chassis_model(variables, fmu_path):
     def warnings(parameters, rpm_from, rpm_to, *spr, **step):
-        cutoff, = cli.cutoffs_in_use(str(fmu_path), [("", parameters)])
-        return cli.sampling_warnings(variables, parameters, rpm_from, rpm_to, *spr, **step,
+        cutoff, = cutoffs_in_use(str(fmu_path), [("", parameters)])
+        return sampling_warnings(variables, parameters, rpm_from, rpm_to, *spr, **step,
                                      cutoff=cutoff)
 
     assert warnings({"scene": 2}, 800, 2500, 72) == []
@@ -305,7 +308,7 @@ def test_fmu_content_is_written_once_under_its_checksum(fmu_path, tmp_path):
     first = os.stat(path).st_mtime_ns
     assert fmu_from_content(content, digest) == path and os.stat(path).st_mtime_ns == first
     # A worker runs from the bytes its plugin got alone: the caller's copy is gone.
-    from emc.distributed import FmuPlugin, evaluate_batch
+    from emc.running.distributed import FmuPlugin, evaluate_batch
 
     copy = tmp_path / "gone.fmu"
     shutil.copy(fmu_path, copy)

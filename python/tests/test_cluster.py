@@ -15,7 +15,7 @@ import pandas as pd
 import pytest
 
 from emc.cli import main
-from emc.distributed import (ClusterMismatch, FmuPool, file_mismatches, identity_mismatches,
+from emc.running.distributed import (ClusterMismatch, FmuPool, file_mismatches, identity_mismatches,
                              settings_files, software_identity)
 
 DASK = str(pathlib.Path(sys.executable).with_name("dask"))
@@ -125,7 +125,7 @@ def test_the_pool_counts_every_thread_of_every_worker_and_warms_an_instance_for_
         pool.warm()
 
         def idle(sha256):
-            from emc.distributed import _IDLE_RUNNERS
+            from emc.running.distributed import _IDLE_RUNNERS
             return len(_IDLE_RUNNERS.get(sha256, []))
 
         assert list(pool.client.run(idle, pool.sha256).values()) == [4]

@@ -5,7 +5,7 @@ import numpy as np
 import pandas as pd
 import pytest
 
-from emc.comfort import comfort_table, weighted_rms, weighting
+from emc.signals.comfort import comfort_table, weighted_rms, weighting
 
 # ISO 2631-1:1997 Table 3 (Wk, Wd) and ISO 5349-1:2001 Table A.2 (Wh): factors x 1000 at
 # one-third-octave centre frequencies (Hz), the ranges the model's spectra cover.

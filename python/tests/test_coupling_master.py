@@ -1,4 +1,4 @@
-"""The fmpy co-simulation master of emc.coupling (engine FMU in scene 3 + body FMU) against the
+"""The fmpy co-simulation master of emc.running.coupling (engine FMU in scene 3 + body FMU) against the
 monolithic scene 2: where plain Jacobi and Gauss-Seidel exchange break down, the linearly
 implicit interface-Jacobian step stays stable and accurate; at a fine step all three agree."""
 
@@ -9,7 +9,7 @@ import sys
 import numpy as np
 import pytest
 
-from emc.coupling import (ALGORITHMS, CoupledPair, Run, coupled, growth, largest_deviation,
+from emc.running.coupling import (ALGORITHMS, CoupledPair, Run, coupled, growth, largest_deviation,
                           monolithic)
 
 ROOT = pathlib.Path(__file__).resolve().parents[2]

@@ -5,8 +5,8 @@ an effect off never makes a run more expensive by much (CPU per simulated second
 import numpy as np
 import pytest
 
-from emc.runner import OperatingPoint, Runner
-from emc.spectra import order_amplitudes
+from emc.running.runner import OperatingPoint, Runner
+from emc.signals.spectra import order_amplitudes
 
 SIGNALS = ["mount[1].F[3]", "mount[1].F[1]", "mount[3].F[2]"]
 REVOLUTIONS = 8

@@ -13,7 +13,7 @@ import pytest
 from fmpy import read_model_description, simulate_fmu
 from fmpy.validation import validate_fmu
 
-from emc.spectra import order_amplitudes
+from emc.signals.spectra import order_amplitudes
 
 ROOT = pathlib.Path(__file__).resolve().parents[2]
 

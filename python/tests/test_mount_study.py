@@ -9,10 +9,10 @@ import math
 import numpy as np
 import pytest
 
-from emc import doe
-from emc.mount_study import (Evaluator, Limits, Problem, Store, StudyError, base_configuration,
+from emc.studies import doe
+from emc.studies.mount_study import (Evaluator, Limits, Problem, Store, StudyError, base_configuration,
                              parse_variable)
-from emc.optimise import local_check, minimise
+from emc.studies.optimise import local_check, minimise
 
 
 # --- sensitivity indices against known ones ------------------------------------------------------

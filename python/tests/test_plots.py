@@ -9,8 +9,8 @@ import pandas as pd
 import pytest
 from matplotlib.collections import QuadMesh
 
-from emc import plots
-from emc.spectra import ORDERS
+from emc.figures import plots
+from emc.signals.spectra import ORDERS
 
 SPEEDS = (1000.0, 1500.0, 2000.0)
 

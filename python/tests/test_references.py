@@ -13,7 +13,7 @@ import zipfile
 import numpy as np
 import pytest
 
-from emc import references
+from emc.running import references
 
 ROOT = pathlib.Path(__file__).resolve().parents[2]
 DIST = ROOT / "dist"

@@ -4,9 +4,9 @@ import numpy as np
 import pandas as pd
 import pytest
 
-from emc.runner import OperatingPoint, Runner
-from emc.spectra import ORDERS, amplitude_spectrum, order_amplitudes
-from emc.sweep import run_sweep, speed_points
+from emc.running.runner import OperatingPoint, Runner
+from emc.signals.spectra import ORDERS, amplitude_spectrum, order_amplitudes
+from emc.running.sweep import run_sweep, speed_points
 
 
 def test_order_amplitudes_of_a_synthetic_signal_are_exact():
@@ -34,7 +34,7 @@ def test_operating_points_reject_windows_without_half_orders():
 def test_dask_sweeps_equal_the_serial_sweep_for_any_worker_count(fmu_path):
     """Workers keep their instance from batch to batch: whatever the worker count and batching,
     the tables are the serial sweep's to the bit (scene 2, five points)."""
-    from emc.distributed import FmuPool
+    from emc.running.distributed import FmuPool
 
     points = speed_points(900, 2100, 5, revolutions=4)
     signals = ["mount[1].F[3]", "mount[3].F[1]", "steeringWheel.a[3]"]
@@ -56,7 +56,7 @@ def test_dask_sweeps_equal_the_serial_sweep_for_any_worker_count(fmu_path):
 
 
 def test_batches_interleave_the_items_and_cover_each_once():
-    from emc.distributed import interleaved_batches
+    from emc.running.distributed import interleaved_batches
 
     assert interleaved_batches(7, 3) == [[0, 3, 6], [1, 4], [2, 5]]
     assert interleaved_batches(2, 8) == [[0], [1]]
@@ -65,7 +65,7 @@ def test_batches_interleave_the_items_and_cover_each_once():
 
 
 def test_guided_batches_shrink_to_single_items_and_spread_over_the_items():
-    from emc.distributed import guided_batches, guided_sizes
+    from emc.running.distributed import guided_batches, guided_sizes
 
     assert guided_sizes(48, 2) == [12, 12, 6, 6, 3, 3, 2, 2, 1, 1]
     sizes = guided_sizes(192, 16)
@@ -84,7 +84,7 @@ def test_guided_batches_shrink_to_single_items_and_spread_over_the_items():
 
 
 def test_a_maps_anatomy_splits_the_workers_time():
-    from emc.distributed import BatchRecord, MapRecord
+    from emc.running.distributed import BatchRecord, MapRecord
 
     # Two workers over 10 s: one busy 1-9 s in two batches, the other 2-6 s; a third never used.
     record = MapRecord(100.0, 110.0, [BatchRecord(1, 7, 2, 101.0, 105.0, 3.5),
@@ -164,7 +164,7 @@ def test_instances_log_to_their_own_sink_and_outlive_each_other(fmu_path):
     """fmpy's logger proxy keeps one logger per process: each instance's messages must still
     reach its own log, and an instance closed first must not take the logger with it (a later
     message of the other one called freed memory: a segmentation fault)."""
-    from emc.runner import PointFailed
+    from emc.running.runner import PointFailed
 
     broken = OperatingPoint(rpm=1500.0, revolutions=2,
                             parameters=(("scene", 1), ("configFile", "/nonexistent/a.json")))
@@ -208,7 +208,7 @@ def test_the_scaling_benchmark_checks_each_pool_run_and_splits_its_time(fmu_path
 def test_the_command_line_keeps_freed_memory_for_reuse(monkeypatch):
     import platform
 
-    from emc.runner import MALLOC_SETTINGS, keep_freed_memory
+    from emc.running.runner import MALLOC_SETTINGS, keep_freed_memory
 
     if platform.system() != "Linux" or platform.libc_ver()[0] != "glibc":
         assert keep_freed_memory() == []

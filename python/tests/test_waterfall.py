@@ -5,8 +5,8 @@ the steering-wheel response consists of half-order traces, the 1.5 order dominat
 import numpy as np
 import pytest
 
-from emc.runner import OperatingPoint, Runner
-from emc.spectra import amplitude_spectrum, order_amplitudes
+from emc.running.runner import OperatingPoint, Runner
+from emc.signals.spectra import amplitude_spectrum, order_amplitudes
 
 SIGNAL = "steeringWheel.a[3]"
 REVOLUTIONS = 8

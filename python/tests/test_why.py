@@ -13,10 +13,18 @@ import numpy as np
 import pandas as pd
 import pytest
 
-from emc import cli, decoupling, frf, ods, tpa
-from emc.modal import export_from_fmu
-from emc.runner import OperatingPoint, Runner
-from emc.spectra import order_components
+from emc import cli
+
+from emc.diagnosis import decoupling
+
+from emc.diagnosis import frf
+
+from emc.diagnosis import ods
+
+from emc.diagnosis import tpa
+from emc.running.modal import export_from_fmu
+from emc.running.runner import OperatingPoint, Runner
+from emc.signals.spectra import order_components
 
 ROOT = pathlib.Path(__file__).resolve().parents[2]
 RESPONSES = [f"steeringWheel.a[{j}]" for j in (1, 2, 3)] + [f"seat.a[{j}]" for j in (1, 2, 3)]
@@ -62,7 +70,7 @@ def test_the_paths_add_up_to_the_simulated_response(fmu_path, export):
 
 def test_a_path_is_its_force_times_the_body_transfer(fmu_path, export):
     """One path by hand: the order of mount[1].F[3] times the accelerance synthesised here from
-    body.json's rows (not emc.modal's), per the modal superposition formula."""
+    body.json's rows (not emc.running.modal's), per the modal superposition formula."""
     samples = window(fmu_path, export, 1100.0, tpa.force_signals(export))
     table = tpa.contributions(export, "steeringWheel.a[3]", samples, 8, 1100.0)
     row = table[(table.order == 1.5) & (table.path == "mount[1] z")].iloc[0]
@@ -272,13 +280,13 @@ def test_tpa_writes_tables_plots_and_metadata(capsys, tmp_path, fmu_path):
 # --- transfer paths in the time domain (run-ups, the coupled pair) -----------------------------
 
 def test_the_path_synthesis_matches_an_independent_integration():
-    """emc.synthesis against scipy's DOP853 on the modal equations: forces held and ramped with
+    """emc.running.synthesis against scipy's DOP853 on the modal equations: forces held and ramped with
     jumps between steps (what a master applies) from a static start, including a critically
     damped mode; and the periodic state against the modal steady state of two harmonics."""
     from scipy.integrate import solve_ivp
 
-    from emc.modal import Body
-    from emc.synthesis import HeldForces, path_responses, periodic_state, static_state
+    from emc.running.modal import Body
+    from emc.running.synthesis import HeldForces, path_responses, periodic_state, static_state
 
     omega = 2 * np.pi * np.array([5.0, 30.0, 1300.0])
     zeta = np.array([0.01, 0.05, 1.0])
@@ -325,7 +333,7 @@ RUNUP_RESPONSES = ["steeringWheel.a[3]", "seat.a[3]", "steeringWheel.a[2]"]
 
 
 def runup_table(fmu_path, export, rpm_from, rpm_to, duration, start):
-    from emc import tpa_time
+    from emc.diagnosis import tpa_time
 
     params = {"scene": 2, "solver.relTol": 1e-7}
     signals = tpa.force_signals(export) + RUNUP_RESPONSES

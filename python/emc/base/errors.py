@@ -1,0 +1,10 @@
+"""The failures a command reports as one line (``error: …``) without a traceback."""
+
+
+class UsageError(Exception):
+    """A bad option, setting, file or folder: reported as one line before anything runs."""
+
+
+class ClusterMismatch(UsageError):
+    """A Dask worker cannot give the numbers this process would: another emc, fmpy or numpy,
+    or another copy (or none) of a file the settings name."""

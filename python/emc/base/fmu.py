@@ -1,0 +1,99 @@
+"""What an FMU's model description says, for checks before anything runs: its variables, its
+outputs, how many mounts it has, the signals a sweep records, and which configuration files a
+``configFile`` can name."""
+
+from __future__ import annotations
+
+import difflib
+import pathlib
+import re
+import zipfile
+from typing import Iterable
+
+from .errors import UsageError
+
+# What a sweep records without --signal: the mount forces and the comfort points.
+DEFAULT_SIGNAL_PREFIXES = ("mount[", "steeringWheel.a", "seat.a")
+# The chassis mode cut-off (Hz) the body in use keeps, as the FMU reports it.
+CUTOFF_IN_USE = "chassis.modeCutoffInUse"
+
+
+def model_variables(fmu: str) -> dict:
+    """The FMU's variables by name (from its model description)."""
+    # Deferred: fmpy imports numpy, which the command line does not need to start.
+    from fmpy import read_model_description
+
+    if not pathlib.Path(fmu).is_file():
+        raise UsageError(f"--fmu {fmu}: no such file (package it with bash packaging/package.sh)")
+    return {v.name: v for v in read_model_description(fmu).modelVariables}
+
+
+def output_names(variables: dict) -> list[str]:
+    return [n for n, v in variables.items() if v.causality == "output"]
+
+
+def default_signals(variables: dict) -> list[str]:
+    """What a sweep records without --signal: the mount forces and the comfort points."""
+    return [n for n in output_names(variables) if variables[n].type == "Real"
+            and n.startswith(DEFAULT_SIGNAL_PREFIXES)]
+
+
+def units_of(variables: dict) -> dict:
+    return {name: v.unit for name, v in variables.items()}
+
+
+def highest_speed(variables: dict) -> float:
+    rpm = variables.get("rpm")
+    return float(rpm.max) if rpm is not None and rpm.max is not None else 6000.0
+
+
+def start_value(variables: dict, parameters: dict, name: str):
+    """The value ``name`` starts with: set in ``parameters``, else the model description's."""
+    if name in parameters:
+        return parameters[name]
+    v = variables.get(name)
+    return None if v is None or v.start is None else float(v.start)
+
+
+def mount_count(names: Iterable[str]) -> int:
+    """How many mounts an FMU has: the highest ``i`` of its variables ``mount[i].…`` (``names``:
+    the variable names of its model description)."""
+    found = [int(m.group(1)) for name in names if (m := re.match(r"mount\[(\d+)\]\.", name))]
+    return max(found, default=0)
+
+
+def variable_names(model_description) -> list[str]:
+    return [v.name for v in model_description.modelVariables]
+
+
+def check_outputs(option: str, names: list[str], variables: dict, among: list[str] | None = None):
+    """Each name an output of the FMU (and, if ``among`` is given, one of those)."""
+    outputs = output_names(variables)
+    for name in names:
+        if name not in variables or variables[name].causality != "output":
+            close = difflib.get_close_matches(name, outputs, n=3)
+            hint = f" (did you mean {', '.join(close)}?)" if close else ""
+            raise UsageError(f"{option} {name}: not an output of the FMU{hint}")
+        if among is not None and name not in among:
+            raise UsageError(f"{option} {name}: not among the analysed signals "
+                             f"({', '.join(among)}); add --signal {name}")
+
+
+def check_config_file(fmu: str, parameters: dict, remote: bool = False):
+    """A configFile names a file in the FMU's resources (relative) or an existing file (absolute;
+    on a Dask cluster the workers' file system counts, where the pool checks it)."""
+    name = str(parameters.get("configFile", "") or "")
+    if not name:
+        return
+    if pathlib.PurePosixPath(name).is_absolute():
+        if not remote and not pathlib.Path(name).is_file():
+            raise UsageError(f"--set configFile={name}: no such file")
+        return
+    with zipfile.ZipFile(fmu) as z:
+        resources = [n[len("resources/"):] for n in z.namelist()
+                     if n.startswith("resources/") and not n.endswith("/")]
+    if name not in resources:
+        close = difflib.get_close_matches(name, resources, n=3)
+        hint = f"did you mean {', '.join(close)}? " if close else ""
+        raise UsageError(f"--set configFile={name}: not in the FMU's resources ({hint}"
+                         f"available: {', '.join(sorted(resources))}); or give an absolute path")

@@ -1,0 +1,112 @@
+"""``emc sweep``: constant-speed points over a speed range, for each case (and at the damping
+band's bounds), into order and spectrum tables, waterfalls, order cuts and comfort values."""
+
+from __future__ import annotations
+
+import pathlib
+import time
+
+import pandas as pd
+
+from ..base.checks import (analysed_signals, check_range, check_speeds, prepare,
+                           sampling_warnings, start_options)
+from ..base.fmu import default_signals, highest_speed, units_of
+from ..base.outputs import (fmu_warnings_summary, reduction_notice, safe_name, save, warn_cases,
+                            write_metadata)
+from ..figures import plots
+from ..signals.comfort import comfort_table
+from . import band as bands
+from .distributed import FmuPool, settings_files
+from .runner import cutoffs_in_use
+from .sweep import run_sweep, speed_points
+
+
+def sweep_cases(args, cases: list[tuple[str, dict]], signals: list[str], out: pathlib.Path,
+                point_options: dict, band: bands.Band | None = None
+                ) -> tuple[pd.DataFrame, pd.DataFrame, list[str]]:
+    """Every case's speed points (serial or on Dask), at the band's three bounds if a band is
+    given (a ``bound`` column then), the FMU's warnings summarised, the order and spectrum tables
+    of all cases written; returns (orders, spectra, FMU warnings)."""
+    fmu_warnings = []
+    # One pool for every case and bound: its workers start and load the FMU once.
+    files = sorted({f for _, parameters in cases for f in settings_files(parameters)})
+    pool = None if args.serial else FmuPool(args.fmu, args.workers, args.scheduler, files=files)
+
+    def run(_settings: dict, bound: str | None = None):
+        tables = []
+        for label, parameters in cases:
+            if bound is not None:
+                parameters = band.applied(parameters, bound)
+            points = speed_points(args.rpm[0], args.rpm[1], args.count,
+                                  parameters=tuple(parameters.items()), **point_options)
+            tables.append(run_sweep(args.fmu, points, signals=signals, case=label,
+                                    parallel=not args.serial, progress=not args.quiet,
+                                    warnings=fmu_warnings, pool=pool))
+        return (pd.concat([t[0] for t in tables], ignore_index=True),
+                pd.concat([t[1] for t in tables], ignore_index=True))
+
+    try:
+        if band is None:
+            orders, spectra = run({})
+        else:
+            result = bands.run_band(run, band)
+            orders, spectra = result.stack(0), result.stack(1)
+    finally:
+        if pool is not None:
+            pool.close()
+    fmu_warnings_summary(fmu_warnings)
+    suffix = ".parquet" if args.parquet else ".csv"
+    save(orders, str(out / f"orders{suffix}"))
+    save(spectra, str(out / f"spectra{suffix}"))
+    return orders, spectra, fmu_warnings
+
+
+def cmd_sweep(args) -> int:
+    check_range("--count", args.count, 1)
+    check_range("--steps-per-rev", args.steps_per_rev, 4, 10000)
+    check_range("--workers", args.workers, 1)
+    check_range("--load-torque", args.load_torque)
+    options = start_options(args)
+    variables, cases = prepare(args)
+    band = bands.band_of(args, variables, cases)
+    check_speeds(args.rpm, increasing=args.count > 1, highest=highest_speed(variables))
+    signals = analysed_signals(args, variables, default_signals(variables))
+    warn_cases([(label, sampling_warnings(variables, parameters, args.rpm[0], args.rpm[1],
+                                          args.steps_per_rev, cutoff=cutoff))
+                for (label, parameters), cutoff in zip(cases, cutoffs_in_use(args.fmu, cases))])
+    reduction_notice(cases[0][1], variables)
+    out = pathlib.Path(args.out)
+    out.mkdir(parents=True, exist_ok=True)
+    started = time.perf_counter()
+    orders, spectra, fmu_warnings = sweep_cases(
+        args, cases, signals, out, {**options, "steps_per_revolution": args.steps_per_rev,
+                                    "load_torque": args.load_torque}, band)
+    elapsed = time.perf_counter() - started
+    suffix = ".parquet" if args.parquet else ".csv"
+    units = units_of(variables)
+    labels = [label for label, _ in cases]
+    if band is not None:
+        bands.report_sweep(out, band, orders, spectra, signals, args.plot or signals[:1], units,
+                           suffix)
+    for signal in [] if band is not None else args.plot or signals[:1]:
+        name = safe_name(signal)
+        if len(cases) == 1:
+            plots.waterfall(spectra, signal, str(out / f"waterfall_{name}.png"), unit=units.get(signal))
+            plots.order_cuts(orders, signal, str(out / f"order_cuts_{name}.png"),
+                             unit=units.get(signal))
+        else:
+            plots.side_by_side(spectra, orders, signal, labels, str(out / f"waterfall_{name}.png"),
+                               str(out / f"order_cuts_{name}.png"), unit=units.get(signal))
+    exposure = comfort_table(spectra) if band is None else pd.DataFrame()
+    if not exposure.empty:
+        save(exposure, str(out / f"comfort{suffix}"))
+        plots.comfort(exposure, str(out / "comfort.png"), cases=labels)
+    write_metadata(out, args, variables, cases,
+                   {"speeds": {"from": args.rpm[0], "to": args.rpm[1], "count": args.count},
+                    "start": options, "steps_per_revolution": args.steps_per_rev,
+                    "load_torque": args.load_torque, "signals": signals,
+                    **bands.band_metadata(band)},
+                   fmu_warnings)
+    runs = len(cases) * args.count * (1 if band is None else len(bands.BOUNDS))
+    print(f"{runs} points in {elapsed:.1f} s -> {out}")
+    return 0

@@ -1,0 +1,177 @@
+"""``emc doe``: a design of experiments over mount variables with the variance-based
+sensitivity of the comfort objective (and of the static travel) to each variable, so that the
+engineer sees which mounts matter before optimising (:mod:`emc.studies.mount_study`).
+
+Two plans, both from SALib (the field's library for global sensitivity analysis), seeded:
+
+- ``sobol`` (default): Saltelli's extension of a scrambled Sobol' sequence, N (n + 2) designs for
+  n variables; Sobol' first-order and total indices (S1: the share of the objective's variance
+  each variable explains alone; ST: with all its interactions) with bootstrap confidence
+  intervals.
+- ``lhs``: a Latin hypercube of N designs; first-order indices by RBD-FAST (random balance
+  designs), which works on any such sample.
+
+Every design runs its speed band and its static equilibria (all designs' runs spread over the
+pool, stored as they finish). The designs' table, the indices and plots go to the study folder.
+"""
+
+from __future__ import annotations
+
+import json
+import pathlib
+import time
+
+import numpy as np
+import pandas as pd
+
+from .mount_study import Problem, design_table, open_study, problem_from_args
+from ..base.checks import check_range
+from ..base.outputs import reduction_notice, write_metadata
+from SALib.analyze import rbd_fast
+from SALib.analyze import sobol as sobol_analysis
+from SALib.sample import latin
+from SALib.sample import sobol as sobol_sampling
+from ..running.distributed import progress_bar
+from ..figures.plots import plt
+
+# The responses whose sensitivities are reported: the objective and the limits' quantities.
+RESPONSES = {"objective": "objective", "max_deflection_mm": "largest mount deflection",
+             "max_rotation_deg": "largest powertrain rotation"}
+
+
+def salib_problem(names: list[str], bounds: list[tuple[float, float]]) -> dict:
+    return {"num_vars": len(names), "names": list(names), "bounds": [list(b) for b in bounds]}
+
+
+def sample(problem: dict, method: str, n: int, seed: int) -> np.ndarray:
+    """The designs of the plan (rows: designs, columns: variables in their units)."""
+    if method == "sobol":
+        return sobol_sampling.sample(problem, n, calc_second_order=False, seed=seed)
+    return latin.sample(problem, n, seed=seed)
+
+
+def indices(problem: dict, method: str, X: np.ndarray, Y: np.ndarray, seed: int) -> pd.DataFrame:
+    """Sensitivity indices of response ``Y`` (one value per row of ``X``, the plan's order):
+    S1 and ST (``sobol``) or S1 (``lhs``, RBD-FAST), with confidence half-widths."""
+    if method == "sobol":
+        s = sobol_analysis.analyze(problem, np.asarray(Y, dtype=float), calc_second_order=False,
+                          seed=seed)
+        return pd.DataFrame({"variable": problem["names"], "S1": s["S1"],
+                             "S1_conf": s["S1_conf"], "ST": s["ST"], "ST_conf": s["ST_conf"]})
+    s = rbd_fast.analyze(problem, np.asarray(X, dtype=float), np.asarray(Y, dtype=float),
+                         seed=seed)
+    return pd.DataFrame({"variable": problem["names"], "S1": s["S1"], "S1_conf": s["S1_conf"]})
+
+
+def plot_indices(table: pd.DataFrame, path: str, title: str):
+    responses = list(dict.fromkeys(table.response))
+    fig, axes = plt.subplots(1, len(responses), figsize=(4.2 * len(responses), 0.45 *
+                             table.variable.nunique() + 1.8), sharey=True, squeeze=False)
+    for ax, response in zip(axes[0], responses):
+        t = table[table.response == response]
+        y = np.arange(len(t))
+        ax.barh(y - 0.18, t.S1, 0.36, xerr=t.S1_conf, label="first order S1", color="C0")
+        if "ST" in t and t.ST.notna().any():
+            ax.barh(y + 0.18, t.ST, 0.36, xerr=t.ST_conf, label="total ST", color="C1")
+        ax.set_yticks(y, t.variable)
+        ax.invert_yaxis()
+        ax.set_xlim(0, 1.05)
+        ax.set_title(RESPONSES.get(response, response), fontsize=9)
+        ax.grid(True, axis="x", alpha=0.3)
+    axes[0][0].legend(fontsize=8)
+    fig.suptitle(title, fontsize=10)
+    fig.tight_layout()
+    fig.savefig(path, dpi=120)
+    plt.close(fig)
+
+
+def plot_scatter(designs: pd.DataFrame, names: list[str], path: str):
+    cols = min(4, len(names))
+    rows = -(-len(names) // cols)
+    fig, axes = plt.subplots(rows, cols, figsize=(3.3 * cols, 2.8 * rows), sharey=True,
+                             squeeze=False)
+    ok = designs.feasible
+    for ax, name in zip(axes.flat, names):
+        ax.plot(designs[name][ok], designs.objective[ok], ".", ms=4, color="C0", label="feasible")
+        ax.plot(designs[name][~ok], designs.objective[~ok], "x", ms=4, color="C3",
+                label="beyond a limit")
+        ax.set_xlabel(name, fontsize=8)
+        ax.grid(True, alpha=0.3)
+    for ax in axes.flat[len(names):]:
+        ax.axis("off")
+    axes[0][0].set_ylabel("objective [m/s²]")
+    axes[0][0].legend(fontsize=7)
+    fig.tight_layout()
+    fig.savefig(path, dpi=110)
+    plt.close(fig)
+
+
+def cmd_doe(args) -> int:
+    problem, variables, mounts = problem_from_args(args)
+    # RBD-FAST reads 10 harmonics of each variable's ordering of the sample: it needs more
+    # designs than 2 x 10.
+    check_range("--samples", args.samples, 21 if args.method == "lhs" else 2)
+    out = pathlib.Path(args.out)
+    names = [v.name for v in problem.variables]
+    salib = salib_problem(names, [(v.low, v.high) for v in problem.variables])
+    X = sample(salib, args.method, args.samples, args.seed)
+    reduction_notice({"scene": 2}, variables)
+    started = time.perf_counter()
+    store, evaluator, pool = open_study(args, problem, mounts)
+    # The current design first: the reference of the table.
+
+    bar = progress_bar(len(X) + 1, "designs", not args.quiet, unit="design")
+    evaluator.progress = None if bar is None else (lambda record: bar.update(1))
+    try:
+        baseline = evaluator([problem.baseline()])[0]
+        records = evaluator(list(X))
+    finally:
+        if bar is not None:
+            bar.close()
+        evaluator.close()
+        if pool is not None:
+            pool.close()
+    elapsed = time.perf_counter() - started
+    designs = design_table(problem, records)
+    designs.to_csv(out / "designs.csv", index=False)
+    tables = []
+    for response in RESPONSES:
+        t = indices(salib, args.method, X, designs[response].to_numpy(), args.seed)
+        t.insert(0, "response", response)
+        tables.append(t)
+    table = pd.concat(tables, ignore_index=True)
+    table.to_csv(out / "sensitivity.csv", index=False)
+    what = ("Sobol' indices (Saltelli)" if args.method == "sobol" else
+            "first-order indices (RBD-FAST on a Latin hypercube)")
+    plot_indices(table, str(out / "sensitivity.png"),
+                 f"{what}, {len(X)} designs, {problem.objective} over "
+                 f"{problem.rpm_from:g}-{problem.rpm_to:g} rpm")
+    plot_scatter(designs, names, str(out / "scatter.png"))
+    best = designs[designs.feasible].sort_values("objective").head(1)
+    summary = {"designs": len(X), "evaluated_now": evaluator.evaluated, "seconds": elapsed,
+               "baseline_objective": baseline["objective"],
+               "best_feasible": best.to_dict("records")}
+    (out / "doe.json").write_text(json.dumps(summary, indent=2, default=float) + "\n")
+    write_metadata(out, args, variables, [("", dict(problem.parameters))],
+                       {"problem": problem.settings(), "plan": {"method": args.method,
+                                                                "samples": args.samples,
+                                                                "seed": args.seed}})
+    print_summary(problem, table, designs, baseline, len(X), evaluator.evaluated, elapsed)
+    print(f"-> {out}")
+    return 0
+
+
+def print_summary(problem: Problem, table: pd.DataFrame, designs: pd.DataFrame, baseline: dict,
+                  count: int, evaluated: int, elapsed: float):
+    shown = table.pivot(index="variable", columns="response",
+                        values=[c for c in ("S1", "ST") if c in table]).reindex(
+        [v.name for v in problem.variables])
+    print(f"{count} designs ({evaluated} run now) in {elapsed:.1f} s; objective "
+          f"({problem.objective}, m/s²) of the current design {baseline['objective']:.4g}, "
+          f"{designs.feasible.sum()} designs within the limits")
+    print(shown.to_string(float_format=lambda v: f"{v:.3f}"))
+    if designs.feasible.any():
+        best = designs[designs.feasible].sort_values("objective").iloc[0]
+        print(f"best feasible design: objective {best.objective:.4g} "
+              f"({best.objective / baseline['objective'] - 1:+.1%}): "
+              + ", ".join(f"{v.name}={best[v.name]:.3g}" for v in problem.variables))
