@@ -1,7 +1,7 @@
 """Benchmarks that print a table: what each effect costs, the FMU's speed through fmpy, and how
 a study scales on Dask.
 
-    python -m emc.bench scaling --fmu dist/EngineMountChassis.fmu --points 192 --workers 1 4 16
+    emc bench-scaling --fmu dist/EngineMountChassis.fmu --points 192 --workers 1 4 16
 
 What each effect costs (``effects_table``): each case runs a constant-speed point (fade-in, then a fixed simulated time) in this process
 through fmpy; the CPU time covers the stepping only (not the instantiation, which may reduce the
@@ -11,13 +11,15 @@ chassis), including fmpy's per-step call overhead. The integrator counters come 
 
 from __future__ import annotations
 
-import argparse
 import datetime
 import functools
 import itertools
 import os
 import platform
 import sys
+import shutil
+import subprocess
+import tempfile
 import time
 
 import numpy as np
@@ -388,48 +390,53 @@ def cmd_bench_realtime(args) -> int:
     return 0
 
 
+# ----- emc bench-startup --------------------------------------------------------------------------
 
-def main(argv: list[str] | None = None) -> int:
-    parser = argparse.ArgumentParser(prog="python -m emc.bench", description=__doc__,
-                                     formatter_class=argparse.RawDescriptionHelpFormatter)
-    sub = parser.add_subparsers(dest="command", required=True)
-    s = sub.add_parser("scaling", help="a sweep serial and on Dask pools of several worker counts "
-                                       "(warm instances), with speed-ups and a bit-for-bit check")
-    options.add_fmu(s)
-    s.add_argument("--points", type=int, default=48, help="speed points (default 48)")
-    options.add_speed_range(s, (800.0, 4000.0))
-    s.add_argument("--workers", type=int, nargs="+", default=[2], help="worker counts (default 2)")
-    s.add_argument("--threads", type=int, nargs="+", default=[1],
-                   help="threads per worker (default 1); a worker with several runs that many "
-                        "evaluations at once, each on an instance of its own")
-    s.add_argument("--repeat", type=int, default=2, help="timed runs per row (default 2)")
-    s.add_argument("--batching", nargs="+", choices=("guided", "equal"), default=["guided"],
-                   help="how a pool batches the points: shrinking batches (guided, the default) "
-                        "and/or four equal batches per worker (equal); both to compare them in "
-                        "one run")
-    s.add_argument("--csv", help="also write the table here")
-    s.set_defaults(func=cmd_scaling)
-    d = sub.add_parser("scheduling", help="what distribution alone costs at many workers, on few "
-                                          "cores: each point replaced by a wait of its measured "
-                                          "time")
-    options.add_fmu(d)
-    d.add_argument("--points", type=int, default=192, help="speed points (default 192)")
-    options.add_speed_range(d, (800.0, 4000.0))
-    d.add_argument("--workers", type=int, nargs="+", default=[16],
-                   help="worker counts (default 16)")
-    d.add_argument("--scale", type=float, default=1.0,
-                   help="each wait is this times the point's measured time (to stand in for a "
-                        "slower machine; default 1)")
-    d.add_argument("--repeat", type=int, default=2, help="timed runs per row (default 2)")
-    d.add_argument("--batching", nargs="+", choices=("guided", "equal"),
-                   default=["guided", "equal"], help="batchings to compare (default both)")
-    d.add_argument("--csv", help="also write the table here")
-    d.set_defaults(func=cmd_scheduling)
-    args = parser.parse_args(argv)
-    # The serial loop at its best, with the malloc settings the workers get.
-    keep_freed_memory()
-    return args.func(args)
+def startup_table(fmu_path: str, repeat: int = 3) -> pd.DataFrame:
+    """The wall time of whole ``emc`` commands, each in a fresh process as a user runs it: the
+    help, an argument error, a 2-point sweep (its fixed cost: start-up, the FMU's instantiation,
+    tables, plots, metadata) and 48 points serially and on 2 local workers (the pool's start
+    included). The reduced body is in the cache before the first row."""
+    emc = [sys.executable, "-m", "emc"]
+    work = tempfile.mkdtemp(prefix="emc-startup-")
+
+    def sweep(count: int, *extra: str) -> list[str]:
+        return ["sweep", "--fmu", fmu_path, "--rpm", "800", "4000", "--count", str(count),
+                "--quiet", "--overwrite", "--out", os.path.join(work, f"sweep-{count}"), *extra]
+
+    rows = [("emc --help", ["--help"], 0), ("an argument error", ["sweep", "--rpm", "800"], 2),
+            ("2-point sweep (serial, as emc chooses for so few)", sweep(2), 0),
+            ("48-point sweep, --serial", sweep(48, "--serial"), 0),
+            ("48-point sweep, --workers 2", sweep(48, "--workers", "2"), 0)]
+    subprocess.run(emc + sweep(1, "--serial"), check=True, capture_output=True)  # the cache
+    table = []
+    try:
+        for label, command, expected in rows:
+            times = []
+            for _ in range(repeat):
+                started = time.perf_counter()
+                done = subprocess.run(emc + command, capture_output=True, text=True)
+                times.append(time.perf_counter() - started)
+                if done.returncode != expected:
+                    raise RuntimeError(f"emc {' '.join(command)}: exit {done.returncode}\n"
+                                       f"{done.stderr}")
+            table.append({"command": label, "min_s": min(times), "max_s": max(times)})
+    finally:
+        shutil.rmtree(work, ignore_errors=True)
+    table = pd.DataFrame(table)
+    serial = table.min_s.iloc[3]
+    table["speed-up"] = [""] * 4 + [f"{serial / table.min_s.iloc[4]:.2f}x "
+                                    f"({table.max_s.iloc[3] / table.max_s.iloc[4]:.2f}x)"]
+    return table
 
 
-if __name__ == "__main__":
-    sys.exit(main())
+def cmd_startup(args) -> int:
+    print(machine_line(), flush=True)
+    table = startup_table(args.fmu, args.repeat)
+    print(table.to_string(index=False, float_format=lambda v: f"{v:.2f}"))
+    print("min_s / max_s: wall time of the whole command over the runs; speed-up: 48 points "
+          "serially against 2 workers (best; worst)")
+    if args.csv:
+        table.insert(0, "machine", machine_line())
+        table.to_csv(args.csv, index=False)
+    return 0

@@ -22,6 +22,7 @@ import importlib
 import re
 import sys
 
+from .base import outputs
 from .base.errors import UsageError
 from .commands import MODULES
 
@@ -58,8 +59,6 @@ def main(argv: list[str] | None = None) -> int:
 
         keep_freed_memory()
         if getattr(args, "out_policy", None):
-            from .base import outputs
-
             claim = args.out_claim = outputs.claim(args)
         return args.func(args)
     except UsageError as error:

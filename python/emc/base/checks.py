@@ -7,6 +7,7 @@ import math
 
 from .errors import UsageError
 from .fmu import check_config_file, check_outputs, model_variables, start_value
+from .options import DEFAULT_WORKERS, POOL_FROM
 from .orders import HIGHEST_ORDER
 
 # The default of every command: the engine in the elastic body (scene 1 has no steering wheel).
@@ -86,6 +87,16 @@ def parse_cases(items: list[str] | None, variables: dict) -> list[tuple[str, dic
 
 def case_parameters(common: dict, own: dict) -> dict:
     return {**DEFAULT_PARAMETERS, **common, **own}
+
+
+def pool_workers(args, runs: int) -> int | None:
+    """How many local workers a command's ``runs`` get: ``None`` to run in this process (with
+    --serial, or without --workers and --scheduler for fewer than :data:`POOL_FROM` runs)."""
+    if args.workers is not None:
+        check_range("--workers", args.workers, 1)
+    if args.serial or (args.workers is None and args.scheduler is None and runs < POOL_FROM):
+        return None
+    return args.workers or DEFAULT_WORKERS
 
 
 def check_range(name: str, value, low=None, high=None, strict_low=False):

@@ -13,6 +13,9 @@ import importlib
 import math
 
 DEFAULT_FMU = "dist/EngineMountChassis.fmu"
+# A local pool without --workers: this many workers, for this many runs or more.
+DEFAULT_WORKERS = 2
+POOL_FROM = 16
 
 # The damping band's default bounds. The body: 5 % of critical nominal, 3–7 % (Adams &
 # Askenazi's range for metal structures with joints) as modalDampingScale 0.6–1.4. The mounts: a
@@ -162,7 +165,10 @@ def add_band(p):
 
 def add_pool(p):
     """Where the points run: local Dask workers, a running cluster, or this process."""
-    p.add_argument("--workers", type=int, default=2, help="local Dask workers (default 2)")
+    p.add_argument("--workers", type=int, default=None,
+                   help=f"local Dask workers (default {DEFAULT_WORKERS}; fewer than "
+                        f"{POOL_FROM} runs go in this process, where a pool's start would cost "
+                        "more than it saves)")
     p.add_argument("--scheduler", help="address of a running Dask scheduler (the FMU is sent to "
                                        "the workers by content)")
     p.add_argument("--serial", action="store_true", help="no Dask")

@@ -81,6 +81,7 @@ class Claim:
 def _lock(path: pathlib.Path):
     """The folder's lock file, held exclusively (None where the system has no locks)."""
     try:
+        # Deferred: fcntl exists on POSIX systems only.
         import fcntl
     except ImportError:  # not POSIX: the folder is not locked
         return None

@@ -1,11 +1,10 @@
 """Log-log plot of the work-precision table written by `examples/accuracy_cost.rs`.
 
-Usage: python -m emc.figures.accuracy_plot accuracy.csv accuracy.png
+Usage: emc accuracy-plot accuracy.csv accuracy.png
 """
 
 from __future__ import annotations
 
-import sys
 
 import matplotlib
 
@@ -55,5 +54,7 @@ def plot(csv: str, png: str) -> None:
     fig.savefig(png, dpi=110)
 
 
-if __name__ == "__main__":
-    plot(sys.argv[1], sys.argv[2])
+def cmd_accuracy_plot(args) -> int:
+    """``emc accuracy-plot``: the plot of a table written by ``examples/accuracy_cost.rs``."""
+    plot(args.table, args.png)
+    return 0

@@ -33,12 +33,11 @@ The interface starts at the coupled static equilibrium: in initialisation mode t
 go to the body and the body's mount motion back to the engine, a few times (reading outputs in
 initialisation mode makes each FMU solve its static equilibrium for the inputs set so far).
 
-    python -m emc.running.coupling --table        # the table of the user guide (minutes)
+    emc coupling-table        # the table of the user guide (minutes)
 """
 
 from __future__ import annotations
 
-import argparse
 import dataclasses
 import pathlib
 import sys
@@ -48,8 +47,11 @@ import time
 import numpy as np
 from fmpy import read_model_description
 
-from .runner import Runner, mount_count, variable_names
-from ..signals.spectra import ORDERS, order_amplitudes
+from ..base.errors import UsageError
+from ..base.fmu import mount_count, variable_names
+from .runner import Runner
+from ..base.orders import ORDERS
+from ..signals.spectra import order_amplitudes
 from .synthesis import HeldForces
 
 ALGORITHMS = ("jacobi", "gauss_seidel", "interface_jacobian")
@@ -597,28 +599,15 @@ def table(engine_fmu, body_fmu, rpms=(1100.0, 2000.0), steps=STEPS, algorithms=A
     return rows
 
 
-def main(argv=None):
-    root = pathlib.Path(__file__).resolve().parents[3]
-    parser = argparse.ArgumentParser(description=__doc__,
-                                     formatter_class=argparse.RawDescriptionHelpFormatter)
-    parser.add_argument("--table", action="store_true", help="the stability and accuracy table")
-    parser.add_argument("--engine", default=str(root / "dist" / "EngineMountChassis.fmu"))
-    parser.add_argument("--body", default=str(root / "dist" / "EngineMountBody.fmu"))
-    parser.add_argument("--rpm", type=float, nargs="*", default=[1100.0, 2000.0])
-    parser.add_argument("--steps", type=float, nargs="*", default=[h * 1e3 for h in STEPS],
-                        help="coupling steps in ms")
-    parser.add_argument("--algorithms", nargs="*", default=list(ALGORITHMS), choices=ALGORITHMS)
-    parser.add_argument("--t-end", type=float, default=1.0)
-    parser.add_argument("--stiffness-scale", type=float, default=1.0,
-                        help="mount[i].stiffnessScale of the engine (both scene 2 and scene 3)")
-    args = parser.parse_args(argv)
-    if not args.table:
-        parser.error("nothing to do: pass --table")
-    mounts = mount_count(variable_names(read_model_description(args.engine)))
+def cmd_coupling_table(args) -> int:
+    """``emc coupling-table``: the stability and accuracy table of the coupling algorithms."""
+    algorithms = args.algorithms or list(ALGORITHMS)
+    unknown = [a for a in algorithms if a not in ALGORITHMS]
+    if unknown:
+        raise UsageError(f"--algorithms {' '.join(unknown)}: none of {', '.join(ALGORITHMS)}")
+    steps = args.steps or [h * 1e3 for h in STEPS]
+    mounts = mount_count(variable_names(read_model_description(args.fmu)))
     scale = {f"mount[{i}].stiffnessScale": args.stiffness_scale for i in range(1, mounts + 1)}
-    table(args.engine, args.body, args.rpm, [s * 1e-3 for s in args.steps], args.algorithms,
+    table(args.fmu, args.body_fmu, args.rpm, [s * 1e-3 for s in steps], algorithms,
           args.t_end, engine_parameters=scale if args.stiffness_scale != 1.0 else None)
-
-
-if __name__ == "__main__":
-    main()
+    return 0

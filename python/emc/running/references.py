@@ -27,22 +27,22 @@ in row-major order (``"mount.F"`` holds ``mount[1].F[1]``, ``mount[1].F[2]``, â€
 as fmpy's ``fmpy.util.write_csv`` and the Modelica Reference-FMUs write them; their outputs are
 the whole arrays that hold the 2.0 experiment's outputs.
 
-    python -m emc.running.references dist/EngineMountChassis.fmu dist/EngineMountBody.fmu
+    emc check-references dist/EngineMountChassis.fmu dist/EngineMountBody.fmu
 """
 
 from __future__ import annotations
 
-import argparse
 import dataclasses
 import hashlib
 import pathlib
 import re
 import shutil
-import sys
 import xml.etree.ElementTree as ET
 import zipfile
 
 import numpy as np
+from fmpy import extract, read_model_description, simulate_fmu
+from fmpy.fmi3 import FMU3Slave
 
 LS_NAME = "org.fmi-standard.fmi-ls-ref"
 LS_VERSION = "1.0.0-beta.1"
@@ -76,7 +76,6 @@ def simulate(fmu: pathlib.Path, experiment: Experiment, tolerance: float | None 
     """The experiment run in fmpy (its solver tolerance unless ``tolerance`` is given): the
     outputs every ``step``, the inputs set from the stimulus (linear between its rows) at each
     communication point."""
-    from fmpy import read_model_description, simulate_fmu
 
     model = read_model_description(str(fmu))
     if model.fmiVersion == "3.0":
@@ -94,8 +93,6 @@ def _simulate3(fmu: pathlib.Path, model, experiment: Experiment, tolerance: floa
     ``simulate_fmu`` (parameters, initialization at ``tolerance``, the inputs at each
     communication point before the step). ``simulate_fmu`` itself cannot take a stimulus that
     mixes scalars and arrays (its input table stacks the columns into one array)."""
-    from fmpy import extract
-    from fmpy.fmi3 import FMU3Slave
 
     variables = {v.name: v for v in model.modelVariables}
     stimuli = experiment.stimuli
@@ -305,20 +302,14 @@ def check(fmu: pathlib.Path) -> list[tuple[Experiment, dict[str, float]]]:
     return [(e, excess(simulate(fmu, e), e)) for e in carried(fmu)]
 
 
-def main(argv: list[str] | None = None) -> None:
-    parser = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
-    parser.add_argument("fmu", nargs="+", type=pathlib.Path)
-    args = parser.parse_args(argv)
+def cmd_check_references(args) -> int:
+    """``emc check-references``: each FMU through every reference experiment it carries."""
     failed = False
-    for fmu in args.fmu:
-        for experiment, worst in check(fmu):
+    for fmu in args.fmus:
+        for experiment, worst in check(pathlib.Path(fmu)):
             name, ratio = max(worst.items(), key=lambda kv: kv[1])
             ok = ratio <= 1.0
             failed |= not ok
-            print(f"{fmu.name} {experiment.name}: {'passed' if ok else 'FAILED'} "
+            print(f"{pathlib.Path(fmu).name} {experiment.name}: {'passed' if ok else 'FAILED'} "
                   f"(closest to its band: {name} at {ratio:.2g} of the allowed deviation)")
-    sys.exit(1 if failed else 0)
-
-
-if __name__ == "__main__":
-    main()
+    return 1 if failed else 0

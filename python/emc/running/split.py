@@ -1,7 +1,7 @@
 """Scene 2 split at the mounts, measured: the engine FMU (scene 3) and the body FMU run from their
 SSP archive in libcosim against the monolithic scene 2 of the engine FMU.
 
-    python -m emc.running.split [--steps 1e-4 1e-3 1e-2] [--rpm 1100 2000]
+    emc split-table [--steps 0.1 1 10] [--rpm 1100 2000]      # coupling steps in ms
 
 prints, per coupling step and speed, whether the split run stayed finite, the largest deviation
 of the order amplitudes from scene 2 and the wall time of both.
@@ -9,7 +9,6 @@ of the order amplitudes from scene 2 and the wall time of both.
 
 from __future__ import annotations
 
-import argparse
 import pathlib
 import tempfile
 import time
@@ -36,6 +35,7 @@ def scene_2(engine_fmu, rpm: float, h: float, t_end: float, cache, rel_tol: floa
 def split_in_libcosim(ssp, rpm: float, h: float, t_end: float) -> dict:
     """The two FMUs from ``ssp`` in libcosim's fixed-step master, sampled every ``h``; stops early
     (the rest NaN) if a step fails."""
+    # Deferred: libcosim's native library is loaded only where a split run is measured.
     from libcosimpy.CosimExecution import CosimExecution
     from libcosimpy.CosimLogging import CosimLogLevel, log_output_level
     from libcosimpy.CosimObserver import CosimObserver
@@ -81,25 +81,18 @@ def compare(engine_fmu, body_fmu, rpm: float, h: float, t_end: float, work: path
             "t_split": t_split}
 
 
-def main(argv: list[str] | None = None) -> None:
-    parser = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
-    parser.add_argument("--engine", default=str(ROOT / "dist" / "EngineMountChassis.fmu"))
-    parser.add_argument("--body", default=str(ROOT / "dist" / "EngineMountBody.fmu"))
-    parser.add_argument("--steps", type=float, nargs="+", default=[1e-4, 1e-3, 1e-2])
-    parser.add_argument("--rpm", type=float, nargs="+", default=[1100.0, 2000.0])
-    parser.add_argument("--t-end", type=float, default=1.2)
-    parser.add_argument("--rel-tol", type=float, default=1e-8)
-    args = parser.parse_args(argv)
-    print(f"| coupling step | rpm | largest order deviation from scene 2 | where | wall time scene 2 (fmpy) | wall time split (libcosim) |")
+def cmd_split_table(args) -> int:
+    """``emc split-table``: scene 2 split at the mounts in libcosim against the monolithic scene 2."""
+    print("| coupling step | rpm | largest order deviation from scene 2 | where | wall time scene 2 "
+          "(fmpy) | wall time split (libcosim) |")
     print("|---|---|---|---|---|---|")
     with tempfile.TemporaryDirectory() as work:
-        for h in args.steps:
+        for h in [ms * 1e-3 for ms in args.steps]:
             for rpm in args.rpm:
-                r = compare(args.engine, args.body, rpm, h, args.t_end, pathlib.Path(work), args.rel_tol)
-                dev = "diverged" if not np.isfinite(r["deviation"]) else f"{r['deviation'] * 100:.2f} %"
-                print(f"| {h * 1e3:g} ms | {rpm:.0f} | {dev} | {r['where']} | {r['t_mono']:.1f} s | {r['t_split']:.1f} s |",
-                      flush=True)
-
-
-if __name__ == "__main__":
-    main()
+                r = compare(args.fmu, args.body_fmu, rpm, h, args.t_end, pathlib.Path(work),
+                            args.rel_tol)
+                dev = "diverged" if not np.isfinite(r["deviation"]) else \
+                    f"{r['deviation'] * 100:.2f} %"
+                print(f"| {h * 1e3:g} ms | {rpm:.0f} | {dev} | {r['where']} | "
+                      f"{r['t_mono']:.1f} s | {r['t_split']:.1f} s |", flush=True)
+    return 0

@@ -11,12 +11,11 @@ The engine FMU (EngineMountChassis, scene 3) passes each mount's force on the bo
 FMU (EngineMountBody); the body passes the displacement and velocity of each mount point back.
 Together they are scene 2 split at the mounts.
 
-    python -m emc.running.ssp dist/EngineMountChassis.fmu dist/EngineMountBody.fmu -o dist/EngineInBody.ssp
+    emc ssp --fmu dist/EngineMountChassis.fmu --body-fmu dist/EngineMountBody.fmu dist/EngineInBody.ssp
 """
 
 from __future__ import annotations
 
-import argparse
 import pathlib
 import zipfile
 from xml.sax.saxutils import quoteattr
@@ -184,17 +183,7 @@ def write_ssp(engine_fmu: pathlib.Path, body_fmu: pathlib.Path, out: pathlib.Pat
     return out
 
 
-def main(argv: list[str] | None = None) -> None:
-    parser = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
-    parser.add_argument("engine_fmu")
-    parser.add_argument("body_fmu")
-    parser.add_argument("-o", "--out", default="dist/EngineInBody.ssp")
-    parser.add_argument("--step", type=float, default=5e-5,
-                        help="coupling step in s (default 5e-5: a plain exchange within 0.5 %% of "
-                             "the monolithic model at the default damping)")
-    args = parser.parse_args(argv)
-    print(write_ssp(args.engine_fmu, args.body_fmu, pathlib.Path(args.out), step_size=args.step))
-
-
-if __name__ == "__main__":
-    main()
+def cmd_ssp(args) -> int:
+    """``emc ssp``: writes the archive of the engine and the body FMU."""
+    print(write_ssp(args.fmu, args.body_fmu, pathlib.Path(args.archive), step_size=args.step))
+    return 0

@@ -8,7 +8,7 @@ import time
 
 import pandas as pd
 
-from ..base.checks import (analysed_signals, check_range, check_speeds, prepare,
+from ..base.checks import (analysed_signals, check_range, check_speeds, pool_workers, prepare,
                            sampling_warnings, start_options)
 from ..base.fmu import default_signals, highest_speed, units_of
 from ..base.outputs import (fmu_warnings_summary, reduction_notice, safe_name, save, warn_cases,
@@ -29,8 +29,11 @@ def sweep_cases(args, cases: list[tuple[str, dict]], signals: list[str], out: pa
     of all cases written; returns (orders, spectra, FMU warnings)."""
     fmu_warnings = []
     # One pool for every case and bound: its workers start and load the FMU once.
+    runs = len(cases) * args.count * (1 if band is None else len(bands.BOUNDS))
+    workers = pool_workers(args, runs)
+    parallel = workers is not None or args.scheduler is not None
     files = sorted({f for _, parameters in cases for f in settings_files(parameters)})
-    pool = None if args.serial else FmuPool(args.fmu, args.workers, args.scheduler, files=files)
+    pool = FmuPool(args.fmu, workers, args.scheduler, files=files) if parallel else None
 
     def run(_settings: dict, bound: str | None = None):
         tables = []
@@ -40,7 +43,7 @@ def sweep_cases(args, cases: list[tuple[str, dict]], signals: list[str], out: pa
             points = speed_points(args.rpm[0], args.rpm[1], args.count,
                                   parameters=tuple(parameters.items()), **point_options)
             tables.append(run_sweep(args.fmu, points, signals=signals, case=label,
-                                    parallel=not args.serial, progress=not args.quiet,
+                                    parallel=parallel, progress=not args.quiet,
                                     warnings=fmu_warnings, pool=pool))
         return (pd.concat([t[0] for t in tables], ignore_index=True),
                 pd.concat([t[1] for t in tables], ignore_index=True))
@@ -64,7 +67,6 @@ def sweep_cases(args, cases: list[tuple[str, dict]], signals: list[str], out: pa
 def cmd_sweep(args) -> int:
     check_range("--count", args.count, 1)
     check_range("--steps-per-rev", args.steps_per_rev, 4, 10000)
-    check_range("--workers", args.workers, 1)
     check_range("--load-torque", args.load_torque)
     options = start_options(args)
     variables, cases = prepare(args)

@@ -50,7 +50,8 @@ import pandas as pd
 from ..signals.comfort import SEAT, WHEEL, comfort_table
 from ..running.runner import OperatingPoint, PointFailed, Runner
 from ..running.sweep import analyse, speed_points, tables
-from ..base.checks import check_range, check_speeds, parse_settings
+from ..base.checks import check_range, check_speeds, parse_settings, pool_workers
+from ..base.options import POOL_FROM
 from ..base.errors import UsageError
 from ..base.fmu import check_config_file, highest_speed, model_variables, mount_count
 from .defaults import BASELINE, DEFAULT_BOUNDS, Limits
@@ -376,7 +377,6 @@ def problem_from_args(args) -> tuple[Problem, dict, int]:
     mounts = mount_count(variables)
     check_speeds(args.rpm, increasing=True, highest=highest_speed(variables))
     check_range("--count", args.count, 1)
-    check_range("--workers", args.workers, 1)
     if args.revolutions < 2 or args.revolutions % 2:
         raise UsageError(f"--revolutions must be even and >= 2, got {args.revolutions}")
     for option, value in (("--max-deflection", args.max_deflection),
@@ -431,7 +431,8 @@ def open_study(args, problem: Problem, mounts: int):
     if store.records:
         print(f"note: {len(store.records)} evaluations found in {store.path}: the study "
               "continues from them", file=sys.stderr)
-    pool = None if args.serial else FmuPool(args.fmu, args.workers, args.scheduler,
+    workers = pool_workers(args, POOL_FROM)  # a study runs many designs
+    pool = None if workers is None else FmuPool(args.fmu, workers, args.scheduler,
                                             files=settings_files(dict(problem.parameters)))
     evaluator = Evaluator(problem, args.fmu, store, mounts, pool)
     return store, evaluator, pool

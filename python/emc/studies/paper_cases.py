@@ -58,7 +58,6 @@ def run_study(args, cases: dict) -> int:
     """Sweeps each case and writes side-by-side waterfalls and overlaid order cuts on common
     scales."""
     check_range("--count", args.count, 1)
-    check_range("--workers", args.workers, 1)
     options = start_options(args)
     variables = model_variables(args.fmu)
     check_speeds(args.rpm, increasing=args.count > 1, highest=highest_speed(variables))
