@@ -25,11 +25,10 @@ import time
 import numpy as np
 import pandas as pd
 
-from .base import options
 from .base.checks import DEFAULT_PARAMETERS, check_range
 from .base.fmu import check_outputs, highest_speed, model_variables
 from .base.outputs import save
-from .running.runner import OperatingPoint, Runner, keep_freed_memory
+from .running.runner import OperatingPoint, Runner
 from .running.sweep import speed_points
 from .running.distributed import FmuPool
 import psutil

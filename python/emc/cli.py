@@ -28,13 +28,17 @@ from .commands import MODULES
 
 
 class Parser(argparse.ArgumentParser):
-    """argparse, taking ``--opt -1e-4`` as a negative number (argparse alone takes only
-    ``-1`` and ``-.5`` so, and a value in exponent form for an option)."""
+    """argparse, taking ``--opt -1e-4`` as a negative number (argparse alone takes only ``-1``
+    and ``-.5`` so, and a value in exponent form for an option), and reporting a bad argument
+    in one line."""
 
     def __init__(self, *args, **kwargs):
         super().__init__(*args, **kwargs)
         self._negative_number_matcher = re.compile(
             r"^-(\d+\.?\d*|\.\d+)([eE][-+]?\d+)?$|^-(inf|nan)$")
+
+    def error(self, message):
+        self.exit(2, f"error: {message} (see {self.prog} --help)\n")
 
 
 def build_parser() -> argparse.ArgumentParser:
@@ -49,9 +53,11 @@ def build_parser() -> argparse.ArgumentParser:
 def main(argv: list[str] | None = None) -> int:
     """Runs one command; expected failures (a refused option, a failed point) end with the cause
     on stderr and a non-zero exit code, without a Python traceback."""
-    args = build_parser().parse_args(argv)
+    try:
+        args = build_parser().parse_args(argv)
+    except SystemExit as done:  # --help, or a bad argument reported by the parser
+        return done.code or 0
     args.command_line = ["emc"] + list(sys.argv[1:] if argv is None else argv)
-    claim = None
     try:
         # Deferred: the runner imports fmpy and numpy, which --help and argument errors do not
         # need (start-up time).
@@ -59,7 +65,7 @@ def main(argv: list[str] | None = None) -> int:
 
         keep_freed_memory()
         if getattr(args, "out_policy", None):
-            claim = args.out_claim = outputs.claim(args)
+            outputs.check(args)
         return args.func(args)
     except UsageError as error:
         print(f"error: {error}", file=sys.stderr)
@@ -71,8 +77,8 @@ def main(argv: list[str] | None = None) -> int:
         print("error: interrupted", file=sys.stderr)
         return 130
     finally:
-        if claim is not None:
-            claim.release()
+        if getattr(args, "out_claim", None) is not None:
+            args.out_claim.release()
 
 
 if __name__ == "__main__":

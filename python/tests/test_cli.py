@@ -87,7 +87,7 @@ def test_bad_settings_are_refused_before_anything_runs(fmu_path, tmp_path, capsy
     ("sweep", ["--revolutions", "3"], "--revolutions must be even"),
     ("sweep", ["--workers", "0"], "--workers must be >= 1"),
     ("sweep", ["--steps-per-rev", "2"], "--steps-per-rev must be >= 4"),
-    ("sweep", ["--load-torque", "nan"], "--load-torque must be"),
+    ("sweep", ["--load-torque", "nan"], "--load-torque: must be finite"),
     ("sweep", ["--signal", "mount[9].F[3]"], "not an output of the FMU (did you mean"),
     ("sweep", ["--signal", "mount[1].F[3]", "--plot", "mount[2].F[3]"],
      "--plot mount[2].F[3]: not among the analysed signals"),

@@ -89,11 +89,16 @@ def case_parameters(common: dict, own: dict) -> dict:
     return {**DEFAULT_PARAMETERS, **common, **own}
 
 
+def check_pool(args):
+    """--workers, if given, at least one."""
+    if args.workers is not None:
+        check_range("--workers", args.workers, 1)
+
+
 def pool_workers(args, runs: int) -> int | None:
     """How many local workers a command's ``runs`` get: ``None`` to run in this process (with
     --serial, or without --workers and --scheduler for fewer than :data:`POOL_FROM` runs)."""
-    if args.workers is not None:
-        check_range("--workers", args.workers, 1)
+    check_pool(args)
     if args.serial or (args.workers is None and args.scheduler is None and runs < POOL_FROM):
         return None
     return args.workers or DEFAULT_WORKERS

@@ -1,7 +1,8 @@
 """Where results go and what is said about them: the one output-folder policy of every
 command, tables, ``metadata.json``, warnings and notes.
 
-The policy (:func:`claim`, applied by ``emc``'s ``main`` to every command with ``--out``):
+The policy (:func:`check`, applied by ``emc``'s ``main`` to every command with ``--out`` before
+anything runs, and :func:`claim`, where the command starts writing):
 
 - ``--out`` must be a folder that can be written: a file, or a place that cannot be created or
   written, is a one-line error.
@@ -138,45 +139,68 @@ def _remove_previous(path: pathlib.Path):
             target.unlink()
 
 
-def claim(args) -> Claim:
-    """Applies the output-folder policy (module doc) to ``args.out`` for ``args.command``;
-    ``args.out_policy`` is "replace" (written again) or "resume" (a study continues)."""
+def _problem(path: pathlib.Path, args) -> str | None:
+    """Why ``path`` may not take this run's results (None: it may)."""
+    previous = _previous_run(path) if path.is_dir() else None
+    if previous is None:
+        return None
+    command, settings = previous
+    now = run_settings(args)
+    if command != args.command:
+        return f"holds the results of emc {command}"
+    if settings != now:
+        return f"holds emc {command} results of {_differences(settings, now)}"
+    return None
+
+
+def check(args):
+    """The output-folder policy (module doc) for ``args.out``, read only: run before anything
+    else, so that a refused folder costs nothing and nothing is written."""
     path = pathlib.Path(args.out)
     if path.exists() and not path.is_dir():
         raise UsageError(f"--out {path}: a file, not a folder (results are written into a "
                          "folder)")
+    existing = path
+    while not existing.exists():
+        existing = existing.parent
+    if not existing.is_dir() or not os.access(existing, os.W_OK | os.X_OK):
+        where = "the folder" if existing == path else f"{existing}, where it would be created,"
+        raise UsageError(f"--out {path}: {where} cannot be written")
+    problem = _problem(path, args)
+    if problem and not getattr(args, "overwrite", False):
+        raise UsageError(f"--out {path} {problem} (see its metadata.json): use another folder, "
+                         "or --overwrite to replace them")
+
+
+def claim(args) -> pathlib.Path:
+    """The result folder, created and held by this run (until ``emc`` ends, which releases
+    ``args.out_claim``) when a command is about to write: checked again under the folder's
+    lock, the previous run's files removed if ``--overwrite`` replaces them, a study's
+    continuation said."""
+    path = pathlib.Path(args.out)
+    check(args)
     try:
         path.mkdir(parents=True, exist_ok=True)
     except OSError as error:
         raise UsageError(f"--out {path}: cannot create the folder ({error.strerror})") from None
-    if not os.access(path, os.W_OK | os.X_OK):
-        raise UsageError(f"--out {path}: the folder cannot be written")
     started = time.time()
     lock = _lock(path)
     try:
-        previous = _previous_run(path)
-        if previous is not None:
-            command, settings = previous
-            now = run_settings(args)
-            if command != args.command:
-                problem = f"holds the results of emc {command}"
-            elif settings != now:
-                problem = f"holds emc {command} results of {_differences(settings, now)}"
-            else:
-                problem = None
-            if problem and not getattr(args, "overwrite", False):
-                raise UsageError(f"--out {path} {problem} (see its metadata.json): use another "
-                                 "folder, or --overwrite to replace them")
-            if problem:
-                _remove_previous(path)
-            elif args.out_policy == "resume":
-                print(f"note: {path} holds this study with the same settings: it continues "
-                      "from the evaluations stored there", file=sys.stderr)
+        problem = _problem(path, args)
+        if problem and not getattr(args, "overwrite", False):
+            raise UsageError(f"--out {path} {problem} (see its metadata.json): use another "
+                             "folder, or --overwrite to replace them")
+        if problem:
+            _remove_previous(path)
+        elif args.out_policy == "resume" and (path / "metadata.json").exists():
+            print(f"note: {path} holds this study with the same settings: it continues from "
+                  "the evaluations stored there", file=sys.stderr)
     except BaseException:
         if lock is not None:
             lock.close()
         raise
-    return Claim(path, lock, started)
+    args.out_claim = Claim(path, lock, started)
+    return path
 
 
 def warn(lines: list[str]):

@@ -10,5 +10,6 @@ def register(sub):
     options.add_speed_range(c)
     options.add_settings(c)
     options.add_cases(c)
+    options.add_quiet(c)
     options.add_out(c)
     c.set_defaults(func=options.runs("emc.diagnosis.campbell:cmd_campbell"))

@@ -12,11 +12,10 @@ from __future__ import annotations
 import numpy as np
 import pandas as pd
 
-import pathlib
 
 from ..base.checks import check_speeds, prepare
 from ..base.orders import MAIN_ORDERS, ORDERS
-from ..base.outputs import reduction_notice, safe_name, save, write_metadata
+from ..base.outputs import claim, reduction_notice, safe_name, save, write_metadata
 from ..running.runner import Runner
 from ..figures.plots import plt
 
@@ -111,23 +110,22 @@ def cmd_campbell(args) -> int:
 
     check_speeds(args.rpm)
     variables, cases = prepare(args)
-    out = pathlib.Path(args.out)
-    out.mkdir(parents=True, exist_ok=True)
+    out = claim(args)
     reduction_notice(cases[0][1], variables)
     tables = [natural_modes(args.fmu, parameters, case=label)
               for label, parameters in cases]
     modes = pd.concat(tables, ignore_index=True)
     save(modes, str(out / "natural_modes.csv"))
-    crossings = pd.concat([crossings(t, args.rpm[0], args.rpm[1]) for t in tables],
+    crossing = pd.concat([crossings(t, args.rpm[0], args.rpm[1]) for t in tables],
                           ignore_index=True)
-    save(crossings, str(out / "crossings.csv"))
+    save(crossing, str(out / "crossings.csv"))
     for label, table in zip([c[0] for c in cases], tables):
         suffix = f"_{safe_name(label)}" if label else ""
         plot(table, args.rpm[0], args.rpm[1], str(out / f"campbell{suffix}.png"),
                       title=f"Campbell diagram{': ' + label if label else ''} "
                             f"({len(table)} natural modes of the linearised model)")
     write_metadata(out, args, variables, cases)
-    powertrain = crossings[crossings.powertrain_share >= 0.5]
+    powertrain = crossing[crossing.powertrain_share >= 0.5]
     print(powertrain.to_string(index=False, float_format=lambda v: f"{v:.4g}"))
     print(f"Campbell diagram -> {out}")
     return 0

@@ -27,7 +27,8 @@ from ..base.orders import ORDERS
 from ..base.checks import check_range, check_speeds, prepare
 from ..base.errors import UsageError
 from ..base.fmu import highest_speed
-from ..base.outputs import fmu_warnings_summary, reduction_notice, safe_name, save, write_metadata
+from ..base.outputs import (claim, fmu_warnings_summary, reduction_notice, safe_name, save,
+                            write_metadata)
 from ..running.band import band_metadata, band_of
 from ..running.runup import run_up
 from tqdm import tqdm
@@ -272,8 +273,7 @@ def cmd_tpa(args) -> int:
     responses = parse_responses(args)
     reduction_notice(cases[0][1], variables)
     speeds = sorted(set(np.round(np.linspace(args.rpm[0], args.rpm[1], args.count), 6)) | {at})
-    out = pathlib.Path(args.out)
-    out.mkdir(parents=True, exist_ok=True)
+    out = claim(args)
     started = time.perf_counter()
     tables, exports = [], {}
     for label, parameters in cases:
@@ -343,8 +343,7 @@ def cmd_tpa_runup(args) -> int:
     periodic = args.start == "periodic"
     cases = [(label, with_closing_tolerance(parameters)) for label, parameters in cases]
     reduction_notice(cases[0][1], variables)
-    out = pathlib.Path(args.out)
-    out.mkdir(parents=True, exist_ok=True)
+    out = claim(args)
     started = time.perf_counter()
     tables, exports, warnings = [], {}, []
     band = band_of(args, variables, cases)
@@ -419,8 +418,7 @@ def cmd_tpa_coupled(args) -> int:
     responses = parse_responses(args)
     check_responses(responses, export, variables)
     window = args.revolutions * 60.0 / args.rpm_point
-    out = pathlib.Path(args.out)
-    out.mkdir(parents=True, exist_ok=True)
+    out = claim(args)
     started = time.perf_counter()
     if not args.quiet:
         print(f"coupling the engine and the body at {args.rpm_point:g} rpm for "
@@ -478,8 +476,7 @@ def cmd_frf(args) -> int:
                          ignore_index=True)
 
     responses = check_responses(args.response or ["steeringWheel.a[3]"], export, variables)
-    out = pathlib.Path(args.out)
-    out.mkdir(parents=True, exist_ok=True)
+    out = claim(args)
     freqs = np.geomspace(args.freq[0], args.freq[1], args.points)
     marks = {f"order {o:g} at {args.mark_rpm:g} rpm": o * args.mark_rpm / 60.0
              for o in (args.mark_order or [])} if args.mark_rpm else {}
@@ -582,8 +579,7 @@ def cmd_ods(args) -> int:
     print("note: recovering the body's modes on every node (the reduction is run once more)",
           file=sys.stderr)
     export, samples, shape = operating_shape_at(args, parameters, variables)
-    out = pathlib.Path(args.out)
-    out.mkdir(parents=True, exist_ok=True)
+    out = claim(args)
     stem = f"ods_{args.rpm_point:g}rpm_order{args.order:g}"
     ods.write_vtu(shape, str(out / f"{stem}.vtu"))
     labels = {p: export.body.nodes[p] for p in export.body.shapes if not p.startswith("mount_")}
@@ -625,8 +621,7 @@ def cmd_ods(args) -> int:
 def cmd_decoupling(args) -> int:
     variables, cases = prepare(args, cases_wanted=False)
     parameters = cases[0][1]
-    out = pathlib.Path(args.out)
-    out.mkdir(parents=True, exist_ok=True)
+    out = claim(args)
     record = {}
     for scene, where in ((1, "on ground"), (2, "in the body")):
         if scene == 2:

@@ -3,7 +3,6 @@ crank-angle domain, for each case (and at the damping band's bounds)."""
 
 from __future__ import annotations
 
-import pathlib
 import sys
 import time
 
@@ -13,8 +12,8 @@ import pandas as pd
 from ..base.checks import analysed_signals, check_range, check_speeds, prepare, sampling_warnings
 from ..base.errors import UsageError
 from ..base.fmu import highest_speed, units_of
-from ..base.outputs import (fmu_warnings_summary, reduction_notice, safe_name, save, warn_cases,
-                            write_metadata)
+from ..base.outputs import (claim, fmu_warnings_summary, reduction_notice, safe_name, save,
+                            warn_cases, write_metadata)
 from ..figures import plots
 from ..signals.tracking import track_orders
 from . import band as bands
@@ -46,8 +45,7 @@ def cmd_runup(args) -> int:
                                           step=args.step, cutoff=cutoff))
                 for (label, parameters), cutoff in zip(cases, cutoffs_in_use(args.fmu, cases))])
     reduction_notice(cases[0][1], variables)
-    out = pathlib.Path(args.out)
-    out.mkdir(parents=True, exist_ok=True)
+    out = claim(args)
     started = time.perf_counter()
     records, tracked, fmu_warnings = [], [], []
     runs = ([(label, None, parameters) for label, parameters in cases] if band is None else

@@ -8,11 +8,11 @@ import time
 
 import pandas as pd
 
-from ..base.checks import (analysed_signals, check_range, check_speeds, pool_workers, prepare,
+from ..base.checks import (analysed_signals, check_range, check_pool, check_speeds, pool_workers, prepare,
                            sampling_warnings, start_options)
 from ..base.fmu import default_signals, highest_speed, units_of
-from ..base.outputs import (fmu_warnings_summary, reduction_notice, safe_name, save, warn_cases,
-                            write_metadata)
+from ..base.outputs import (claim, fmu_warnings_summary, reduction_notice, safe_name, save,
+                            warn_cases, write_metadata)
 from ..figures import plots
 from ..signals.comfort import comfort_table
 from . import band as bands
@@ -67,6 +67,7 @@ def sweep_cases(args, cases: list[tuple[str, dict]], signals: list[str], out: pa
 def cmd_sweep(args) -> int:
     check_range("--count", args.count, 1)
     check_range("--steps-per-rev", args.steps_per_rev, 4, 10000)
+    check_pool(args)
     check_range("--load-torque", args.load_torque)
     options = start_options(args)
     variables, cases = prepare(args)
@@ -77,8 +78,7 @@ def cmd_sweep(args) -> int:
                                           args.steps_per_rev, cutoff=cutoff))
                 for (label, parameters), cutoff in zip(cases, cutoffs_in_use(args.fmu, cases))])
     reduction_notice(cases[0][1], variables)
-    out = pathlib.Path(args.out)
-    out.mkdir(parents=True, exist_ok=True)
+    out = claim(args)
     started = time.perf_counter()
     orders, spectra, fmu_warnings = sweep_cases(
         args, cases, signals, out, {**options, "steps_per_revolution": args.steps_per_rev,

@@ -38,10 +38,9 @@ from ..signals.spectra import order_amplitudes
 from ..base.checks import check_range, check_speeds, prepare
 from ..base.errors import UsageError
 from ..base.fmu import check_outputs, highest_speed
-from ..base.outputs import reduction_notice, write_metadata
+from ..base.outputs import claim, reduction_notice, write_metadata
 
 from .defaults import COMPARED_ORDERS, DEFAULT_TOLERANCES, REFERENCE_TOLERANCE
-import pathlib
 import sys
 from ..figures.plots import plt
 
@@ -282,8 +281,7 @@ def cmd_accuracy(args) -> int:
     orders = tuple(args.order or COMPARED_ORDERS)
     tolerances = sorted(set(args.rtol), reverse=True)
     reduction_notice(cases[0][1], variables)
-    out = pathlib.Path(args.out)
-    out.mkdir(parents=True, exist_ok=True)
+    out = claim(args)
 
     def progress(label, scenario, tolerance, result):
         if not args.quiet:

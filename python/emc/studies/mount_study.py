@@ -50,9 +50,10 @@ import pandas as pd
 from ..signals.comfort import SEAT, WHEEL, comfort_table
 from ..running.runner import OperatingPoint, PointFailed, Runner
 from ..running.sweep import analyse, speed_points, tables
-from ..base.checks import check_range, check_speeds, parse_settings, pool_workers
+from ..base.checks import check_pool, check_range, check_speeds, parse_settings, pool_workers
 from ..base.options import POOL_FROM
 from ..base.errors import UsageError
+from ..base.outputs import claim
 from ..base.fmu import check_config_file, highest_speed, model_variables, mount_count
 from .defaults import BASELINE, DEFAULT_BOUNDS, Limits
 from ..running.distributed import FmuPool, settings_files
@@ -268,6 +269,48 @@ def base_configuration(fmu_path: str, parameters: dict) -> str:
     return text
 
 
+# What every stored design carries (Problem.assess writes them).
+RECORD_FIELDS = ("key", "x", "objective", "feasible", "static", "violations")
+
+
+def read_store(path: pathlib.Path) -> tuple[dict | None, list[dict], bool]:
+    """A study's ``evaluations.jsonl``: its header (None for a missing or empty file), its
+    designs, and whether lines were dropped. A line that is not JSON (cut short by an
+    interruption) is dropped: that design runs again. A damaged header, or a design without the
+    fields a study reads or with an objective that is not a finite number, is a StudyError that
+    names the file and the line."""
+    lines = path.read_text().splitlines() if path.exists() else []
+    if not lines:
+        return None, [], False
+    try:
+        header = json.loads(lines[0])
+    except json.JSONDecodeError as error:
+        raise StudyError(f"{path}, line 1 (the study's header) is damaged ({error.msg}): delete "
+                         "the file to start the study again") from None
+    if not isinstance(header, dict) or "settings" not in header:
+        raise StudyError(f"{path}, line 1 is not a study's header: delete the file to start "
+                         "the study again")
+    records, torn = [], not path.read_text().endswith("\n")
+    for number, line in enumerate(lines[1:], start=2):
+        try:
+            record = json.loads(line)
+        except json.JSONDecodeError:
+            torn = True
+            continue
+        missing = [k for k in RECORD_FIELDS if not isinstance(record, dict) or k not in record]
+        if missing:
+            raise StudyError(f"{path}, line {number}: a design without {', '.join(missing)}; "
+                             "delete that line to run the design again")
+        objective = record["objective"]
+        if isinstance(objective, bool) or not isinstance(objective, (int, float)) \
+                or not math.isfinite(objective):
+            raise StudyError(f"{path}, line {number}: design {record['x']} has the objective "
+                             f"{objective!r}, not a finite number; delete that line to run the "
+                             "design again")
+        records.append(record)
+    return header, records, torn
+
+
 class Store:
     """The evaluations of a study folder: ``evaluations.jsonl``, a header line (the FMU's checksum
     and the settings) and one line per design, appended as each is done."""
@@ -277,26 +320,19 @@ class Store:
         self.header = {"fmu_sha256": fmu_sha256, "settings": settings}
         self.records: dict[str, dict] = {}
         self.order: list[str] = []
-        if self.path.exists():
-            lines = self.path.read_text().splitlines()
-            stored = json.loads(lines[0]) if lines else None
-            if stored != json.loads(json.dumps(self.header)):
-                raise StudyError(f"{self.path} holds the evaluations of another FMU or other "
-                                 "settings: use another --out folder (or delete it)")
-            kept = lines[:1]
-            for line in lines[1:]:
-                try:
-                    record = json.loads(line)
-                except json.JSONDecodeError:
-                    continue  # a line cut short by an interruption: that design runs again
-                kept.append(line)
-                self.records[record["key"]] = record
-                self.order.append(record["key"])
-            if len(kept) < len(lines) or not self.path.read_text().endswith("\n"):
-                self.path.write_text("".join(line + "\n" for line in kept))
-        else:
+        stored, records, torn = read_store(self.path)
+        if stored is None:
             self.path.parent.mkdir(parents=True, exist_ok=True)
             self.path.write_text(json.dumps(self.header) + "\n")
+            return
+        if stored != json.loads(json.dumps(self.header)):
+            raise StudyError(f"{self.path} holds the evaluations of another FMU or other "
+                             "settings: use another --out folder (or delete it)")
+        for record in records:
+            self.records[record["key"]] = record
+            self.order.append(record["key"])
+        if torn:
+            self.path.write_text("".join(json.dumps(r) + "\n" for r in [stored] + records))
 
     @staticmethod
     def key(x) -> str:
@@ -377,6 +413,7 @@ def problem_from_args(args) -> tuple[Problem, dict, int]:
     mounts = mount_count(variables)
     check_speeds(args.rpm, increasing=True, highest=highest_speed(variables))
     check_range("--count", args.count, 1)
+    check_pool(args)
     if args.revolutions < 2 or args.revolutions % 2:
         raise UsageError(f"--revolutions must be even and >= 2, got {args.revolutions}")
     for option, value in (("--max-deflection", args.max_deflection),
@@ -425,7 +462,7 @@ def open_study(args, problem: Problem, mounts: int):
     with open(args.fmu, "rb") as f:
         digest = hashlib.sha256(f.read()).hexdigest()
     try:
-        store = Store(pathlib.Path(args.out), digest, problem.settings())
+        store = Store(claim(args), digest, problem.settings())
     except StudyError as error:
         raise UsageError(str(error)) from None
     if store.records:

@@ -28,7 +28,7 @@ import time
 import numpy as np
 import pandas as pd
 
-from .mount_study import (Problem, design_table, open_study,
+from .mount_study import (Problem, StudyError, design_table, read_store, open_study,
                           problem_from_args)
 from ..base.checks import check_range
 from ..base.errors import UsageError
@@ -270,12 +270,24 @@ def best_of_study(folder: pathlib.Path, problem: Problem) -> np.ndarray:
     path = folder / "evaluations.jsonl"
     if not path.exists():
         raise UsageError(f"--start-from {folder}: no evaluations.jsonl there")
-    lines = path.read_text().splitlines()
-    names = [v["name"] for v in json.loads(lines[0])["settings"]["variables"]]
+    try:
+        header, records, _ = read_store(path)
+    except StudyError as error:
+        raise UsageError(f"--start-from {folder}: {error}") from None
+    if header is None:
+        raise UsageError(f"--start-from {folder}: {path} is empty")
+    try:
+        names = [v["name"] for v in header["settings"]["variables"]]
+    except (KeyError, TypeError):
+        raise UsageError(f"--start-from {folder}: {path} is not a study of mount variables") \
+            from None
     if names != [v.name for v in problem.variables]:
         raise UsageError(f"--start-from {folder}: that study has other variables ({names})")
-    records = [json.loads(line) for line in lines[1:] if line.strip()]
     feasible = [r for r in records if r["feasible"]]
     if not feasible:
         raise UsageError(f"--start-from {folder}: no feasible design there")
-    return np.array(min(feasible, key=lambda r: r["objective"])["x"])
+    best = min(feasible, key=lambda r: r["objective"])
+    print(f"note: starting from the best feasible design of {path}: "
+          + ", ".join(f"{n}={v:.4g}" for n, v in zip(names, best["x"]))
+          + f" (objective {best['objective']:.4g} m/s²)", file=sys.stderr)
+    return np.array(best["x"])

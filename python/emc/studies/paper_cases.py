@@ -3,14 +3,13 @@ each case swept and drawn side by side on common scales."""
 
 from __future__ import annotations
 
-import pathlib
 import time
 
-from ..base.checks import (analysed_signals, case_parameters, check_range, check_speeds,
+from ..base.checks import (analysed_signals, case_parameters, check_pool, check_range, check_speeds,
                            parse_settings, sampling_warnings, start_options)
 from ..base.errors import UsageError
 from ..base.fmu import highest_speed, model_variables, units_of
-from ..base.outputs import reduction_notice, safe_name, save, warn_cases, write_metadata
+from ..base.outputs import claim, reduction_notice, safe_name, save, warn_cases, write_metadata
 from ..figures import plots
 from ..running.runner import cutoffs_in_use
 from ..running.sweep_cases import sweep_cases
@@ -58,6 +57,7 @@ def run_study(args, cases: dict) -> int:
     """Sweeps each case and writes side-by-side waterfalls and overlaid order cuts on common
     scales."""
     check_range("--count", args.count, 1)
+    check_pool(args)
     options = start_options(args)
     variables = model_variables(args.fmu)
     check_speeds(args.rpm, increasing=args.count > 1, highest=highest_speed(variables))
@@ -72,8 +72,7 @@ def run_study(args, cases: dict) -> int:
                                           cutoff=cutoff))
                 for (label, parameters), cutoff in zip(study, cutoffs_in_use(args.fmu, study))])
     reduction_notice(study[0][1], variables)
-    out = pathlib.Path(args.out)
-    out.mkdir(parents=True, exist_ok=True)
+    out = claim(args)
     started = time.perf_counter()
     orders, spectra, fmu_warnings = sweep_cases(args, study, signals, out, options)
     suffix = ".parquet" if args.parquet else ".csv"
