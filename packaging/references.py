@@ -186,7 +186,7 @@ correctly.</p>
 <table border="1"><tr><th>experiment</th><th>what</th><th>run</th><th>outputs compared</th><th>tolerance</th></tr>
 {rows}
 </table>
-<p>With fmpy: <code>python -m emc.running.references {fmu.name}</code> (the emc tool of the project).</p>
+<p>With fmpy: <code>emc check-references {fmu.name}</code> (the emc tool of the project).</p>
 </body></html>
 """
 

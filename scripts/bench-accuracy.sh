@@ -16,7 +16,7 @@ fi
 cargo run --release --example reference_vs_cvode --features bench-cvode
 mkdir -p out/accuracy
 cargo run --release --example accuracy_cost -- --scene "${1:-2}" --csv out/accuracy/accuracy.csv
-.venv/bin/python -m emc.figures.accuracy_plot out/accuracy/accuracy.csv out/accuracy/accuracy.png
+.venv/bin/emc accuracy-plot out/accuracy/accuracy.csv out/accuracy/accuracy.png
 echo "plot: out/accuracy/accuracy.png"
 # The same tolerance rows through the packaged FMU, as a user measures them for their own car.
 bash packaging/package.sh

@@ -1,7 +1,7 @@
 #!/usr/bin/env bash
 # The scaling benchmark on a machine without network: the wheels of scripts/bench-wheels.sh are
 # unpacked into a temporary directory (those in fallback/ only where the interpreter lacks the
-# package), then `python -m emc.bench scaling` (or `scheduling`, named after WHEELDIR) runs with
+# package), then `emc bench-scaling` (or `scheduling`, named after WHEELDIR) runs with
 # the remaining arguments.
 #
 #   bash scripts/bench-scaling.sh WHEELDIR --fmu dist/EngineMountChassis.fmu --points 192 \
@@ -29,4 +29,4 @@ for p in numpy pandas lxml dateutil; do
 done
 echo "$("$python" --version), $(nproc) CPUs; packages from $wheels"
 cd "$root"
-PYTHONPATH=$site:$root/python exec "$python" -m emc.bench "$benchmark" "$@"
+PYTHONPATH=$site:$root/python exec "$python" -m emc "bench-$benchmark" "$@"

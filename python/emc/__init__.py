@@ -12,7 +12,7 @@ The package is a house of rooms; a room imports only from the floors below it (c
    the engine and body FMUs coupled, the SSP archive.
 4. :mod:`emc.diagnosis` (why it vibrates: paths, transfer functions, shapes, mounts, Campbell),
    :mod:`emc.studies` (the paper's cases, DOE, optimisation, accuracy) and :mod:`emc.bench`
-   (benchmarks, ``python -m emc.bench``).
+   (benchmarks, ``emc bench-…``).
 5. :mod:`emc.commands`: one module per command, each registering its options.
 6. :mod:`emc.cli`: the ``emc`` command.
 """

@@ -186,8 +186,7 @@ def test_each_shared_option_is_registered_once():
 
 def test_the_command_line_starts_without_the_numerical_libraries():
     """``emc --help`` and an argument error build every parser: none of them may import numpy,
-    pandas, matplotlib, fmpy, dask or scipy (the start-up time is in ``python -m emc.bench
-    startup``)."""
+    pandas, matplotlib, fmpy, dask or scipy (the start-up time is in ``emc bench-startup``)."""
     code = ("import sys\nfrom emc.cli import build_parser\nbuild_parser()\n"
             "heavy = ('numpy', 'pandas', 'matplotlib', 'fmpy', 'dask', 'scipy', 'SALib')\n"
             "print(sorted(m for m in heavy if m in sys.modules))")

@@ -30,7 +30,7 @@ STATUS_LABELS = ("info", "warning", "discard", "error", "fatal", "pending")
 # threshold (128 KiB to start with), and the FMU frees workspaces of that size at every point:
 # the heap shrinks and grows again, and every page it regrows faults in afresh. With a large trim
 # threshold and top pad a scene-2 sweep point costs 5-7 % less CPU (48 points, 2.60-2.67 s against
-# 2.81 s serially, `python -m emc.bench scaling --points 48 --workers 1`, 2026-11-27); the process
+# 2.81 s serially, `emc bench-scaling --points 48 --workers 1`, 2026-11-27); the process
 # keeps up to 256 MiB of freed memory for reuse. Dask workers get the same as environment
 # variables (emc.running.distributed), this process by :func:`keep_freed_memory`.
 MALLOC_SETTINGS = {"MALLOC_TRIM_THRESHOLD_": 1 << 28, "MALLOC_TOP_PAD_": 1 << 26}
