@@ -16,23 +16,22 @@ import functools
 import itertools
 import os
 import platform
-import sys
 import shutil
 import subprocess
+import sys
 import tempfile
 import time
 
 import numpy as np
 import pandas as pd
+import psutil
 
 from .base.checks import DEFAULT_PARAMETERS, check_range
 from .base.fmu import check_outputs, highest_speed, model_variables
 from .base.outputs import save
-from .running.runner import OperatingPoint, Runner
-from .running.sweep import speed_points
 from .running.distributed import FmuPool
-import psutil
-from .running.sweep import sweep_point
+from .running.runner import OperatingPoint, Runner
+from .running.sweep import speed_points, sweep_point
 
 EFFECTS = ("gasForces", "massForces", "balanceShaft", "gyroscopic", "ringCarrier", "mountNonlinearity")
 

@@ -10,11 +10,10 @@ import numpy as np
 import pandas as pd
 import pytest
 
-from emc.studies import accuracy
-
 from emc import cli
-from emc.signals.spectra import order_amplitudes
 from emc.running.runner import Runner
+from emc.signals.spectra import order_amplitudes
+from emc.studies import accuracy
 
 TOLERANCES = (1e-3, 1e-4, 1e-5, 1e-6, 1e-7, 1e-8, 1e-9)
 # The measurement: 2000 rpm from the static start, 1 ms communication step, 0.5 s.

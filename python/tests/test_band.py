@@ -11,10 +11,9 @@ import pandas as pd
 import pytest
 from matplotlib.collections import PolyCollection
 
+from emc import cli
 from emc.figures import plots
 from emc.running import band
-
-from emc import cli
 
 
 def test_the_default_band_scales_body_and_mounts_to_the_ends_of_their_ranges():

@@ -18,8 +18,7 @@ from fmpy import read_model_description
 from emc import cli
 from emc.base.checks import DEFAULT_PARAMETERS, parse_settings, sampling_warnings
 from emc.base.fmu import model_variables
-from emc.running.runner import cutoffs_in_use
-from emc.running.runner import PointFailed, fmu_from_content
+from emc.running.runner import PointFailed, cutoffs_in_use, fmu_from_content
 from emc.running.sweep import run_sweep, speed_points, sweep_point
 from emc.signals.tracking import track_orders
 

@@ -16,7 +16,7 @@ import pytest
 
 from emc.cli import main
 from emc.running.distributed import (ClusterMismatch, FmuPool, file_mismatches, identity_mismatches,
-                             settings_files, software_identity)
+                                     settings_files, software_identity)
 
 DASK = str(pathlib.Path(sys.executable).with_name("dask"))
 

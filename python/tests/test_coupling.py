@@ -9,8 +9,8 @@ import pytest
 from fmpy import read_model_description
 from fmpy.ssp.ssd import read_ssd
 
-from emc.running.split import largest_deviation, scene_2, split_in_libcosim
 from emc.base.fmu import mount_count
+from emc.running.split import largest_deviation, scene_2, split_in_libcosim
 from emc.running.ssp import connections, write_ssp
 
 ROOT = pathlib.Path(__file__).resolve().parents[2]

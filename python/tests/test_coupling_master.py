@@ -10,7 +10,7 @@ import numpy as np
 import pytest
 
 from emc.running.coupling import (ALGORITHMS, CoupledPair, Run, coupled, growth, largest_deviation,
-                          monolithic)
+                                  monolithic)
 
 ROOT = pathlib.Path(__file__).resolve().parents[2]
 STIFF = {f"mount[{i}].stiffnessScale": 20.0 for i in range(1, 5)}

@@ -69,8 +69,8 @@ def test_arrays_units_and_descriptions_follow_the_2_0_variables(fmu3_path, fmu_p
 
 
 def test_terminals_name_existing_variables_and_match_the_schema(fmu3_path):
-    from lxml import etree
     import fmpy
+    from lxml import etree
     schema_dir = pathlib.Path(fmpy.__file__).parent / "schema" / "fmi3"
     with zipfile.ZipFile(fmu3_path) as z:
         xml = z.read("terminalsAndIcons/terminalsAndIcons.xml")

@@ -19,7 +19,8 @@ FLOORS = {"base": 0, "signals": 1, "figures": 2, "running": 3, "diagnosis": 4, "
 # Imports inside functions that are meant: a heavy or optional library deferred for start-up
 # time, each with a comment saying so where it stands.
 DEFERRED = {("base/fmu.py", "fmpy"), ("base/outputs.py", "fmpy"), ("base/outputs.py", "fcntl"),
-            ("cli.py", ".running.runner"),
+            ("cli.py", ".running.runner"), ("running/sweep.py", ".distributed"),
+            ("running/sweep_cases.py", ".distributed"),
             ("running/split.py", "libcosimpy.CosimExecution"),
             ("running/split.py", "libcosimpy.CosimLogging"),
             ("running/split.py", "libcosimpy.CosimObserver"),

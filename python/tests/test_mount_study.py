@@ -10,10 +10,9 @@ import numpy as np
 import pytest
 
 from emc.studies import doe
-from emc.studies.mount_study import (Evaluator, Limits, Problem, Store, StudyError, base_configuration,
-                             parse_variable)
+from emc.studies.mount_study import (Evaluator, Limits, Problem, Store, StudyError,
+                                     base_configuration, parse_variable)
 from emc.studies.optimise import local_check, minimise
-
 
 # --- sensitivity indices against known ones ------------------------------------------------------
 

@@ -5,8 +5,8 @@ import pandas as pd
 import pytest
 
 from emc.running.runner import OperatingPoint, Runner
-from emc.signals.spectra import ORDERS, amplitude_spectrum, order_amplitudes
 from emc.running.sweep import run_sweep, speed_points
+from emc.signals.spectra import ORDERS, amplitude_spectrum, order_amplitudes
 
 
 def test_order_amplitudes_of_a_synthetic_signal_are_exact():

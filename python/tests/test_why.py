@@ -14,14 +14,7 @@ import pandas as pd
 import pytest
 
 from emc import cli
-
-from emc.diagnosis import decoupling
-
-from emc.diagnosis import frf
-
-from emc.diagnosis import ods
-
-from emc.diagnosis import tpa
+from emc.diagnosis import decoupling, frf, ods, tpa
 from emc.running.modal import export_from_fmu
 from emc.running.runner import OperatingPoint, Runner
 from emc.signals.spectra import order_components

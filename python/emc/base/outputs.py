@@ -25,10 +25,10 @@ import platform
 import re
 import sys
 import time
+from importlib import metadata as importlib_metadata
 
 from .errors import UsageError
 from .fmu import start_value
-from importlib import metadata as importlib_metadata
 
 # Options that change where or how fast results are made, not what they are.
 NOT_SETTINGS = {"out", "quiet", "workers", "scheduler", "serial", "overwrite", "func",

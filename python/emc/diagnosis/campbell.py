@@ -12,12 +12,11 @@ from __future__ import annotations
 import numpy as np
 import pandas as pd
 
-
 from ..base.checks import check_speeds, prepare
 from ..base.orders import MAIN_ORDERS, ORDERS
 from ..base.outputs import claim, reduction_notice, safe_name, save, write_metadata
-from ..running.runner import Runner
 from ..figures.plots import plt
+from ..running.runner import Runner
 
 # Body modes damped at most this much are resonant enough to mark their crossings.
 LIGHT_DAMPING = 0.075

@@ -13,8 +13,8 @@ from __future__ import annotations
 import numpy as np
 import pandas as pd
 
-from ..running.modal import Export
 from ..figures.plots import plt
+from ..running.modal import Export
 
 DIRECTIONS = ("x", "y", "z", "rx", "ry", "rz")
 # The paper's names of the directions for the transverse engine (crank axis along y).

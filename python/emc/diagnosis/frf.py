@@ -14,13 +14,12 @@ from __future__ import annotations
 import numpy as np
 import pandas as pd
 
+from ..figures.plots import draw_band, plt
+from ..running.band import wide
 from ..running.modal import Export, body_point_of
 from ..running.runner import Runner, set_value
-from .tpa import AXES, expand_complex, path_label
-from ..figures.plots import draw_band
-from ..running.band import wide
 from ..signals.spectra import dft_at
-from ..figures.plots import plt
+from .tpa import AXES, expand_complex, path_label
 
 
 def linear_output_name(output: str) -> str:

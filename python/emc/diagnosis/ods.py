@@ -13,15 +13,15 @@ animate the phase with the real and imaginary parts) through meshio, and as a pi
 
 from __future__ import annotations
 
+import meshio
 import numpy as np
+import pandas as pd
+from mpl_toolkits.mplot3d.art3d import Line3DCollection, Poly3DCollection
 
+from ..figures.plots import plt
 from ..running.modal import Export
 from ..signals.spectra import order_components
 from .tpa import force_signals
-import meshio
-from mpl_toolkits.mplot3d.art3d import Line3DCollection, Poly3DCollection
-import pandas as pd
-from ..figures.plots import plt
 
 POWERTRAIN_SIGNALS = ([f"powertrain.r[{j}]" for j in (1, 2, 3)]
                       + [f"powertrain.phi[{j}]" for j in (1, 2, 3)])

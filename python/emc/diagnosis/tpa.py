@@ -19,12 +19,11 @@ from __future__ import annotations
 import numpy as np
 import pandas as pd
 
-from ..running.modal import Export, body_point_of
 from ..base.orders import ORDERS
-from ..signals.spectra import order_components
-from ..figures.plots import draw_band
+from ..figures.plots import draw_band, plt
 from ..running.band import wide
-from ..figures.plots import plt
+from ..running.modal import Export, body_point_of
+from ..signals.spectra import order_components
 
 AXES = "xyz"
 

@@ -20,11 +20,11 @@ from __future__ import annotations
 import numpy as np
 import pandas as pd
 
-from . import tpa
 from ..running.modal import Export, body_point_of
-from ..signals.spectra import ORDERS, order_components
 from ..running.synthesis import HeldForces, path_responses, periodic_state, static_state
+from ..signals.spectra import ORDERS, order_components
 from ..signals.tracking import tracked_blocks
+from . import tpa
 
 # Cubic refinement of sampled forces before the hold (emc.running.synthesis): 1.4e-4 at 125 Hz, 0.2 ms.
 REFINE = 4

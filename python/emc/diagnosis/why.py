@@ -14,29 +14,23 @@ import time
 
 import numpy as np
 import pandas as pd
+from tqdm import tqdm
 
-from ..running import band as bands
-from . import decoupling
-from . import frf
-from . import ods
-from . import tpa
-from . import tpa_time
-from ..running.modal import OUTPUT_POINTS, body_point_of, export_from_fmu
-from ..running.runner import OperatingPoint, PointFailed, Runner
-from ..base.orders import ORDERS
 from ..base.checks import check_range, check_speeds, prepare
 from ..base.errors import UsageError
 from ..base.fmu import highest_speed
+from ..base.orders import ORDERS
 from ..base.outputs import (claim, fmu_warnings_summary, reduction_notice, safe_name, save,
                             write_metadata)
+from ..running import band as bands
 from ..running.band import band_metadata, band_of
-from ..running.runup import run_up
-from tqdm import tqdm
 from ..running.coupling import ALGORITHMS, CoupledPair
+from ..running.modal import OUTPUT_POINTS, body_point_of, export_from_fmu
+from ..running.runner import OperatingPoint, PointFailed, Runner
+from ..running.runup import run_up
 from ..running.synthesis import static_state
 from ..signals.spectra import order_components
-
-
+from . import decoupling, frf, ods, tpa, tpa_time
 
 
 def _progress(total: int, what: str, unit: str, quiet: bool):

@@ -49,9 +49,9 @@ from fmpy import read_model_description
 
 from ..base.errors import UsageError
 from ..base.fmu import mount_count, variable_names
-from .runner import Runner
 from ..base.orders import ORDERS
 from ..signals.spectra import order_amplitudes
+from .runner import Runner
 from .synthesis import HeldForces
 
 ALGORITHMS = ("jacobi", "gauss_seidel", "interface_jacobian")

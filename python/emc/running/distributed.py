@@ -41,23 +41,20 @@ import json
 import logging
 import math
 import os
-import sys
 import threading
 import time
 from dataclasses import dataclass, field
+from importlib import metadata
 from typing import Callable, Iterable
 
 import dask
+import fmpy
+import numpy
+from dask.distributed import Client, LocalCluster, as_completed
 from distributed.diagnostics.plugin import WorkerPlugin
 
 from ..base.errors import ClusterMismatch
 from .runner import MALLOC_SETTINGS, PointFailed, Runner, extracted, fmu_from_content
-from importlib import metadata
-import fmpy
-import numpy
-from dask.distributed import Client, LocalCluster
-from dask.distributed import as_completed
-from tqdm import tqdm
 
 # Local workers: Dask's nanny starts them with MALLOC_TRIM_THRESHOLD_=65536 so that they hand
 # memory back to the system; glibc then trims the FMU's short-lived allocations at every free, and
@@ -471,29 +468,3 @@ class FmuPool:
 
     def __exit__(self, *exc):
         self.close()
-
-
-def serial_map(fmu_path: str, evaluate: Callable, items: Iterable,
-               progress: Callable[[int], None] | None = None,
-               runner: Runner | None = None) -> list:
-    """The same evaluations in this process, one instance reused (``runner`` if given)."""
-    own = runner is None
-    runner = Runner(fmu_path) if own else runner
-    try:
-        results = []
-        for item in items:
-            results.append(evaluate(runner, item))
-            if progress is not None:
-                progress(1)
-        return results
-    finally:
-        if own:
-            runner.close()
-
-
-def progress_bar(total: int, description: str, enabled: bool = True, unit: str = "eval"):
-    """A tqdm bar on stderr if wanted (else None); ``bar.update`` fits :meth:`FmuPool.map`'s
-    ``progress``."""
-    if not enabled:
-        return None
-    return tqdm(total=total, desc=description, unit=unit, file=sys.stderr)

@@ -4,25 +4,27 @@ from __future__ import annotations
 
 import ctypes
 import dataclasses
+import hashlib
 import itertools
 import math
 import os
 import re
-import time
 import shutil
+import sys
 import tempfile
-from typing import Iterable
+import time
+from ctypes import byref
+from typing import Callable, Iterable
 
 import numpy as np
 from fmpy import extract, read_model_description
 from fmpy.fmi2 import (FMU2Slave, calloc, fmi2CallbackAllocateMemoryTYPE,
                        fmi2CallbackFreeMemoryTYPE, fmi2CallbackFunctions, fmi2CallbackLoggerTYPE,
                        free)
+from fmpy.logging import addLoggerProxy
+from tqdm import tqdm
 
 from ..base.fmu import CUTOFF_IN_USE
-from ctypes import byref
-from fmpy.logging import addLoggerProxy
-import hashlib
 
 STATUS_LABELS = ("info", "warning", "discard", "error", "fatal", "pending")
 
@@ -375,3 +377,29 @@ def cutoffs_in_use(fmu: str, cases: list[tuple[str, dict]]) -> list[float | None
         if CUTOFF_IN_USE not in runner.vr:
             return [None for _ in cases]
         return [runner.initial_values(parameters, [CUTOFF_IN_USE])[0] for _, parameters in cases]
+
+
+def serial_map(fmu_path: str, evaluate: Callable, items: Iterable,
+               progress: Callable[[int], None] | None = None,
+               runner: Runner | None = None) -> list:
+    """The same evaluations in this process, one instance reused (``runner`` if given)."""
+    own = runner is None
+    runner = Runner(fmu_path) if own else runner
+    try:
+        results = []
+        for item in items:
+            results.append(evaluate(runner, item))
+            if progress is not None:
+                progress(1)
+        return results
+    finally:
+        if own:
+            runner.close()
+
+
+def progress_bar(total: int, description: str, enabled: bool = True, unit: str = "eval"):
+    """A tqdm bar on stderr if wanted (else None); ``bar.update`` fits :meth:`FmuPool.map`'s
+    ``progress``."""
+    if not enabled:
+        return None
+    return tqdm(total=total, desc=description, unit=unit, file=sys.stderr)

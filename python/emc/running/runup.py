@@ -8,6 +8,7 @@ import time
 
 import numpy as np
 import pandas as pd
+from tqdm import tqdm
 
 from ..base.checks import analysed_signals, check_range, check_speeds, prepare, sampling_warnings
 from ..base.errors import UsageError
@@ -18,7 +19,6 @@ from ..figures import plots
 from ..signals.tracking import track_orders
 from . import band as bands
 from .runner import Runner, cutoffs_in_use
-from tqdm import tqdm
 
 
 def cmd_runup(args) -> int:

@@ -19,6 +19,7 @@ from __future__ import annotations
 import pathlib
 import zipfile
 from xml.sax.saxutils import quoteattr
+
 from ..base.checks import typed_value
 from ..base.errors import UsageError
 from ..base.fmu import model_variables, mount_count

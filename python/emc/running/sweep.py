@@ -15,9 +15,8 @@ import pandas as pd
 
 from ..base.fmu import default_signals
 from ..base.orders import HIGHEST_ORDER, ORDERS
-from .distributed import FmuPool, progress_bar, serial_map
-from .runner import OperatingPoint, Runner
 from ..signals.spectra import amplitude_spectrum, order_amplitudes
+from .runner import OperatingPoint, Runner, progress_bar, serial_map
 
 
 @dataclasses.dataclass
@@ -84,7 +83,7 @@ def run_sweep(fmu_path: str, points: list[OperatingPoint], signals: list[str] | 
               case: str = "", parallel: bool = True, scheduler: str | None = None,
               workers: int = 2, progress: bool = True,
               warnings: list | None = None,
-              pool: FmuPool | None = None) -> tuple[pd.DataFrame, pd.DataFrame]:
+              pool=None) -> tuple[pd.DataFrame, pd.DataFrame]:
     """Runs the points; returns (order table, spectrum table). A failed point raises
     :class:`PointFailed` (with its rpm, case and FMU log); the FMU's warnings of the points that
     succeeded are appended to ``warnings`` if given. ``pool``: a running :class:`FmuPool` of
@@ -97,6 +96,9 @@ def run_sweep(fmu_path: str, points: list[OperatingPoint], signals: list[str] | 
         if pool is not None:
             done = pool.map(evaluate, points, update)
         elif parallel:
+            # Deferred: dask is imported only where a sweep runs on a pool (start-up time).
+            from .distributed import FmuPool
+
             with FmuPool(fmu_path, workers, scheduler) as own_pool:
                 done = own_pool.map(evaluate, points, update)
         else:

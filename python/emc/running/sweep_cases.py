@@ -8,15 +8,14 @@ import time
 
 import pandas as pd
 
-from ..base.checks import (analysed_signals, check_range, check_pool, check_speeds, pool_workers, prepare,
-                           sampling_warnings, start_options)
+from ..base.checks import (analysed_signals, check_pool, check_range, check_speeds, pool_workers,
+                           prepare, sampling_warnings, start_options)
 from ..base.fmu import default_signals, highest_speed, units_of
 from ..base.outputs import (claim, fmu_warnings_summary, reduction_notice, safe_name, save,
                             warn_cases, write_metadata)
 from ..figures import plots
 from ..signals.comfort import comfort_table
 from . import band as bands
-from .distributed import FmuPool, settings_files
 from .runner import cutoffs_in_use
 from .sweep import run_sweep, speed_points
 
@@ -32,8 +31,13 @@ def sweep_cases(args, cases: list[tuple[str, dict]], signals: list[str], out: pa
     runs = len(cases) * args.count * (1 if band is None else len(bands.BOUNDS))
     workers = pool_workers(args, runs)
     parallel = workers is not None or args.scheduler is not None
-    files = sorted({f for _, parameters in cases for f in settings_files(parameters)})
-    pool = FmuPool(args.fmu, workers, args.scheduler, files=files) if parallel else None
+    pool = None
+    if parallel:
+        # Deferred: dask is imported only where the points run on a pool (start-up time).
+        from .distributed import FmuPool, settings_files
+
+        files = sorted({f for _, parameters in cases for f in settings_files(parameters)})
+        pool = FmuPool(args.fmu, workers, args.scheduler, files=files)
 
     def run(_settings: dict, bound: str | None = None):
         tables = []

@@ -28,21 +28,20 @@ from __future__ import annotations
 
 import dataclasses
 import math
+import sys
 import time
 
 import numpy as np
 import pandas as pd
 
-from ..running.runner import Runner
-from ..signals.spectra import order_amplitudes
 from ..base.checks import check_range, check_speeds, prepare
 from ..base.errors import UsageError
 from ..base.fmu import check_outputs, highest_speed
 from ..base.outputs import claim, reduction_notice, write_metadata
-
-from .defaults import COMPARED_ORDERS, DEFAULT_TOLERANCES, REFERENCE_TOLERANCE
-import sys
 from ..figures.plots import plt
+from ..running.runner import Runner
+from ..signals.spectra import order_amplitudes
+from .defaults import COMPARED_ORDERS, DEFAULT_TOLERANCES, REFERENCE_TOLERANCE
 
 
 @dataclasses.dataclass(frozen=True)

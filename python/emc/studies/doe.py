@@ -23,16 +23,16 @@ import time
 
 import numpy as np
 import pandas as pd
-
-from .mount_study import Problem, design_table, open_study, problem_from_args
-from ..base.checks import check_range
-from ..base.outputs import reduction_notice, write_metadata
 from SALib.analyze import rbd_fast
 from SALib.analyze import sobol as sobol_analysis
 from SALib.sample import latin
 from SALib.sample import sobol as sobol_sampling
-from ..running.distributed import progress_bar
+
+from ..base.checks import check_range
+from ..base.outputs import reduction_notice, write_metadata
 from ..figures.plots import plt
+from ..running.runner import progress_bar
+from .mount_study import Problem, design_table, open_study, problem_from_args
 
 # The responses whose sensitivities are reported: the objective and the limits' quantities.
 RESPONSES = {"objective": "objective", "max_deflection_mm": "largest mount deflection",

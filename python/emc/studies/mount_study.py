@@ -47,16 +47,16 @@ import zipfile
 import numpy as np
 import pandas as pd
 
-from ..signals.comfort import SEAT, WHEEL, comfort_table
+from ..base.checks import check_pool, check_range, check_speeds, parse_settings, pool_workers
+from ..base.errors import UsageError
+from ..base.fmu import check_config_file, highest_speed, model_variables, mount_count
+from ..base.options import POOL_FROM
+from ..base.outputs import claim
+from ..running.distributed import FmuPool, settings_files
 from ..running.runner import OperatingPoint, PointFailed, Runner
 from ..running.sweep import analyse, speed_points, tables
-from ..base.checks import check_pool, check_range, check_speeds, parse_settings, pool_workers
-from ..base.options import POOL_FROM
-from ..base.errors import UsageError
-from ..base.outputs import claim
-from ..base.fmu import check_config_file, highest_speed, model_variables, mount_count
+from ..signals.comfort import SEAT, WHEEL, comfort_table
 from .defaults import BASELINE, DEFAULT_BOUNDS, Limits
-from ..running.distributed import FmuPool, settings_files
 
 VARIABLE = re.compile(r"^mount\[(\d+)\]\.(stiffnessScale|dampingScale|rate\[([123])\])$")
 SIGNALS = WHEEL + SEAT

@@ -27,20 +27,19 @@ import time
 
 import numpy as np
 import pandas as pd
+from scipy.optimize import Bounds, NonlinearConstraint, minimize
 
-from .mount_study import (Problem, StudyError, design_table, read_store, open_study,
-                          problem_from_args)
 from ..base.checks import check_range
 from ..base.errors import UsageError
 from ..base.fmu import units_of
-from ..base.outputs import reduction_notice, write_metadata
-from scipy.optimize import Bounds, NonlinearConstraint, minimize
+from ..base.outputs import reduction_notice, save, write_metadata
 from ..figures import plots
-from ..signals.comfort import comfort_table
-from ..running.distributed import progress_bar
-from ..running.sweep import tables
-from ..base.outputs import save
 from ..figures.plots import plt
+from ..running.runner import progress_bar
+from ..running.sweep import tables
+from ..signals.comfort import comfort_table
+from .mount_study import (Problem, StudyError, design_table, open_study, problem_from_args,
+                          read_store)
 
 PERTURBATION = 0.05
 

@@ -15,7 +15,6 @@ from ..running.runner import cutoffs_in_use
 from ..running.sweep_cases import sweep_cases
 from ..signals.comfort import comfort_table
 
-
 STUDY_CASES = {
     "4 mounts": {},
     "3 mounts + stiffening bar": {"configFile": "vehicle_three_mounts.json",
