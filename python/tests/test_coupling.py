@@ -10,7 +10,8 @@ from fmpy import read_model_description
 from fmpy.ssp.ssd import read_ssd
 
 from emc.base.fmu import mount_count
-from emc.running.split import largest_deviation, scene_2, split_in_libcosim
+from emc.running.coupling import Run, largest_deviation
+from emc.running.split import scene_2, split_in_libcosim
 from emc.running.ssp import connections, write_ssp
 
 ROOT = pathlib.Path(__file__).resolve().parents[2]
@@ -107,6 +108,6 @@ def test_two_fmus_from_the_ssp_in_libcosim_reproduce_scene_2(fmu_path, body_fmu_
                     body_parameters={"chassis.cacheDir": str(cache)}, step_size=h, stop_time=t_end)
     split = split_in_libcosim(ssp, rpm, h, t_end)
     mono = scene_2(fmu_path, rpm, h, t_end, cache, rel_tol)
-    worst, where = largest_deviation(mono, split, h, rpm)
+    worst, where = largest_deviation(Run.of(mono, h), Run.of(split, h), rpm)
     print(f"{rpm} rpm: largest order deviation {worst * 100:.2f} % ({where})")
     assert worst < 0.02, f"{where}: {worst * 100:.2f} %"

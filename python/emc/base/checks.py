@@ -14,6 +14,18 @@ from .orders import HIGHEST_ORDER
 DEFAULT_PARAMETERS = {"scene": 2}
 BOOLEAN_SPELLINGS = {"true": True, "1": True, "yes": True, "on": True,
                      "false": False, "0": False, "no": False, "off": False}
+# The largest requests the commands take: beyond them a run would last hours on one machine
+# (a scene-2 speed point costs 0.1-0.4 s, a frequency of a transfer function about 1 ms, a
+# verifying sine a few seconds) for no resolution a plot or a table can show.
+MAX_SPEED_POINTS = 2000
+MAX_FREQUENCIES = 20000
+MAX_VERIFY_FREQUENCIES = 20
+# A verifying sine above the body's modes (its cut-off is 225 Hz by default) checks nothing the
+# modal model keeps; its sampling at 32 steps a cycle would make every step tiny.
+MAX_VERIFY_HZ = 1000.0
+# The load torque's sine amplitude: beyond several times the engine's full-load torque
+# (about 300 N·m) the mounts leave their measured curves.
+MAX_TORQUE = 5000.0
 # Inputs and parameters each point's speed, load and start come from: set by the command's own
 # options, never by --set (a --set rpm would run every point at that speed, labelled otherwise).
 CONTROLLED = {"rpm": "--rpm", "loadTorque": "--load-torque", "initialization.periodic": "--start"}
@@ -113,6 +125,17 @@ def check_range(name: str, value, low=None, high=None, strict_low=False):
         raise UsageError(f"{name} must be {bound or 'finite'}, got {value}")
 
 
+def check_count(value: int, option: str = "--count", largest: int = MAX_SPEED_POINTS):
+    """A number of points: at least 1, at most ``largest`` (module constants say why)."""
+    check_range(option, value, 1, largest)
+
+
+def check_revolutions(value: int, option: str = "--revolutions"):
+    """A window of whole working cycles (two revolutions each) puts every half order on a bin."""
+    if value < 2 or value % 2:
+        raise UsageError(f"{option} must be even and >= 2, got {value}")
+
+
 def check_speeds(rpm: list[float], increasing: bool = False, highest: float = 6000.0):
     """FROM and TO positive and at most the FMU's highest speed; TO above FROM where the command
     needs a range (a run-up, a sweep of several points)."""
@@ -160,8 +183,7 @@ def start_options(args) -> dict:
             raise UsageError(f"--settle must be >= 0, got {settle}")
         options = {"periodic": False, "settle_revolutions": settle, "revolutions": 40}
     if args.revolutions is not None:
-        if args.revolutions < 2 or args.revolutions % 2:
-            raise UsageError(f"--revolutions must be even and >= 2, got {args.revolutions}")
+        check_revolutions(args.revolutions)
         options["revolutions"] = args.revolutions
     return options
 

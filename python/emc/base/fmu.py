@@ -6,7 +6,9 @@ from __future__ import annotations
 
 import difflib
 import pathlib
+import platform
 import re
+import xml.etree.ElementTree as ET
 import zipfile
 from typing import Iterable
 
@@ -16,15 +18,69 @@ from .errors import UsageError
 DEFAULT_SIGNAL_PREFIXES = ("mount[", "steeringWheel.a", "seat.a")
 # The chassis mode cut-off (Hz) the body in use keeps, as the FMU reports it.
 CUTOFF_IN_USE = "chassis.modeCutoffInUse"
+# The FMUs of this project, by the model identifier of their co-simulation interface.
+ENGINE = "EngineMountChassis"
+BODY = "EngineMountBody"
+KIND = {ENGINE: "the engine FMU", BODY: "the body FMU"}
 
 
-def model_variables(fmu: str) -> dict:
-    """The FMU's variables by name (from its model description)."""
+def binaries_folder() -> str:
+    """The FMI 2.0 binaries folder of this platform (linux64, win64, darwin64, …)."""
+    system = {"Linux": "linux", "Windows": "win", "Darwin": "darwin"}.get(platform.system(),
+                                                                          platform.system())
+    bits = "64" if platform.architecture()[0] == "64bit" else "32"
+    return system + bits
+
+
+def check_fmu(fmu: str, option: str = "--fmu", model: str | None = ENGINE):
+    """That ``fmu`` is an FMU this tool can run, before anything is extracted or loaded: a file,
+    a zip with an FMI 2.0 co-simulation model description, a binary for this platform, and (if
+    ``model`` is given) the model identifier ``model``."""
+    path = pathlib.Path(fmu)
+    if not path.is_file():
+        hint = " (package it with bash packaging/package.sh)" if option == "--fmu" else ""
+        raise UsageError(f"{option} {fmu}: no such file{hint}")
+    try:
+        with zipfile.ZipFile(path) as z:
+            names = set(z.namelist())
+            if "modelDescription.xml" not in names:
+                raise UsageError(f"{option} {fmu}: an archive without modelDescription.xml, not "
+                                 "an FMU")
+            root = ET.fromstring(z.read("modelDescription.xml"))
+    except zipfile.BadZipFile:
+        raise UsageError(f"{option} {fmu}: not an FMU (not a zip archive)") from None
+    except ET.ParseError as error:
+        raise UsageError(f"{option} {fmu}: its modelDescription.xml is not XML ({error})") \
+            from None
+    version = root.get("fmiVersion", "?")
+    if version != "2.0":
+        twin = f" (the FMI 2.0 twin of {path.name} is {path.name.replace('-fmi3', '')})" \
+            if "-fmi3" in path.name else ""
+        raise UsageError(f"{option} {fmu}: an FMI {version} FMU; emc drives FMI 2.0 FMUs{twin}")
+    cosim = root.find("CoSimulation")
+    if cosim is None:
+        raise UsageError(f"{option} {fmu}: no co-simulation interface (model exchange only)")
+    identifier = cosim.get("modelIdentifier", "")
+    if model is not None and identifier != model:
+        what = KIND.get(identifier, f"the FMU {identifier}")
+        raise UsageError(f"{option} {fmu} is {what}; {option} takes {KIND.get(model, model)} "
+                         f"({model}.fmu)")
+    folder = binaries_folder()
+    suffix = {"linux": ".so", "win": ".dll", "darwin": ".dylib"}.get(folder[:-2], "")
+    if f"binaries/{folder}/{identifier}{suffix}" not in names:
+        have = sorted({n.split("/")[1] for n in names if n.startswith("binaries/")
+                       and n.count("/") >= 2})
+        raise UsageError(f"{option} {fmu}: no binary for this platform ({folder}; it has "
+                         f"{', '.join(have) or 'none'})")
+
+
+def model_variables(fmu: str, option: str = "--fmu", model: str | None = ENGINE) -> dict:
+    """The FMU's variables by name (from its model description), the FMU checked first
+    (:func:`check_fmu`)."""
     # Deferred: fmpy imports numpy, which the command line does not need to start.
     from fmpy import read_model_description
 
-    if not pathlib.Path(fmu).is_file():
-        raise UsageError(f"--fmu {fmu}: no such file (package it with bash packaging/package.sh)")
+    check_fmu(fmu, option, model)
     return {v.name: v for v in read_model_description(fmu).modelVariables}
 
 

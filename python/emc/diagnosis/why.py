@@ -16,10 +16,11 @@ import numpy as np
 import pandas as pd
 from tqdm import tqdm
 
-from ..base.checks import check_range, check_speeds, prepare
+from ..base.checks import (MAX_FREQUENCIES, MAX_TORQUE, MAX_VERIFY_FREQUENCIES, MAX_VERIFY_HZ,
+                           check_count, check_range, check_revolutions, check_speeds, prepare)
 from ..base.errors import UsageError
-from ..base.fmu import highest_speed
-from ..base.orders import ORDERS
+from ..base.fmu import BODY, check_fmu, highest_speed
+from ..base.orders import HIGHEST_ORDER, ORDERS
 from ..base.outputs import (claim, fmu_warnings_summary, reduction_notice, safe_name, save,
                             write_metadata)
 from ..running import band as bands
@@ -251,10 +252,9 @@ def report_band(table: pd.DataFrame, names: dict, responses: list[str], labels: 
 
 
 def cmd_tpa(args) -> int:
-    check_range("--count", args.count, 1)
+    check_count(args.count)
     check_range("--steps-per-rev", args.steps_per_rev, 14, 10000)
-    if args.revolutions < 2 or args.revolutions % 2:
-        raise UsageError(f"--revolutions must be even and >= 2, got {args.revolutions}")
+    check_revolutions(args.revolutions)
     check_order(args.order)
     variables, cases = prepare(args)
     check_speeds(args.rpm, increasing=args.count > 1, highest=highest_speed(variables))
@@ -318,9 +318,7 @@ def start_cycle(args, parameters: dict, export, initial: np.ndarray) -> tuple[np
 def cmd_tpa_runup(args) -> int:
     check_range("--duration", args.duration, 0.0, strict_low=True)
     check_range("--step", args.step, 0.0, 0.01, strict_low=True)
-    if args.block_revolutions < 2 or args.block_revolutions % 2:
-        raise UsageError(f"--block-revolutions must be even and >= 2 (half orders on "
-                             f"bins), got {args.block_revolutions}")
+    check_revolutions(args.block_revolutions, "--block-revolutions")
     check_order(args.order)
     variables, cases = prepare(args)
     check_speeds(args.rpm, increasing=True, highest=highest_speed(variables))
@@ -391,15 +389,15 @@ def cmd_tpa_runup(args) -> int:
 
 def cmd_tpa_coupled(args) -> int:
     check_order(args.order)
-    if args.revolutions < 2 or args.revolutions % 2:
-        raise UsageError(f"--revolutions must be even and >= 2, got {args.revolutions}")
+    check_revolutions(args.revolutions)
     check_range("--settle", args.settle, 0.0)
     check_range("--coupling-step", args.coupling_step, 0.0, 0.05, strict_low=True)
     if args.algorithm not in ALGORITHMS:
         raise UsageError(f"--algorithm: one of {', '.join(ALGORITHMS)}")
     variables, cases = prepare(args, cases_wanted=False)
     check_range("--rpm-point", args.rpm_point, 0.0, highest_speed(variables),
-                    strict_low=True)
+                strict_low=True)
+    check_fmu(args.body_fmu, "--body-fmu", BODY)
     engine = {k: v for k, v in cases[0][1].items() if k != "scene"}  # the pair sets scene 3
     if args.start == "periodic":
         engine["initialization.periodic"] = True
@@ -448,10 +446,21 @@ def cmd_tpa_coupled(args) -> int:
 def cmd_frf(args) -> int:
     check_range("--freq FROM", args.freq[0], 0.0, strict_low=True)
     check_range("--freq TO", args.freq[1], args.freq[0], strict_low=True)
-    check_range("--points", args.points, 2)
+    check_range("--points", args.points, 2, MAX_FREQUENCIES)
+    check_range("the number of --verify frequencies", len(args.verify or []), 0,
+                MAX_VERIFY_FREQUENCIES)
     for f in args.verify or []:
-        check_range("--verify", f, 0.0, strict_low=True)
+        check_range("--verify", f, args.freq[0], min(args.freq[1], MAX_VERIFY_HZ))
+    check_range("--verify-amplitude", args.verify_amplitude, 0.0, MAX_TORQUE, strict_low=True)
+    check_range("--verify-rtol", args.verify_rtol, 0.0, 1e-2, strict_low=True)
+    check_range("--top", args.top, 1)
     variables, cases = prepare(args, cases_wanted=False)
+    if args.mark_order and args.mark_rpm is None:
+        raise UsageError("--mark-order needs --mark-rpm (the speed its frequencies are at)")
+    if args.mark_rpm is not None:
+        check_range("--mark-rpm", args.mark_rpm, 0.0, highest_speed(variables), strict_low=True)
+    for order in args.mark_order or []:
+        check_range("--mark-order", order, 0.0, HIGHEST_ORDER, strict_low=True)
     parameters = cases[0][1]
     band = band_of(args, variables, cases)
     reduction_notice(parameters, variables)
@@ -564,6 +573,9 @@ def compared_points(args, export, samples: dict, shape: dict) -> list[dict]:
 
 def cmd_ods(args) -> int:
     check_order(args.order)
+    check_revolutions(args.revolutions)
+    check_range("--steps-per-rev", args.steps_per_rev, 14, 10000)
+    check_range("--load-torque", args.load_torque)
     variables, cases = prepare(args, cases_wanted=False)
     check_range("--rpm-point", args.rpm_point, 0.0, highest_speed(variables),
                     strict_low=True)

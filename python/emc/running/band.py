@@ -176,6 +176,15 @@ def from_options(args, variables: dict) -> Band | None:
         return None
     body = tuple(args.band_body) if args.band_body else BODY_SCALE
     mounts = tuple(args.band_mounts) if args.band_mounts else MOUNT_SCALE
+    # The low bound is the one with the higher levels at the body's resonances: the less damped
+    # body, with the more damped mounts (see emc.base.options).
+    if body[0] > body[1]:
+        raise ValueError(f"--band-body {body[0]:g} {body[1]:g}: LOW is the less damped body's "
+                         "scale, so LOW <= 1 <= HIGH")
+    if mounts[0] < mounts[1]:
+        raise ValueError(f"--band-mounts {mounts[0]:g} {mounts[1]:g}: LOW is the more damped "
+                         "mounts' scale (they pass more force to the body's resonances), so "
+                         "LOW >= 1 >= HIGH")
     count = sum(1 for i in range(1, 65) if f"mount[{i}].dampingScale" in variables)
     band = Band.damping(body=None if body == (1.0, 1.0) else body,
                         mounts=None if mounts == (1.0, 1.0) or count == 0 else mounts,

@@ -166,17 +166,21 @@ class Runner:
         self.unzipdir = extract(fmu_path) if unzipdir is None else unzipdir
         self.vr = {v.name: v.valueReference for v in self.md.modelVariables}
         self.kind = {v.name: v.type for v in self.md.modelVariables}
-        self.slave = FMU2Slave(
-            guid=self.md.guid,
-            unzipDirectory=self.unzipdir,
-            modelIdentifier=self.md.coSimulation.modelIdentifier,
-            instanceName=instance_name,
-        )
         self.log: list[str] = []
-        self.callbacks = logging_callbacks(self.log)
+        self.callbacks = None
         try:
+            self.slave = FMU2Slave(
+                guid=self.md.guid,
+                unzipDirectory=self.unzipdir,
+                modelIdentifier=self.md.coSimulation.modelIdentifier,
+                instanceName=instance_name,
+            )
+            self.callbacks = logging_callbacks(self.log)
             self.slave.instantiate(callbacks=self.callbacks)
         except Exception as error:  # noqa: BLE001 - fmpy raises a bare Exception
+            # Nothing of a failed start stays behind: not the extracted FMU, not its sink.
+            if self.callbacks is not None:
+                release_logging(self.callbacks)
             if self.own_unzipdir:
                 shutil.rmtree(self.unzipdir, ignore_errors=True)
             raise self.failure(f"instantiating {self.md.modelName}", error) from None

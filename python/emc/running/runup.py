@@ -10,7 +10,8 @@ import numpy as np
 import pandas as pd
 from tqdm import tqdm
 
-from ..base.checks import analysed_signals, check_range, check_speeds, prepare, sampling_warnings
+from ..base.checks import (analysed_signals, check_range, check_revolutions, check_speeds, prepare,
+                           sampling_warnings)
 from ..base.errors import UsageError
 from ..base.fmu import highest_speed, units_of
 from ..base.outputs import (claim, fmu_warnings_summary, reduction_notice, safe_name, save,
@@ -25,9 +26,7 @@ def cmd_runup(args) -> int:
     check_range("--duration", args.duration, 0.0, strict_low=True)
     check_range("--step", args.step, 0.0, 0.01, strict_low=True)
     check_range("--load-torque", args.load_torque)
-    if args.block_revolutions < 2 or args.block_revolutions % 2:
-        raise UsageError(f"--block-revolutions must be even and >= 2 (half orders on bins), "
-                         f"got {args.block_revolutions}")
+    check_revolutions(args.block_revolutions, "--block-revolutions")
     variables, cases = prepare(args)
     band = bands.band_of(args, variables, cases)
     check_speeds(args.rpm, increasing=True, highest=highest_speed(variables))

@@ -145,7 +145,7 @@ def checked_parameters(fmu: pathlib.Path, parameters: dict) -> dict:
     refuse never reaches the archive: libcosim 0.11 aborts the whole process when an FMU refuses
     a parameter value of an SSP."""
 
-    variables = model_variables(str(fmu))
+    variables = model_variables(str(fmu), model=None)
     out = {}
     for name, value in parameters.items():
         if name not in variables:

@@ -8,8 +8,8 @@ import time
 
 import pandas as pd
 
-from ..base.checks import (analysed_signals, check_pool, check_range, check_speeds, pool_workers,
-                           prepare, sampling_warnings, start_options)
+from ..base.checks import (analysed_signals, check_count, check_pool, check_range, check_speeds,
+                           pool_workers, prepare, sampling_warnings, start_options)
 from ..base.fmu import default_signals, highest_speed, units_of
 from ..base.outputs import (claim, fmu_warnings_summary, reduction_notice, safe_name, save,
                             warn_cases, write_metadata)
@@ -69,7 +69,7 @@ def sweep_cases(args, cases: list[tuple[str, dict]], signals: list[str], out: pa
 
 
 def cmd_sweep(args) -> int:
-    check_range("--count", args.count, 1)
+    check_count(args.count)
     check_range("--steps-per-rev", args.steps_per_rev, 4, 10000)
     check_pool(args)
     check_range("--load-torque", args.load_torque)

@@ -47,7 +47,8 @@ import zipfile
 import numpy as np
 import pandas as pd
 
-from ..base.checks import check_pool, check_range, check_speeds, parse_settings, pool_workers
+from ..base.checks import (check_count, check_pool, check_range, check_revolutions, check_speeds,
+                           parse_settings, pool_workers)
 from ..base.errors import UsageError
 from ..base.fmu import check_config_file, highest_speed, model_variables, mount_count
 from ..base.options import POOL_FROM
@@ -411,11 +412,10 @@ def problem_from_args(args) -> tuple[Problem, dict, int]:
 
     variables = model_variables(args.fmu)
     mounts = mount_count(variables)
-    check_speeds(args.rpm, increasing=True, highest=highest_speed(variables))
-    check_range("--count", args.count, 1)
+    check_speeds(args.rpm, increasing=args.count > 1, highest=highest_speed(variables))
+    check_count(args.count)
     check_pool(args)
-    if args.revolutions < 2 or args.revolutions % 2:
-        raise UsageError(f"--revolutions must be even and >= 2, got {args.revolutions}")
+    check_revolutions(args.revolutions)
     for option, value in (("--max-deflection", args.max_deflection),
                           ("--max-translation", args.max_translation),
                           ("--max-rotation", args.max_rotation)):

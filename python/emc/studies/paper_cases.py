@@ -5,7 +5,7 @@ from __future__ import annotations
 
 import time
 
-from ..base.checks import (analysed_signals, case_parameters, check_pool, check_range, check_speeds,
+from ..base.checks import (analysed_signals, case_parameters, check_count, check_pool, check_speeds,
                            parse_settings, sampling_warnings, start_options)
 from ..base.errors import UsageError
 from ..base.fmu import highest_speed, model_variables, units_of
@@ -55,7 +55,7 @@ def cmd_study_engines(args) -> int:
 def run_study(args, cases: dict) -> int:
     """Sweeps each case and writes side-by-side waterfalls and overlaid order cuts on common
     scales."""
-    check_range("--count", args.count, 1)
+    check_count(args.count)
     check_pool(args)
     options = start_options(args)
     variables = model_variables(args.fmu)
