@@ -140,7 +140,7 @@ def test_a_worker_with_other_software_is_refused_naming_both_versions(fmu_path, 
     copy = tmp_path / "other" / "emc"
     shutil.copytree(pathlib.Path(emc.__file__).parent, copy,
                     ignore=shutil.ignore_patterns("__pycache__"))
-    with open(copy / "spectra.py", "a") as f:
+    with open(copy / "signals" / "spectra.py", "a") as f:
         f.write("\n# a change on that worker only\n")
     other = Cluster(tmp_path / "c2")
     try:

@@ -169,7 +169,7 @@ def software_identity() -> dict:
     and a checksum of its source files (two checkouts of one version differ there), fmpy's and
     numpy's versions."""
 
-    package = os.path.dirname(os.path.abspath(__file__))
+    package = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))  # emc/
     digest = hashlib.sha256()
     for folder, dirs, files in sorted(os.walk(package)):
         dirs[:] = sorted(d for d in dirs if d != "__pycache__")
