@@ -41,6 +41,7 @@ import json
 import logging
 import math
 import os
+import signal
 import threading
 import time
 from dataclasses import dataclass, field
@@ -261,6 +262,19 @@ def _warm_up(sha256: str, evaluate: Callable | None, item, dask_worker=None):
         _IDLE_RUNNERS.setdefault(sha256, []).extend(runners)
 
 
+@contextlib.contextmanager
+def _sigint_ignored():
+    """SIGINT ignored while child processes are started from this (main) thread."""
+    if threading.current_thread() is not threading.main_thread():
+        yield
+        return
+    previous = signal.signal(signal.SIGINT, signal.SIG_IGN)
+    try:
+        yield
+    finally:
+        signal.signal(signal.SIGINT, previous)
+
+
 def _quiet_teardown():
     """Run on a local pool's workers before it closes: errors while closing are not logged."""
     logging.getLogger("distributed").setLevel(logging.CRITICAL)
@@ -366,7 +380,11 @@ class FmuPool:
             self.client = Client(scheduler)
         else:
             # Worker logs below ERROR (cancelled tasks after a failure, …) would bury the cause.
-            with dask.config.set(WORKER_CONFIG):
+            # The worker processes start with Ctrl-C ignored (a Python process keeps an
+            # ignored SIGINT): the terminal's interrupt reaches them too, and each would print
+            # its own KeyboardInterrupt traceback before the command's one-line message; the
+            # command stops them itself.
+            with dask.config.set(WORKER_CONFIG), _sigint_ignored():
                 self.cluster = LocalCluster(n_workers=workers,
                                             threads_per_worker=threads_per_worker,
                                             processes=True, dashboard_address=None,

@@ -29,7 +29,8 @@ from SALib.sample import latin
 from SALib.sample import sobol as sobol_sampling
 
 from ..base.checks import check_range
-from ..base.outputs import reduction_notice, write_metadata
+from ..base.errors import UsageError
+from ..base.outputs import reduction_notice, warn, write_metadata
 from ..figures.plots import plt
 from ..running.runner import progress_bar
 from .mount_study import Problem, design_table, open_study, problem_from_args
@@ -50,17 +51,67 @@ def sample(problem: dict, method: str, n: int, seed: int) -> np.ndarray:
     return latin.sample(problem, n, seed=seed)
 
 
+# Resamples of the bootstrap (confidence) and of the permutation test (the index of a response
+# that does not depend on a variable at all), each a few milliseconds on a study's sample.
+RESAMPLES = 200
+# An index whose confidence half-width exceeds this, or an RBD-FAST index below which no
+# sensitivity can be told from none, makes the sample too small for the table: said so.
+PRECISION = 0.1
+
+
+def _rbd_fast_s1(problem: dict, X: np.ndarray, Y: np.ndarray, seed: int) -> np.ndarray:
+    return np.asarray(rbd_fast.analyze(problem, X, Y, seed=seed)["S1"], dtype=float)
+
+
 def indices(problem: dict, method: str, X: np.ndarray, Y: np.ndarray, seed: int) -> pd.DataFrame:
     """Sensitivity indices of response ``Y`` (one value per row of ``X``, the plan's order):
-    S1 and ST (``sobol``) or S1 (``lhs``, RBD-FAST), with confidence half-widths."""
+    S1 and ST (``sobol``) or S1 (``lhs``, RBD-FAST), each with its 95 % confidence half-width
+    from a bootstrap of the designs (SALib's for Sobol', ours for RBD-FAST, whose SALib
+    estimate has none), and whether it can be told from zero: Sobol' indices whose intervals
+    reach zero, RBD-FAST's not above the 95th percentile of the same estimate on responses
+    shuffled against the variable (``S1_null``: the estimator's floor for this sample, its
+    small-sample bias included)."""
+    Y = np.asarray(Y, dtype=float)
+    X = np.asarray(X, dtype=float)
     if method == "sobol":
-        s = sobol_analysis.analyze(problem, np.asarray(Y, dtype=float), calc_second_order=False,
-                          seed=seed)
-        return pd.DataFrame({"variable": problem["names"], "S1": s["S1"],
-                             "S1_conf": s["S1_conf"], "ST": s["ST"], "ST_conf": s["ST_conf"]})
-    s = rbd_fast.analyze(problem, np.asarray(X, dtype=float), np.asarray(Y, dtype=float),
-                         seed=seed)
-    return pd.DataFrame({"variable": problem["names"], "S1": s["S1"], "S1_conf": s["S1_conf"]})
+        s = sobol_analysis.analyze(problem, Y, calc_second_order=False, seed=seed,
+                                   num_resamples=RESAMPLES)
+        table = pd.DataFrame({"variable": problem["names"], "S1": s["S1"],
+                              "S1_conf": s["S1_conf"], "ST": s["ST"], "ST_conf": s["ST_conf"]})
+        table["zero"] = ((table.S1.abs() <= table.S1_conf) & (table.ST.abs() <= table.ST_conf))
+        return table
+    rng = np.random.default_rng(seed)
+    s1 = _rbd_fast_s1(problem, X, Y, seed)
+    rows = rng.integers(0, len(Y), size=(RESAMPLES, len(Y)))
+    boot = np.array([_rbd_fast_s1(problem, X[r], Y[r], seed) for r in rows])
+    null = np.array([_rbd_fast_s1(problem, X, rng.permutation(Y), seed)
+                     for _ in range(RESAMPLES)])
+    table = pd.DataFrame({"variable": problem["names"], "S1": s1,
+                          "S1_conf": 1.96 * boot.std(axis=0),
+                          "S1_null": np.percentile(null, 95, axis=0)})
+    table["zero"] = table.S1 <= table.S1_null
+    return table
+
+
+def precision_warnings(table: pd.DataFrame, method: str, samples: int) -> list[str]:
+    """What the sample cannot resolve: confidence half-widths above :data:`PRECISION`, an
+    RBD-FAST floor above it; each with the sample that would bring it down."""
+    lines = []
+    widest = table[[c for c in ("S1_conf", "ST_conf") if c in table]].max().max()
+    if widest > PRECISION:
+        # The half-width falls as 1 / sqrt(N).
+        needed = int(np.ceil(samples * (widest / PRECISION) ** 2))
+        lines.append(f"the indices' 95 % confidence half-widths reach {widest:.2f} with "
+                     f"--samples {samples}: about --samples {needed} bring them to "
+                     f"{PRECISION:g}")
+    if method == "lhs" and table.S1_null.max() > PRECISION:
+        floor = table.S1_null.max()
+        needed = int(np.ceil(samples * floor / PRECISION))
+        lines.append(f"with --samples {samples} RBD-FAST reports up to {floor:.2f} for a "
+                     f"variable the response does not depend on (its small-sample bias): "
+                     f"first-order indices below that cannot be told from zero; about "
+                     f"--samples {needed} bring the floor to {PRECISION:g}")
+    return lines
 
 
 def plot_indices(table: pd.DataFrame, path: str, title: str):
@@ -136,11 +187,21 @@ def cmd_doe(args) -> int:
     designs.to_csv(out / "designs.csv", index=False)
     tables = []
     for response in RESPONSES:
-        t = indices(salib, args.method, X, designs[response].to_numpy(), args.seed)
+        values = designs[response].to_numpy(dtype=float)
+        bad = np.flatnonzero(~np.isfinite(values))
+        if bad.size:
+            k = int(bad[0])
+            raise UsageError(f"design {k + 1} of the plan ("
+                             + ", ".join(f"{n}={designs[n].iloc[k]:.4g}" for n in names)
+                             + f") has {RESPONSES[response]} {values[k]}: the indices need a "
+                             "finite value of every design")
+        t = indices(salib, args.method, X, values, args.seed)
         t.insert(0, "response", response)
         tables.append(t)
     table = pd.concat(tables, ignore_index=True)
     table.to_csv(out / "sensitivity.csv", index=False)
+    warnings = precision_warnings(table, args.method, args.samples)
+    warn(warnings)
     what = ("Sobol' indices (Saltelli)" if args.method == "sobol" else
             "first-order indices (RBD-FAST on a Latin hypercube)")
     plot_indices(table, str(out / "sensitivity.png"),
@@ -148,9 +209,13 @@ def cmd_doe(args) -> int:
                  f"{problem.rpm_from:g}-{problem.rpm_to:g} rpm")
     plot_scatter(designs, names, str(out / "scatter.png"))
     best = designs[designs.feasible].sort_values("objective").head(1)
+    current = design_table(problem, [baseline]).iloc[0].to_dict()
     summary = {"designs": len(X), "evaluated_now": evaluator.evaluated, "seconds": elapsed,
-               "baseline_objective": baseline["objective"],
-               "best_feasible": best.to_dict("records")}
+               "current_design": current, "baseline_objective": baseline["objective"],
+               "best_feasible": best.to_dict("records"),
+               "current_is_best": bool(baseline["feasible"] and (
+                   best.empty or baseline["objective"] <= best.objective.iloc[0])),
+               "warnings": warnings}
     (out / "doe.json").write_text(json.dumps(summary, indent=2, default=float) + "\n")
     write_metadata(out, args, variables, [("", dict(problem.parameters))],
                        {"problem": problem.settings(), "plan": {"method": args.method,
@@ -170,8 +235,18 @@ def print_summary(problem: Problem, table: pd.DataFrame, designs: pd.DataFrame, 
           f"({problem.objective}, m/s²) of the current design {baseline['objective']:.4g}, "
           f"{designs.feasible.sum()} designs within the limits")
     print(shown.to_string(float_format=lambda v: f"{v:.3f}"))
+    print(f"current design: objective {baseline['objective']:.4g}, "
+          + ("within the limits" if baseline["feasible"] else "beyond a limit") + ": "
+          + ", ".join(f"{v.name}={x:.3g}" for v, x in zip(problem.variables, baseline["x"])))
+    zero = table[table.zero]
+    if not zero.empty:
+        print("indistinguishable from zero (95 %): " + "; ".join(
+            f"{RESPONSES.get(r, r)}: " + ", ".join(g.variable)
+            for r, g in zero.groupby("response", sort=False)))
     if designs.feasible.any():
         best = designs[designs.feasible].sort_values("objective").iloc[0]
-        print(f"best feasible design: objective {best.objective:.4g} "
-              f"({best.objective / baseline['objective'] - 1:+.1%}): "
+        print(f"best feasible design of the plan: objective {best.objective:.4g} "
+              f"({best.objective / baseline['objective'] - 1:+.1%} against the current): "
               + ", ".join(f"{v.name}={best[v.name]:.3g}" for v in problem.variables))
+        if baseline["feasible"] and baseline["objective"] <= best.objective:
+            print("no design of the plan beats the current design")
