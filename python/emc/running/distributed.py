@@ -42,6 +42,7 @@ import logging
 import math
 import os
 import signal
+import sys
 import threading
 import time
 from dataclasses import dataclass, field
@@ -55,7 +56,8 @@ from dask.distributed import Client, LocalCluster, as_completed
 from distributed.diagnostics.plugin import WorkerPlugin
 
 from ..base.errors import ClusterMismatch
-from .runner import MALLOC_SETTINGS, PointFailed, Runner, extracted, fmu_from_content
+from .runner import (MALLOC_SETTINGS, PointFailed, Runner, extracted, fmu_from_content,
+                     keep_freed_memory)
 
 # Local workers: Dask's nanny starts them with MALLOC_TRIM_THRESHOLD_=65536 so that they hand
 # memory back to the system; glibc then trims the FMU's short-lived allocations at every free, and
@@ -67,7 +69,14 @@ from .runner import MALLOC_SETTINGS, PointFailed, Runner, extracted, fmu_from_co
 # 0.5 s and 0.1 s, work stealing every 0.1 s) cost the caller 4 % and each worker 2 % of a core
 # while a study runs; at 1-5 s they cost a tenth of that (2 workers, 48 scene-2 points: all
 # processes together within 1-4 % of the serial loop's CPU time instead of 22 % above it).
+# Local workers are forked from the calling process where the system allows it (Linux): they
+# start with its modules imported, a pool of 2 in 0.27-0.35 s against 1.8-2.4 s spawned (each
+# worker importing dask, fmpy and emc anew; /tmp/poolstart-like timing of FmuPool and warm(),
+# machine F under load, 2026-12-04). The fork happens on Dask's event-loop thread while the
+# calling thread waits for the cluster, holding no lock a worker needs.
+START_METHOD = "fork" if sys.platform.startswith("linux") else "spawn"
 WORKER_CONFIG = {
+    "distributed.worker.multiprocessing-method": START_METHOD,
     "distributed.nanny.pre-spawn-environ": {
         **MALLOC_SETTINGS, "OMP_NUM_THREADS": 1, "MKL_NUM_THREADS": 1, "OPENBLAS_NUM_THREADS": 1},
     "distributed.worker.profile.enabled": False,
@@ -98,6 +107,8 @@ class FmuPlugin(WorkerPlugin):
 
     def setup(self, worker):
         _FMU_FILES[self.sha256] = fmu_from_content(self.content, self.sha256)
+        # The FMU's short-lived workspaces stay with the worker (as in emc's own process).
+        keep_freed_memory()
 
     def teardown(self, worker):
         # Idle instances are dropped, not freed: freeing is cheap to skip, the worker process
