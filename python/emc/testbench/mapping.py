@@ -10,7 +10,7 @@ A TOML file (comments allowed), paths relative to its own folder::
     label = "steering wheel vertical, order 1.5"   # optional
     node = 101                  # UFF: the set's response node and direction (record 6) ...
     direction = 3
-    id = "order 1.5"            # ... and/or text one of its ID lines contains
+    id = "SW +Z order 1.5"      # ... and/or the whole text of one of its ID lines
     # channel = "SW_Z"          # CSV: the channel column (the order column must equal `order`)
     output = "steeringWheel.a[3]"
     order = 1.5                 # order cuts: the engine order (0.5 ... 6, in halves)
@@ -222,7 +222,7 @@ def _selects(m: ChannelMap, f: Function) -> bool:
         return f.channel == m.channel and f.order == m.order
     if m.node is not None and (f.node, f.direction) != (m.node, m.direction):
         return False
-    if m.id is not None and not any(m.id.lower() in i.lower() for i in f.ids):
+    if m.id is not None and not any(m.id.strip().lower() == i.strip().lower() for i in f.ids):
         return False
     return True
 
