@@ -1,0 +1,105 @@
+"""Benchmark of calibration and correlation at full size (a command that prints a table):
+
+    python -m emc.testbench.bench [--fmu dist/EngineMountChassis.fmu] [--workers 2]
+                                  [--speeds 35] [--revolutions 4] [--out DIR]
+
+A twin measurement (:mod:`.synthetic`: six hidden parameters, four mount stiffness scales, the
+mounts' damping and the body's, 3 % noise and noise floors) of 4 channels × 4 orders at 35
+speeds (800-2500 rpm), then ``emc calibrate`` of the six parameters from the nominal and
+``emc correlate`` of the measurement (with and without the damping band), each timed: wall
+time, the parameter sets and points simulated, the CPU time of the points (the workers'
+threads) and of this process. The recovered parameters are printed against the truth.
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import pathlib
+import tempfile
+import time
+
+import numpy as np
+import pandas as pd
+
+from .. import cli
+from ..runner import keep_freed_memory
+from .synthetic import twin_measurement
+
+TRUTH = {"mount[1].stiffnessScale": 1.15, "mount[2].stiffnessScale": 0.88,
+         "mount[3].stiffnessScale": 1.10, "mount[4].stiffnessScale": 0.92,
+         **{f"mount[{i}].dampingScale": 1.3 for i in range(1, 5)},
+         "chassis.modalDampingScale": 0.75}
+FITTED = {"mount[1].stiffnessScale": 1.15, "mount[2].stiffnessScale": 0.88,
+          "mount[3].stiffnessScale": 1.10, "mount[4].stiffnessScale": 0.92,
+          "mount[*].dampingScale": 1.3, "chassis.modalDampingScale": 0.75}
+OUTPUTS = {"steeringWheel.a[3]": "g", "seat.a[3]": "m/s^2", "mount[3].F[3]": "N",
+           "mount[4].F[3]": "N"}
+FLOORS = {"steeringWheel.a[3]": 0.005, "seat.a[3]": 0.005, "mount[3].F[3]": 0.1,
+          "mount[4].F[3]": 0.1}
+ORDERS = [1.0, 1.5, 2.0, 3.0]
+
+
+def timed(argv: list[str]) -> tuple[float, float]:
+    """(wall, CPU of this process) of one emc command, which must succeed."""
+    wall, cpu = time.perf_counter(), time.process_time()
+    code = cli.main(argv)
+    if code != 0:
+        raise SystemExit(f"emc {argv[0]} failed (exit {code})")
+    return time.perf_counter() - wall, time.process_time() - cpu
+
+
+def main(argv: list[str] | None = None) -> int:
+    parser = argparse.ArgumentParser(description=__doc__,
+                                     formatter_class=argparse.RawDescriptionHelpFormatter)
+    parser.add_argument("--fmu", default="dist/EngineMountChassis.fmu")
+    parser.add_argument("--workers", type=int, default=2)
+    parser.add_argument("--speeds", type=int, default=35)
+    parser.add_argument("--revolutions", type=int, default=4)
+    parser.add_argument("--out", help="keep the files here (default: a temporary folder)")
+    args = parser.parse_args(argv)
+    keep_freed_memory()
+    folder = pathlib.Path(args.out or tempfile.mkdtemp(prefix="emc-bench-calibration-"))
+    speeds = np.linspace(800.0, 2500.0, args.speeds)
+    made = time.perf_counter()
+    mapping = twin_measurement(args.fmu, folder, TRUTH, list(OUTPUTS), ORDERS, speeds, OUTPUTS,
+                               0.03, FLOORS, seed=11, revolutions=args.revolutions)
+    made = time.perf_counter() - made
+    common = ["--fmu", args.fmu, "--mapping", str(mapping), "--revolutions",
+              str(args.revolutions), "--workers", str(args.workers), "--quiet"]
+    rows = []
+    out = folder / "calibration"
+    wall, cpu = timed(["calibrate", *common, "--out", str(out), "--uncertainty", "0.03"])
+    report = json.loads((out / "calibration.json").read_text())
+    rows.append({"task": f"calibrate 6 parameters, {len(OUTPUTS)} channels x {len(ORDERS)} "
+                         f"orders x {args.speeds} speeds",
+                 "evaluations": report["fit"]["nfev"],
+                 "parameter_sets": report["parameter_sets_run_now"],
+                 "points": report["points_run_now"], "wall_s": wall,
+                 "cpu_points_s": report["cpu_seconds_points"], "cpu_caller_s": cpu})
+    for band in (True, False):
+        target = folder / f"correlate{'' if band else '_noband'}"
+        wall, cpu = timed(["correlate", *common, "--out", str(target)]
+                          + ([] if band else ["--no-band"]))
+        points = args.speeds * (3 if band else 1)
+        rows.append({"task": f"correlate {'with' if band else 'without'} the damping band",
+                     "evaluations": 3 if band else 1, "parameter_sets": 3 if band else 1,
+                     "points": points, "wall_s": wall, "cpu_points_s": float("nan"),
+                     "cpu_caller_s": cpu})
+    table = pd.DataFrame(rows)
+    print(f"twin measurement ({args.speeds} speeds, {args.revolutions} revolutions per point) "
+          f"simulated in {made:.1f} s; {args.workers} workers")
+    with pd.option_context("display.width", 160, "display.max_columns", 20):
+        print(table.to_string(index=False, float_format=lambda v: f"{v:.1f}"))
+    fitted = pd.read_csv(out / "parameters.csv").set_index("parameter")
+    fitted["truth"] = pd.Series(FITTED)
+    fitted["error_pct"] = 100.0 * (fitted.value / fitted.truth - 1.0)
+    fitted["inside_95"] = (fitted.low95 <= fitted.truth) & (fitted.truth <= fitted.high95)
+    print(fitted[["truth", "value", "low95", "high95", "error_pct", "inside_95"]].to_string(
+        float_format=lambda v: f"{v:.4g}"))
+    print(f"-> {folder}")
+    return 0
+
+
+if __name__ == "__main__":
+    raise SystemExit(main())
