@@ -62,7 +62,7 @@ from .correlate import (Setup, add_common_options, cuts_table, metrics_table, op
                         overlay_figure, run_sets, safe)
 from .simulate import Grid, Simulator
 
-STEP = 0.02               # forward-difference step of the log factors
+STEP = 0.005              # forward-difference step of the log factors
 NOT_TOLD_APART = 0.95     # |correlation| above which two parameters trade off
 UNDETERMINED = np.log(2.0)  # a 95 % half-width beyond a factor 2: not determined
 DEFAULT_PARAMETERS = ("mount[{i}].stiffnessScale", "mount[*].dampingScale",
