@@ -116,10 +116,11 @@ def mapping_text(file: str, cuts: list[Cut], unit: dict[str, str], amplitude: st
 def twin_measurement(fmu: str, folder, truth: dict, outputs: list[str], orders: list[float],
                      speeds, unit: dict[str, str], relative: float, floors: dict[str, float],
                      seed: int = 1, revolutions: int = 4, amplitude: str = "peak",
-                     parameters: dict | None = None, pool=None) -> pathlib.Path:
+                     parameters: dict | None = None, pool=None,
+                     name: str = "twin") -> pathlib.Path:
     """Simulates the car with the start values ``truth`` (on top of ``parameters``, default
     scene 2) at ``speeds``, writes its order cuts with noise (:func:`noisy`; ``floors`` in SI
-    per output) as ``twin.uff`` in ``folder`` and its mapping as ``twin.toml``; returns the
+    per output) as ``<name>.uff`` in ``folder`` and its mapping as ``<name>.toml``; returns the
     mapping's path."""
     from .simulate import Grid, Simulator, points
 
@@ -138,12 +139,12 @@ def twin_measurement(fmu: str, folder, truth: dict, outputs: list[str], orders: 
         for k, order in enumerate(orders):
             values = noisy(simulated[:, k, j], relative, floors.get(output, 0.0), rng)
             cuts.append(Cut(output, order, np.asarray(grid.speeds), values))
-    write_uff(folder / "twin.uff", cuts, unit, amplitude)
+    write_uff(folder / f"{name}.uff", cuts, unit, amplitude)
     shown = {o: floors[o] / units.UNITS[units.normalise(unit[o])][1] /
              units.CONVENTIONS[amplitude] for o in floors if units.quantity(unit[o]) in (
                  "acceleration", "force")}
     header = ("# SYNTHETIC measurement: the model's own order cuts at hidden parameters, with "
               f"{relative:.0%} noise and a noise floor")
-    (folder / "twin.toml").write_text(mapping_text("twin.uff", cuts, unit, amplitude, shown,
-                                                   header) + "\n")
-    return folder / "twin.toml"
+    (folder / f"{name}.toml").write_text(mapping_text(f"{name}.uff", cuts, unit, amplitude,
+                                                      shown, header) + "\n")
+    return folder / f"{name}.toml"
