@@ -208,7 +208,7 @@ def test_the_commands_the_guide_names_exist():
     for path in paths:
         assert (ROOT / path).is_file(), path
     # Subcommands are registered in cli.py and by modules that add their own parser (accuracy.py).
-    cli = "\n".join(p.read_text() for p in sorted((ROOT / "python" / "emc").glob("*.py")))
+    cli = "\n".join(p.read_text() for p in sorted((ROOT / "python" / "emc").rglob("*.py")))
     subcommands = set(re.findall(r'add_parser\(\s*"([\w-]+)"', cli))
     subcommands |= set(re.findall(r'\("(study-[\w-]+)"', cli))
     commands = set(re.findall(r"(?:`|bin/)emc ([a-z][\w-]+)", text))
