@@ -21,6 +21,8 @@ import pyuff
 
 from emc import band as bands
 from emc import cli
+from emc.modal import export_from_fmu
+from emc.mount_study import base_configuration
 from emc.testbench import metrics, parameters
 from emc.testbench.mapping import load
 from emc.testbench.measurement import MeasurementError, read_csv, read_modes, read_uff_functions
@@ -31,7 +33,7 @@ OUTPUTS = {"steeringWheel.a[3]": "m/s2", "seat.a[3]": "m/s2", "mount[1].F[3]": "
            "mount[1].F[1]": "N", "mount[3].F[3]": "N", "mount[4].F[3]": "N"}
 
 
-# --- universal files through pyuff -----------------------------------------------------------------
+# --- universal files through pyuff ----------------------------------------------------------------
 
 def uff58(**fields) -> dict:
     base = dict(func_type=0, rsp_node=101, rsp_dir=3, ref_node=0, ref_dir=0, ord_data_type=6,
@@ -168,7 +170,7 @@ def test_csv_with_the_documented_header(tmp_path):
                                atol=1e-12)
 
 
-# --- bad input: one line naming the file, the set and the field ------------------------------------
+# --- bad input: one line naming the file, the set and the field -----------------------------------
 
 GOOD_X = np.array([800.0, 900.0, 1000.0, 1100.0])
 
@@ -282,7 +284,7 @@ def test_the_commands_report_bad_input_in_one_line_without_traceback(tmp_path, f
         assert code == 2 and fragment in err[-1], err
 
 
-# --- correlation metrics against values worked out by hand -----------------------------------------
+# --- correlation metrics against values worked out by hand ----------------------------------------
 
 def test_order_cut_metrics_by_hand():
     """Measured 1, 2, 4, 2 and 0.01 (below the 0.05 floor, left out); simulated 1, 4, 2, 2, 1.
@@ -342,13 +344,33 @@ def test_the_folded_configuration_gives_the_fmus_own_scales(tmp_path, fmu_path):
     np.testing.assert_allclose(by_file, by_inputs, rtol=1e-4, atol=1e-6 * np.abs(by_inputs).max())
 
 
-def cli_base(fmu_path) -> str:
-    from emc.mount_study import base_configuration
+def test_rates_and_table_ordinates_are_the_fmus_own_scales(fmu_path):
+    """Second method: mount 2's rates along its three axes at one factor are its stiffnessScale
+    (an FMU input), and the default body table's only ordinate is chassis.modalDampingScale (an
+    FMU parameter)."""
+    base = json.loads(cli_base(fmu_path))
+    in_file = parameters.parse_all([f"mount[2].rate[{j}]" for j in (1, 2, 3)]
+                                   + ["body.damping.table[1]"], 4)
+    config = parameters.apply(base, in_file, [0.8, 0.8, 0.8, 1.5], fold_inputs=False)
+    grid = Grid((1100.0,), ("steeringWheel.a[3]", "mount[2].F[3]"), (1.5, 3.0))
+    simulator = Simulator(str(fmu_path))
+    try:
+        by_inputs, by_file = simulator.run(
+            points(grid, {"scene": 2, "mount[2].stiffnessScale": 0.8,
+                          "chassis.modalDampingScale": 1.5}, None, 2)
+            + points(grid, {"scene": 2}, parameters.configuration_text(config), 2))
+    finally:
+        simulator.close()
+    np.testing.assert_allclose(by_file, by_inputs, rtol=1e-4, atol=1e-6 * np.abs(by_inputs).max())
+    with pytest.raises(parameters.ParameterError, match=r"table\[2\].*has 1 point"):
+        parameters.apply(base, parameters.parse_all(["body.damping.table[2]"], 4), [1.2], False)
 
+
+def cli_base(fmu_path) -> str:
     return base_configuration(str(fmu_path), {})
 
 
-# --- the twin experiment ---------------------------------------------------------------------------
+# --- the twin experiment --------------------------------------------------------------------------
 
 TRUTH = {"mount[1].stiffnessScale": 1.15, "mount[2].stiffnessScale": 0.88,
          "mount[3].stiffnessScale": 1.10, "mount[4].stiffnessScale": 0.92,
@@ -441,3 +463,78 @@ def test_twin_correlation_at_the_truth_is_at_the_noise_level(twin, fmu_path):
         assert table.loc[channel, "score"] == 100.0
     metadata = json.loads((out / "metadata.json").read_text())
     assert str(twin["mapping"].resolve()) in metadata["files"]
+
+
+def test_a_calibration_that_cannot_converge_says_why(twin, fmu_path, capsys):
+    """One stiffness bounded below its true 1.15, the other hidden offsets left out: the
+    parameter ends at its bound and the report names the bound, the residual and the channels
+    that disagree most."""
+    out = twin["folder"] / "bounded"
+    code = cli.main(["calibrate", "--fmu", str(fmu_path), "--mapping", str(twin["mapping"]),
+                     "--out", str(out), "--revolutions", "2", "--uncertainty", "0.03", "--serial",
+                     "--quiet", "--param", "mount[1].stiffnessScale=0.8:1.05",
+                     "--max-evaluations", "6"])
+    err = capsys.readouterr().err
+    assert code == 0
+    assert "mount[1].stiffnessScale ends at its bound 1.05" in err, err
+    assert "channels that disagree most:" in err and "RMS" in err, err
+    report = json.loads((out / "calibration.json").read_text())
+    assert report["parameters"][0]["at_bound"] and len(report["warnings"]) >= 2
+
+
+def test_sweep_takes_its_band_from_a_calibration(twin, fmu_path, tmp_path):
+    """emc sweep --band-from: the three bounds run with the band file's factors."""
+    out = tmp_path / "sweep"
+    assert cli.main(["sweep", "--fmu", str(fmu_path), "--rpm", "1100", "1100", "--count", "1",
+                     "--revolutions", "2", "--signal", "steeringWheel.a[3]", "--serial",
+                     "--quiet", "--band-from", str(twin["out"] / "band.json"),
+                     "--out", str(out)]) == 0
+    metadata = json.loads((out / "metadata.json").read_text())
+    band = json.loads((twin["out"] / "band.json").read_text())
+    assert metadata["band"]["low"] == band["low"] and metadata["band"]["high"] == band["high"]
+
+
+# --- FRFs and modes: the body's own, measured in other units -----------------------------------
+
+def test_frf_and_modes_of_the_body_itself_correlate_perfectly(fmu_path, tmp_path):
+    """The body's own accelerance written in g/N and its own modes at six body nodes with the
+    coordinates in mm: the mapping's conversions and the node matching must give FRAC 1, level
+    errors 0 and every measured mode paired with its own (MAC 1, 0 % frequency difference)."""
+    export = export_from_fmu(str(fmu_path), {"scene": 2}, full_recovery=True)
+    mesh, shapes = export.full_recovery()
+    at = {i: p for i, _, p in export.paths()}
+    f = np.linspace(15.0, 60.0, 31)
+    h = export.body.accelerance("steering_wheel", 2, [(at[1], 2)], f)[:, 0]
+    nodes = np.asarray(mesh["nodes"])
+    chosen = np.linspace(0, len(nodes) - 1, 6).astype(int)
+    model_hz = export.body.omega / (2 * np.pi)
+    modes = [k for k in range(len(model_hz)) if model_hz[k] > 20.0][:3]
+    sets = [uff58(func_type=4, abscissa_spec_data_type=18, ordinate_axis_units_lab="g/N",
+                  ref_node=11, ref_dir=3, x=f, data=h / 9.80665, id1="FRF SW:+Z / MNT1:+Z"),
+            pyuff.prepare_2411(node_nums=chosen + 1, x=nodes[chosen, 0] * 1e3,
+                               y=nodes[chosen, 1] * 1e3, z=nodes[chosen, 2] * 1e3,
+                               def_cs=np.zeros(6, int), disp_cs=np.zeros(6, int),
+                               color=np.ones(6, int))]
+    for n, k in enumerate(modes, 1):
+        shape = shapes[chosen, :3, k]
+        sets.append(pyuff.prepare_55(
+            analysis_type=2, data_ch=2, spec_data_type=8, node_nums=chosen + 1, r1=shape[:, 0],
+            r2=shape[:, 1], r3=shape[:, 2], mode_n=n, freq=model_hz[k], modal_damp_vis=0.05,
+            model_type=1, load_case=0, data_type=2, n_data_per_node=3))
+    write(tmp_path / "frf.uff", sets[:1])
+    write(tmp_path / "modes.unv", sets[1:])
+    (tmp_path / "map.toml").write_text(
+        '[measurement]\nfile = "frf.uff"\n[[channel]]\nnode = 101\ndirection = 3\n'
+        'output = "steeringWheel.a[3]"\ninput = "mount[1].F[3]"\nunit = "g/N"\n'
+        'amplitude = "peak"\n[modes]\nfile = "modes.unv"\nlength_unit = "mm"\n'
+        'tolerance = 0.001\n')
+    out = tmp_path / "out"
+    assert cli.main(["correlate", "--fmu", str(fmu_path), "--mapping", str(tmp_path / "map.toml"),
+                     "--out", str(out), "--quiet", "--serial"]) == 0
+    frf = pd.read_csv(out / "frf_correlation.csv")
+    assert frf.frac[0] == pytest.approx(1.0, abs=1e-9)
+    assert abs(frf.mean_db[0]) < 1e-6 and frf.rms_db[0] < 1e-6
+    pairs = pd.read_csv(out / "modes.csv")
+    assert list(pairs.model_mode) == [k + 1 for k in modes]
+    # UFF 55 writes frequencies and shapes with 6 significant digits.
+    assert (pairs.mac > 1 - 1e-6).all() and (pairs.difference_pct.abs() < 1e-3).all()

@@ -236,13 +236,14 @@ def calibrated_band(problem: Problem, result: dict, mounts: int) -> bands.Band:
     values); a damping not calibrated keeps the default band's bounds. Paired like the default:
     the low bound has the least damped body with the most damped mounts."""
     low, high, parts = {}, {}, []
-    body = next((k for k, p in enumerate(problem.parameters)
-                 if p.kind == "modalDampingScale"), None)
-    if body is None:
+    # The body's scale, else the widest interval of its table's ordinates.
+    body = [k for k, p in enumerate(problem.parameters) if p.kind == "modalDampingScale"] or [
+        k for k, p in enumerate(problem.parameters) if p.kind == "dampingTable"]
+    if not body:
         a, b = bands.BODY_SCALE
         parts.append(f"body modal damping x{a:g}..x{b:g} (default, not calibrated)")
     else:
-        half = result["quantile"] * result["sd_log"][body]
+        half = result["quantile"] * max(result["sd_log"][k] for k in body)
         a, b = float(np.exp(-half)), float(np.exp(half))
         parts.append(f"body modal damping x{a:.3g}..x{b:.3g} (calibrated, 95 %)")
     low["chassis.modalDampingScale"], high["chassis.modalDampingScale"] = a, b
@@ -456,7 +457,8 @@ def register(subparsers):
     p.add_argument("--param", action="append", metavar="NAME[=LOW:HIGH]",
                    help="a parameter to fit (repeatable): mount[i].stiffnessScale, "
                         "mount[i].rate[j], mount[i].dampingScale, mount[*].dampingScale, "
-                        "chassis.modalDampingScale; factors on the nominal, default bounds "
+                        "chassis.modalDampingScale, body.damping.table[k] (the k-th ordinate of "
+                        "the body's damping table); factors on the nominal, default bounds "
                         "0.5:2 (stiffness) and 0.25:4 (damping); default: every mount's "
                         "stiffnessScale, mount[*].dampingScale, chassis.modalDampingScale")
     p.add_argument("--uncertainty", type=float, default=0.05,

@@ -19,6 +19,7 @@ from __future__ import annotations
 import argparse
 import hashlib
 import pathlib
+import re
 import sys
 import time
 
@@ -29,6 +30,7 @@ from .. import band as bands
 from .. import cli
 from .. import plots
 from ..distributed import FmuPool, progress_bar
+from ..modal import body_point_of, export_from_fmu
 from . import metrics
 from .mapping import Mapping, MeasurementError, load
 from .simulate import Grid, Simulator, grid_of, points
@@ -196,16 +198,13 @@ def frf_correlation(fmu: str, parameters: dict, mapping: Mapping, out: pathlib.P
                     units: dict) -> pd.DataFrame:
     """FRAC and level error of every FRF channel against the body's accelerance from the
     force at the input mount's body point (the body the FMU simulates, :mod:`emc.modal`)."""
-    from ..modal import body_point_of, export_from_fmu
-
     export = export_from_fmu(fmu, parameters)
     if export.body is None:
         raise cli.UsageError("FRF channels need the elastic body (scene 2)")
     at = {i: p for i, _, p in export.paths()}
     rows = []
     for c in mapping.frf_channels():
-        i, j = (int(v) for v in c.map.input.replace("mount[", "").replace("].F[", " ")
-                .rstrip("]").split())
+        i, j = (int(v) for v in re.match(r"mount\[(\d+)\]\.F\[(\d)\]", c.map.input).groups())
         if i not in at:
             raise cli.UsageError(f"{mapping.path}, channel {c.map.number} ({c.label}), input: "
                                  f"mount[{i}] acts on no body point")
@@ -236,8 +235,6 @@ def mode_correlation(fmu: str, parameters: dict, mapping: Mapping,
                      out: pathlib.Path) -> pd.DataFrame:
     """The measured modes against the body's modes at the measured points (nearest body node
     within the mapping's tolerance): MAC matrix, pairs, frequency table."""
-    from ..modal import export_from_fmu
-
     measured = mapping.modes
     export = export_from_fmu(fmu, parameters, full_recovery=True)
     mesh, shapes = export.full_recovery()

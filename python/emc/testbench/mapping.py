@@ -170,8 +170,9 @@ def _channel_map(path: pathlib.Path, number: int, entry: dict, default_file: str
                                                  and unit_quantity in ("velocity",
                                                                        "displacement")))
     if not fits:
-        _fail(path, where, "unit", f"{unit!r} measures {unit_quantity}, {output} is "
-                                   f"{'an' if output_quantity[0] == 'a' else 'a'} {output_quantity}")
+        article = "an" if output_quantity[0] == "a" else "a"
+        _fail(path, where, "unit", f"{unit!r} measures {unit_quantity}, {output} is {article} "
+                                   f"{output_quantity}")
     amplitude = str(entry["amplitude"]).lower()
     if amplitude not in units.CONVENTIONS:
         _fail(path, where, "amplitude", f"{entry['amplitude']!r}: one of peak, rms, peak-peak")

@@ -8,7 +8,10 @@ Every parameter is a positive factor on a nominal property (1 = the configuratio
 - ``mount[i].dampingScale``: mount ``i``'s viscous damping (an FMU input);
 - ``mount[*].dampingScale``: every mount's damping by one factor;
 - ``chassis.modalDampingScale``: the body's physical modal damping, its table and overrides (an
-  FMU parameter; the interface modes' numerical damping stays).
+  FMU parameter; the interface modes' numerical damping stays);
+- ``body.damping.table[k]``: the ``k``-th ordinate (1-based) of the body's damping table alone
+  (a change of the vehicle configuration; without a table of its own the procedural body's
+  default is one point, 5 % at every frequency): a damping that changes with frequency.
 
 The calibrated configuration folds the factors into the vehicle configuration, exactly as the FMU
 applies them: a stiffness scale multiplies every knot's stiffness (the mount force is
@@ -26,9 +29,9 @@ import math
 import re
 
 PATTERN = re.compile(r"^(?:mount\[(\d+|\*)\]\.(stiffnessScale|dampingScale|rate\[([123])\])"
-                     r"|(chassis\.modalDampingScale))$")
+                     r"|(chassis\.modalDampingScale)|body\.damping\.table\[(\d+)\])$")
 DEFAULT_BOUNDS = {"stiffnessScale": (0.5, 2.0), "rate": (0.5, 2.0), "dampingScale": (0.25, 4.0),
-                  "modalDampingScale": (0.25, 4.0)}
+                  "modalDampingScale": (0.25, 4.0), "dampingTable": (0.25, 4.0)}
 # The default body damping when the configuration gives none (src/cms/damping.rs).
 DEFAULT_BODY_DAMPING = 0.05
 
@@ -40,19 +43,19 @@ class ParameterError(ValueError):
 @dataclasses.dataclass(frozen=True)
 class Parameter:
     name: str
-    kind: str                 # stiffnessScale, rate, dampingScale, modalDampingScale
+    kind: str                 # stiffnessScale, rate, dampingScale, modalDampingScale, dampingTable
     mounts: tuple[int, ...]   # 1-based; empty for the body
-    axis: int | None
+    axis: int | None          # a rate's axis, a damping table's point (1-based)
     low: float
     high: float
 
     @property
     def is_damping(self) -> bool:
-        return self.kind in ("dampingScale", "modalDampingScale")
+        return self.kind in ("dampingScale", "modalDampingScale", "dampingTable")
 
     @property
     def in_configuration(self) -> bool:
-        return self.kind == "rate"
+        return self.kind in ("rate", "dampingTable")
 
     def fmu_values(self, value: float) -> dict:
         if self.kind == "modalDampingScale":
@@ -70,9 +73,14 @@ def parse(text: str, mounts: int) -> Parameter:
     if not match:
         raise ParameterError(f"--param {text}: not a calibration parameter (mount[i]."
                              "stiffnessScale, mount[i].rate[j], mount[i].dampingScale, "
-                             "mount[*].dampingScale, chassis.modalDampingScale)")
+                             "mount[*].dampingScale, chassis.modalDampingScale, "
+                             "body.damping.table[k])")
     if match.group(4):
         kind, chosen, axis = "modalDampingScale", (), None
+    elif match.group(5):
+        kind, chosen, axis = "dampingTable", (), int(match.group(5))
+        if axis < 1:
+            raise ParameterError(f"--param {text}: the table's points are numbered from 1")
     else:
         kind = match.group(2).split("[")[0]
         axis = int(match.group(3)) if match.group(3) else None
@@ -138,6 +146,8 @@ def apply(config: dict, parameters, values, fold_inputs: bool) -> dict:
         value = float(value)
         if p.kind == "rate":
             _scale_curve(out["mounts"][p.mounts[0] - 1], p.axis - 1, value)
+        elif p.kind == "dampingTable":
+            _scale_body_damping(out, value, point=p.axis)
         elif not fold_inputs:
             continue
         elif p.kind == "stiffnessScale":
@@ -152,20 +162,29 @@ def apply(config: dict, parameters, values, fold_inputs: bool) -> dict:
     return out
 
 
-def _scale_body_damping(config: dict, value: float):
+def _scale_body_damping(config: dict, value: float, point: int | None = None):
+    """The body's damping table (and overrides) times ``value``; only its ``point``-th ordinate
+    if given."""
     body = config["body"]
     damping = body.get("damping")
     if damping is None:
         if body.get("kind") != "procedural":
             raise ParameterError(
-                f"chassis.modalDampingScale: the body ({body.get('kind')}) brings its own "
-                "damping (a deck's TABDMP1 or a reduced body's ratios) that the configuration "
-                "does not hold; give it a body.damping table to calibrate, or keep the scale as "
-                f"--set chassis.modalDampingScale={value:.6g}")
+                f"the body's damping: the {body.get('kind')} body brings its own (a deck's "
+                "TABDMP1 or a reduced body's ratios), which the vehicle configuration does not "
+                "hold; give the configuration a body.damping table to calibrate it")
         damping = {"table": {"type": "crit", "points": [[0.0, DEFAULT_BODY_DAMPING]]}}
     damping = copy.deepcopy(damping)
     table = damping["table"]
     unit = str(table.get("type", "crit")).lower()
+    if point is not None:
+        if point > len(table["points"]):
+            raise ParameterError(f"body.damping.table[{point}]: the body's damping table has "
+                                 f"{len(table['points'])} point(s)")
+        f, v = table["points"][point - 1]
+        table["points"][point - 1] = [f, v / value if unit == "q" else v * value]
+        body["damping"] = damping
+        return
     table["points"] = [[f, v / value if unit == "q" else v * value] for f, v in table["points"]]
     if "modes" in damping:
         damping["modes"] = [[mode, zeta * value] for mode, zeta in damping["modes"]]

@@ -15,6 +15,7 @@ import numpy as np
 import pyuff
 
 from . import units
+from .simulate import Grid, Simulator, points
 
 # The response nodes the synthetic files give each output (a test rig's numbering).
 NODES = {"steeringWheel": 101, "seat": 201}
@@ -122,8 +123,6 @@ def twin_measurement(fmu: str, folder, truth: dict, outputs: list[str], orders: 
     scene 2) at ``speeds``, writes its order cuts with noise (:func:`noisy`; ``floors`` in SI
     per output) as ``<name>.uff`` in ``folder`` and its mapping as ``<name>.toml``; returns the
     mapping's path."""
-    from .simulate import Grid, Simulator, points
-
     folder = pathlib.Path(folder)
     folder.mkdir(parents=True, exist_ok=True)
     grid = Grid(tuple(float(s) for s in speeds), tuple(outputs), tuple(orders))
