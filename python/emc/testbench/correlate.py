@@ -301,6 +301,7 @@ def cmd_correlate(args) -> int:
     band = band_for(args, setup.variables)
     units = cli.units_of(setup.variables)
     started = time.perf_counter()
+    seconds = {}
     table = pd.DataFrame()
     if setup.grid is not None:
         bounds = ["nominal"] + ([] if band is None else ["low", "high"])
@@ -308,6 +309,7 @@ def cmd_correlate(args) -> int:
                 for b in bounds]
         pool = open_pool(args)
         simulator = Simulator(args.fmu, pool)
+        seconds["start"] = time.perf_counter() - started
         try:
             sims = dict(zip(bounds, run_sets(simulator, setup.grid, sets, args.revolutions,
                                              args.quiet, "correlate")))
@@ -315,11 +317,13 @@ def cmd_correlate(args) -> int:
             simulator.close()
             if pool is not None:
                 pool.close()
+        seconds["simulation"] = time.perf_counter() - started - seconds["start"]
         table = metrics_table(setup.grid, setup.channels, sims["nominal"], sims.get("low"),
                               sims.get("high"))
         table.to_csv(out / "correlation.csv", index=False)
         cuts_table(setup.grid, setup.channels, {f"simulated_{b}": s for b, s in sims.items()}
                    ).to_csv(out / "order_cuts.csv", index=False)
+        seconds["metrics"] = time.perf_counter() - started - sum(seconds.values())
         what = "" if band is None else band.description
         for output in dict.fromkeys(c.map.output for c in setup.channels):
             fig = overlay_figure(setup.grid, setup.channels, output, units.get(output),
@@ -329,6 +333,7 @@ def cmd_correlate(args) -> int:
                                  f"{output}: measured against the model"
                                  + (f" with the damping band ({what})" if what else ""))
             plots._save(fig, str(out / f"correlate_{safe(output)}.png"))
+        seconds["plots"] = time.perf_counter() - started - sum(seconds.values())
     frf = (frf_correlation(args.fmu, setup.parameters, setup.mapping, out, units)
            if setup.mapping.frf_channels() else pd.DataFrame())
     modes = (mode_correlation(args.fmu, setup.parameters, setup.mapping, out)
@@ -337,7 +342,9 @@ def cmd_correlate(args) -> int:
     cli.write_metadata(out, args, setup.variables, [("", setup.parameters)],
                        {"files": setup.files(), "mapping": setup.mapping.describe(),
                         "speeds": list(setup.grid.speeds) if setup.grid else [],
-                        "revolutions": args.revolutions, **cli.band_metadata(band)})
+                        "revolutions": args.revolutions, "seconds": {**seconds,
+                                                                     "total": elapsed},
+                        **cli.band_metadata(band)})
     print_correlation(table, frf, modes)
     print(f"correlation in {elapsed:.1f} s -> {out}")
     return 0
