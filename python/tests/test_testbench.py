@@ -13,6 +13,7 @@ Sized for CI (2 cores, about 3 minutes for this file): the twin experiment simul
 import json
 import math
 import pathlib
+import re
 
 import numpy as np
 import pandas as pd
@@ -282,6 +283,19 @@ def test_the_commands_report_bad_input_in_one_line_without_traceback(tmp_path, f
                          str(tmp_path / "out"), "--serial", "--param", param])
         err = capsys.readouterr().err.strip().splitlines()
         assert code == 2 and fragment in err[-1], err
+
+
+@pytest.mark.parametrize("text, fragment", [
+    ("not json", "not a band file"),
+    ('{"low": {}}', 'holds "low" and "high"'),
+    ('{"low": {"mount[9].dampingScale": 1}, "high": {}}', "this FMU has no mount[9]"),
+    ('{"low": {"chassis.modalDampingScale": -1}, "high": {}}', "a factor >= 0"),
+])
+def test_bad_band_files_are_refused(tmp_path, fmu_path, text, fragment):
+    path = tmp_path / "band.json"
+    path.write_text(text)
+    with pytest.raises(ValueError, match=re.escape(fragment)):
+        bands.from_file(path, cli.model_variables(str(fmu_path)))
 
 
 # --- correlation metrics against values worked out by hand ----------------------------------------
