@@ -18,9 +18,11 @@ that takes the Jacobian from the caller, so that the ``n + 1`` parameter sets of
 its extras (parameter objects, MCMC through emcee) are not needed here.
 
 **Resumable.** Every parameter set's simulated order components are stored as they come
-(``evaluations.jsonl`` in ``--out``, with the FMU's checksum and the settings); the solver is
-deterministic, so a calibration started again in the same folder asks for the same sets, reads
-them and continues where it stopped, to the same result.
+(``evaluations.jsonl`` in ``--out``, with the FMU's checksum and what decides the simulation: the
+parameters, speeds, outputs, orders, window, fixed start values and base configuration); the
+solver is deterministic, so a calibration started again in the same folder asks for the same
+sets, reads them and continues where it stopped, to the same result. Another ``--uncertainty``,
+``--no-phase`` or other bounds reuse the stored simulations.
 
 **What the data determine.** At the optimum, the covariance of the log factors is ``s² (JᵀJ)⁻¹``
 (``J`` the Jacobian of the weighted residuals, ``s²`` the residual variance per degree of
@@ -91,10 +93,12 @@ class Problem:
         return values, None
 
     def settings(self) -> dict:
-        """What decides an evaluation's numbers, stored with the evaluations."""
+        """What decides a parameter set's simulated numbers, stored with them. Not the
+        measurement, the weighting or the bounds: a calibration of the same speeds with another
+        --uncertainty, --no-phase or bounds reuses the stored simulations."""
         base = None if self.base is None else hashlib.sha256(
             params.configuration_text(self.base).encode()).hexdigest()
-        return {"parameters": [dataclasses.asdict(p) for p in self.parameters],
+        return {"parameters": [p.name for p in self.parameters],
                 "speeds": list(self.grid.speeds), "signals": list(self.grid.signals),
                 "orders": list(self.grid.orders), "revolutions": self.revolutions,
                 "fixed": {k: v for k, v in self.fixed.items()}, "base_configuration": base}
@@ -337,11 +341,12 @@ def cmd_calibrate(args) -> int:
     out = pathlib.Path(args.out)
     with open(args.fmu, "rb") as f:
         digest = hashlib.sha256(f.read()).hexdigest()
-    settings = problem.settings()
-    settings["measurement"] = setup.files()
-    settings["uncertainty"], settings["phase"] = problem.uncertainty, problem.phase
+    used = sum(int(np.sum(np.abs(c.values) > c.floor)) for c in problem.channels)
+    if used <= len(chosen):
+        raise cli.UsageError(f"{args.mapping}: {used} measured points above the noise floors "
+                             f"for {len(chosen)} parameters: too few to fit")
     try:
-        store = Store(out, digest, json.loads(json.dumps(settings)))
+        store = Store(out, digest, json.loads(json.dumps(problem.settings())))
     except StudyError as error:
         raise cli.UsageError(str(error)) from None
     if store.records:
