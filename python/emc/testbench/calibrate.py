@@ -103,17 +103,22 @@ class Problem:
                 "orders": list(self.grid.orders), "revolutions": self.revolutions,
                 "fixed": {k: v for k, v in self.fixed.items()}, "base_configuration": base}
 
-    def residuals(self, simulated: np.ndarray) -> np.ndarray:
+    def residuals(self, simulated: np.ndarray, reference: np.ndarray | None = None
+                  ) -> np.ndarray:
+        """The weighted residuals of ``simulated`` against the measurement; with ``reference``
+        (another simulation) their change from the reference's, the phase's taken as the angle
+        between the two (no jump where a residual crosses ±π)."""
         parts = []
         for c in self.channels:
-            s = channel_of(self.grid, c, simulated)
             m = c.values
             valid = np.abs(m) > c.floor
             sigma = np.sqrt(self.uncertainty**2 + (c.floor[valid] / np.abs(m[valid]))**2)
-            s, m = s[valid], m[valid]
-            parts.append((np.log(np.maximum(np.abs(s), 1e-300)) - np.log(np.abs(m))) / sigma)
+            s = channel_of(self.grid, c, simulated)[valid]
+            base = m[valid] if reference is None else channel_of(self.grid, c, reference)[valid]
+            parts.append((np.log(np.maximum(np.abs(s), 1e-300))
+                          - np.log(np.maximum(np.abs(base), 1e-300))) / sigma)
             if self.phase and c.has_phase:
-                parts.append(np.angle(s / m) / sigma)
+                parts.append(np.angle(s / base) / sigma)
         return np.concatenate(parts)
 
     def channel_residuals(self, simulated: np.ndarray) -> pd.DataFrame:
@@ -187,8 +192,7 @@ def fit(problem: Problem, evaluations: Evaluations, max_evaluations: int = 40) -
         steps = np.where(u + STEP <= high, STEP, -STEP)
         sets = [np.exp(u)] + [np.exp(u + steps[k] * np.eye(n)[k]) for k in range(n)]
         sims = evaluations(sets)
-        base = problem.residuals(sims[0])
-        return np.column_stack([(problem.residuals(s) - base) / steps[k]
+        return np.column_stack([problem.residuals(s, reference=sims[0]) / steps[k]
                                 for k, s in enumerate(sims[1:])])
 
     result = least_squares(fun, np.zeros(n), jac=jac, bounds=(low, high), method="trf",
