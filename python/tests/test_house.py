@@ -15,7 +15,7 @@ PACKAGE = pathlib.Path(__file__).resolve().parents[1] / "emc"
 
 # The floor of each room (a module at the package's top is its own room).
 FLOORS = {"base": 0, "signals": 1, "figures": 2, "running": 3, "diagnosis": 4, "studies": 4,
-          "testbench": 4, "bench": 4, "commands": 5, "cli": 6, "__main__": 7, "__init__": 0}
+          "bench": 4, "testbench": 5, "commands": 6, "cli": 7, "__main__": 8, "__init__": 0}
 # Imports inside functions that are meant: a heavy or optional library deferred for start-up
 # time, each with a comment saying so where it stands.
 DEFERRED = {("base/fmu.py", "fmpy"), ("base/outputs.py", "fmpy"), ("base/outputs.py", "fcntl"),
@@ -153,6 +153,8 @@ def test_every_command_module_registers_itself_once():
 # (the scaling benchmarks), a study's or a coupled run's own window and start, the accuracy
 # study's time settings, a list of speeds or coupling steps (the coupled-FMU tables).
 OWN_MEANING = {("commands/bench.py", "--workers"), ("commands/bench.py", "--repeat"),
+               ("commands/bench.py", "--revolutions"), ("commands/testbench.py", "--revolutions"),
+               ("commands/bench.py", "--speeds"),
                ("commands/why.py", "--start"), ("commands/why.py", "--settle"),
                ("commands/why.py", "--revolutions"), ("commands/tuning.py", "--revolutions"),
                ("commands/accuracy.py", "--start"), ("commands/accuracy.py", "--settle"),

@@ -161,6 +161,14 @@ def add_band(p):
     p.add_argument("--band-mounts", nargs=2, type=number, metavar=("LOW", "HIGH"),
                    help="the band's mount[i].dampingScale at the low and the high bound, every "
                         "mount (implies --band; 1 1 leaves the mounts nominal)")
+    add_band_from(p)
+
+
+def add_band_from(p):
+    """The band's bounds from a calibration (``emc calibrate`` writes them as band.json)."""
+    p.add_argument("--band-from", metavar="BAND_JSON",
+                   help="the band's bounds from a calibration (the band.json emc calibrate "
+                        "writes: the calibrated damping's 95 %% intervals; implies --band)")
 
 
 def add_pool(p):

@@ -8,7 +8,8 @@ anything runs, and :func:`claim`, where the command starts writing):
   written, is a one-line error.
 - A folder whose ``metadata.json`` says it holds another command's results, or the same
   command's with other settings, is refused unless ``--overwrite`` is given; ``--overwrite``
-  removes the files that run wrote (``metadata.json`` lists them) before this one starts.
+  removes the files that run wrote (``metadata.json`` lists them as ``written``) before this
+  one starts.
 - A folder of the same command with the same settings is written again; a study continues from
   the evaluations stored there, and says so.
 - One run writes a folder at a time: a second run is refused with the first's process id.
@@ -130,7 +131,7 @@ def _remove_previous(path: pathlib.Path):
     """Removes what the run recorded in ``path``'s metadata.json wrote, and the record."""
     meta = path / "metadata.json"
     try:
-        files = json.loads(meta.read_text()).get("files") or []
+        files = json.loads(meta.read_text()).get("written") or []
     except (OSError, ValueError, AttributeError):
         files = []
     for name in list(files) + ["evaluations.jsonl", "metadata.json"]:
@@ -295,6 +296,6 @@ def write_metadata(out: pathlib.Path, args, variables: dict, cases: list[tuple[s
         # What the output-folder policy compares a later run in this folder with, and removes
         # with --overwrite.
         "run": {"command": getattr(args, "command", None), "settings": run_settings(args)},
-        "files": written_files(out, args),
+        "written": written_files(out, args),
     }
     (out / "metadata.json").write_text(json.dumps(record, indent=2, default=str) + "\n")

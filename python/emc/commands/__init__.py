@@ -8,4 +8,5 @@ import numpy, pandas, fmpy, matplotlib or dask. Adding a command: a module here 
 """
 
 # In the order of ``emc --help``.
-MODULES = ("sweep", "runup", "campbell", "paper", "why", "accuracy", "tuning", "bench", "tools")
+MODULES = ("sweep", "runup", "campbell", "paper", "why", "accuracy", "tuning", "testbench", "bench",
+           "tools")

@@ -53,6 +53,18 @@ def register(sub):
     _timed_runs(d, ["guided", "equal"], "batchings to compare (default both)")
     d.set_defaults(func=options.runs("emc.bench:cmd_scheduling"))
 
+    c = sub.add_parser("bench-calibration", help="emc calibrate of 6 parameters and emc "
+                                                 "correlate against a twin measurement of 4 "
+                                                 "channels x 4 orders x 35 speeds, timed")
+    options.add_fmu(c)
+    c.add_argument("--workers", type=int, default=2, help="local Dask workers (default 2)")
+    c.add_argument("--speeds", type=int, default=35, help="measured speeds (default 35)")
+    c.add_argument("--revolutions", type=int, default=4,
+                   help="analysed window per speed (even; default 4)")
+    c.add_argument("--keep", metavar="DIR", help="keep the files here (default: a temporary "
+                                                 "folder)")
+    c.set_defaults(func=options.runs("emc.testbench.bench:cmd_bench_calibration"))
+
     u = sub.add_parser("bench-startup", help="what the command line costs before and around "
                                              "its work: emc --help, an argument error, a 2-point "
                                              "sweep, 48 points serial and on 2 workers")

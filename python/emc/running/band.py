@@ -31,6 +31,8 @@ values.
 from __future__ import annotations
 
 import dataclasses
+import json
+import pathlib
 from typing import Callable
 
 import numpy as np
@@ -171,6 +173,10 @@ def comfort_table(spectra: pd.DataFrame) -> pd.DataFrame:
 
 def from_options(args, variables: dict) -> Band | None:
     """The band the options ask for (None: no band), checked against the FMU's variables."""
+    if getattr(args, "band_from", None):
+        if getattr(args, "band_body", None) or getattr(args, "band_mounts", None):
+            raise ValueError("--band-from gives the bounds: drop --band-body/--band-mounts")
+        return from_file(args.band_from, variables)
     if not (getattr(args, "band", False) or getattr(args, "band_body", None)
             or getattr(args, "band_mounts", None)):
         return None
@@ -194,6 +200,30 @@ def from_options(args, variables: dict) -> Band | None:
             if name not in variables:
                 raise ValueError(f"--band: this FMU has no {name}")
     return band
+
+
+def from_file(path, variables: dict) -> Band:
+    """The band a calibration wrote (``band.json`` of ``emc calibrate``: ``low`` and ``high``,
+    factors on the FMU's damping scales, and a ``description``), checked against the FMU's
+    variables."""
+    path = pathlib.Path(path)
+    try:
+        data = json.loads(path.read_text())
+    except (OSError, UnicodeDecodeError, json.JSONDecodeError) as error:
+        raise ValueError(f"--band-from {path}: not a band file ({error})") from None
+    if not isinstance(data, dict) or not all(isinstance(data.get(k), dict)
+                                             for k in ("low", "high")):
+        raise ValueError(f"--band-from {path}: a band file holds \"low\" and \"high\" "
+                         "settings")
+    for bound in ("low", "high"):
+        for name, value in data[bound].items():
+            if name not in variables:
+                raise ValueError(f"--band-from {path}, {bound}: this FMU has no {name}")
+            if not (isinstance(value, (int, float)) and np.isfinite(value) and value >= 0.0):
+                raise ValueError(f"--band-from {path}, {bound}, {name}: a factor >= 0, "
+                                 f"got {value!r}")
+    return Band(low=dict(data["low"]), high=dict(data["high"]),
+                description=str(data.get("description", f"from {path.name}")), multiplies=True)
 
 
 def report_sweep(out, band: Band, orders: pd.DataFrame, spectra: pd.DataFrame, signals,

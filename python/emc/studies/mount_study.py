@@ -274,12 +274,12 @@ def base_configuration(fmu_path: str, parameters: dict) -> str:
 RECORD_FIELDS = ("key", "x", "objective", "feasible", "static", "violations")
 
 
-def read_store(path: pathlib.Path) -> tuple[dict | None, list[dict], bool]:
+def read_store(path: pathlib.Path, fields=RECORD_FIELDS) -> tuple[dict | None, list[dict], bool]:
     """A study's ``evaluations.jsonl``: its header (None for a missing or empty file), its
     designs, and whether lines were dropped. A line that is not JSON (cut short by an
     interruption) is dropped: that design runs again. A damaged header, or a design without the
-    fields a study reads or with an objective that is not a finite number, is a StudyError that
-    names the file and the line."""
+    ``fields`` a study reads or (where it has one) with an objective that is not a finite number,
+    is a StudyError that names the file and the line."""
     lines = path.read_text().splitlines() if path.exists() else []
     if not lines:
         return None, [], False
@@ -298,11 +298,11 @@ def read_store(path: pathlib.Path) -> tuple[dict | None, list[dict], bool]:
         except json.JSONDecodeError:
             torn = True
             continue
-        missing = [k for k in RECORD_FIELDS if not isinstance(record, dict) or k not in record]
+        missing = [k for k in fields if not isinstance(record, dict) or k not in record]
         if missing:
             raise StudyError(f"{path}, line {number}: a design without {', '.join(missing)}; "
                              "delete that line to run the design again")
-        objective = record["objective"]
+        objective = record.get("objective", 0.0)
         if isinstance(objective, bool) or not isinstance(objective, (int, float)) \
                 or not math.isfinite(objective):
             raise StudyError(f"{path}, line {number}: design {record['x']} has the objective "
@@ -316,12 +316,15 @@ class Store:
     """The evaluations of a study folder: ``evaluations.jsonl``, a header line (the FMU's checksum
     and the settings) and one line per design, appended as each is done."""
 
-    def __init__(self, folder: pathlib.Path, fmu_sha256: str, settings: dict):
+    def __init__(self, folder: pathlib.Path, fmu_sha256: str, settings: dict,
+                 fields=RECORD_FIELDS):
+        """``fields``: what every stored evaluation carries (a design of a tuning study by
+        default)."""
         self.path = pathlib.Path(folder) / "evaluations.jsonl"
         self.header = {"fmu_sha256": fmu_sha256, "settings": settings}
         self.records: dict[str, dict] = {}
         self.order: list[str] = []
-        stored, records, torn = read_store(self.path)
+        stored, records, torn = read_store(self.path, fields)
         if stored is None:
             self.path.parent.mkdir(parents=True, exist_ok=True)
             self.path.write_text(json.dumps(self.header) + "\n")
