@@ -12,6 +12,7 @@
 
 use super::instance::Instance;
 use super::parameters;
+use super::values::Num;
 use crate::cosim::Runtime;
 use crate::variables::REALS;
 
@@ -33,14 +34,19 @@ impl Instance {
         let h = RELATIVE_STEP * u.abs().max(1.0);
         // A perturbed input the model refuses (a bound of its declared range) falls back to a
         // one-sided difference.
-        let column = match (self.initial_outputs(k, u + h), self.initial_outputs(k, u - h)) {
+        let at = self.core.values.reals.as_slice();
+        let column = match (
+            self.initial_outputs(k, u + h),
+            self.initial_outputs(k, u - h),
+        ) {
             (Ok(up), Ok(down)) => difference(&up, &down, 2.0 * h),
-            (Ok(up), Err(_)) => difference(&up, &self.core.values.reals.as_slice().to_vec(), h),
-            (Err(_), Ok(down)) => difference(&self.core.values.reals.as_slice().to_vec(), &down, h),
+            (Ok(up), Err(_)) => difference(&up, at, h),
+            (Err(_), Ok(down)) => difference(at, &down, h),
             (Err(e), Err(_)) => {
                 return Err(format!(
                     "derivative with respect to {}: the initialisation fails around {}: {e}",
-                    REALS[k].name, u
+                    REALS[k].name,
+                    Num(u)
                 ))
             }
         };

@@ -275,7 +275,11 @@ fn initial_unknowns_have_directional_derivatives_with_the_whole_dependency_list(
         .map(|&d| variables[d - 1].1)
         .collect();
     let config = value_references(3, &[string::CONFIG_FILE])[0];
-    assert!(knowns.contains(&scene) && knowns.contains(&config) && knowns.contains(&real::SOLVER_REL_TOL));
+    assert!(
+        knowns.contains(&scene)
+            && knowns.contains(&config)
+            && knowns.contains(&real::SOLVER_REL_TOL)
+    );
     for (input, h) in [
         (real::MOUNT_BODY_R[0][2], 1e-6),
         (real::MOUNT_BODY_R[2][0], 1e-6),
@@ -288,17 +292,27 @@ fn initial_unknowns_have_directional_derivatives_with_the_whole_dependency_list(
         let scale = derivative.iter().fold(1.0f64, |m, x| m.max(x.abs()));
         assert!(scale > 10.0, "{derivative:?}");
         for (d, c) in derivative.iter().zip(&difference) {
-            assert!((d - c).abs() <= 1e-5 * scale, "{d:e} vs central difference {c:e}");
+            assert!(
+                (d - c).abs() <= 1e-5 * scale,
+                "{d:e} vs central difference {c:e}"
+            );
         }
         for axis in 0..3 {
             let sum: f64 = (0..4).map(|i| derivative[3 * i + axis]).sum();
-            assert!(sum.abs() <= 1e-5 * scale, "axis {axis}: forces change their sum by {sum:e}");
+            assert!(
+                sum.abs() <= 1e-5 * scale,
+                "axis {axis}: forces change their sum by {sum:e}"
+            );
         }
     }
     // A seed on a non-Real or a parameter asks for what is not provided: refused, naming it.
     let (status, _) = s.directional_derivative(&forces, &[scene], &[1.0]);
     assert_eq!(status, ERROR);
-    assert!(s.logs().iter().any(|l| l.contains("scene is not a Real")), "{:?}", s.logs());
+    assert!(
+        s.logs().iter().any(|l| l.contains("scene is not a Real")),
+        "{:?}",
+        s.logs()
+    );
     let (status, _) = s.directional_derivative(&forces, &[real::SOLVER_REL_TOL], &[1.0]);
     assert_eq!(status, ERROR);
     // A value reference of no variable stays refused, whatever its seed.
@@ -328,7 +342,9 @@ fn the_body_initial_derivatives_are_a_symmetric_compliance() {
     assert_eq!(s.setup(0.0, None), OK);
     assert_eq!(s.enter_init(), OK);
     let forces: Vec<u32> = real::BODY_MOUNT_F.iter().flatten().copied().collect();
-    let weight: Vec<f64> = (0..12).map(|k| if k % 3 == 2 { -400.0 } else { 0.0 }).collect();
+    let weight: Vec<f64> = (0..12)
+        .map(|k| if k % 3 == 2 { -400.0 } else { 0.0 })
+        .collect();
     assert_eq!(s.set_real(&forces, &weight), OK);
     let displacements: Vec<u32> = real::BODY_MOUNT_R.iter().flatten().copied().collect();
     let compliance: Vec<Vec<f64>> = forces
@@ -339,10 +355,16 @@ fn the_body_initial_derivatives_are_a_symmetric_compliance() {
             column
         })
         .collect();
-    let largest = compliance.iter().flatten().fold(0.0f64, |m, x| m.max(x.abs()));
+    let largest = compliance
+        .iter()
+        .flatten()
+        .fold(0.0f64, |m, x| m.max(x.abs()));
     assert!(largest > 1e-7, "{largest:e} m/N");
     for i in 0..12 {
-        assert!(compliance[i][i] > 0.0, "a force moves its own point along it");
+        assert!(
+            compliance[i][i] > 0.0,
+            "a force moves its own point along it"
+        );
         for j in 0..12 {
             assert!(
                 (compliance[i][j] - compliance[j][i]).abs() <= 1e-6 * largest,
