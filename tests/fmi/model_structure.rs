@@ -360,17 +360,13 @@ fn the_body_initial_derivatives_are_a_symmetric_compliance() {
         .flatten()
         .fold(0.0f64, |m, x| m.max(x.abs()));
     assert!(largest > 1e-7, "{largest:e} m/N");
-    for i in 0..12 {
-        assert!(
-            compliance[i][i] > 0.0,
-            "a force moves its own point along it"
-        );
-        for j in 0..12 {
+    for (i, column) in compliance.iter().enumerate() {
+        assert!(column[i] > 0.0, "a force moves its own point along it");
+        for (j, c) in column.iter().enumerate() {
+            let mirror = compliance[j][i];
             assert!(
-                (compliance[i][j] - compliance[j][i]).abs() <= 1e-6 * largest,
-                "C[{i}][{j}] = {:e}, C[{j}][{i}] = {:e}",
-                compliance[i][j],
-                compliance[j][i]
+                (c - mirror).abs() <= 1e-6 * largest,
+                "C[{i}][{j}] = {c:e}, C[{j}][{i}] = {mirror:e}"
             );
         }
     }
