@@ -23,3 +23,12 @@ def fmu3_path(fmu_path) -> pathlib.Path:
     if not path.exists():
         subprocess.run([sys.executable, str(ROOT / "packaging" / "package.py")], check=True)
     return path
+
+
+@pytest.fixture(scope="session")
+def body_fmu_path(fmu_path) -> pathlib.Path:
+    """The packaged body FMU, which package.py writes beside the engine FMU."""
+    path = ROOT / "dist" / "EngineMountBody.fmu"
+    if not path.exists():
+        subprocess.run([sys.executable, str(ROOT / "packaging" / "package.py")], check=True)
+    return path

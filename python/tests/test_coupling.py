@@ -2,8 +2,6 @@
 loaded and run by libcosim, against the monolithic scene 2."""
 
 import pathlib
-import subprocess
-import sys
 
 import pytest
 from fmpy import read_model_description
@@ -15,14 +13,6 @@ from emc.running.split import scene_2, split_in_libcosim
 from emc.running.ssp import connections, write_ssp
 
 ROOT = pathlib.Path(__file__).resolve().parents[2]
-
-
-@pytest.fixture(scope="session")
-def body_fmu_path(fmu_path) -> pathlib.Path:
-    path = ROOT / "dist" / "EngineMountBody.fmu"
-    if not path.exists():
-        subprocess.run([sys.executable, str(ROOT / "packaging" / "package.py")], check=True)
-    return path
 
 
 def test_the_shipped_ssp_is_valid_against_the_ssp_1_0_schemas(body_fmu_path):

@@ -13,7 +13,7 @@ use fmi_sys::fmi2::*;
 
 use super::state;
 use super::uri::resource_path;
-use super::values::{indices, slots};
+use super::values::{indices, real_knowns, slots};
 use crate::cosim::FmuKind;
 use crate::fmu::c_args::{array, array_mut, place, string_value, texts};
 use crate::fmu::guard::{self, Abi, FunctionNames, Request};
@@ -460,10 +460,11 @@ pub extern "C" fn fmi2DeSerializeFMUstate(
 }
 const _: fmi2DeSerializeFMUstateTYPE = Some(fmi2DeSerializeFMUstate);
 
-/// Directional derivatives of Real outputs with respect to Real inputs between steps
-/// (`providesDirectionalDerivative="true"`): `dvUnknown[i] = Σ_k ∂unknown_i/∂known_k · dvKnown[k]`
-/// at the current communication point, the state held. Non-zero only through the interface
-/// inputs the model structure declares as direct dependencies.
+/// Directional derivatives of Real outputs with respect to Real inputs
+/// (`providesDirectionalDerivative="true"`): `dvUnknown[i] = Σ_k ∂unknown_i/∂known_k · dvKnown[k]`,
+/// in initialisation mode of the initial unknowns and between steps at the current
+/// communication point, the state held (see `Instance::directional_derivative`). A known of
+/// another type is accepted with a zero seed (`real_knowns`).
 #[no_mangle]
 pub extern "C" fn fmi2GetDirectionalDerivative(
     c: fmi2Component,
@@ -490,10 +491,10 @@ pub extern "C" fn fmi2GetDirectionalDerivative(
                 )
             };
             let unknowns = indices::<f64>(unknowns)?;
-            let knowns = indices::<f64>(knowns)?;
+            let (knowns, seeds) = real_knowns(knowns, seeds, h.instance.fmu_bit())?;
             let values = h
                 .instance
-                .directional_derivative(&unknowns, &knowns, seeds)?;
+                .directional_derivative(&unknowns, &knowns, &seeds)?;
             out.copy_from_slice(&values);
             Ok(Status::Ok)
         },

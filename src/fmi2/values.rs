@@ -29,6 +29,49 @@ pub fn indices<T: VarType>(vrs: &[u32]) -> Result<Vec<usize>, String> {
         .collect()
 }
 
+/// The Real knowns of a directional derivative (indices among the Reals) with their seeds, for
+/// the FMU with variable bit `fmu`. FMI 2.0 defines the derivative with respect to Real knowns
+/// only (§2.1.9: the others are among `v_rest`), yet a host that passes an unknown's whole
+/// `dependencies` list (OMSimulator) names this FMU's Integer and String parameters too, each
+/// seeded 0. Such a known adds nothing to `Σ ∂unknown/∂known · seed`, so with a zero seed it is
+/// left out; with any other seed it is refused. Value references are unique across types here,
+/// so a non-Real one is recognised for what it is; one of no variable of this FMU is refused.
+pub fn real_knowns(vrs: &[u32], seeds: &[f64], fmu: u8) -> Result<(Vec<usize>, Vec<f64>), String> {
+    let mut knowns = Vec::with_capacity(vrs.len());
+    let mut kept = Vec::with_capacity(vrs.len());
+    for (&vr, &seed) in vrs.iter().zip(seeds) {
+        if let Ok(i) = indices::<f64>(&[vr]) {
+            knowns.push(i[0]);
+            kept.push(seed);
+            continue;
+        }
+        let Some(name) = other_type(vr, fmu) else {
+            return Err(format!(
+                "unknown value reference {vr} (no variable of this FMU)"
+            ));
+        };
+        if seed != 0.0 {
+            return Err(format!(
+                "{name} is not a Real: directional derivatives are with respect to Real knowns \
+                 (FMI 2.0 section 2.1.9); give it a zero seed or leave it out"
+            ));
+        }
+    }
+    Ok((knowns, kept))
+}
+
+/// The name of this FMU's Integer, Boolean or String variable behind `vr`, if there is one.
+fn other_type(vr: u32, fmu: u8) -> Option<&'static str> {
+    fn find<T: VarType>(vr: u32, fmu: u8) -> Option<&'static str> {
+        let i = indices::<T>(&[vr]).ok()?[0];
+        let v = &T::table()[i];
+        (v.fmus & fmu != 0).then_some(v.name)
+    }
+    find::<i32>(vr, fmu)
+        .or_else(|| find::<bool>(vr, fmu))
+        .or_else(|| find::<String>(vr, fmu))
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -47,5 +90,21 @@ mod tests {
         assert!(err.contains(&format!("{scene} (not a Real")), "{err}");
         assert!(indices::<bool>(&[scene]).is_err());
         assert!(indices::<String>(&[u32::MAX]).is_err());
+    }
+
+    #[test]
+    fn a_non_real_known_is_dropped_with_a_zero_seed_and_refused_with_another() {
+        use crate::variables::{string, ENGINE_FMU, STRINGS};
+        let rpm = REALS[real::RPM as usize].vr;
+        let scene = INTEGERS[integer::SCENE as usize].vr;
+        let config = STRINGS[string::CONFIG_FILE as usize].vr;
+        let (knowns, seeds) =
+            real_knowns(&[scene, rpm, config], &[0.0, 2.0, 0.0], ENGINE_FMU).unwrap();
+        assert_eq!(knowns, vec![real::RPM as usize]);
+        assert_eq!(seeds, vec![2.0]);
+        let err = real_knowns(&[scene], &[1.0], ENGINE_FMU).unwrap_err();
+        assert!(err.contains("scene is not a Real"), "{err}");
+        let err = real_knowns(&[u32::MAX], &[0.0], ENGINE_FMU).unwrap_err();
+        assert!(err.contains("no variable of this FMU"), "{err}");
     }
 }

@@ -827,12 +827,11 @@ refused!(fmi3GetAdjointDerivative, fmi3GetAdjointDerivativeTYPE,
      nKnowns: usize, seed: *const fmi3Float64, nSeed: usize, sensitivity: *mut fmi3Float64,
      nSensitivity: usize));
 
-/// Directional derivatives of Float64 outputs with respect to Float64 inputs at the current
-/// communication point, the state held (`providesDirectionalDerivatives="true"`, as FMI 2.0's
-/// fmi2GetDirectionalDerivative): `sensitivity[i] = Σ_k ∂unknown_i/∂known_k · seed[k]`, arrays
-/// standing for their elements (row-major). Non-zero only through the interface inputs the
-/// model structure declares as direct dependencies; exact (the mounts' tangent stiffness and
-/// damping, the body's modal shapes).
+/// Directional derivatives of Float64 outputs with respect to Float64 inputs
+/// (`providesDirectionalDerivatives="true"`, as FMI 2.0's fmi2GetDirectionalDerivative):
+/// `sensitivity[i] = Σ_k ∂unknown_i/∂known_k · seed[k]`, arrays standing for their elements
+/// (row-major); in initialisation mode of the initialisation, between steps at the current
+/// communication point, the state held (see `Instance::directional_derivative`).
 #[no_mangle]
 pub extern "C" fn fmi3GetDirectionalDerivative(
     instance: fmi3Instance,

@@ -7,6 +7,7 @@
 //! `Err(message)` to refuse a call; the guard logs it once, naming the function. A refused call leaves the instance exactly as it was: values
 //! are checked as a whole before any is applied.
 
+use std::collections::BTreeMap;
 use std::path::PathBuf;
 
 use super::guard::{self, Abi};
@@ -84,6 +85,10 @@ pub struct Core {
     /// Why building the model failed with the current parameters and inputs: asked again
     /// without a change, the answer is the same, without building again.
     pub setup_failure: Option<String>,
+    /// In initialisation mode, the columns `∂(Reals)/∂(Real input k)` of the initialisation at
+    /// the current parameters and inputs, by input index, as computed when first asked for
+    /// (cleared with the model whenever a value is set).
+    pub initial_sensitivities: BTreeMap<usize, Vec<f64>>,
 }
 
 impl Core {
@@ -102,6 +107,7 @@ impl Core {
             terminated: false,
             simulation: None,
             setup_failure: None,
+            initial_sensitivities: BTreeMap::new(),
         }
     }
 
@@ -190,7 +196,7 @@ impl Instance {
     }
 
     /// The bit of this instance's FMU in [`Variable::fmus`].
-    fn fmu_bit(&self) -> u8 {
+    pub(crate) fn fmu_bit(&self) -> u8 {
         match self.kind {
             FmuKind::Engine => crate::variables::ENGINE_FMU,
             FmuKind::Body => crate::variables::BODY_FMU,
@@ -315,16 +321,19 @@ impl Instance {
         Ok(self.warn_unused_body_point(&set))
     }
 
-    /// Warns, once per instance, when the engine FMU gets body-point inputs (`mount[i].body.*`)
-    /// in a scene without an external body, which ignores them (an SSP whose scene binding was
-    /// lost would otherwise run uncoupled with no sign).
+    /// Warns, once per instance, when the engine FMU gets a moving body point (`mount[i].body.*`
+    /// not zero) in a scene without an external body, which ignores it (an SSP whose scene
+    /// binding was lost would otherwise run uncoupled with no sign). A body point at rest is what
+    /// those scenes assume: a master that feeds every input (fmusim, the cross-check rules, the
+    /// packaged reference experiments) sets them to zero and gets no warning it did not cause.
     fn warn_unused_body_point(&mut self, indices: &[usize]) -> Status {
         if self.warned_unused_body_point || self.kind != FmuKind::Engine {
             return Status::Ok;
         }
+        let reals = self.core.values.reals.as_slice();
         let Some(&first) = indices
             .iter()
-            .find(|&&i| parameters::is_body_point_input(i))
+            .find(|&&i| parameters::is_body_point_input(i) && reals[i] != 0.0)
         else {
             return Status::Ok;
         };
@@ -413,7 +422,7 @@ impl Instance {
     }
 
     /// The model settings the parameters of `core` describe.
-    fn settings_for(&self, core: &Core) -> Result<cosim::Settings, String> {
+    pub(super) fn settings_for(&self, core: &Core) -> Result<cosim::Settings, String> {
         let config_file = parameters::config_file(&core.values, self.resource_dir.as_deref())?;
         parameters::settings(&core.values, config_file, core.experiment_tolerance)
     }
@@ -529,6 +538,7 @@ impl Instance {
             // are warned about).
             self.core.simulation = None;
             self.core.setup_failure = None;
+            self.core.initial_sensitivities.clear();
             return Ok(Status::Ok);
         }
         Ok(if T::TYPE_INDEX == <f64 as VarType>::TYPE_INDEX {
@@ -553,11 +563,21 @@ impl Instance {
         Ok(())
     }
 
-    /// Directional derivatives: `Σ_k ∂unknown/∂known_k · seed_k` for Real outputs with
-    /// respect to Real inputs at the current communication point, the state held — the same
-    /// instantaneous dependence the model structure declares (non-zero only through the
-    /// interface inputs). Exact: from the mounts' tangent stiffness and damping and the
+    /// Directional derivatives `Σ_k ∂unknown/∂known_k · seed_k` of Real outputs with respect to
+    /// Real inputs. A known with a zero seed adds nothing, whatever it is: a host may pass an
+    /// unknown's whole `dependencies` list (parameters included) and seed the input it wants;
+    /// a non-zero seed must be on an input.
+    ///
+    /// Between steps: at the current communication point, the state held — the same
+    /// instantaneous dependence the model structure's `Outputs` declare (non-zero only through
+    /// the interface inputs), exact: from the mounts' tangent stiffness and damping and the
     /// housing's mass matrix, or the body's modal shapes.
+    ///
+    /// In initialisation mode: of the initial unknowns, the outputs of the initialisation at
+    /// the current parameters and inputs (the static equilibrium re-solved, or the periodic
+    /// orbit), as `InitialUnknowns` declare them; by central differences of the initialisation
+    /// (`initial_sensitivity`), which FMI 2.0 §2.1.9 permits ("may compute the directional
+    /// derivatives by numerical differentiation").
     pub fn directional_derivative(
         &mut self,
         unknowns: &[usize],
@@ -566,12 +586,22 @@ impl Instance {
     ) -> Result<Vec<f64>, String> {
         self.check_members::<f64>(unknowns)?;
         self.check_members::<f64>(knowns)?;
-        if let Some(&i) = knowns
+        if let Some(s) = seeds.iter().find(|s| !s.is_finite()) {
+            return Err(format!("seed {} is not finite", Num(*s)));
+        }
+        let seeded: Vec<(usize, f64)> = knowns
             .iter()
-            .find(|&&i| REALS[i].causality != Causality::Input)
+            .zip(seeds)
+            .filter(|(_, &s)| s != 0.0)
+            .map(|(&k, &s)| (k, s))
+            .collect();
+        if let Some(&(i, _)) = seeded
+            .iter()
+            .find(|(i, _)| REALS[*i].causality != Causality::Input)
         {
             return Err(format!(
-                "{} is not an input: the derivatives provided are of outputs with respect to inputs",
+                "{} is not an input: the derivatives provided are with respect to inputs (any \
+                 other known may be listed with a zero seed)",
                 REALS[i].name
             ));
         }
@@ -584,17 +614,35 @@ impl Instance {
                 REALS[i].name
             ));
         }
-        if let Some(s) = seeds.iter().find(|s| !s.is_finite()) {
-            return Err(format!("seed {} is not finite", Num(*s)));
-        }
-        if self.core.phase != Phase::StepComplete {
-            return Err(format!(
-                "directional derivatives are provided between steps, after {}",
+        match self.core.phase {
+            Phase::StepComplete => self.step_sensitivity(unknowns, &seeded),
+            Phase::InitializationMode => {
+                let mut out = vec![0.0; unknowns.len()];
+                for &(k, s) in &seeded {
+                    let column = self.initial_sensitivity(k)?;
+                    for (o, &u) in out.iter_mut().zip(unknowns) {
+                        *o += column[u] * s;
+                    }
+                }
+                Ok(out)
+            }
+            _ => Err(format!(
+                "directional derivatives are provided in initialisation mode and between \
+                 steps, after {}",
                 self.abi.names.exit_initialization
-            ));
+            )),
         }
+    }
+
+    /// Between steps: the response of the outputs at `unknowns` to the input increments
+    /// `seeded`, the state held.
+    fn step_sensitivity(
+        &mut self,
+        unknowns: &[usize],
+        seeded: &[(usize, f64)],
+    ) -> Result<Vec<f64>, String> {
         let mut increments = vec![0.0; REALS.len()];
-        for (&k, &s) in knowns.iter().zip(seeds) {
+        for &(k, s) in seeded {
             increments[k] += s;
         }
         let seed = parameters::input_increments(&increments);

@@ -9,7 +9,8 @@
 //!   positions, FMU states). Each ABI describes itself as a [`guard::Abi`].
 //! - [`state`]: the one co-simulation state type of both standards and the masks of phases.
 //! - [`instance`]: one instance: life cycle, reading and writing variables, FMU states;
-//!   [`step`]: a communication step.
+//!   [`step`]: a communication step; [`initial_sensitivity`]: directional derivatives of the
+//!   initialisation.
 //! - [`values`]: the variable values, one store generic over the four types.
 //! - [`parameters`]: the one mapping between FMU variables and the co-simulation runtime's typed
 //!   settings, inputs and errors.
@@ -23,6 +24,7 @@
 pub mod c_args;
 pub mod fmu_states;
 pub mod guard;
+pub mod initial_sensitivity;
 pub mod input_track;
 pub mod instance;
 pub mod logger;

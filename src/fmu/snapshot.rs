@@ -77,6 +77,7 @@ pub fn deserialize(
         terminated: saved.terminated,
         simulation: None,
         setup_failure: None,
+        initial_sensitivities: Default::default(),
     };
     core.check()?;
     if let Some(dynamic) = &saved.simulation {

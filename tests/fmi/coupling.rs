@@ -381,6 +381,18 @@ fn body_point_inputs_outside_scene_3_are_answered_with_a_warning_once() {
     assert_eq!(b.set_real(&[real::MOUNT_BODY_V[1][0]], &[0.1]), WARNING);
     assert_eq!(b.set_real(&[real::MOUNT_BODY_V[1][0]], &[0.2]), OK);
     assert_eq!(warned(&b), 1);
+    // A body point at rest is what scene 1 assumes: a master feeding every input zeros there
+    // (fmusim, the packaged reference experiments) is not warned, before or after initialisation.
+    let d = fmu.instantiate("body-point-at-rest");
+    assert_eq!(d.setup(0.0, None), OK);
+    assert_eq!(d.enter_init(), OK);
+    assert_eq!(d.set_real(&[real::MOUNT_BODY_R[0][2]], &[0.0]), OK);
+    assert_eq!(d.exit_init(), OK, "{:?}", d.logs());
+    assert_eq!(d.set_real(&[real::MOUNT_BODY_V[1][0]], &[0.0]), OK);
+    assert_eq!(d.do_step(0.0, 1e-3), OK);
+    assert_eq!(warned(&d), 0, "{:?}", d.logs());
+    assert_eq!(d.set_real(&[real::MOUNT_BODY_V[1][0]], &[0.1]), WARNING);
+    assert_eq!(warned(&d), 1);
     // In scene 3 they are the scene's inputs: no warning.
     let c = scene_3(&fmu, "used-body-point");
     assert_eq!(c.set_real(&[real::MOUNT_BODY_R[0][2]], &[1e-4]), OK);

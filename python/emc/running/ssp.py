@@ -4,8 +4,9 @@ holding both FMUs, their mount-by-mount connections and the parameter values.
 The archive is valid against the SSP 1.0 schemas (fmpy's ``read_ssd(..., validate=True)`` checks
 it in python/tests/test_coupling.py): the parameter values of each FMU are an SSV parameter set of
 their own, ``resources/<element>.ssv``, bound by ``source`` (fmpy validates it against the SSV
-schema; libcosim reads it from there too), and the fixed coupling step libcosim takes from the
-system is an ``ssd:Annotations`` entry of ``ssd:DefaultExperiment``.
+schema; libcosim reads it from there too). The one fixed coupling step is written where each
+common SSP host looks for it (``host_annotations``): OSP's annotation on ``ssd:DefaultExperiment``
+(libcosim) and OpenModelica's on ``ssd:System`` (OMSimulator).
 
 The engine FMU (EngineMountChassis, scene 3) passes each mount's force on the body to the body
 FMU (EngineMountBody); the body passes the displacement and velocity of each mount point back.
@@ -31,6 +32,10 @@ SSV = "http://ssp-standard.org/SSP1/SystemStructureParameterValues"
 # every child of osp:Algorithm, attributes included, as an algorithm, so an xmlns attribute there
 # makes it refuse the file ("Unknown algorithm: <xmlattr>").
 OSP = "http://opensimulationplatform.com/SSP/OSPAnnotations"
+# OMSimulator's annotation namespace (the URI its own exporter declares).
+OMS = "https://raw.githubusercontent.com/OpenModelica/OMSimulator/master/schema/oms.xsd"
+# The relative tolerance OMSimulator's algebraic-loop solver gets (its own default, --tolerance).
+OMS_TOLERANCE = 1e-4
 
 AXES = 3
 
@@ -117,7 +122,7 @@ def system_structure(engine_fmu: str, body_fmu: str, mounts: int,
         f'endElement="{c}" endConnector={quoteattr(d)}/>' for a, b, c, d in links)
     return f"""<?xml version="1.0" encoding="UTF-8"?>
 <ssd:SystemStructureDescription xmlns:ssd="{SSD}" xmlns:ssc="{SSC}" xmlns:osp="{OSP}"
-    version="1.0" name="EngineInBody">
+    xmlns:oms="{OMS}" version="1.0" name="EngineInBody">
   <ssd:System name="EngineInBody" description="The engine (EngineMountChassis, scene 3) on the elastic body (EngineMountBody), coupled at the four engine mounts: scene 2 split at the mounts.">
     <ssd:Elements>
 {elements}
@@ -125,18 +130,45 @@ def system_structure(engine_fmu: str, body_fmu: str, mounts: int,
     <ssd:Connections>
 {wires}
     </ssd:Connections>
+{system_annotation(step_size)}
   </ssd:System>
   <ssd:DefaultExperiment startTime="0.0" stopTime="{stop_time!r}">
-    <ssd:Annotations>
+{experiment_annotation(step_size)}
+  </ssd:DefaultExperiment>
+</ssd:SystemStructureDescription>
+"""
+
+
+def system_annotation(step_size: float) -> str:
+    """OpenModelica's annotation on ``ssd:System``: the fixed-step master at ``step_size``.
+
+    OMSimulator needs it to load the file at all: its command line (``oms_importFile``) takes the
+    system type from ``oms:SimulationInformation`` and, with none, refuses the system ("Unable to
+    add System") and aborts. The command line reads the ``oms:FixedStepMaster`` child; its Python
+    API (``OMSimulator.SSP``) reads the attributes of ``oms:SimulationInformation`` as a solver,
+    which it gives to every co-simulation FMU that names none under the name ``oms_ma_default`` (a
+    component cannot name one here: the command line refuses annotations on components)."""
+    return f"""    <ssd:Annotations>
+      <ssc:Annotation type="org.openmodelica">
+        <oms:Annotations>
+          <oms:SimulationInformation name="oms_ma_default" method="oms_ma" fixedStepSize="{step_size!r}" relativeTolerance="{OMS_TOLERANCE!r}">
+            <oms:FixedStepMaster description="oms-ma" stepSize="{step_size!r}" relativeTolerance="{OMS_TOLERANCE!r}"/>
+          </oms:SimulationInformation>
+        </oms:Annotations>
+      </ssc:Annotation>
+    </ssd:Annotations>"""
+
+
+def experiment_annotation(step_size: float) -> str:
+    """OSP's annotation on ``ssd:DefaultExperiment``: libcosim's fixed-step algorithm at
+    ``step_size``."""
+    return f"""    <ssd:Annotations>
       <ssc:Annotation type="com.opensimulationplatform">
         <osp:Algorithm>
           <osp:FixedStepAlgorithm baseStepSize="{step_size!r}"/>
         </osp:Algorithm>
       </ssc:Annotation>
-    </ssd:Annotations>
-  </ssd:DefaultExperiment>
-</ssd:SystemStructureDescription>
-"""
+    </ssd:Annotations>"""
 
 
 def checked_parameters(fmu: pathlib.Path, parameters: dict) -> dict:
