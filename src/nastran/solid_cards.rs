@@ -6,6 +6,7 @@ use std::collections::BTreeMap;
 use super::cards::Reader;
 use super::lexer::{Loc, Value};
 use super::NastranBody;
+use crate::fe::elements::Entity;
 use crate::fe::error::FeError;
 use crate::fe::mesh::{Material, Solid};
 use crate::fe::solid::check_geometry;
@@ -199,7 +200,7 @@ pub(crate) fn add_solids(
         let x: Vec<_> = nodes.iter().map(|&k| body.mesh.nodes[k]).collect();
         check_geometry(&x).map_err(|why| mesh_error(&e.line, format!("{user}: {why}")))?;
         body.mesh.solids.push(Solid { nodes, material: m });
-        body.element_ids.solids.push(id);
+        body.element_ids.push(Entity::Solid, id);
     }
     Ok(())
 }

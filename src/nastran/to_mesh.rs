@@ -11,6 +11,7 @@ use super::lexer::{CardSink, Loc, RawCard, Value};
 use super::reader::DeckInfo;
 use super::solid_cards;
 use super::NastranBody;
+use crate::fe::elements::{all_nodes, Entity};
 use crate::fe::error::FeError;
 use crate::fe::mesh::{
     Beam, BeamEnds, BeamSection, Bush, GroundSpring, InterpolationLink, InterpolationSource,
@@ -570,30 +571,7 @@ const LISTED_UNUSED: usize = 10;
 fn drop_unused_grids(body: &mut NastranBody) {
     let mesh = &body.mesh;
     let mut used = vec![false; mesh.nodes.len()];
-    let referenced = mesh
-        .beams
-        .iter()
-        .flat_map(|b| b.nodes)
-        .chain(mesh.shells.iter().flat_map(|s| s.nodes))
-        .chain(mesh.triangles.iter().flat_map(|t| t.nodes))
-        .chain(mesh.solids.iter().flat_map(|s| s.nodes.iter().copied()))
-        .chain(mesh.masses.iter().map(|m| m.node))
-        .chain(mesh.ground_springs.iter().map(|s| s.node))
-        .chain(mesh.springs.iter().flat_map(|s| s.nodes))
-        .chain(
-            mesh.bushes
-                .iter()
-                .flat_map(|b| std::iter::once(b.a).chain(b.b)),
-        )
-        .chain(
-            mesh.rigid_links
-                .iter()
-                .flat_map(|l| std::iter::once(l.independent).chain(l.dependent.iter().copied())),
-        )
-        .chain(mesh.interpolation_links.iter().flat_map(|l| {
-            std::iter::once(l.reference)
-                .chain(l.sources.iter().flat_map(|s| s.nodes.iter().copied()))
-        }));
+    let referenced = all_nodes(mesh).flat_map(|(_, _, nodes)| nodes);
     for k in referenced {
         if let Some(u) = used.get_mut(k) {
             *u = true;
@@ -711,7 +689,7 @@ fn add_beams(c: &Cards, body: &mut NastranBody) -> Result<(), FeError> {
             orientation,
             extra_mass_per_length: p.nsm * c.mass_scale,
         });
-        body.element_ids.beams.push(id);
+        body.element_ids.push(Entity::Beam, id);
     }
     Ok(())
 }
@@ -894,7 +872,7 @@ fn place_mass(
             dependent: vec![cg],
             components: [true; 6],
         });
-        body.element_ids.rigid_links.push(id);
+        body.element_ids.push(Entity::RigidLink, id);
         cg
     };
     body.mesh.masses.push(PointMass {
@@ -902,7 +880,7 @@ fn place_mass(
         mass: mass * scale,
         inertia: inertia * scale,
     });
-    body.element_ids.masses.push(id);
+    body.element_ids.push(Entity::Mass, id);
 }
 
 fn add_bushes(c: &Cards, systems: &Systems, body: &mut NastranBody) -> Result<(), FeError> {
@@ -965,7 +943,7 @@ fn add_bushes(c: &Cards, systems: &Systems, body: &mut NastranBody) -> Result<()
             stiffness: p.k,
             damping: p.b,
         });
-        body.element_ids.bushes.push(id);
+        body.element_ids.push(Entity::Bush, id);
     }
     Ok(())
 }
@@ -1071,7 +1049,7 @@ fn add_links(c: &Cards, body: &mut NastranBody) -> Result<(), FeError> {
             dependent,
             components: e.components,
         });
-        body.element_ids.rigid_links.push(id);
+        body.element_ids.push(Entity::RigidLink, id);
     }
     for (&id, e) in &c.interpolation {
         let user = format!("RBE3 {id}");
@@ -1098,7 +1076,7 @@ fn add_links(c: &Cards, body: &mut NastranBody) -> Result<(), FeError> {
             reference_components: e.reference_components,
             sources,
         });
-        body.element_ids.interpolation_links.push(id);
+        body.element_ids.push(Entity::InterpolationLink, id);
     }
     Ok(())
 }

@@ -7,6 +7,7 @@ use nalgebra::{Matrix2, Matrix3, Vector3};
 use super::super::cards::{Pshell, Reader};
 use super::super::lexer::Loc;
 use super::{mesh_error, moduli, node_of, Cards, NastranBody, Systems};
+use crate::fe::elements::Entity;
 use crate::fe::error::FeError;
 use crate::fe::mesh::{Material, Shell, TriShell};
 use crate::fe::shell::ShellSection;
@@ -396,7 +397,7 @@ pub(super) fn add_shells(
                 extra_mass_per_area,
                 section,
             });
-            body.element_ids.shells.push(id);
+            body.element_ids.push(Entity::Shell, id);
         } else if let [a, b, cc] = nodes[..] {
             body.mesh.triangles.push(TriShell {
                 nodes: [a, b, cc],
@@ -406,7 +407,7 @@ pub(super) fn add_shells(
                 extra_mass_per_area,
                 section,
             });
-            body.element_ids.triangles.push(id);
+            body.element_ids.push(Entity::Triangle, id);
         }
     }
     Ok(())
