@@ -116,8 +116,10 @@
 //!   set in the file.
 //! - PARAM WTMASS (scales all mass), PARAM POST/GRDPNT/… (output only) and EIGRL/EIGR
 //!   (extraction requests) are accepted; any other card is an error naming card and line and
-//!   listing the supported cards (one table, [`card_table::CARD_TABLE`], which the card dispatch
-//!   uses and the user guide's card table is generated from).
+//!   listing the supported cards (one table, [`card_table::CARD_TABLE`]: each row says how its
+//!   cards are read (the parser in `cards/`, one file per family, and where the card is kept),
+//!   what is refused and which cards the writer writes back; the card dispatch is the table and
+//!   the user guide's card table is generated from it).
 //! - GRIDs that no element, spring, damper, bush, mass or link references (coordinate
 //!   definition grids, leftovers) get no DOFs: all six are constrained, as Nastran's AUTOSPC
 //!   does, and [`NastranBody::unused_grids`] and a note in [`NastranBody::notes`] name them.
@@ -139,7 +141,6 @@ mod dmig;
 mod lexer;
 mod names;
 mod reader;
-mod solid_cards;
 mod to_mesh;
 mod writer;
 
