@@ -194,6 +194,9 @@ pub fn check_mesh(mesh: &Mesh, limits: &CheckLimits) -> Result<(), FeError> {
 /// exist, its own shape checks ([`super::element::Element::check_shape`]) refuse or count, and
 /// its nodes are connected (and held, unless it is a point mass). Then the nodes: connected,
 /// held, in the main part (or held by ground), and the named nodes exist.
+///
+/// Long on purpose: the per-entity checks and the per-node checks share the connectivity they
+/// build (connected, held) and the list of problems reported together.
 pub fn check_mesh_named(
     mesh: &Mesh,
     limits: &CheckLimits,
