@@ -8,7 +8,7 @@
 //! function that parses and checks its fields and where the card is kept), what it becomes,
 //! which of its fields are read, what is refused and which cards the writer writes for what it
 //! becomes; and the cards often met in production decks that it refuses, with what to use
-//! instead. The deck reader's dispatch is this table ([`read_card`]), its refusal of any other
+//! instead. The deck reader's dispatch is this table (`read_card`), its refusal of any other
 //! card lists the table's cards, and the user guide's table is generated from here (`cargo run
 //! --example supported_cards`, run by `docs/generate.py`).
 
