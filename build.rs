@@ -2,7 +2,8 @@
 //! FMUs the crate's library serves (the engine FMU and, from the variables tagged `"fmus":
 //! [.., "body"]`, the body FMU; one library, told apart by the GUID at instantiation):
 //! - `modelDescription.xml` and `body.modelDescription.xml` (packaged into the FMUs),
-//! - `variables.rs` (the value-reference table the FMI layer includes),
+//! - `variables.rs` (the value-reference table the FMI layer includes, with the unit factors)
+//!   and `bindings.rs` (each Real output bound to its accessor; `build/bindings.rs`),
 //! - `index.html` and `body.index.html` (the FMUs' documentation pages),
 //! - `exports.map`, a linker version script that exports exactly the fmi2 and fmi3 functions;
 //! - the FMI 3.0 files of both FMUs (`build/fmi3_description.rs`).
@@ -16,6 +17,8 @@ use std::collections::BTreeMap;
 use std::fmt::Write as _;
 use std::path::{Path, PathBuf};
 
+#[path = "build/bindings.rs"]
+mod bindings;
 #[path = "build/fmi3_description.rs"]
 mod fmi3_description;
 
@@ -126,6 +129,7 @@ fn main() {
     println!("cargo:rerun-if-changed={}", table_path.display());
     println!("cargo:rerun-if-changed=build.rs");
     println!("cargo:rerun-if-changed=build/fmi3_description.rs");
+    println!("cargo:rerun-if-changed=build/bindings.rs");
     write_algorithm_sources(&manifest, &out);
 
     let text = std::fs::read_to_string(&table_path)
@@ -167,8 +171,10 @@ fn main() {
     write(
         &out.join("variables.rs"),
         &(rust_table(&table, &scalars, &families, &fmus)
-            + &fmi3_description::rust_map(&table, &families)),
+            + &fmi3_description::rust_map(&table, &families)
+            + &bindings::rust_units(&table)),
     );
+    write(&out.join("bindings.rs"), &bindings::rust_bindings(&table));
     fmi3_description::write_files(&out, &table, &families, &fmus);
 
     let mut map = String::from("{\n  global:\n");

@@ -1,5 +1,6 @@
 //! Prints the supported-card table of the bulk deck reader as the user guide shows it (Markdown):
-//! every card the reader accepts with what it becomes, the fields read and what is refused, the
+//! every card the reader accepts with what it becomes, the fields read, what is refused and which
+//! card the writer writes for it, the
 //! ignored `PARAM`s, and the cards often met in production decks that it refuses, with what to
 //! use instead. `docs/generate.py` puts the output into docs/src/cae/bulk-deck.md.
 //!
@@ -16,8 +17,8 @@ fn code_list(names: &[&str]) -> String {
 }
 
 fn main() {
-    println!("| card | read as | fields read | refused |");
-    println!("|---|---|---|---|");
+    println!("| card | read as | fields read | refused | written back as |");
+    println!("|---|---|---|---|---|");
     for row in CARD_TABLE {
         let dash = |s: &str| {
             if s.is_empty() {
@@ -26,12 +27,14 @@ fn main() {
                 s.to_owned()
             }
         };
+        let names: Vec<&str> = row.cards.iter().map(|card| card.name).collect();
         println!(
-            "| {} | {} | {} | {} |",
-            code_list(row.cards),
+            "| {} | {} | {} | {} | {} |",
+            code_list(&names),
             row.read_as,
             dash(row.fields),
-            dash(row.refused)
+            dash(row.refused),
+            dash(&code_list(row.written))
         );
     }
     println!();

@@ -75,6 +75,10 @@ fn cells(mesh: &Mesh) -> Vec<(&'static str, Vec<Vec<usize>>)> {
 
 /// The modes of `body` (reduced from `spec`, then possibly filtered: a rigid chassis keeps its
 /// lowest modes only) on every node of the body's mesh.
+///
+/// Long on purpose: per mode, the recomputed reduction is matched to the simulated body (the
+/// mode of the same frequency, its sign and identity checked on the recovery rows of every named
+/// point) and then spread over every node; the matching and the spreading share the indices.
 pub fn recover_all_nodes(
     spec: &ReductionSpec,
     body: &ReducedChassis,

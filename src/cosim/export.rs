@@ -19,15 +19,15 @@
 //!   export only and dropped afterwards ([`crate::cms::recover_all_nodes`]).
 
 use std::io::Write;
-use std::path::{Path, PathBuf};
+use std::path::Path;
 
 use faer::Mat;
 use serde::Serialize;
 use serde_json::json;
 
 use super::body::BodySimulation;
-use super::runtime::Runtime;
 use super::scene::vehicle_config;
+use super::settings::ExportRequest;
 use super::{Error, Settings, Simulation};
 use crate::cms::{recover_all_nodes, ReducedChassis};
 use crate::model::coupled::{Linearisation, MountTarget, RigidPowertrain};
@@ -36,15 +36,6 @@ use crate::model::{Mode, ModeKind};
 
 /// Version of the folder's layout; a reader refuses another.
 pub const EXPORT_VERSION: u32 = 1;
-
-/// Where to write and what.
-#[derive(Debug, Clone, PartialEq, Eq)]
-pub struct ExportRequest {
-    /// The folder.
-    pub folder: PathBuf,
-    /// Also recover the body's modes on every node (`mesh.json`, `shapes.npy`).
-    pub full_recovery: bool,
-}
 
 fn io_error(path: &Path, e: std::io::Error) -> Error {
     Error::Model(format!("analysis export: {}: {e}", path.display()))
@@ -287,24 +278,49 @@ fn body_alone(
     Ok((written, json!(mount_points)))
 }
 
-/// Writes the export of `runtime` built from `settings`; returns a line for the log.
-pub fn write(
-    runtime: &Runtime,
+/// Writes the export of the engine simulation `sim` built from `settings`; returns a line for
+/// the log.
+pub fn write_engine(
+    sim: &Simulation,
     settings: &Settings,
     request: &ExportRequest,
 ) -> Result<String, Error> {
+    let folder = create_folder(request)?;
+    let (written, mount_points) = engine(folder, request, settings, sim)?;
+    finish(
+        folder,
+        written,
+        mount_points,
+        "engine",
+        Some(settings.scene.number()),
+    )
+}
+
+/// Writes the export of the body alone `sim` built from `settings`; returns a line for the log.
+pub fn write_body(
+    sim: &BodySimulation,
+    settings: &Settings,
+    request: &ExportRequest,
+) -> Result<String, Error> {
+    let folder = create_folder(request)?;
+    let (written, mount_points) = body_alone(folder, request, settings, sim)?;
+    finish(folder, written, mount_points, "body", None)
+}
+
+fn create_folder(request: &ExportRequest) -> Result<&Path, Error> {
     let folder = &request.folder;
     std::fs::create_dir_all(folder).map_err(|e| io_error(folder, e))?;
-    let (written, mount_points, fmu, scene) = match runtime {
-        Runtime::Engine(sim) => {
-            let (w, m) = engine(folder, request, settings, sim)?;
-            (w, m, "engine", Some(settings.scene.number()))
-        }
-        Runtime::Body(sim) => {
-            let (w, m) = body_alone(folder, request, settings, sim)?;
-            (w, m, "body", None)
-        }
-    };
+    Ok(folder)
+}
+
+/// Writes the manifest of what was `written` and returns the line for the log.
+fn finish(
+    folder: &Path,
+    written: Written,
+    mount_points: serde_json::Value,
+    fmu: &str,
+    scene: Option<i32>,
+) -> Result<String, Error> {
     write_json(
         folder,
         "manifest.json",

@@ -21,11 +21,12 @@ pub use crate::model::RampInput;
 pub use crate::model::{EffectSwitch, Effects};
 pub use body::{BodySimulation, BodyState};
 pub use error::{Error, Input};
-pub use export::ExportRequest;
 pub use inputs::Inputs;
 pub use runtime::{FmuKind, Runtime, RuntimeState};
 pub use scene::{ComfortPoints, FMU_MOUNTS};
-pub use settings::{EffectOverrides, Replaced, Settings, VehicleOverrides, VehicleSetting};
+pub use settings::{
+    EffectOverrides, ExportRequest, Replaced, Settings, VehicleOverrides, VehicleSetting,
+};
 
 pub use crate::model::body_alone::PointKinematics;
 use crate::model::CoupledModel;
@@ -39,8 +40,8 @@ pub const DEFAULT_CONFIG_NAME: &str = "vehicle.json";
 /// relative rounding 1e-16 becomes 1e-9 of the value per second).
 pub const OUTPUT_DERIVATIVE_STEP: f64 = 1e-7;
 
-/// rpm → rad/s.
-pub const RPM_TO_RAD_PER_S: f64 = std::f64::consts::PI / 30.0;
+/// rpm → rad/s: the `rpm` unit of the variable table.
+pub const RPM_TO_RAD_PER_S: f64 = crate::variables::units::RPM;
 
 /// Results at a communication point, SI units, vehicle frame.
 #[derive(Debug, Clone, Copy, PartialEq, Default)]

@@ -47,10 +47,15 @@ impl Runtime {
             FmuKind::Body => Runtime::Body(Box::new(BodySimulation::new(settings, t0, inputs)?)),
         };
         if let Some(request) = &settings.export {
-            let line = super::export::write(&runtime, settings, request)?;
             match &mut runtime {
-                Runtime::Engine(s) => s.notes.push(line),
-                Runtime::Body(s) => s.notes.push(line),
+                Runtime::Engine(s) => {
+                    let line = super::export::write_engine(s, settings, request)?;
+                    s.notes.push(line);
+                }
+                Runtime::Body(s) => {
+                    let line = super::export::write_body(s, settings, request)?;
+                    s.notes.push(line);
+                }
             }
         }
         Ok(runtime)

@@ -32,7 +32,7 @@ pub struct Settings {
     pub chassis: BodyOptions,
     /// Write the modal data and the linearised model for the analyses at initialisation
     /// ([`super::export`]).
-    pub export: Option<super::ExportRequest>,
+    pub export: Option<ExportRequest>,
 }
 
 impl Default for Settings {
@@ -176,4 +176,14 @@ impl VehicleOverrides {
         }
         replaced
     }
+}
+
+/// What an instance writes for the analyses at initialisation ([`super::export`]): where, and
+/// what.
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub struct ExportRequest {
+    /// The folder.
+    pub folder: PathBuf,
+    /// Also recover the body's modes on every node (`mesh.json`, `shapes.npy`).
+    pub full_recovery: bool,
 }

@@ -504,6 +504,10 @@ fn orthogonalise(
 
 /// One restart-free block Lanczos process at `factor.shift` with at most `capacity` vectors,
 /// M-orthogonal to `deflate`.
+///
+/// Long on purpose: one block Lanczos recurrence (expand, orthonormalise against the basis and
+/// `deflate`, Rayleigh-Ritz on the columns whose images are known, convergence) sharing its
+/// basis and block buffers, which the steps change in place.
 fn lanczos_run(
     f: &Factorizer,
     factor: &Factor,

@@ -4,9 +4,11 @@ use faer::sparse::{SparseColMat, Triplet};
 use nalgebra::{DMatrix, Dim, Matrix, RawStorage};
 
 use super::dof::{DofMap, Expansion, DOF_PER_NODE};
+use super::element::LinkEquation;
+use super::elements::Entity;
 use super::error::FeError;
 use super::mesh::Mesh;
-use super::{beam, links, mass, nodal_frames, shell, shell3, solid, spring};
+use super::solid;
 
 /// Sparse symmetric matrix type of the FE model (both triangles stored).
 pub type SparseMat = SparseColMat<usize, f64>;
@@ -105,107 +107,50 @@ fn terms(e: Expansion<'_>) -> Vec<(usize, f64)> {
     }
 }
 
-/// Assembles K, M, C of `mesh` on the DOFs left free by `mesh.constraints`.
+/// All constraint equations of the links of `mesh` ([`super::element::Element::equations`] of
+/// every entity, in the registry's order).
+pub fn link_equations(mesh: &Mesh) -> Result<Vec<LinkEquation>, FeError> {
+    let mut out = Vec::new();
+    for kind in Entity::ALL {
+        let list = kind.of(mesh);
+        for i in 0..list.len() {
+            out.extend(list.equations(i, mesh)?);
+        }
+    }
+    Ok(out)
+}
+
+/// Assembles K, M, C of `mesh` on the DOFs left free by `mesh.constraints`: every entity's
+/// [`super::element::Element::matrices`], in the registry's order, scattered through the DOF
+/// map of the constraints and the links' equations.
 pub fn assemble(mesh: &Mesh) -> Result<Assembled, FeError> {
-    let equations = links::equations(mesh)?;
+    let equations = link_equations(mesh)?;
     let dofs = DofMap::with_frames(
         mesh.nodes.len(),
         &mesh.constraints,
         &equations,
         &mesh.displacement_frames,
     )?;
-    // Scalar springs and dampers act on node components (GRID CD): carried to global axes so
-    // that scattering through the DOF map gives them back on the components.
-    let frames = &mesh.displacement_frames;
-    let mut k = TripletSink {
+    let sink = || TripletSink {
         dofs: &dofs,
         entries: Vec::new(),
     };
-    let mut m = TripletSink {
-        dofs: &dofs,
-        entries: Vec::new(),
-    };
-    let mut c = TripletSink {
-        dofs: &dofs,
-        entries: Vec::new(),
-    };
-    for (i, b) in mesh.beams.iter().enumerate() {
-        let what = format!("beam {i}");
-        let p1 = mesh.position(&what, b.nodes[0])?;
-        let p2 = mesh.position(&what, b.nodes[1])?;
-        let ends = mesh.beam_ends.get(&i).copied().unwrap_or_default();
-        k.scatter(&b.nodes, &beam::stiffness_with_ends(i, b, &ends, &p1, &p2)?);
-        m.scatter(
-            &b.nodes,
-            &beam::lumped_mass_with_ends(i, b, &ends, &p1, &p2)?,
-        );
-    }
-    for (i, s) in mesh.shells.iter().enumerate() {
-        let what = format!("shell {i}");
-        let p = [
-            mesh.position(&what, s.nodes[0])?,
-            mesh.position(&what, s.nodes[1])?,
-            mesh.position(&what, s.nodes[2])?,
-            mesh.position(&what, s.nodes[3])?,
-        ];
-        k.scatter(&s.nodes, &shell::stiffness(i, s, &p)?);
-        m.scatter(&s.nodes, &shell::lumped_mass(i, s, &p)?);
-    }
-    for (i, t) in mesh.triangles.iter().enumerate() {
-        let what = format!("triangle {i}");
-        let p = [
-            mesh.position(&what, t.nodes[0])?,
-            mesh.position(&what, t.nodes[1])?,
-            mesh.position(&what, t.nodes[2])?,
-        ];
-        k.scatter(&t.nodes, &shell3::stiffness(i, t, &p)?);
-        m.scatter(&t.nodes, &shell3::lumped_mass(i, t, &p)?);
-    }
-    for (i, pm) in mesh.masses.iter().enumerate() {
-        mesh.position(&format!("point mass {i}"), pm.node)?;
-        m.scatter(&[pm.node], &mass::matrix(i, pm)?);
-    }
-    for (i, s) in mesh.ground_springs.iter().enumerate() {
-        mesh.position(&format!("ground spring {i}"), s.node)?;
-        let (ks, cs) = spring::ground_matrices(i, s)?;
-        k.scatter(
-            &[s.node],
-            &nodal_frames::to_global_axes(frames, &[s.node], &ks),
-        );
-        c.scatter(
-            &[s.node],
-            &nodal_frames::to_global_axes(frames, &[s.node], &cs),
-        );
-    }
-    for (i, s) in mesh.springs.iter().enumerate() {
-        let what = format!("spring {i}");
-        mesh.position(&what, s.nodes[0])?;
-        mesh.position(&what, s.nodes[1])?;
-        let (ks, cs) = spring::two_node_matrices(i, s)?;
-        k.scatter(
-            &s.nodes,
-            &nodal_frames::to_global_axes(frames, &s.nodes, &ks),
-        );
-        c.scatter(
-            &s.nodes,
-            &nodal_frames::to_global_axes(frames, &s.nodes, &cs),
-        );
-    }
-    for (i, bush) in mesh.bushes.iter().enumerate() {
-        let what = format!("bush {i}");
-        let xa = mesh.position(&what, bush.a)?;
-        let (nodes, xb) = match bush.b {
-            Some(b) => (vec![bush.a, b], Some(mesh.position(&what, b)?)),
-            None => (vec![bush.a], None),
-        };
-        let (kb, cb) = spring::bush_matrices(i, bush, &xa, xb.as_ref())?;
-        k.scatter(&nodes, &kb);
-        c.scatter(&nodes, &cb);
-    }
-    for i in 0..mesh.solids.len() {
-        let (ks, ms) = solid::assembly_matrices(mesh, i)?;
-        k.scatter(&mesh.solids[i].nodes, &ks);
-        m.scatter(&mesh.solids[i].nodes, &ms);
+    let (mut k, mut m, mut c) = (sink(), sink(), sink());
+    for kind in Entity::ALL {
+        let list = kind.of(mesh);
+        for i in 0..list.len() {
+            let matrices = list.matrices(i, mesh)?;
+            let nodes = list.nodes(i);
+            for (sink, matrix) in [
+                (&mut k, &matrices.k),
+                (&mut m, &matrices.m),
+                (&mut c, &matrices.c),
+            ] {
+                if let Some(matrix) = matrix {
+                    sink.scatter(&nodes, matrix);
+                }
+            }
+        }
     }
     let entries = [k.entries, m.entries, c.entries];
     let (dofs, [k, m, c]) = solid::remove_free_rotations(mesh, dofs, &equations, entries)?;

@@ -39,8 +39,9 @@
 
 use nalgebra::{Matrix3, SMatrix, Vector3};
 
+use super::element::{BulkWriter, CheckLimits, Element, ElementMatrices, Field, Finding};
 use super::error::{require_non_negative, require_positive, FeError};
-use super::mesh::{Beam, BeamEnds};
+use super::mesh::{Beam, BeamEnds, Mesh};
 
 /// 12 × 12 element matrix, DOF order (ux uy uz rx ry rz) at node 1 then node 2.
 pub type Mat12 = SMatrix<f64, 12, 12>;
@@ -287,6 +288,107 @@ pub fn lumped_mass_with_ends(
     }
     let t = end_transform(&r, &ends.offsets);
     Ok(t.transpose() * local * t)
+}
+
+impl Element for Beam {
+    const NAME: &'static str = "beam";
+
+    fn nodes(&self) -> Vec<usize> {
+        self.nodes.to_vec()
+    }
+
+    fn matrices(&self, index: usize, mesh: &Mesh) -> Result<ElementMatrices, FeError> {
+        let what = format!("beam {index}");
+        let p1 = mesh.position(&what, self.nodes[0])?;
+        let p2 = mesh.position(&what, self.nodes[1])?;
+        let ends = mesh.beam_ends.get(&index).copied().unwrap_or_default();
+        Ok(ElementMatrices::stiffness_and_mass(
+            &stiffness_with_ends(index, self, &ends, &p1, &p2)?,
+            &lumped_mass_with_ends(index, self, &ends, &p1, &p2)?,
+        ))
+    }
+
+    fn check_shape(
+        &self,
+        index: usize,
+        mesh: &Mesh,
+        points: &[Vector3<f64>],
+        limits: &CheckLimits,
+    ) -> Vec<Finding> {
+        // With offsets the element runs between the offset ends, not the nodes.
+        let w = mesh
+            .beam_ends
+            .get(&index)
+            .map_or([Vector3::zeros(); 2], |e| e.offsets);
+        let (p1, p2) = (points[0] + w[0], points[1] + w[1]);
+        if self.nodes[0] == self.nodes[1] || (p2 - p1).norm() < limits.min_beam_length {
+            vec![Finding::Wrong(format!(
+                "degenerate (length {:.3e} m)",
+                (p2 - p1).norm()
+            ))]
+        } else if (p2 - p1).normalize().cross(&self.orientation).norm()
+            < 1e-6 * self.orientation.norm().max(1e-300)
+        {
+            vec![Finding::Wrong(
+                "orientation vector parallel to the axis or zero".into(),
+            )]
+        } else {
+            Vec::new()
+        }
+    }
+
+    /// A CBAR with its PBAR; offsets and pin flags on the CBAR (OFFT blank, GGG: the grids are
+    /// written in basic, so their displacement systems are basic too).
+    fn write_bulk(
+        &self,
+        index: usize,
+        mesh: &Mesh,
+        deck: &mut dyn BulkWriter,
+    ) -> Result<(), FeError> {
+        let mid = deck.material(&self.material)?;
+        let s = &self.section;
+        let nsm = self.extra_mass_per_length;
+        // PBAR K1/K2 = 0.0 reads back as rigid in shear, the same as blank.
+        let k = [s.shear_factor_y, s.shear_factor_z].map(|k| k.unwrap_or(0.0));
+        let values = [mid as f64, s.area, s.iz, s.iy, s.j, nsm, k[0], k[1]];
+        let pid = deck.property("PBAR", &values, &|pid| {
+            let mut fields = vec![
+                Field::Int(pid),
+                Field::Int(mid),
+                Field::Real(s.area),
+                Field::Real(s.iz),
+                Field::Real(s.iy),
+                Field::Real(s.j),
+                Field::Real(nsm),
+            ];
+            if k.iter().any(|&k| k != 0.0) {
+                // Field 9 and the stress recovery points C1 … F2 stay blank.
+                fields.extend((0..9).map(|_| Field::Blank));
+                fields.extend([Field::Real(k[0]), Field::Real(k[1])]);
+            }
+            fields
+        })?;
+        let what = format!("beam {index}");
+        let mut fields = vec![
+            deck.element_id(),
+            Field::Int(pid),
+            deck.grid(&what, self.nodes[0])?,
+            deck.grid(&what, self.nodes[1])?,
+            Field::Real(self.orientation.x),
+            Field::Real(self.orientation.y),
+            Field::Real(self.orientation.z),
+        ];
+        if let Some(ends) = mesh.beam_ends.get(&index) {
+            fields.push(Field::Blank);
+            for pins in ends.pins {
+                fields.push(Field::components(&pins).unwrap_or(Field::Blank));
+            }
+            for w in ends.offsets {
+                fields.extend(w.iter().map(|&c| Field::Real(c)));
+            }
+        }
+        deck.card("CBAR", &fields)
+    }
 }
 
 #[cfg(test)]

@@ -14,52 +14,12 @@
 use nalgebra::Vector3;
 
 use super::assembly::Assembled;
+pub use super::element::{CheckLimits, PoorShape};
+use super::element::{Finding, ShapeTest};
+use super::elements::all_nodes;
+pub use super::elements::Entity;
 use super::error::FeError;
 use super::mesh::Mesh;
-use super::{shell, shell3};
-
-/// Which kind of mesh entity a message names.
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
-pub enum Entity {
-    /// `mesh.beams[i]`.
-    Beam,
-    /// `mesh.shells[i]`.
-    Shell,
-    /// `mesh.triangles[i]`.
-    Triangle,
-    /// `mesh.solids[i]`.
-    Solid,
-    /// `mesh.masses[i]`.
-    Mass,
-    /// `mesh.ground_springs[i]`.
-    GroundSpring,
-    /// `mesh.springs[i]`.
-    Spring,
-    /// `mesh.bushes[i]`.
-    Bush,
-    /// `mesh.rigid_links[i]`.
-    RigidLink,
-    /// `mesh.interpolation_links[i]`.
-    InterpolationLink,
-}
-
-impl Entity {
-    /// The entity's name in a mesh built in code (`shell`, `ground spring`, …).
-    pub fn mesh_name(self) -> &'static str {
-        match self {
-            Entity::Beam => "beam",
-            Entity::Shell => "shell",
-            Entity::Triangle => "triangle",
-            Entity::Solid => "solid",
-            Entity::Mass => "point mass",
-            Entity::GroundSpring => "ground spring",
-            Entity::Spring => "spring",
-            Entity::Bush => "bush",
-            Entity::RigidLink => "rigid link",
-            Entity::InterpolationLink => "interpolation link",
-        }
-    }
-}
 
 /// How check messages name nodes and elements: the user must find them in their own model.
 pub trait Naming {
@@ -80,71 +40,6 @@ impl Naming for MeshIndices {
 
     fn entity(&self, kind: Entity, index: usize) -> String {
         format!("{} {index}", kind.mesh_name())
-    }
-}
-
-/// What to do with elements whose shape is poor but whose matrices are still valid (warp,
-/// taper, skew, Jacobian ratio beyond the limits).
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
-pub enum PoorShape {
-    /// Refuse the mesh (a mesh built in code must be good).
-    Refuse,
-    /// Accept and report counted warnings, as Nastran's GEOMCHECK does by default.
-    Warn,
-}
-
-/// Limits of the geometric checks.
-#[derive(Debug, Clone, Copy, PartialEq)]
-pub struct CheckLimits {
-    /// Largest corner offset from the mean plane / √area of a shell.
-    pub max_warp: f64,
-    /// Smallest ratio of corner Jacobians of a shell (1 = parallelogram, ≤ 0 = inverted).
-    pub min_jacobian_ratio: f64,
-    /// Largest taper of a CQUAD4: 1 − 2·(smallest corner triangle area)/(element area)
-    /// (0 for a parallelogram, 1 when a corner collapses); `None`: not checked.
-    pub max_taper: Option<f64>,
-    /// Smallest angle (degrees) between the lines joining the midpoints of opposite sides of
-    /// a CQUAD4 (90 for a rectangle); `None`: not checked.
-    pub min_skew_angle_deg: Option<f64>,
-    /// Smallest beam length (m).
-    pub min_beam_length: f64,
-    /// Smallest shell area (m²).
-    pub min_shell_area: f64,
-    /// Accept structures made of several parts that share no element.
-    pub allow_disconnected_parts: bool,
-    /// Poorly shaped but valid elements: refused or reported.
-    pub poor_shape: PoorShape,
-}
-
-impl Default for CheckLimits {
-    fn default() -> Self {
-        Self {
-            max_warp: 0.01,
-            min_jacobian_ratio: 0.2,
-            max_taper: None,
-            min_skew_angle_deg: None,
-            min_beam_length: 1e-6,
-            min_shell_area: 1e-10,
-            allow_disconnected_parts: false,
-            poor_shape: PoorShape::Refuse,
-        }
-    }
-}
-
-impl CheckLimits {
-    /// Limits for a body read from a user's Nastran deck: what makes an element's matrices
-    /// wrong (zero or negative Jacobian or area, coincident corners, non-finite coordinates)
-    /// is refused; poor shapes are warnings at Nastran's GEOMCHECK defaults (Q4_WARP 0.05,
-    /// Q4_TAPER 0.5, Q4_SKEW 30°) and a corner Jacobian ratio below 0.2.
-    pub fn nastran_deck() -> Self {
-        Self {
-            max_warp: 0.05,
-            min_jacobian_ratio: 0.2,
-            max_taper: Some(0.5),
-            min_skew_angle_deg: Some(30.0),
-            poor_shape: PoorShape::Warn,
-            ..Self::default()
-        }
     }
 }
 
@@ -208,6 +103,9 @@ impl Tally {
 
 /// The poor-shape tests of a shell, each failing one counted or refused per the policy.
 struct ShapeTallies {
+    refuse: bool,
+    max_warp: f64,
+    min_jacobian_ratio: f64,
     warp: Tally,
     jacobian: Tally,
     taper: Tally,
@@ -217,6 +115,9 @@ struct ShapeTallies {
 impl ShapeTallies {
     fn new(limits: &CheckLimits) -> Self {
         Self {
+            refuse: limits.poor_shape == PoorShape::Refuse,
+            max_warp: limits.max_warp,
+            min_jacobian_ratio: limits.min_jacobian_ratio,
             warp: Tally::new("warped", format!("warp > {}", limits.max_warp), true),
             jacobian: Tally::new(
                 "distorted",
@@ -236,6 +137,40 @@ impl ShapeTallies {
         }
     }
 
+    /// A failed shape test of element `name`: the problem that refuses it under
+    /// [`PoorShape::Refuse`] (warp and Jacobian ratio; taper and skew are only ever counted),
+    /// else counted.
+    fn add(
+        &mut self,
+        test: ShapeTest,
+        value: f64,
+        name: impl FnOnce() -> String,
+    ) -> Option<String> {
+        if self.refuse {
+            return match test {
+                ShapeTest::Warp => Some(format!(
+                    "{}: warped (warp ratio {value:.4} > {})",
+                    name(),
+                    self.max_warp
+                )),
+                ShapeTest::JacobianRatio => Some(format!(
+                    "{}: distorted or inverted (Jacobian ratio {value:.3} < {})",
+                    name(),
+                    self.min_jacobian_ratio
+                )),
+                ShapeTest::Taper | ShapeTest::Skew => None,
+            };
+        }
+        let tally = match test {
+            ShapeTest::Warp => &mut self.warp,
+            ShapeTest::JacobianRatio => &mut self.jacobian,
+            ShapeTest::Taper => &mut self.taper,
+            ShapeTest::Skew => &mut self.skew,
+        };
+        tally.add(value, name);
+        None
+    }
+
     fn notes(&self) -> Vec<String> {
         [&self.warp, &self.jacobian, &self.taper, &self.skew]
             .into_iter()
@@ -243,26 +178,6 @@ impl ShapeTallies {
             .map(|n| format!("element shape (warning, as Nastran's GEOMCHECK): {n}"))
             .collect()
     }
-}
-
-/// Taper (1 − 2·smallest corner triangle / area) and skew angle (degrees, between the lines
-/// joining midpoints of opposite sides) of a quadrilateral.
-fn taper_and_skew(p: &[Vector3<f64>; 4]) -> (f64, f64) {
-    let area = 0.5 * (p[2] - p[0]).cross(&(p[3] - p[1])).norm();
-    let corner = |i: usize| {
-        let (a, b, c) = (p[(i + 3) % 4], p[i], p[(i + 1) % 4]);
-        0.5 * (a - b).cross(&(c - b)).norm()
-    };
-    let smallest = (0..4).map(corner).fold(f64::INFINITY, f64::min);
-    let taper = 1.0 - 2.0 * smallest / area;
-    let m = |i: usize| (p[i] + p[(i + 1) % 4]) / 2.0;
-    let (u, v) = (m(2) - m(0), m(3) - m(1));
-    let cos = (u.dot(&v) / (u.norm() * v.norm())).abs().min(1.0);
-    (taper, cos.acos().to_degrees())
-}
-
-fn node(mesh: &Mesh, id: usize) -> Option<Vector3<f64>> {
-    mesh.nodes.get(id).copied()
 }
 
 /// Geometric and topological checks of `mesh` before assembly, named by mesh index; poor
@@ -275,7 +190,13 @@ pub fn check_mesh(mesh: &Mesh, limits: &CheckLimits) -> Result<(), FeError> {
 /// by `names`. Returns the warnings (counted poor shapes under [`PoorShape::Warn`], one line
 /// per test with the worst element); refuses what makes the model wrong.
 ///
-/// Long on purpose: one list of short checks per entity kind that share the node lookup and the limits; read as a table.
+/// Every entity of the registry ([`Entity::ALL`]) is checked the same way: its nodes must
+/// exist, its own shape checks ([`super::element::Element::check_shape`]) refuse or count, and
+/// its nodes are connected (and held, unless it is a point mass). Then the nodes: connected,
+/// held, in the main part (or held by ground), and the named nodes exist.
+///
+/// Long on purpose: the per-entity checks and the per-node checks share the connectivity they
+/// build (connected, held) and the list of problems reported together.
 pub fn check_mesh_named(
     mesh: &Mesh,
     limits: &CheckLimits,
@@ -283,7 +204,6 @@ pub fn check_mesh_named(
 ) -> Result<Vec<String>, FeError> {
     let mut problems = Vec::new();
     let mut tallies = ShapeTallies::new(limits);
-    let refuse = limits.poor_shape == PoorShape::Refuse;
     let n = mesh.nodes.len();
     let mut connected = vec![false; n];
     let mut has_stiffness = vec![false; n];
@@ -292,190 +212,42 @@ pub fn check_mesh_named(
             problems.push(format!("{}: non-finite coordinates", names.node(i)));
         }
     }
-    let missing = |kind: Entity, i: usize, nodes: &[usize]| {
-        format!(
-            "{}: node index {:?} does not exist",
-            names.entity(kind, i),
-            nodes.iter().filter(|&&k| k >= n).collect::<Vec<_>>()
-        )
-    };
-    for (i, b) in mesh.beams.iter().enumerate() {
-        let (Some(p1), Some(p2)) = (node(mesh, b.nodes[0]), node(mesh, b.nodes[1])) else {
-            problems.push(missing(Entity::Beam, i, &b.nodes));
-            continue;
-        };
-        // With offsets the element runs between the offset ends, not the nodes.
-        let w = mesh
-            .beam_ends
-            .get(&i)
-            .map_or([Vector3::zeros(); 2], |e| e.offsets);
-        let (p1, p2) = (p1 + w[0], p2 + w[1]);
-        if b.nodes[0] == b.nodes[1] || (p2 - p1).norm() < limits.min_beam_length {
-            problems.push(format!(
-                "{}: degenerate (length {:.3e} m)",
-                names.entity(Entity::Beam, i),
-                (p2 - p1).norm()
-            ));
-        } else if (p2 - p1).normalize().cross(&b.orientation).norm()
-            < 1e-6 * b.orientation.norm().max(1e-300)
-        {
-            problems.push(format!(
-                "{}: orientation vector parallel to the axis or zero",
-                names.entity(Entity::Beam, i)
-            ));
-        }
-        for &k in &b.nodes {
-            connected[k] = true;
-            has_stiffness[k] = true;
-        }
-    }
-    for (i, s) in mesh.shells.iter().enumerate() {
-        let name = || names.entity(Entity::Shell, i);
-        let pts: Option<Vec<Vector3<f64>>> = s.nodes.iter().map(|&k| node(mesh, k)).collect();
-        let Some(pts) = pts else {
-            problems.push(missing(Entity::Shell, i, &s.nodes));
-            continue;
-        };
-        let mut distinct = s.nodes.to_vec();
-        distinct.sort_unstable();
-        distinct.dedup();
-        if distinct.len() < 4 {
-            let grids: Vec<String> = s.nodes.iter().map(|&k| names.node(k)).collect();
-            problems.push(format!(
-                "{}: repeated node in [{}]",
-                name(),
-                grids.join(", ")
-            ));
-            continue;
-        }
-        let corners = [pts[0], pts[1], pts[2], pts[3]];
-        match shell::geometry(i, &corners) {
-            Err(e) => problems.push(format!(
-                "{}: {}",
-                name(),
-                strip_index(&e, &format!("shell {i}: "))
-            )),
-            Ok(g) => {
-                if g.area < limits.min_shell_area {
-                    problems.push(format!("{}: degenerate (area {:.3e} m²)", name(), g.area));
-                } else if g.jacobian_ratio <= 0.0 {
-                    problems.push(format!(
-                        "{}: inverted or degenerate (corner Jacobian ratio {:.3} ≤ 0: a corner \
-                         angle of 180° or more; check the corner order)",
-                        name(),
-                        g.jacobian_ratio
-                    ));
-                } else if refuse {
-                    if g.warp > limits.max_warp {
+    for &kind in Entity::ALL {
+        let list = kind.of(mesh);
+        for i in 0..list.len() {
+            let nodes = list.nodes(i);
+            if nodes.iter().any(|&k| k >= n) {
+                problems.push(format!(
+                    "{}: node index {:?} does not exist",
+                    names.entity(kind, i),
+                    nodes.iter().filter(|&&k| k >= n).collect::<Vec<_>>()
+                ));
+                continue;
+            }
+            let points: Vec<Vector3<f64>> = nodes.iter().map(|&k| mesh.nodes[k]).collect();
+            for finding in list.check_shape(i, mesh, &points, limits) {
+                let name = || names.entity(kind, i);
+                match finding {
+                    Finding::Wrong(why) => problems.push(format!("{}: {why}", name())),
+                    Finding::RepeatedNode => {
+                        let grids: Vec<String> = nodes.iter().map(|&k| names.node(k)).collect();
                         problems.push(format!(
-                            "{}: warped (warp ratio {:.4} > {})",
+                            "{}: repeated node in [{}]",
                             name(),
-                            g.warp,
-                            limits.max_warp
+                            grids.join(", ")
                         ));
                     }
-                    if g.jacobian_ratio < limits.min_jacobian_ratio {
-                        problems.push(format!(
-                            "{}: distorted or inverted (Jacobian ratio {:.3} < {})",
-                            name(),
-                            g.jacobian_ratio,
-                            limits.min_jacobian_ratio
-                        ));
-                    }
-                } else {
-                    if g.warp > limits.max_warp {
-                        tallies.warp.add(g.warp, name);
-                    }
-                    if g.jacobian_ratio < limits.min_jacobian_ratio {
-                        tallies.jacobian.add(g.jacobian_ratio, name);
-                    }
-                    let (taper, skew) = taper_and_skew(&corners);
-                    if limits.max_taper.is_some_and(|t| taper > t) {
-                        tallies.taper.add(taper, name);
-                    }
-                    if limits.min_skew_angle_deg.is_some_and(|s| skew < s) {
-                        tallies.skew.add(skew, name);
+                    Finding::Poor(test, value) => {
+                        if let Some(problem) = tallies.add(test, value, name) {
+                            problems.push(problem);
+                        }
                     }
                 }
             }
-        }
-        for &k in &s.nodes {
-            connected[k] = true;
-            has_stiffness[k] = true;
-        }
-    }
-    for (i, t) in mesh.triangles.iter().enumerate() {
-        let pts: Option<Vec<Vector3<f64>>> = t.nodes.iter().map(|&k| node(mesh, k)).collect();
-        let Some(pts) = pts else {
-            problems.push(missing(Entity::Triangle, i, &t.nodes));
-            continue;
-        };
-        let name = names.entity(Entity::Triangle, i);
-        match shell3::geometry(i, &[pts[0], pts[1], pts[2]]) {
-            Err(e) => problems.push(format!(
-                "{name}: {}",
-                strip_index(&e, &format!("triangle {i}: "))
-            )),
-            Ok(g) if g.area < limits.min_shell_area => {
-                problems.push(format!("{name}: degenerate (area {:.3e} m²)", g.area))
+            for k in nodes {
+                connected[k] = true;
+                has_stiffness[k] |= list.holds();
             }
-            Ok(_) => {}
-        }
-        for &k in &t.nodes {
-            connected[k] = true;
-            has_stiffness[k] = true;
-        }
-    }
-    for (i, s) in mesh.solids.iter().enumerate() {
-        let pts: Option<Vec<Vector3<f64>>> = s.nodes.iter().map(|&k| node(mesh, k)).collect();
-        let Some(pts) = pts else {
-            problems.push(missing(Entity::Solid, i, &s.nodes));
-            continue;
-        };
-        if let Err(why) = super::solid::check_geometry(&pts) {
-            problems.push(format!("{}: {why}", names.entity(Entity::Solid, i)));
-        }
-        for &k in &s.nodes {
-            connected[k] = true;
-            has_stiffness[k] = true;
-        }
-    }
-    for (i, m) in mesh.masses.iter().enumerate() {
-        match connected.get_mut(m.node) {
-            Some(c) => *c = true,
-            None => problems.push(missing(Entity::Mass, i, &[m.node])),
-        }
-    }
-    // Springs, dampers and bushes hold their nodes (a wheel-centre grid on a CBUSH, a CELAS2
-    // to ground): whether every DOF gets stiffness is for `check_assembled`.
-    let spring_like = mesh
-        .ground_springs
-        .iter()
-        .enumerate()
-        .map(|(i, s)| (Entity::GroundSpring, i, vec![s.node]))
-        .chain(
-            mesh.springs
-                .iter()
-                .enumerate()
-                .map(|(i, s)| (Entity::Spring, i, s.nodes.to_vec())),
-        )
-        .chain(
-            mesh.bushes
-                .iter()
-                .enumerate()
-                .map(|(i, b)| (Entity::Bush, i, std::iter::once(b.a).chain(b.b).collect())),
-        )
-        .chain(link_node_sets(mesh));
-    // A node tied by a rigid or interpolation link is held by the link (or holds it); a link
-    // on a node without any real stiffness shows up as a singular DOF in `check_assembled`.
-    for (kind, i, nodes) in spring_like {
-        if nodes.iter().any(|&k| k >= n) {
-            problems.push(missing(kind, i, &nodes));
-            continue;
-        }
-        for k in nodes {
-            connected[k] = true;
-            has_stiffness[k] = true;
         }
     }
     let mut constrained_count = vec![0usize; n];
@@ -515,28 +287,6 @@ pub fn check_mesh_named(
     Ok(tallies.notes())
 }
 
-/// `message` without the index prefix the element code puts in front (the caller names the
-/// element itself).
-fn strip_index(e: &FeError, prefix: &str) -> String {
-    let (FeError::Mesh(m) | FeError::InvalidInput(m) | FeError::Numerical(m) | FeError::Io(m)) = e;
-    m.strip_prefix(prefix).unwrap_or(m).to_string()
-}
-
-/// The nodes of every rigid and interpolation link.
-fn link_node_sets(mesh: &Mesh) -> impl Iterator<Item = (Entity, usize, Vec<usize>)> + '_ {
-    let rigid = mesh.rigid_links.iter().enumerate().map(|(i, l)| {
-        let mut nodes = vec![l.independent];
-        nodes.extend(&l.dependent);
-        (Entity::RigidLink, i, nodes)
-    });
-    let interpolation = mesh.interpolation_links.iter().enumerate().map(|(i, l)| {
-        let mut nodes = vec![l.reference];
-        nodes.extend(l.sources.iter().flat_map(|s| s.nodes.iter().copied()));
-        (Entity::InterpolationLink, i, nodes)
-    });
-    rigid.chain(interpolation)
-}
-
 fn find(parent: &mut [usize], mut i: usize) -> usize {
     while parent[i] != i {
         parent[i] = parent[parent[i]];
@@ -562,23 +312,12 @@ fn disconnected_parts(
             parent[ra] = rb;
         }
     };
-    let links = mesh
-        .beams
-        .iter()
-        .map(|b| b.nodes.to_vec())
-        .chain(mesh.shells.iter().map(|s| s.nodes.to_vec()))
-        .chain(mesh.triangles.iter().map(|t| t.nodes.to_vec()))
-        .chain(mesh.solids.iter().map(|s| s.nodes.clone()))
-        .chain(mesh.springs.iter().map(|s| s.nodes.to_vec()))
-        .chain(
-            mesh.bushes
-                .iter()
-                .map(|b| std::iter::once(b.a).chain(b.b).collect()),
-        )
-        .chain(link_node_sets(mesh).map(|(_, _, nodes)| nodes));
-    for nodes in links {
-        for w in nodes.windows(2) {
-            join(w[0], w[1]);
+    // Every entity that holds its nodes joins them (a point mass does not).
+    for (kind, _, nodes) in all_nodes(mesh) {
+        if kind.of(mesh).holds() {
+            for w in nodes.windows(2) {
+                join(w[0], w[1]);
+            }
         }
     }
     let mut parts: std::collections::BTreeMap<usize, Vec<usize>> = Default::default();
@@ -590,11 +329,14 @@ fn disconnected_parts(
     }
     // Ground holds a part too: a spring or bush to ground, or a constrained DOF.
     let mut grounded = vec![false; n];
-    let ground_ends = mesh
-        .ground_springs
+    let ground_ends = Entity::ALL
         .iter()
-        .map(|s| s.node)
-        .chain(mesh.bushes.iter().filter(|b| b.b.is_none()).map(|b| b.a))
+        .flat_map(|&kind| {
+            let list = kind.of(mesh);
+            (0..list.len())
+                .filter(move |&i| list.grounds(i))
+                .flat_map(move |i| list.nodes(i))
+        })
         .chain(mesh.constraints.iter().map(|&(k, _)| k));
     for k in ground_ends {
         if let Some(g) = grounded.get_mut(k) {

@@ -67,6 +67,10 @@ impl DofMap {
     /// Like [`DofMap::with_links`] for a mesh whose nodes in `frames` have displacement frames:
     /// their slots (in `constrained` and in the link equations) are components in the frame,
     /// and [`DofMap::motion_row`] (and assembly) see their motion in global axes.
+    ///
+    /// Long on purpose: the constraints, the link equations (each dependent slot checked once,
+    /// chains resolved) and the frames' global rows are built on one slot table, in this order,
+    /// each refusal naming the link.
     pub fn with_frames(
         n_nodes: usize,
         constrained: &[(usize, usize)],

@@ -1,4 +1,6 @@
-//! Constraint equations of the rigid and interpolation links (Nastran RBE2 / RBE3).
+//! How the rigid and interpolation links (Nastran RBE2 / RBE3; the elements in
+//! [`super::rigid_link`] and [`super::interpolation_link`]) are eliminated, and the rigid map
+//! they share.
 //!
 //! Each dependent DOF becomes one equation u_dep = Σ cᵢ uᵢ over other DOFs; [`super::dof::DofMap`]
 //! resolves chains and numbers the remaining independent DOFs, and assembly forms Tᵀ K T exactly
@@ -14,204 +16,28 @@
 //! source translations. Reference components left undetermined by the sources (e.g. rotation
 //! about the line through collinear sources) are an error.
 
-use nalgebra::{Matrix3, Matrix6, SMatrix, Vector3};
+use nalgebra::{Matrix3, Matrix6, Vector3};
 
-use super::error::FeError;
-use super::mesh::DOF_PER_NODE;
-use super::mesh::{InterpolationLink, Mesh, RigidLink};
-use super::nodal_frames;
-
-/// One dependent DOF expressed through other DOFs.
-#[derive(Debug, Clone, PartialEq)]
-pub struct LinkEquation {
-    /// Dependent slot `node * 6 + dof`.
-    pub dependent: usize,
-    /// `(slot, coefficient)` terms; the referenced slots may themselves be dependent.
-    pub terms: Vec<(usize, f64)>,
-    /// The link that produced the equation, for error messages ("rigid link 3").
-    pub origin: String,
-}
+pub use super::element::LinkEquation;
 
 /// Rigid map from the motion (u, θ) of a point to the motion of a point at offset `d` from it:
 /// u' = u + θ × d = u − [d]× θ, θ' = θ.
-fn rigid_map(d: &Vector3<f64>) -> Matrix6<f64> {
+pub(crate) fn rigid_map(d: &Vector3<f64>) -> Matrix6<f64> {
     let mut s = Matrix6::identity();
     let skew = Matrix3::new(0.0, -d.z, d.y, d.z, 0.0, -d.x, -d.y, d.x, 0.0);
     s.fixed_view_mut::<3, 3>(0, 3).copy_from(&(-skew));
     s
 }
 
-fn rigid_equations(
-    mesh: &Mesh,
-    index: usize,
-    link: &RigidLink,
-) -> Result<Vec<LinkEquation>, FeError> {
-    let origin = format!("rigid link {index}");
-    let xi = mesh.position(&origin, link.independent)?;
-    let mut out = Vec::new();
-    for &dep in &link.dependent {
-        if dep == link.independent {
-            return Err(FeError::Mesh(format!(
-                "{origin}: node {dep} is both independent and dependent"
-            )));
-        }
-        // Components on nodes with a displacement frame (GRID CD) are the node's own: the
-        // dependent's listed components in its frame, the independent's six in its frame.
-        let s = nodal_frames::node_block(&mesh.displacement_frames, dep).transpose()
-            * rigid_map(&(mesh.position(&origin, dep)? - xi))
-            * nodal_frames::node_block(&mesh.displacement_frames, link.independent);
-        for (row, _) in link.components.iter().enumerate().filter(|(_, on)| **on) {
-            let terms = (0..DOF_PER_NODE)
-                .filter(|&col| s[(row, col)] != 0.0)
-                .map(|col| (link.independent * DOF_PER_NODE + col, s[(row, col)]))
-                .collect();
-            out.push(LinkEquation {
-                dependent: dep * DOF_PER_NODE + row,
-                terms,
-                origin: origin.clone(),
-            });
-        }
-    }
-    Ok(out)
-}
-
-const DOF_NAMES: [&str; 6] = ["ux", "uy", "uz", "rx", "ry", "rz"];
-
-/// Long on purpose: one RBE3 formulation (weights, centroid, rigid-body projection, dependent DOFs) in Nastran's order.
-fn interpolation_equations(
-    mesh: &Mesh,
-    index: usize,
-    link: &InterpolationLink,
-) -> Result<Vec<LinkEquation>, FeError> {
-    let origin = format!("interpolation link {index}");
-    let xr = mesh.position(&origin, link.reference)?;
-    let mut sources = Vec::new();
-    for group in &link.sources {
-        if !(group.weight.is_finite() && group.weight > 0.0) {
-            return Err(FeError::InvalidInput(format!(
-                "{origin}: weight must be finite and > 0, got {}",
-                group.weight
-            )));
-        }
-        if !group.components.iter().any(|c| *c) {
-            return Err(FeError::InvalidInput(format!(
-                "{origin}: a source group lists no components"
-            )));
-        }
-        for &node in &group.nodes {
-            if node == link.reference {
-                return Err(FeError::Mesh(format!(
-                    "{origin}: reference node {node} is also a source node"
-                )));
-            }
-            sources.push((node, mesh.position(&origin, node)? - xr, group));
-        }
-    }
-    if sources.is_empty() {
-        return Err(FeError::InvalidInput(format!("{origin}: no source nodes")));
-    }
-    let mean_distance =
-        sources.iter().map(|(_, d, _)| d.norm()).sum::<f64>() / sources.len() as f64;
-    let length = if mean_distance > 0.0 {
-        mean_distance
-    } else {
-        1.0
-    };
-    let weight_of = |group: &super::mesh::InterpolationSource, c: usize| {
-        if !group.components[c] {
-            0.0
-        } else if c < 3 {
-            group.weight
-        } else {
-            group.weight * length * length
-        }
-    };
-    // Source components are those of each source node's displacement frame (GRID CD):
-    // Sⱼ maps the reference's global motion to them; the reference's own components are
-    // B_refᵀ times its global motion.
-    let frames = &mesh.displacement_frames;
-    let source_map = |node: usize, d: &Vector3<f64>| {
-        nodal_frames::node_block(frames, node).transpose() * rigid_map(d)
-    };
-    let to_reference = nodal_frames::node_block(frames, link.reference).transpose();
-    let mut normal = Matrix6::<f64>::zeros();
-    for (node, d, group) in &sources {
-        let s = source_map(*node, d);
-        let w = Matrix6::from_diagonal(&SMatrix::<f64, 6, 1>::from_fn(|c, _| weight_of(group, c)));
-        normal += s.transpose() * w * s;
-    }
-    // Pseudo-inverse: reference components in the null space are reported below rather than
-    // silently set to zero.
-    let eig = normal.symmetric_eigen();
-    let largest = eig.eigenvalues.amax();
-    let mut pinv = Matrix6::<f64>::zeros();
-    for k in 0..6 {
-        let v = eig.eigenvectors.column(k);
-        if eig.eigenvalues[k] > 1e-10 * largest {
-            pinv += v * v.transpose() / eig.eigenvalues[k];
-        } else {
-            let v = to_reference * v;
-            for (c, _) in link
-                .reference_components
-                .iter()
-                .enumerate()
-                .filter(|(_, on)| **on)
-            {
-                if v[c].abs() > 1e-6 {
-                    return Err(FeError::Mesh(format!(
-                        "{origin}: reference component {} of node {} is not determined by the \
-                         source nodes and components (collinear or too few sources)",
-                        DOF_NAMES[c], link.reference
-                    )));
-                }
-            }
-        }
-    }
-    let pinv = to_reference * pinv;
-    let mut out = Vec::new();
-    for (row, _) in link
-        .reference_components
-        .iter()
-        .enumerate()
-        .filter(|(_, on)| **on)
-    {
-        let mut terms = Vec::new();
-        for (node, d, group) in &sources {
-            let s = source_map(*node, d);
-            // Row `row` of pinv · Sⱼᵀ Wⱼ: the coefficient of each source component.
-            let coupling = pinv.row(row) * s.transpose();
-            for c in 0..DOF_PER_NODE {
-                let coefficient = coupling[c] * weight_of(group, c);
-                if coefficient != 0.0 {
-                    terms.push((node * DOF_PER_NODE + c, coefficient));
-                }
-            }
-        }
-        out.push(LinkEquation {
-            dependent: link.reference * DOF_PER_NODE + row,
-            terms,
-            origin: origin.clone(),
-        });
-    }
-    Ok(out)
-}
-
-/// All constraint equations of the rigid and interpolation links of `mesh`.
-pub fn equations(mesh: &Mesh) -> Result<Vec<LinkEquation>, FeError> {
-    let mut out = Vec::new();
-    for (i, link) in mesh.rigid_links.iter().enumerate() {
-        out.extend(rigid_equations(mesh, i, link)?);
-    }
-    for (i, link) in mesh.interpolation_links.iter().enumerate() {
-        out.extend(interpolation_equations(mesh, i, link)?);
-    }
-    Ok(out)
-}
-
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::fe::assembly::link_equations as equations;
+    use crate::fe::element::LinkEquation;
     use crate::fe::mesh::InterpolationSource;
+    use crate::fe::mesh::{InterpolationLink, Mesh, RigidLink};
+    use crate::fe::nodal_frames;
+    use nalgebra::SMatrix;
 
     fn evaluate(eq: &LinkEquation, u: &dyn Fn(usize) -> f64) -> f64 {
         eq.terms.iter().map(|&(slot, c)| c * u(slot)).sum()

@@ -12,22 +12,33 @@
 //!
 //! Rigid and interpolation links (RBE2/RBE3, [`links`]) are eliminated exactly in assembly.
 //!
-//! Elements: [`beam`] (Timoshenko or Euler-Bernoulli, 12 DOF, HRZ-lumped mass), [`shell`] (QM6
-//! membrane with Hughes–Brezzi drilling rotation + MITC4 plate, lumped mass), [`shell3`] (CST
-//! membrane + DKT plate), [`section`] (general shell sections), [`solid`] (tetrahedra, wedge,
-//! hexahedron; consistent mass), [`mass`] (point mass with rotary inertia), [`spring`] (grounded
-//! and two-node spring-dampers).
+//! Every kind of mesh entity implements one trait, [`element::Element`] (its nodes, matrices or
+//! constraint equations, shape checks and bulk data cards), in its own file, and is listed once
+//! in the registry [`elements`]; assembly, the checks and the deck writer loop over the
+//! registry. Kinds: [`beam`] (Timoshenko or Euler-Bernoulli, 12 DOF, HRZ-lumped mass),
+//! [`shell`] (QM6 membrane with Hughes–Brezzi drilling rotation + MITC4 plate, lumped mass),
+//! [`shell3`] (CST membrane + DKT plate), [`solid`] (tetrahedra, wedge, hexahedron; consistent
+//! mass), [`mass`] (point mass with rotary inertia), [`ground_spring`] and [`spring`]
+//! (spring-dampers to ground and between two nodes), [`bush`] (spring-dampers in their own
+//! axes), [`rigid_link`] and [`interpolation_link`]; [`section`] holds the materials and general
+//! shell sections they use.
 
 pub mod assembly;
 pub mod beam;
+pub mod bush;
 pub mod checks;
 pub mod dof;
+pub mod element;
+pub mod elements;
 pub mod error;
 pub mod export;
+pub mod ground_spring;
+pub mod interpolation_link;
 pub mod links;
 pub mod mass;
 pub mod mesh;
 pub mod nodal_frames;
+pub mod rigid_link;
 pub mod section;
 pub mod shell;
 pub mod shell3;

@@ -7,8 +7,11 @@
 
 use nalgebra::{Matrix2, Matrix3, SMatrix, Vector3};
 
+use super::element::{
+    BulkWriter, CheckLimits, Element, ElementMatrices, Field, Finding, ShapeTest,
+};
 use super::error::{require_non_negative, require_positive, FeError};
-use super::mesh::Shell;
+use super::mesh::{Material, Mesh, Shell};
 pub use super::section::ShellSection;
 use super::section::SHEAR_CORRECTION;
 
@@ -410,6 +413,211 @@ pub fn lumped_mass(index: usize, shell: &Shell, p: &[Vector3<f64>; 4]) -> Result
         }
         None => Ok(m),
     }
+}
+
+impl Element for Shell {
+    const NAME: &'static str = "shell";
+
+    fn nodes(&self) -> Vec<usize> {
+        self.nodes.to_vec()
+    }
+
+    fn matrices(&self, index: usize, mesh: &Mesh) -> Result<ElementMatrices, FeError> {
+        let what = format!("shell {index}");
+        let p = [
+            mesh.position(&what, self.nodes[0])?,
+            mesh.position(&what, self.nodes[1])?,
+            mesh.position(&what, self.nodes[2])?,
+            mesh.position(&what, self.nodes[3])?,
+        ];
+        Ok(ElementMatrices::stiffness_and_mass(
+            &stiffness(index, self, &p)?,
+            &lumped_mass(index, self, &p)?,
+        ))
+    }
+
+    /// Refused: repeated corners, a geometry the element cannot be formed on, an area below
+    /// the limit, an inverted corner; the poor-shape tests (warp and Jacobian ratio, and when
+    /// poor shapes are only counted taper and skew) are findings of their own.
+    fn check_shape(
+        &self,
+        index: usize,
+        _mesh: &Mesh,
+        points: &[Vector3<f64>],
+        limits: &CheckLimits,
+    ) -> Vec<Finding> {
+        let mut distinct = self.nodes.to_vec();
+        distinct.sort_unstable();
+        distinct.dedup();
+        if distinct.len() < 4 {
+            return vec![Finding::RepeatedNode];
+        }
+        let corners = [points[0], points[1], points[2], points[3]];
+        let g = match geometry(index, &corners) {
+            Err(e) => return vec![Finding::Wrong(without_index(&e, "shell", index))],
+            Ok(g) => g,
+        };
+        if g.area < limits.min_shell_area {
+            return vec![Finding::Wrong(format!(
+                "degenerate (area {:.3e} m²)",
+                g.area
+            ))];
+        }
+        if g.jacobian_ratio <= 0.0 {
+            return vec![Finding::Wrong(format!(
+                "inverted or degenerate (corner Jacobian ratio {:.3} ≤ 0: a corner angle of \
+                 180° or more; check the corner order)",
+                g.jacobian_ratio
+            ))];
+        }
+        let mut found = Vec::new();
+        if g.warp > limits.max_warp {
+            found.push(Finding::Poor(ShapeTest::Warp, g.warp));
+        }
+        if g.jacobian_ratio < limits.min_jacobian_ratio {
+            found.push(Finding::Poor(ShapeTest::JacobianRatio, g.jacobian_ratio));
+        }
+        let (taper, skew) = taper_and_skew(&corners);
+        if limits.max_taper.is_some_and(|t| taper > t) {
+            found.push(Finding::Poor(ShapeTest::Taper, taper));
+        }
+        if limits.min_skew_angle_deg.is_some_and(|s| skew < s) {
+            found.push(Finding::Poor(ShapeTest::Skew, skew));
+        }
+        found
+    }
+
+    fn write_bulk(
+        &self,
+        index: usize,
+        _mesh: &Mesh,
+        deck: &mut dyn BulkWriter,
+    ) -> Result<(), FeError> {
+        let sheet = [
+            self.thickness,
+            self.bending_thickness,
+            self.extra_mass_per_area,
+        ];
+        let what = format!("shell {index}");
+        write_sheet(
+            deck,
+            "CQUAD4",
+            &what,
+            &self.material,
+            sheet,
+            self.section.as_deref(),
+            &self.nodes,
+        )
+    }
+}
+
+/// `e`'s message without the `"{name} {index}: "` the element code puts in front (the caller
+/// names the element itself).
+pub(crate) fn without_index(e: &FeError, name: &str, index: usize) -> String {
+    let (FeError::Mesh(m) | FeError::InvalidInput(m) | FeError::Numerical(m) | FeError::Io(m)) = e;
+    m.strip_prefix(&format!("{name} {index}: "))
+        .unwrap_or(m)
+        .to_string()
+}
+
+/// Taper (1 − 2·smallest corner triangle / area) and skew angle (degrees, between the lines
+/// joining midpoints of opposite sides) of a quadrilateral.
+fn taper_and_skew(p: &[Vector3<f64>; 4]) -> (f64, f64) {
+    let area = 0.5 * (p[2] - p[0]).cross(&(p[3] - p[1])).norm();
+    let corner = |i: usize| {
+        let (a, b, c) = (p[(i + 3) % 4], p[i], p[(i + 1) % 4]);
+        0.5 * (a - b).cross(&(c - b)).norm()
+    };
+    let smallest = (0..4).map(corner).fold(f64::INFINITY, f64::min);
+    let taper = 1.0 - 2.0 * smallest / area;
+    let m = |i: usize| (p[i] + p[(i + 1) % 4]) / 2.0;
+    let (u, v) = (m(2) - m(0), m(3) - m(1));
+    let cos = (u.dot(&v) / (u.norm() * v.norm())).abs().min(1.0);
+    (taper, cos.acos().to_degrees())
+}
+
+/// A CQUAD4 or CTRIA3 (`card`) of an isotropic sheet `[thickness, bending thickness,
+/// non-structural mass]` with its PSHELL and MAT1, with THETA and ZOFFS when the sheet is
+/// offset.
+pub(crate) fn write_sheet(
+    deck: &mut dyn BulkWriter,
+    card: &str,
+    what: &str,
+    material: &Material,
+    sheet: [f64; 3],
+    section: Option<&ShellSection>,
+    nodes: &[usize],
+) -> Result<(), FeError> {
+    let placement = placement(what, material, sheet, section)?;
+    let [t, bending_t, nsm] = sheet;
+    // PSHELL with MID1 = MID2 = MID3, so Nastran also includes transverse shear, like the
+    // four-node shell.
+    let mid = deck.material(material)?;
+    let ratio = (bending_t / t).powi(3);
+    // The mesh's sheet shears over 5/6 of its bending thickness, Nastran over TS/T·T.
+    let ts_t = 5.0 / 6.0 * bending_t / t;
+    let pid = deck.property("PSHELL", &[mid as f64, t, ratio, nsm], &|pid| {
+        vec![
+            Field::Int(pid),
+            Field::Int(mid),
+            Field::Real(t),
+            Field::Int(mid),
+            Field::Real(ratio),
+            Field::Int(mid),
+            Field::Real(ts_t),
+            Field::Real(nsm),
+        ]
+    })?;
+    let mut fields = vec![deck.element_id(), Field::Int(pid)];
+    for &n in nodes {
+        fields.push(deck.grid(what, n)?);
+    }
+    if let Some([theta, zoffs]) = placement {
+        fields.push(Field::Real(theta.to_degrees()));
+        fields.push(Field::Real(zoffs));
+    }
+    deck.card(card, &fields)
+}
+
+/// THETA (rad) and ZOFFS of a sheet with a section, `None` without one.
+///
+/// The writer emits isotropic PSHELL/MAT1 sheets only, so a section is written when it is that
+/// sheet placed by an offset and a material angle (what production decks carry: panels meshed on
+/// a surface rather than the mid-plane); a general section (MAT2/MAT8, separate bending or shear
+/// materials) would be written wrong, so it is refused. The comparison allows rounding (1e-12 of
+/// each matrix's largest entry) since a section read from a deck is built in another order.
+fn placement(
+    what: &str,
+    material: &Material,
+    [t, bending_t, _]: [f64; 3],
+    section: Option<&ShellSection>,
+) -> Result<Option<[f64; 2]>, FeError> {
+    let Some(section) = section else {
+        return Ok(None);
+    };
+    let sheet = ShellSection::isotropic(material, t, bending_t);
+    let close = |a: &[f64], b: &[f64], tol: f64| {
+        let scale = b.iter().fold(0.0_f64, |m, v| m.max(v.abs()));
+        a.iter().zip(b).all(|(x, y)| (x - y).abs() <= tol * scale)
+    };
+    // Nastran's default TS/T is 0.833333, 5/6 to 4e-7: the reader also takes it as the sheet's.
+    let shear = match (&section.transverse_shear, &sheet.transverse_shear) {
+        (Some(a), Some(b)) => close(a.as_slice(), b.as_slice(), 1e-5),
+        _ => false,
+    };
+    if !(close(
+        section.membrane.as_slice(),
+        sheet.membrane.as_slice(),
+        1e-12,
+    ) && close(section.bending.as_slice(), sheet.bending.as_slice(), 1e-12)
+        && shear)
+    {
+        return Err(FeError::InvalidInput(format!(
+            "{what}: shells with a general section (anisotropic materials, separate bending or \
+             shear material) are not written; an isotropic sheet with an offset is"
+        )));
+    }
+    Ok(Some([section.material_angle, section.offset]))
 }
 
 #[cfg(test)]

@@ -13,9 +13,10 @@
 
 use nalgebra::{Matrix3, SMatrix, Vector3};
 
+use super::element::{BulkWriter, CheckLimits, Element, ElementMatrices, Finding};
 use super::error::{require_non_negative, require_positive, FeError};
-use super::mesh::TriShell;
-use super::shell::{apply_offset, rotate_plane, DRILLING_FACTOR};
+use super::mesh::{Mesh, TriShell};
+use super::shell::{apply_offset, rotate_plane, without_index, write_sheet, DRILLING_FACTOR};
 
 /// 18 × 18 element matrix, DOF order (ux uy uz rx ry rz) per corner node.
 pub type Mat18 = SMatrix<f64, 18, 18>;
@@ -296,6 +297,67 @@ pub fn lumped_mass(index: usize, tri: &TriShell, p: &[Vector3<f64>; 3]) -> Resul
             Ok(to_global(&m, &frame))
         }
         None => Ok(m),
+    }
+}
+
+impl Element for TriShell {
+    const NAME: &'static str = "triangle";
+
+    fn nodes(&self) -> Vec<usize> {
+        self.nodes.to_vec()
+    }
+
+    fn matrices(&self, index: usize, mesh: &Mesh) -> Result<ElementMatrices, FeError> {
+        let what = format!("triangle {index}");
+        let p = [
+            mesh.position(&what, self.nodes[0])?,
+            mesh.position(&what, self.nodes[1])?,
+            mesh.position(&what, self.nodes[2])?,
+        ];
+        Ok(ElementMatrices::stiffness_and_mass(
+            &stiffness(index, self, &p)?,
+            &lumped_mass(index, self, &p)?,
+        ))
+    }
+
+    fn check_shape(
+        &self,
+        index: usize,
+        _mesh: &Mesh,
+        points: &[Vector3<f64>],
+        limits: &CheckLimits,
+    ) -> Vec<Finding> {
+        match geometry(index, &[points[0], points[1], points[2]]) {
+            Err(e) => vec![Finding::Wrong(without_index(&e, "triangle", index))],
+            Ok(g) if g.area < limits.min_shell_area => vec![Finding::Wrong(format!(
+                "degenerate (area {:.3e} m²)",
+                g.area
+            ))],
+            Ok(_) => Vec::new(),
+        }
+    }
+
+    fn write_bulk(
+        &self,
+        index: usize,
+        _mesh: &Mesh,
+        deck: &mut dyn BulkWriter,
+    ) -> Result<(), FeError> {
+        let sheet = [
+            self.thickness,
+            self.bending_thickness,
+            self.extra_mass_per_area,
+        ];
+        let what = format!("triangle {index}");
+        write_sheet(
+            deck,
+            "CTRIA3",
+            &what,
+            &self.material,
+            sheet,
+            self.section.as_deref(),
+            &self.nodes,
+        )
     }
 }
 

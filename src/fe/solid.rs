@@ -32,8 +32,9 @@ use faer::sparse::Triplet;
 use nalgebra::{DMatrix, DVector, Matrix3, Matrix6, Vector3};
 
 use super::dof::{DofMap, DOF_PER_NODE};
+use super::element::LinkEquation;
+use super::element::{BulkWriter, CheckLimits, Element, ElementMatrices, Field, Finding};
 use super::error::FeError;
-use super::links::LinkEquation;
 use super::mesh::{Material, Mesh, Solid};
 
 /// The element formulations, chosen by the number of nodes.
@@ -745,6 +746,61 @@ pub(crate) fn remove_free_rotations(
     };
     let [k, m, c] = triplets;
     Ok((reduced, [renumber(k), renumber(m), renumber(c)]))
+}
+
+impl Element for Solid {
+    const NAME: &'static str = "solid";
+
+    fn nodes(&self) -> Vec<usize> {
+        self.nodes.clone()
+    }
+
+    fn matrices(&self, index: usize, mesh: &Mesh) -> Result<ElementMatrices, FeError> {
+        let (k, m) = assembly_matrices(mesh, index)?;
+        Ok(ElementMatrices {
+            k: Some(k),
+            m: Some(m),
+            c: None,
+        })
+    }
+
+    fn check_shape(
+        &self,
+        _index: usize,
+        _mesh: &Mesh,
+        points: &[Vector3<f64>],
+        _limits: &CheckLimits,
+    ) -> Vec<Finding> {
+        match check_geometry(points) {
+            Err(why) => vec![Finding::Wrong(why)],
+            Ok(_) => Vec::new(),
+        }
+    }
+
+    /// CTETRA / CPENTA / CHEXA with a PSOLID per material (IN, ISOP, FCTN blank: the defaults).
+    fn write_bulk(
+        &self,
+        index: usize,
+        _mesh: &Mesh,
+        deck: &mut dyn BulkWriter,
+    ) -> Result<(), FeError> {
+        let what = format!("solid {index}");
+        let kind = SolidKind::from_node_count(self.nodes.len()).ok_or_else(|| {
+            FeError::Mesh(format!(
+                "{what}: {} nodes (4, 6, 8 or 10)",
+                self.nodes.len()
+            ))
+        })?;
+        let mid = deck.material(&self.material)?;
+        let pid = deck.property("PSOLID", &[mid as f64], &|pid| {
+            vec![Field::Int(pid), Field::Int(mid)]
+        })?;
+        let mut fields = vec![deck.element_id(), Field::Int(pid)];
+        for &n in &self.nodes {
+            fields.push(deck.grid(&what, n)?);
+        }
+        deck.card(kind.card(), &fields)
+    }
 }
 
 #[cfg(test)]

@@ -1,31 +1,21 @@
-//! Grounded and two-node spring-dampers, uncoupled per global DOF.
+//! Two-node spring-dampers acting on the relative displacement, uncoupled per DOF of the nodes
+//! (Nastran CELAS/CDAMP between two grids, merged per node pair), and what scalar springs share
+//! with [`super::ground_spring`]: their checks and their cards.
 
-use nalgebra::{DMatrix, Matrix3, SMatrix, Vector3};
+use nalgebra::SMatrix;
 
+use super::element::{BulkWriter, Element, ElementMatrices, Field};
 use super::error::{require_non_negative, FeError};
-use super::mesh::{Bush, GroundSpring, Spring};
+use super::mesh::{Mesh, Spring};
+use super::nodal_frames;
 
-fn validate(what: &str, k: &[f64; 6], c: &[f64; 6]) -> Result<(), FeError> {
+/// Checks the six stiffnesses and dampings of a spring-damper `what`.
+pub(crate) fn validate(what: &str, k: &[f64; 6], c: &[f64; 6]) -> Result<(), FeError> {
     for d in 0..6 {
         require_non_negative(&format!("{what}: stiffness[{d}]"), k[d])?;
         require_non_negative(&format!("{what}: damping[{d}]"), c[d])?;
     }
     Ok(())
-}
-
-/// Diagonal 6 × 6 stiffness and damping of a spring to ground.
-pub fn ground_matrices(
-    index: usize,
-    s: &GroundSpring,
-) -> Result<(SMatrix<f64, 6, 6>, SMatrix<f64, 6, 6>), FeError> {
-    validate(&format!("ground spring {index}"), &s.stiffness, &s.damping)?;
-    let mut k = SMatrix::<f64, 6, 6>::zeros();
-    let mut c = SMatrix::<f64, 6, 6>::zeros();
-    for d in 0..6 {
-        k[(d, d)] = s.stiffness[d];
-        c[(d, d)] = s.damping[d];
-    }
-    Ok((k, c))
 }
 
 /// 12 × 12 stiffness and damping of a two-node spring acting on the relative displacement.
@@ -50,43 +40,61 @@ pub fn two_node_matrices(
     Ok((k, c))
 }
 
-/// Stiffness and damping of a bush (6 × 6 to ground, 12 × 12 between `a` and `b`, node order
-/// a, b): Bᵀ diag(k) B with B the relative motion at the spring point in element axes,
-/// u(p) = u_n + θ_n × (p − x_n) for each end n.
-pub fn bush_matrices(
-    index: usize,
-    bush: &Bush,
-    xa: &Vector3<f64>,
-    xb: Option<&Vector3<f64>>,
-) -> Result<(DMatrix<f64>, DMatrix<f64>), FeError> {
-    let what = format!("bush {index}");
-    validate(&what, &bush.stiffness, &bush.damping)?;
-    let r = &bush.frame;
-    if (r.transpose() * r - Matrix3::identity()).abs().max() > 1e-9 {
-        return Err(FeError::InvalidInput(format!(
-            "{what}: frame is not orthonormal"
-        )));
+impl Element for Spring {
+    const NAME: &'static str = "spring";
+
+    fn nodes(&self) -> Vec<usize> {
+        self.nodes.to_vec()
     }
-    // Rows: element components of the motion of the spring point due to one end's six DOFs.
-    let carried = |x: &Vector3<f64>| {
-        let mut t = DMatrix::<f64>::zeros(6, 6);
-        let lever = -r.transpose() * (bush.point - x).cross_matrix();
-        t.view_mut((0, 0), (3, 3)).copy_from(&r.transpose());
-        t.view_mut((0, 3), (3, 3)).copy_from(&lever);
-        t.view_mut((3, 3), (3, 3)).copy_from(&r.transpose());
-        t
-    };
-    let b = match xb {
-        None => carried(xa),
-        Some(xb) => {
-            let mut b = DMatrix::<f64>::zeros(6, 12);
-            b.view_mut((0, 0), (6, 6)).copy_from(&(-carried(xa)));
-            b.view_mut((0, 6), (6, 6)).copy_from(&carried(xb));
-            b
+
+    /// Scalar springs act on node components (GRID CD): carried to global axes so that
+    /// scattering through the DOF map gives them back on the components.
+    fn matrices(&self, index: usize, mesh: &Mesh) -> Result<ElementMatrices, FeError> {
+        let what = format!("spring {index}");
+        mesh.position(&what, self.nodes[0])?;
+        mesh.position(&what, self.nodes[1])?;
+        let (ks, cs) = two_node_matrices(index, self)?;
+        let frames = &mesh.displacement_frames;
+        Ok(ElementMatrices::stiffness_and_damping(
+            &nodal_frames::to_global_axes(frames, &self.nodes, &ks),
+            &nodal_frames::to_global_axes(frames, &self.nodes, &cs),
+        ))
+    }
+
+    fn write_bulk(
+        &self,
+        index: usize,
+        _mesh: &Mesh,
+        deck: &mut dyn BulkWriter,
+    ) -> Result<(), FeError> {
+        let what = format!("spring {index}");
+        let ends = [
+            deck.grid(&what, self.nodes[0])?,
+            deck.grid(&what, self.nodes[1])?,
+        ];
+        write_scalar(deck, &ends, &self.stiffness, &self.damping)
+    }
+}
+
+/// CELAS2 and CDAMP2 of the non-zero components of a spring-damper between `grids` (one
+/// grid: to ground).
+pub(crate) fn write_scalar(
+    deck: &mut dyn BulkWriter,
+    grids: &[Field],
+    stiffness: &[f64; 6],
+    damping: &[f64; 6],
+) -> Result<(), FeError> {
+    for d in 0..6 {
+        for (name, value) in [("CELAS2", stiffness[d]), ("CDAMP2", damping[d])] {
+            if value != 0.0 {
+                let mut fields = vec![deck.element_id(), Field::Real(value)];
+                for &g in grids {
+                    fields.push(g);
+                    fields.push(Field::Int(d as u64 + 1));
+                }
+                deck.card(name, &fields)?;
+            }
         }
-    };
-    let diag = |v: &[f64; 6]| DMatrix::from_diagonal(&nalgebra::DVector::from_row_slice(v));
-    let k = b.transpose() * diag(&bush.stiffness) * &b;
-    let c = b.transpose() * diag(&bush.damping) * &b;
-    Ok((k, c))
+    }
+    Ok(())
 }

@@ -4,9 +4,9 @@
 //! and the work both standards share behind their own signatures: reading and writing values
 //! at resolved positions, and the FMU-state functions.
 //!
-//! Each ABI describes itself once, as an [`Abi`]: its live marker, how it names its phases and
-//! functions, and whether every refusal leads to the error state (FMI 3.0) or leaves the phase
-//! as it was (FMI 2.0).
+//! Each ABI describes itself once, as an [`Abi`] ([`super::abi`]): its live marker, how it names
+//! its phases and functions, and whether every refusal leads to the error state (FMI 3.0) or
+//! leaves the phase as it was (FMI 2.0).
 
 use std::cell::UnsafeCell;
 use std::ffi::{c_char, c_void, CString};
@@ -14,6 +14,7 @@ use std::panic::{catch_unwind, AssertUnwindSafe};
 use std::path::PathBuf;
 use std::sync::atomic::{AtomicBool, AtomicU64, Ordering};
 
+pub use super::abi::{guid, model_identifier, Abi, FunctionNames};
 use super::c_args::{array, array_mut, place, text};
 use super::fmu_states::FmuStates;
 use super::instance::{Instance, Outcome, Status};
@@ -21,51 +22,7 @@ use super::logger::{Level, Logger};
 use super::snapshot;
 use super::state::{Mask, Phase};
 use super::values::{Slot, Typed};
-use crate::cosim::FmuKind;
-use crate::variables::{
-    string, LogCategory, BODY_GUID, BODY_MODEL_IDENTIFIER, GUID, MODEL_IDENTIFIER, STRINGS,
-};
-
-/// The names of an ABI's functions that the runtime's messages mention.
-#[derive(Debug)]
-pub struct FunctionNames {
-    /// Instantiation (`fmi2Instantiate`, `fmi3InstantiateCoSimulation`).
-    pub instantiate: &'static str,
-    /// Freeing an instance.
-    pub free_instance: &'static str,
-    /// Where the experiment's tolerance comes from (`fmi2SetupExperiment`,
-    /// `fmi3EnterInitializationMode`).
-    pub setup_experiment: &'static str,
-    /// Leaving initialisation mode.
-    pub exit_initialization: &'static str,
-    /// A communication step.
-    pub do_step: &'static str,
-    /// Restoring an FMU state.
-    pub set_fmu_state: &'static str,
-}
-
-/// What the runtime needs to know of the standard an instance was created through.
-#[derive(Debug)]
-pub struct Abi {
-    /// Marks a live instance of this standard; another value than the other standard's, so an
-    /// instance of one standard is never used through the other.
-    pub live: u64,
-    /// The FMUs this ABI instantiates.
-    pub kinds: &'static [FmuKind],
-    /// Its word for the instantiation token (`GUID`, `instantiation token`).
-    pub token: &'static str,
-    /// Its word for the resources argument (`resource location`, `resource path`).
-    pub resources: &'static str,
-    /// FMI 3.0: every call answered with an error leads to [`Phase::Error`]; FMI 2.0 leaves
-    /// the phase of a refused call as it was.
-    pub errors_enter_error_state: bool,
-    /// How the standard names the phases, for messages.
-    pub phase_name: fn(Phase) -> &'static str,
-    /// What to do in the error state, said when a call is refused there.
-    pub error_state_hint: &'static str,
-    /// Function names for messages.
-    pub names: FunctionNames,
-}
+use crate::variables::{string, LogCategory, STRINGS};
 
 /// What the pointer both ABIs hand out points to: the instance's handle behind a flag that
 /// admits one call at a time.
@@ -343,22 +300,6 @@ pub fn instantiate(
         Box::into_raw(shell) as *mut c_void
     }));
     result.unwrap_or(std::ptr::null_mut())
-}
-
-/// The GUID (FMI 3.0: instantiation token) of an FMU of this library.
-pub fn guid(kind: FmuKind) -> &'static str {
-    match kind {
-        FmuKind::Engine => GUID,
-        FmuKind::Body => BODY_GUID,
-    }
-}
-
-/// The `modelIdentifier` of an FMU of this library.
-pub fn model_identifier(kind: FmuKind) -> &'static str {
-    match kind {
-        FmuKind::Engine => MODEL_IDENTIFIER,
-        FmuKind::Body => BODY_MODEL_IDENTIFIER,
-    }
 }
 
 /// Frees the instance behind `ptr` and every FMU state it handed out. A null or already freed

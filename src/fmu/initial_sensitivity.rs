@@ -10,6 +10,7 @@
 //! the initialisation, one column per input and cached until a value changes: the equilibrium is
 //! solved to round-off, and FMI 2.0 §2.1.9 permits numerical differentiation.
 
+use super::bindings;
 use super::instance::Instance;
 use super::parameters;
 use super::values::Num;
@@ -65,7 +66,7 @@ impl Instance {
             .map_err(|e| parameters::message(&e))?;
         let outputs = runtime.outputs().map_err(|e| parameters::message(&e))?;
         let mut reals = self.core.values.reals.clone();
-        parameters::put_outputs(&mut reals, &outputs);
+        bindings::put_outputs(&mut reals, &outputs);
         Ok(reals.as_slice().to_vec())
     }
 }

@@ -10,7 +10,8 @@
 use std::collections::BTreeMap;
 use std::path::PathBuf;
 
-use super::guard::{self, Abi};
+use super::abi::{self, Abi};
+use super::bindings;
 use super::input_track::InputTrack;
 use super::logger::{Level, Logger};
 use super::parameters::{self, Calculated};
@@ -192,7 +193,7 @@ impl Instance {
 
     /// The GUID of this instance's FMU.
     pub fn guid(&self) -> &'static str {
-        guard::guid(self.kind)
+        abi::guid(self.kind)
     }
 
     /// The bit of this instance's FMU in [`Variable::fmus`].
@@ -214,7 +215,7 @@ impl Instance {
                     "value reference {} ({}) is not a variable of {}",
                     v.vr,
                     v.name,
-                    guard::model_identifier(self.kind)
+                    abi::model_identifier(self.kind)
                 ))
             }
             None => Ok(()),
@@ -559,7 +560,7 @@ impl Instance {
         let outputs = runtime
             .outputs_with(&interface)
             .map_err(|e| parameters::message(&e))?;
-        parameters::put_outputs(&mut self.core.values.reals, &outputs);
+        bindings::put_outputs(&mut self.core.values.reals, &outputs);
         Ok(())
     }
 
@@ -654,7 +655,7 @@ impl Instance {
             .input_sensitivities(&at, &seed)
             .map_err(|e| parameters::message(&e))?;
         let mut scratch = self.core.values.reals.clone();
-        parameters::put_outputs(&mut scratch, &response);
+        bindings::put_outputs(&mut scratch, &response);
         Ok(unknowns.iter().map(|&u| *scratch.get(u as u32)).collect())
     }
 

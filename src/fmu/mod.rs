@@ -6,14 +6,16 @@
 //! - [`guard`]: the handle a master holds, the one guard every exported function passes
 //!   ([`guard::Abi::entry`]: instance pointer, liveness marker, state mask, panics), instantiation
 //!   and freeing, and the work both standards share behind their signatures (values at resolved
-//!   positions, FMU states). Each ABI describes itself as a [`guard::Abi`].
+//!   positions, FMU states).
+//! - [`abi`]: each ABI's description of itself ([`abi::Abi`]) and the FMU's GUID and model
+//!   identifier, which the instance and the guard read.
 //! - [`state`]: the one co-simulation state type of both standards and the masks of phases.
 //! - [`instance`]: one instance: life cycle, reading and writing variables, FMU states;
 //!   [`step`]: a communication step; [`initial_sensitivity`]: directional derivatives of the
 //!   initialisation.
 //! - [`values`]: the variable values, one store generic over the four types.
 //! - [`parameters`]: the one mapping between FMU variables and the co-simulation runtime's typed
-//!   settings, inputs and errors.
+//!   settings, inputs and errors; [`bindings`]: the outputs, bound from the variable table.
 //! - [`input_track`]: how the values and derivatives a master sets become input signals.
 //! - [`logger`], [`snapshot`], [`fmu_states`]: logging through the environment's callback, the
 //!   serialized FMU state, and the FMU states an instance handed out.
@@ -21,6 +23,8 @@
 //!
 //! No physics lives here: the model is driven through [`crate::cosim::Runtime`].
 
+pub mod abi;
+pub mod bindings;
 pub mod c_args;
 pub mod fmu_states;
 pub mod guard;

@@ -16,7 +16,7 @@ use crate::cosim::{
 use crate::model::inputs::AttachmentMotion;
 use crate::model::{ModelInputs, RampInput};
 use crate::variables::{
-    boolean, integer, real, string, Parameters, BOOLEANS, INTEGERS, REALS, STRINGS,
+    boolean, integer, real, string, units, Parameters, BOOLEANS, INTEGERS, REALS, STRINGS,
 };
 
 /// The Boolean parameter of an effect switch.
@@ -31,9 +31,6 @@ fn effect_parameter(switch: EffectSwitch) -> u32 {
         EffectSwitch::ChassisFlexibility => boolean::EFFECT_CHASSIS_FLEXIBILITY,
     }
 }
-
-/// rpm (the `rpm` input's unit) → rad/s.
-const RPM: f64 = std::f64::consts::PI / 30.0;
 
 /// The settings the parameters in `values` describe, with the vehicle from `config_file`.
 /// Vehicle parameters the master set replace the configuration's values; the others keep them.
@@ -267,7 +264,7 @@ fn inputs_by(ramp: impl Fn(u32, f64) -> RampInput) -> cosim::Inputs {
     let per_mount = |indices: &[u32]| indices.iter().map(|&i| ramp(i, 1.0)).collect();
     let axes = |indices: &[u32; 3]| indices.map(|i| ramp(i, 1.0));
     let mut model = ModelInputs::new(0);
-    model.crank_speed = ramp(real::RPM, RPM);
+    model.crank_speed = ramp(real::RPM, units::RPM);
     model.load_torque = ramp(real::LOAD_TORQUE, 1.0);
     model.stiffness_scale = per_mount(&real::MOUNT_STIFFNESS_SCALE);
     model.damping_scale = per_mount(&real::MOUNT_DAMPING_SCALE);
@@ -282,30 +279,6 @@ fn inputs_by(ramp: impl Fn(u32, f64) -> RampInput) -> cosim::Inputs {
     cosim::Inputs {
         model,
         body_force: real::BODY_MOUNT_F.iter().map(axes).collect(),
-    }
-}
-
-/// Writes the runtime's outputs into the Reals (both FMUs' outputs: each FMU lists its own).
-pub fn put_outputs(r: &mut super::values::Store<f64>, o: &cosim::Outputs) {
-    for (i, mount) in o.mount_force.iter().enumerate() {
-        for (j, f) in mount.iter().enumerate() {
-            r.put(real::MOUNT_F[i][j], *f);
-        }
-    }
-    r.put(real::CRANK_ANGLE, o.crank_angle);
-    for k in 0..3 {
-        r.put(real::POWERTRAIN_R[k], o.powertrain_displacement[k]);
-        r.put(real::POWERTRAIN_PHI[k], o.powertrain_rotation[k]);
-        r.put(real::POWERTRAIN_A[k], o.powertrain_acceleration[k]);
-        r.put(real::STEERING_WHEEL_A[k], o.steering_wheel_acceleration[k]);
-        r.put(real::SEAT_A[k], o.seat_acceleration[k]);
-    }
-    for (i, p) in o.mount_point.iter().enumerate() {
-        for j in 0..3 {
-            r.put(real::BODY_MOUNT_R[i][j], p.displacement[j]);
-            r.put(real::BODY_MOUNT_V[i][j], p.velocity[j]);
-            r.put(real::BODY_MOUNT_A[i][j], p.acceleration[j]);
-        }
     }
 }
 
@@ -354,7 +327,7 @@ fn input_variable(input: Input) -> Option<(u32, f64)> {
         family.get(i).and_then(|m| m.get(j)).map(|&k| (k, 1.0))
     };
     match input {
-        Input::CrankSpeed => Some((real::RPM, 1.0 / RPM)),
+        Input::CrankSpeed => Some((real::RPM, 1.0 / units::RPM)),
         Input::LoadTorque => Some((real::LOAD_TORQUE, 1.0)),
         Input::StiffnessScale(i) => mount(&real::MOUNT_STIFFNESS_SCALE, i),
         Input::DampingScale(i) => mount(&real::MOUNT_DAMPING_SCALE, i),
@@ -490,7 +463,7 @@ mod tests {
     fn messages_name_the_fmu_variables() {
         let e = cosim::Error::Input {
             input: Input::CrankSpeed,
-            value: -100.0 * RPM,
+            value: -100.0 * units::RPM,
             rule: "is negative".into(),
         };
         let m = message(&e);

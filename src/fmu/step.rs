@@ -1,6 +1,7 @@
 //! A communication step (fmi2DoStep, fmi3DoStep): check the step, commit the inputs for it,
 //! advance the simulation, report.
 
+use super::bindings;
 use super::instance::{Instance, Outcome, Status};
 use super::logger::Level;
 use super::parameters;
@@ -231,7 +232,7 @@ impl Instance {
 
     /// Writes the outputs and the solver counters.
     pub(super) fn write_outputs(&mut self, o: &cosim::Outputs, c: &cosim::Counters) {
-        parameters::put_outputs(&mut self.core.values.reals, o);
+        bindings::put_outputs(&mut self.core.values.reals, o);
         let n = &mut self.core.values.integers;
         let clamp = |x: u64| x.min(i32::MAX as u64) as i32;
         n.put(integer::SOLVER_STEPS, clamp(c.steps));

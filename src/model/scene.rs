@@ -323,6 +323,9 @@ pub fn build_body_alone(
 /// What the reduction of the vehicle's body depends on for these options (procedural chassis,
 /// bulk data deck, or Craig-Bampton matrices reduced elsewhere), and a description of the mode
 /// selection for the log.
+///
+/// Long on purpose: one match over the body sources (procedural chassis, deck, reduced
+/// matrices), each arm gathering every input of its reduction, so that the cache key sees them all.
 pub fn reduction_spec(
     vehicle: &VehicleConfig,
     options: &BodyOptions,

@@ -202,6 +202,12 @@ impl Collector {
         Ok(())
     }
 
+    /// A DMIG card: the header (NAME, 0: form, types, NCOL) or one column (GJ, CJ and its
+    /// (GI, CI, value) entries), added to its matrix.
+    ///
+    /// Long on purpose: the header and the column share the field layout and the checks (repeated
+    /// entries, symmetry of a symmetric form against the entry already read); one card is one
+    /// pass over its fields, each error naming the field it is about.
     fn dmig(&mut self, card: &RawCard) -> Result<(), FeError> {
         let (name, _) = Self::field(card, 0);
         if name.is_empty() {

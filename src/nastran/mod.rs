@@ -116,8 +116,10 @@
 //!   set in the file.
 //! - PARAM WTMASS (scales all mass), PARAM POST/GRDPNT/… (output only) and EIGRL/EIGR
 //!   (extraction requests) are accepted; any other card is an error naming card and line and
-//!   listing the supported cards (one table, [`card_table::CARD_TABLE`], which the card dispatch
-//!   uses and the user guide's card table is generated from).
+//!   listing the supported cards (one table, [`card_table::CARD_TABLE`]: each row says how its
+//!   cards are read (the parser in `cards/`, one file per family, and where the card is kept),
+//!   what is refused and which cards the writer writes back; the card dispatch is the table and
+//!   the user guide's card table is generated from it).
 //! - GRIDs that no element, spring, damper, bush, mass or link references (coordinate
 //!   definition grids, leftovers) get no DOFs: all six are constrained, as Nastran's AUTOSPC
 //!   does, and [`NastranBody::unused_grids`] and a note in [`NastranBody::notes`] name them.
@@ -139,7 +141,6 @@ mod dmig;
 mod lexer;
 mod names;
 mod reader;
-mod solid_cards;
 mod to_mesh;
 mod writer;
 
@@ -153,29 +154,26 @@ pub use names::DeckNames;
 pub use reader::{lex, DeckLimits, DeckOptions};
 pub use writer::write_bulk_deck;
 
+use crate::fe::elements::Entity;
 use crate::fe::error::FeError;
 use crate::fe::mesh::Mesh;
 
-/// Nastran ids of the mesh entities, in mesh order (`beams[i]` is the CBAR/CBEAM id of
-/// `mesh.beams[i]`, …). A CONM2/CONM1 with an offset appears in `masses` and in `rigid_links`.
+/// Nastran ids of the mesh entities, by kind in mesh order (`of(Entity::Beam)[i]` is the
+/// CBAR/CBEAM id of `mesh.beams[i]`, …). Merged scalar springs and dampers have none; a
+/// CONM2/CONM1 with an offset appears among the masses and the rigid links.
 #[derive(Debug, Clone, Default, PartialEq)]
-pub struct ElementIds {
-    /// CBAR / CBEAM ids.
-    pub beams: Vec<u32>,
-    /// CQUAD4 ids.
-    pub shells: Vec<u32>,
-    /// CTRIA3 ids.
-    pub triangles: Vec<u32>,
-    /// CONM2 ids, then CONM1 ids.
-    pub masses: Vec<u32>,
-    /// RBE2 ids (and CONM2/CONM1 ids of offset masses).
-    pub rigid_links: Vec<u32>,
-    /// RBE3 ids.
-    pub interpolation_links: Vec<u32>,
-    /// CBUSH ids.
-    pub bushes: Vec<u32>,
-    /// CTETRA / CPENTA / CHEXA ids.
-    pub solids: Vec<u32>,
+pub struct ElementIds(BTreeMap<Entity, Vec<u32>>);
+
+impl ElementIds {
+    /// The ids of the entities of `kind`, in mesh order.
+    pub fn of(&self, kind: Entity) -> &[u32] {
+        self.0.get(&kind).map_or(&[], Vec::as_slice)
+    }
+
+    /// Records `id` as the id of the next entity of `kind`.
+    pub fn push(&mut self, kind: Entity, id: u32) {
+        self.0.entry(kind).or_default().push(id);
+    }
 }
 
 /// A body read from bulk data.

@@ -3,8 +3,9 @@
 
 use std::collections::BTreeMap;
 
-use super::{Loc, NastranBody};
-use crate::fe::checks::{Entity, Naming};
+use super::{ElementIds, Loc, NastranBody};
+use crate::fe::checks::Naming;
+use crate::fe::elements::Entity;
 
 /// Names of a deck body's nodes and elements for [`crate::fe::checks`] and the reduction's
 /// messages. Owns what it needs, so it outlives the body's mesh being moved on.
@@ -15,39 +16,12 @@ pub struct DeckNames {
     /// Names of nodes that are no GRID: the centres of gravity of offset masses.
     added: BTreeMap<usize, String>,
     /// Element ids per mesh entity kind, in mesh order.
-    ids: BTreeMap<EntityKey, Vec<u32>>,
+    ids: ElementIds,
     /// Element id → (card, where).
     cards: BTreeMap<u32, (Loc, &'static str)>,
     /// GRID ids of the ends of each merged scalar spring/damper (ground: one).
     springs: Vec<Vec<u32>>,
     ground_springs: Vec<u32>,
-}
-
-/// [`Entity`] as a map key.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, PartialOrd, Ord)]
-enum EntityKey {
-    Beam,
-    Shell,
-    Triangle,
-    Solid,
-    Mass,
-    Bush,
-    RigidLink,
-    InterpolationLink,
-}
-
-fn key(kind: Entity) -> Option<EntityKey> {
-    Some(match kind {
-        Entity::Beam => EntityKey::Beam,
-        Entity::Shell => EntityKey::Shell,
-        Entity::Triangle => EntityKey::Triangle,
-        Entity::Solid => EntityKey::Solid,
-        Entity::Mass => EntityKey::Mass,
-        Entity::Bush => EntityKey::Bush,
-        Entity::RigidLink => EntityKey::RigidLink,
-        Entity::InterpolationLink => EntityKey::InterpolationLink,
-        Entity::GroundSpring | Entity::Spring => return None,
-    })
 }
 
 impl DeckNames {
@@ -61,23 +35,10 @@ impl DeckNames {
             }
         }
         let e = &body.element_ids;
-        let ids: BTreeMap<EntityKey, Vec<u32>> = [
-            (EntityKey::Beam, &e.beams),
-            (EntityKey::Shell, &e.shells),
-            (EntityKey::Triangle, &e.triangles),
-            (EntityKey::Solid, &e.solids),
-            (EntityKey::Mass, &e.masses),
-            (EntityKey::Bush, &e.bushes),
-            (EntityKey::RigidLink, &e.rigid_links),
-            (EntityKey::InterpolationLink, &e.interpolation_links),
-        ]
-        .into_iter()
-        .map(|(k, v)| (k, v.clone()))
-        .collect();
         let mut names = Self {
             grids,
             added: BTreeMap::new(),
-            ids,
+            ids: e.clone(),
             cards: body.element_cards.clone(),
             springs: Vec::new(),
             ground_springs: Vec::new(),
@@ -85,7 +46,7 @@ impl DeckNames {
         // An offset CONM2/CONM1 puts its mass on a node of its own, carried by a rigid link
         // that bears the mass's id.
         for (i, link) in mesh.rigid_links.iter().enumerate() {
-            let Some(&id) = e.rigid_links.get(i) else {
+            let Some(&id) = e.of(Entity::RigidLink).get(i) else {
                 continue;
             };
             if let Some((_, card @ ("CONM2" | "CONM1"))) = body.element_cards.get(&id) {
@@ -148,7 +109,7 @@ impl Naming for DeckNames {
                 Some(g) => format!("the CELAS/CDAMP cards from GRID {g} to ground"),
                 None => format!("ground spring {index}"),
             },
-            _ => match key(kind).and_then(|k| self.ids.get(&k)?.get(index)) {
+            _ => match self.ids.of(kind).get(index) {
                 Some(&id) => self.element(id),
                 None => format!("{} {index}", kind.mesh_name()),
             },

@@ -448,6 +448,12 @@ impl<'a, 's> DeckReader<'a, 's> {
         Ok(Flow::Continue)
     }
 
+    /// One physical line of bulk data: ENDDATA, an INCLUDE, or a line of a card (its fields in
+    /// small, large or free format; a continuation, or the start of the next card, which hands the
+    /// card before it to the sink).
+    ///
+    /// Long on purpose: the line formats share the limits (fields per card, cards, line length) and
+    /// the pending card they add to; split by format, each piece would need the whole reader state.
     fn bulk_line(&mut self, raw: &str, loc: Loc) -> Result<Flow, FeError> {
         let line = strip_comment(raw);
         let head = line.trim_start();
@@ -677,6 +683,12 @@ impl<'a, 's> DeckReader<'a, 's> {
         labels.join(" → ")
     }
 
+    /// `INCLUDE 'file'`: the file read in place, after the checks that keep it inside the include
+    /// root (resolved path, no `..` or symbolic link out), refuse cycles and too deep nesting, and
+    /// count it against the card limit.
+    ///
+    /// Long on purpose: the checks run in this order on one resolved path, each refusal naming the
+    /// include chain; the file is then pushed on the same stack the checks read.
     fn include(&mut self, raw: &str, loc: Loc) -> Result<(), FeError> {
         // Counted like a card: a deck of endless INCLUDE lines is bounded like one of cards.
         self.cards += 1;

@@ -6,272 +6,19 @@ use std::collections::{BTreeMap, BTreeSet};
 use nalgebra::{Matrix3, Vector3};
 
 use super::card_table;
-use super::cards::{self, Orientation, Reader, ScalarValue, SystemKind};
-use super::lexer::{CardSink, Loc, RawCard, Value};
+use super::cards::{self, deck_error as mesh_error, Cards, Orientation, ScalarValue, SystemKind};
+use super::lexer::{CardSink, Loc, RawCard};
 use super::reader::DeckInfo;
-use super::solid_cards;
 use super::NastranBody;
+use crate::fe::elements::{all_nodes, Entity};
 use crate::fe::error::FeError;
 use crate::fe::mesh::{
     Beam, BeamEnds, BeamSection, Bush, GroundSpring, InterpolationLink, InterpolationSource,
     Material, Mesh, PointMass, RigidLink, Spring,
 };
 
-mod shell_cards;
-
-fn unsupported(card: &str, line: &Loc) -> FeError {
-    mesh_error(
-        line,
-        format!(
-            "card {card} is not supported (supported: {})",
-            card_table::supported_list()
-        ),
-    )
-}
-
-fn mesh_error(line: impl std::fmt::Display, message: impl std::fmt::Display) -> FeError {
-    FeError::InvalidInput(format!("Nastran bulk data line {line}: {message}"))
-}
-
-#[derive(Default)]
-struct Cards {
-    grids: BTreeMap<u32, cards::Grid>,
-    systems: BTreeMap<u32, cards::Cord2r>,
-    materials: BTreeMap<u32, cards::Mat1>,
-    shell_materials: BTreeMap<u32, shell_cards::ShellMaterialCard>,
-    shell_properties: BTreeMap<u32, cards::Pshell>,
-    beam_properties: BTreeMap<u32, (cards::BeamProperty, &'static str)>,
-    spring_properties: BTreeMap<u32, (f64, Loc)>,
-    damper_properties: BTreeMap<u32, (f64, Loc)>,
-    bars: BTreeMap<u32, cards::Bar>,
-    plates: BTreeMap<u32, (cards::Plate, &'static str)>,
-    masses: BTreeMap<u32, cards::Conm2>,
-    general_masses: BTreeMap<u32, cards::Conm1>,
-    bush_properties: BTreeMap<u32, cards::Pbush>,
-    bushes: BTreeMap<u32, cards::Cbush>,
-    springs: BTreeMap<u32, cards::Scalar>,
-    dampers: BTreeMap<u32, cards::Scalar>,
-    rigid: BTreeMap<u32, cards::Rbe2>,
-    interpolation: BTreeMap<u32, cards::Rbe3>,
-    solids: BTreeMap<u32, solid_cards::SolidElement>,
-    solid_properties: BTreeMap<u32, solid_cards::Psolid>,
-    supports: Vec<(cards::Support, Loc)>,
-    damping_tables: BTreeMap<u32, cards::DampingTableCard>,
-    element_lines: BTreeMap<u32, (Loc, &'static str)>,
-    mass_scale: f64,
-}
-
-fn insert_unique<T>(
-    map: &mut BTreeMap<u32, T>,
-    what: &str,
-    id: u32,
-    line: &Loc,
-    value: T,
-) -> Result<(), FeError> {
-    if map.insert(id, value).is_some() {
-        return Err(mesh_error(line, format!("{what} {id} is defined twice")));
-    }
-    Ok(())
-}
-
-impl Cards {
-    /// Element ids are unique over all element cards, as in Nastran.
-    fn element_id(&mut self, id: u32, line: &Loc, name: &'static str) -> Result<(), FeError> {
-        if let Some((first, other)) = self.element_lines.get(&id) {
-            return Err(mesh_error(
-                line,
-                format!("{name} {id}: element id already used by {other} at line {first}"),
-            ));
-        }
-        self.element_lines.insert(id, (line.clone(), name));
-        Ok(())
-    }
-
-    /// Long on purpose: a table, one arm per card kind.
-    fn new() -> Self {
-        Cards {
-            mass_scale: 1.0,
-            ..Cards::default()
-        }
-    }
-
-    fn add(&mut self, raw: &RawCard) -> Result<(), FeError> {
-        let c = self;
-        {
-            let r = Reader::new(raw);
-            let line = raw.loc();
-            let Some(name) = card_table::supported_card(&raw.name) else {
-                return Err(unsupported(&raw.name, &line));
-            };
-            match name {
-                "GRID" => {
-                    let g = cards::grid(&r)?;
-                    insert_unique(&mut c.grids, "GRID", g.id, &line, g)?;
-                }
-                "CORD2R" | "CORD2C" | "CORD2S" => {
-                    let kind = match raw.name.as_str() {
-                        "CORD2R" => SystemKind::Rectangular,
-                        "CORD2C" => SystemKind::Cylindrical,
-                        _ => SystemKind::Spherical,
-                    };
-                    let s = cards::cord2(&r, kind)?;
-                    insert_unique(&mut c.systems, "coordinate system", s.id, &line, s)?;
-                }
-                "MAT1" => {
-                    let m = cards::mat1(&r)?;
-                    insert_unique(&mut c.materials, "MAT1", m.id, &line, m)?;
-                }
-                "MAT2" | "MAT8" => {
-                    let m = if raw.name == "MAT2" {
-                        shell_cards::mat2(&r)?
-                    } else {
-                        shell_cards::mat8(&r)?
-                    };
-                    insert_unique(&mut c.shell_materials, &raw.name, m.id(), &line, m)?;
-                }
-                "PSHELL" => {
-                    let p = cards::pshell(&r)?;
-                    insert_unique(&mut c.shell_properties, "property", p.id, &line, p)?;
-                }
-                "PBAR" | "PBEAM" => {
-                    let p = if raw.name == "PBAR" {
-                        (cards::pbar(&r)?, "PBAR")
-                    } else {
-                        (cards::pbeam(&r)?, "PBEAM")
-                    };
-                    insert_unique(&mut c.beam_properties, "property", p.0.id, &line, p)?;
-                }
-                "PELAS" => {
-                    for (pid, k) in cards::scalar_properties(&r, 4)? {
-                        insert_unique(
-                            &mut c.spring_properties,
-                            "PELAS",
-                            pid,
-                            &line,
-                            (k, line.clone()),
-                        )?;
-                    }
-                }
-                "PDAMP" => {
-                    for (pid, b) in cards::scalar_properties(&r, 2)? {
-                        insert_unique(
-                            &mut c.damper_properties,
-                            "PDAMP",
-                            pid,
-                            &line,
-                            (b, line.clone()),
-                        )?;
-                    }
-                }
-                "CBAR" | "CBEAM" => {
-                    let b = cards::bar(&r, raw.name == "CBEAM")?;
-                    c.element_id(b.id, &line, name)?;
-                    c.bars.insert(b.id, b);
-                }
-                "CQUAD4" | "CTRIA3" => {
-                    let (corners, name) = if raw.name == "CQUAD4" {
-                        (4, "CQUAD4")
-                    } else {
-                        (3, "CTRIA3")
-                    };
-                    let p = cards::plate(&r, corners)?;
-                    c.element_id(p.id, &line, name)?;
-                    c.plates.insert(p.id, (p, name));
-                }
-                "CONM2" => {
-                    let m = cards::conm2(&r)?;
-                    c.element_id(m.id, &line, "CONM2")?;
-                    c.masses.insert(m.id, m);
-                }
-                "CONM1" => {
-                    let m = cards::conm1(&r)?;
-                    c.element_id(m.id, &line, "CONM1")?;
-                    c.general_masses.insert(m.id, m);
-                }
-                "PBUSH" => {
-                    let p = cards::pbush(&r)?;
-                    insert_unique(&mut c.bush_properties, "PBUSH", p.id, &line, p)?;
-                }
-                "CBUSH" => {
-                    let b = cards::cbush(&r)?;
-                    c.element_id(b.id, &line, "CBUSH")?;
-                    c.bushes.insert(b.id, b);
-                }
-                "CELAS1" | "CELAS2" => {
-                    let s = cards::scalar(&r, raw.name == "CELAS2", true)?;
-                    c.element_id(s.id, &line, name)?;
-                    c.springs.insert(s.id, s);
-                }
-                "CDAMP1" | "CDAMP2" => {
-                    let s = cards::scalar(&r, raw.name == "CDAMP2", false)?;
-                    c.element_id(s.id, &line, name)?;
-                    c.dampers.insert(s.id, s);
-                }
-                "RBE2" => {
-                    let e = cards::rbe2(&r)?;
-                    c.element_id(e.id, &line, "RBE2")?;
-                    c.rigid.insert(e.id, e);
-                }
-                "RBE3" => {
-                    let e = cards::rbe3(&r)?;
-                    c.element_id(e.id, &line, "RBE3")?;
-                    c.interpolation.insert(e.id, e);
-                }
-                "SPC1" | "SPC" => {
-                    let list = if raw.name == "SPC1" {
-                        cards::spc1(&r)?
-                    } else {
-                        cards::spc(&r)?
-                    };
-                    c.supports
-                        .extend(list.into_iter().map(|s| (s, line.clone())));
-                }
-                "CTETRA" | "CPENTA" | "CHEXA" => {
-                    let e = solid_cards::element(&r, name)?;
-                    c.element_id(e.id, &line, name)?;
-                    c.solids.insert(e.id, e);
-                }
-                "PSOLID" => {
-                    let p = solid_cards::psolid(&r)?;
-                    insert_unique(&mut c.solid_properties, "PSOLID", p.id, &line, p)?;
-                }
-                "PARAM" => c.param(&r)?,
-                "TABDMP1" => {
-                    let t = cards::tabdmp1(&r)?;
-                    insert_unique(&mut c.damping_tables, "TABDMP1", t.id, &line, t)?;
-                }
-                // Eigenvalue extraction requests: the caller chooses the modes.
-                "EIGRL" | "EIGR" => {}
-                // A listed card without an arm: the table test names it.
-                other => return Err(unsupported(other, &line)),
-            }
-        }
-        Ok(())
-    }
-
-    fn param(&mut self, r: &Reader) -> Result<(), FeError> {
-        let name = match r.value(0, "N")? {
-            Value::Text(t) => t,
-            other => return Err(r.error(0, "N", format!("expected a name, found {other:?}"))),
-        };
-        if name == "WTMASS" {
-            let w = r.real(1, "V1")?;
-            if !(w.is_finite() && w > 0.0) {
-                return Err(r.error(1, "V1", format!("WTMASS must be > 0, got {w}")));
-            }
-            self.mass_scale = w;
-            Ok(())
-        } else if card_table::IGNORED_PARAMS.contains(&name.as_str()) {
-            Ok(())
-        } else {
-            Err(r.card_error(format!(
-                "PARAM {name} is not supported (it may change K or M); supported: WTMASS, and \
-                 ignored as output-only: {}",
-                card_table::IGNORED_PARAMS.join(", ")
-            )))
-        }
-    }
-}
+mod shells;
+mod solids;
 
 /// A resolved system: origin and rotation (columns: axes in basic) of its Cartesian frame.
 #[derive(Debug, Clone, Copy)]
@@ -484,7 +231,7 @@ impl Collector {
 
 impl CardSink for Collector {
     fn card(&mut self, card: RawCard) -> Result<(), FeError> {
-        self.0.add(&card)
+        card_table::read_card(&mut self.0, &card)
     }
 
     fn reset(&mut self) {
@@ -545,7 +292,7 @@ pub(crate) fn build(cards: Collector, info: &DeckInfo) -> Result<NastranBody, Fe
             .constraints
             .extend(mask_nodes(g.ps).map(|d| (node, d)));
     }
-    shell_cards::add_shells(&c, &systems, &mut body)?;
+    shells::add_shells(&c, &systems, &mut body)?;
     add_beams(&c, &mut body)?;
     add_solids(&c, &systems, &mut body)?;
     add_masses(&c, &systems, &mut body)?;
@@ -570,30 +317,7 @@ const LISTED_UNUSED: usize = 10;
 fn drop_unused_grids(body: &mut NastranBody) {
     let mesh = &body.mesh;
     let mut used = vec![false; mesh.nodes.len()];
-    let referenced = mesh
-        .beams
-        .iter()
-        .flat_map(|b| b.nodes)
-        .chain(mesh.shells.iter().flat_map(|s| s.nodes))
-        .chain(mesh.triangles.iter().flat_map(|t| t.nodes))
-        .chain(mesh.solids.iter().flat_map(|s| s.nodes.iter().copied()))
-        .chain(mesh.masses.iter().map(|m| m.node))
-        .chain(mesh.ground_springs.iter().map(|s| s.node))
-        .chain(mesh.springs.iter().flat_map(|s| s.nodes))
-        .chain(
-            mesh.bushes
-                .iter()
-                .flat_map(|b| std::iter::once(b.a).chain(b.b)),
-        )
-        .chain(
-            mesh.rigid_links
-                .iter()
-                .flat_map(|l| std::iter::once(l.independent).chain(l.dependent.iter().copied())),
-        )
-        .chain(mesh.interpolation_links.iter().flat_map(|l| {
-            std::iter::once(l.reference)
-                .chain(l.sources.iter().flat_map(|s| s.nodes.iter().copied()))
-        }));
+    let referenced = all_nodes(mesh).flat_map(|(_, _, nodes)| nodes);
     for k in referenced {
         if let Some(u) = used.get_mut(k) {
             *u = true;
@@ -653,7 +377,7 @@ fn add_solids(c: &Cards, systems: &Systems, body: &mut NastranBody) -> Result<()
         })
     };
     let system = |cid: u32, line: &Loc, user: &str| systems.get(cid, line, user).map(|_| ());
-    solid_cards::add_solids(&c.solids, &c.solid_properties, &material, &system, body)
+    solids::add_solids(&c.solids, &c.solid_properties, &material, &system, body)
 }
 
 fn add_beams(c: &Cards, body: &mut NastranBody) -> Result<(), FeError> {
@@ -711,7 +435,7 @@ fn add_beams(c: &Cards, body: &mut NastranBody) -> Result<(), FeError> {
             orientation,
             extra_mass_per_length: p.nsm * c.mass_scale,
         });
-        body.element_ids.beams.push(id);
+        body.element_ids.push(Entity::Beam, id);
     }
     Ok(())
 }
@@ -894,7 +618,7 @@ fn place_mass(
             dependent: vec![cg],
             components: [true; 6],
         });
-        body.element_ids.rigid_links.push(id);
+        body.element_ids.push(Entity::RigidLink, id);
         cg
     };
     body.mesh.masses.push(PointMass {
@@ -902,7 +626,7 @@ fn place_mass(
         mass: mass * scale,
         inertia: inertia * scale,
     });
-    body.element_ids.masses.push(id);
+    body.element_ids.push(Entity::Mass, id);
 }
 
 fn add_bushes(c: &Cards, systems: &Systems, body: &mut NastranBody) -> Result<(), FeError> {
@@ -965,7 +689,7 @@ fn add_bushes(c: &Cards, systems: &Systems, body: &mut NastranBody) -> Result<()
             stiffness: p.k,
             damping: p.b,
         });
-        body.element_ids.bushes.push(id);
+        body.element_ids.push(Entity::Bush, id);
     }
     Ok(())
 }
@@ -1071,7 +795,7 @@ fn add_links(c: &Cards, body: &mut NastranBody) -> Result<(), FeError> {
             dependent,
             components: e.components,
         });
-        body.element_ids.rigid_links.push(id);
+        body.element_ids.push(Entity::RigidLink, id);
     }
     for (&id, e) in &c.interpolation {
         let user = format!("RBE3 {id}");
@@ -1098,7 +822,7 @@ fn add_links(c: &Cards, body: &mut NastranBody) -> Result<(), FeError> {
             reference_components: e.reference_components,
             sources,
         });
-        body.element_ids.interpolation_links.push(id);
+        body.element_ids.push(Entity::InterpolationLink, id);
     }
     Ok(())
 }

@@ -11,6 +11,7 @@ use engine_mount_chassis::chassis::config::ChassisConfig;
 use engine_mount_chassis::chassis::Chassis;
 use engine_mount_chassis::eigen::{lowest_modes, Modes};
 use engine_mount_chassis::fe::assembly::{assemble, mat_vec, Assembled};
+use engine_mount_chassis::fe::elements::Entity;
 use engine_mount_chassis::nastran::{parse_str, read_bulk_deck, write_bulk_deck, NastranBody};
 use nalgebra::{DMatrix, Matrix3, Vector3};
 
@@ -498,7 +499,7 @@ fn grids_and_masses_in_nested_cord2r_systems_land_in_basic() {
         assert!((got - want).abs() < 1e-14, "{diagonal:?}");
     }
     assert_eq!(body.mesh.rigid_links.len(), 1);
-    assert_eq!(body.element_ids.rigid_links, vec![9]);
+    assert_eq!(body.element_ids.of(Entity::RigidLink), [9]);
 }
 
 #[test]

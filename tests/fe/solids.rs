@@ -9,6 +9,7 @@ use std::fmt::Write;
 use engine_mount_chassis::eigen::{lowest_modes, Modes};
 use engine_mount_chassis::fe::assembly::{assemble, translational_mass, Assembled};
 use engine_mount_chassis::fe::checks::{check_assembled, check_mesh, CheckLimits};
+use engine_mount_chassis::fe::elements::Entity;
 use engine_mount_chassis::fe::mesh::{Material, Mesh, Solid};
 use engine_mount_chassis::fe::solid::{self, SolidKind};
 use engine_mount_chassis::nastran::{parse_str, write_bulk_deck};
@@ -799,7 +800,7 @@ fn solids_written_to_bulk_data_read_back_unchanged() {
     }
     let body = parse_str(&deck).unwrap();
     assert_eq!(body.mesh.solids, mesh.solids);
-    assert_eq!(body.element_ids.solids.len(), 4);
+    assert_eq!(body.element_ids.of(Entity::Solid).len(), 4);
 }
 
 // ---------------------------------------------------------------------------------------------

@@ -202,8 +202,6 @@ impl CoupledModel {
     /// Assembles the model. With a body without modes (rigid ground) every mount attaches at its
     /// ground point; otherwise at its `body_node`, which the body must provide, as must every
     /// name in `outputs`.
-    ///
-    /// Long on purpose: it checks and wires every mount against the body once; split, the partly built model would travel between the pieces.
     pub fn new(
         powertrain: Powertrain,
         mounts: &[MountConfig],
@@ -216,6 +214,9 @@ impl CoupledModel {
 
     /// [`Self::new`], or with `external` every mount attached at its ground point to a body
     /// outside the model whose motion is an input (the body must then have no modes).
+    ///
+    /// Long on purpose: it checks and wires every mount against the body once; split, the
+    /// partly built model would travel between the pieces.
     fn assemble(
         powertrain: Powertrain,
         mounts: &[MountConfig],

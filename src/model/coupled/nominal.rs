@@ -76,6 +76,10 @@ impl CoupledModel {
     /// Per state, its nominal magnitude at the operating point `(t, y_op)` (see the module
     /// documentation). `y_op` is the state the simulation starts from; the crank-speed set-point
     /// at `t` is the operating speed.
+    ///
+    /// Long on purpose: the powertrain's accelerations sampled over one working cycle, the forced
+    /// response of each coordinate to their harmonics, and the modes' nominals from those
+    /// positions are one computation on the same cycle samples.
     pub fn state_nominals(&mut self, t: f64, y_op: &[f64]) -> Result<Vec<f64>, ProblemError> {
         self.check_state(y_op)?;
         let l = self.layout;

@@ -1,120 +1,16 @@
-//! Shells: MAT2 and MAT8 cards, PSHELL with its MID1/MID2/MID3 materials, THETA/MCID and
+//! Shells: PSHELL with its MID1/MID2/MID3 materials (MAT1, MAT2, MAT8), THETA/MCID and
 //! ZOFFS of CQUAD4/CTRIA3 → [`Shell`] / [`TriShell`] (with a [`ShellSection`] unless the
 //! element is the plain isotropic sheet the mesh has always had).
 
 use nalgebra::{Matrix2, Matrix3, Vector3};
 
-use super::super::cards::{Pshell, Reader};
+use super::super::cards::{Pshell, ShellMaterialCard};
 use super::super::lexer::Loc;
 use super::{mesh_error, moduli, node_of, Cards, NastranBody, Systems};
+use crate::fe::elements::Entity;
 use crate::fe::error::FeError;
 use crate::fe::mesh::{Material, Shell, TriShell};
 use crate::fe::shell::ShellSection;
-
-/// MAT2 (anisotropic plane stress) or MAT8 (orthotropic lamina).
-#[derive(Debug, Clone, PartialEq)]
-pub(super) enum ShellMaterialCard {
-    Mat2 {
-        id: u32,
-        /// G11 G12 G13 / G12 G22 G23 / G13 G23 G33.
-        g: Matrix3<f64>,
-        rho: f64,
-        line: Loc,
-    },
-    Mat8 {
-        id: u32,
-        e1: f64,
-        e2: f64,
-        nu12: f64,
-        g12: f64,
-        g1z: Option<f64>,
-        g2z: Option<f64>,
-        rho: f64,
-        line: Loc,
-    },
-}
-
-impl ShellMaterialCard {
-    pub(super) fn id(&self) -> u32 {
-        match self {
-            Self::Mat2 { id, .. } | Self::Mat8 { id, .. } => *id,
-        }
-    }
-}
-
-pub(super) fn mat2(r: &Reader) -> Result<ShellMaterialCard, FeError> {
-    // A1, A2, A3, TREF (thermal), GE (structural damping, added modally by the caller like MAT1
-    // GE), ST/SC/SS (allowables), MCSID: accepted, they do not enter K or M.
-    r.at_most(17)?;
-    for (k, n) in [
-        (8, "A1"),
-        (9, "A2"),
-        (10, "A3"),
-        (11, "TREF"),
-        (12, "GE"),
-        (13, "ST"),
-        (14, "SC"),
-        (15, "SS"),
-    ] {
-        r.opt_real(k, n)?;
-    }
-    r.opt_int(16, "MCSID")?;
-    let names = ["G11", "G12", "G13", "G22", "G23", "G33"];
-    let mut v = [0.0; 6];
-    for (k, n) in names.iter().enumerate() {
-        v[k] = r.real_or(1 + k, n, 0.0)?;
-    }
-    Ok(ShellMaterialCard::Mat2 {
-        id: r.id(0, "MID")?,
-        g: Matrix3::new(v[0], v[1], v[2], v[1], v[3], v[4], v[2], v[4], v[5]),
-        rho: r.real_or(7, "RHO", 0.0)?,
-        line: r.card().loc(),
-    })
-}
-
-pub(super) fn mat8(r: &Reader) -> Result<ShellMaterialCard, FeError> {
-    // Thermal data, allowables, GE, F12, STRN: accepted, they do not enter K or M.
-    r.at_most(19)?;
-    for (k, n) in [
-        (8, "A1"),
-        (9, "A2"),
-        (10, "TREF"),
-        (11, "Xt"),
-        (12, "Xc"),
-        (13, "Yt"),
-        (14, "Yc"),
-        (15, "S"),
-        (16, "GE"),
-        (17, "F12"),
-        (18, "STRN"),
-    ] {
-        r.opt_real(k, n)?;
-    }
-    let positive = |k: usize, n: &str, v: f64| {
-        if v > 0.0 && v.is_finite() {
-            Ok(v)
-        } else {
-            Err(r.error(k, n, format!("must be > 0, got {v}")))
-        }
-    };
-    let optional = |k: usize, n: &str| -> Result<Option<f64>, FeError> {
-        match r.opt_real(k, n)? {
-            None | Some(0.0) => Ok(None),
-            Some(v) => positive(k, n, v).map(Some),
-        }
-    };
-    Ok(ShellMaterialCard::Mat8 {
-        id: r.id(0, "MID")?,
-        e1: positive(1, "E1", r.real(1, "E1")?)?,
-        e2: positive(2, "E2", r.real(2, "E2")?)?,
-        nu12: r.real(3, "NU12")?,
-        g12: positive(4, "G12", r.real(4, "G12")?)?,
-        g1z: optional(5, "G1Z")?,
-        g2z: optional(6, "G2Z")?,
-        rho: r.real_or(7, "RHO", 0.0)?,
-        line: r.card().loc(),
-    })
-}
 
 /// A shell material as the section needs it.
 struct Resolved {
@@ -128,6 +24,9 @@ struct Resolved {
 }
 
 /// Material `mid` as PSHELL field `field` uses it.
+///
+/// Long on purpose: one match over the material cards a PSHELL field may name (MAT1, MAT2, MAT8)
+/// and the field's role (membrane, bending, shear), each refusal naming the card and field.
 fn resolve(c: &Cards, p: &Pshell, field: &str, mid: u32, user: &str) -> Result<Resolved, FeError> {
     let who = format!("PSHELL {} (used by {user}) {field}", p.id);
     match (c.materials.get(&mid), c.shell_materials.get(&mid)) {
@@ -396,7 +295,7 @@ pub(super) fn add_shells(
                 extra_mass_per_area,
                 section,
             });
-            body.element_ids.shells.push(id);
+            body.element_ids.push(Entity::Shell, id);
         } else if let [a, b, cc] = nodes[..] {
             body.mesh.triangles.push(TriShell {
                 nodes: [a, b, cc],
@@ -406,7 +305,7 @@ pub(super) fn add_shells(
                 extra_mass_per_area,
                 section,
             });
-            body.element_ids.triangles.push(id);
+            body.element_ids.push(Entity::Triangle, id);
         }
     }
     Ok(())
