@@ -37,6 +37,7 @@ import zipfile
 
 sys.path.insert(0, str(pathlib.Path(__file__).resolve().parent))
 import figures  # noqa: E402  (beside this script, not a package)
+import reference  # noqa: E402
 
 ROOT = pathlib.Path(__file__).resolve().parent.parent
 PAGES = ROOT / "docs" / "src"
@@ -307,10 +308,13 @@ SECTIONS = {
     "body-variables": body_variables,
     "fmi3-terminals": fmi3_terminals,
     "supported-cards": supported_cards,
+    "cli-reference": reference.cli_reference,
+    "vehicle-fields": reference.vehicle_fields,
+    "result-files": reference.result_files_reference,
 }
 
 
-LIGHT = {"machines", "figure-list"}
+LIGHT = {"machines", "figure-list", "cli-reference", "vehicle-fields", "result-files"}
 
 
 def section(name: str, page: pathlib.Path, cache: dict[str, str]) -> str:

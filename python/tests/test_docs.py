@@ -396,3 +396,59 @@ def test_a_quoted_figure_carries_its_marker():
     assert not found, found
     assert unmarked_copies("scene 2 at 11.8–14× real time", sources) == [
         "realtime.scene2.2000: '11.8–14×' without its marker"]
+
+
+# ---------------------------------------------------------------------------------------------
+# Reference pages generated from the code
+
+
+REFERENCE_PAGES = {"reference/cli.md": "cli-reference", "reference/vehicle.md": "vehicle-fields",
+                   "reference/results.md": "result-files"}
+
+
+@pytest.mark.parametrize("page", REFERENCE_PAGES)
+def test_a_reference_page_is_what_the_code_says(page):
+    generate = _generator()
+    path = BOOK_SRC / page
+    text = path.read_text()
+    assert f"<!-- generated: {REFERENCE_PAGES[page]} -->" in text
+    assert generate.regenerate(text, path, {}, generate.light) == text, (
+        f"{page} is stale: run `{generate.COMMAND} --light`")
+    assert f"]({page})" in (BOOK_SRC / "SUMMARY.md").read_text()
+
+
+def test_the_cli_reference_names_every_command_and_option():
+    generate = _generator()
+    text = (BOOK_SRC / "reference" / "cli.md").read_text()
+    from emc.cli import build_parser
+
+    emc_parser = build_parser()
+    commands = generate.reference.commands(emc_parser)
+    assert len(commands) >= 20
+    for name, command in commands.items():
+        assert f"### emc {name}\n" in text, name
+        section = text.split(f"### emc {name}\n", 1)[1].split("\n### ", 1)[0]
+        for action in command._actions:
+            for option in action.option_strings:
+                if option not in ("-h", "--help"):
+                    assert f"`{option}" in section, f"emc {name} {option}"
+    # A new option is on the page at once.
+    accuracy = commands["accuracy"]
+    accuracy.add_argument("--brand-new", type=float, default=3.5, help="an option")
+    assert "| `--brand-new BRAND_NEW` | 3.5 | an option |" in generate.reference.cli_reference(emc_parser)
+    assert "--brand-new" not in generate.reference.cli_reference()
+
+
+def test_the_vehicle_reference_has_every_field_of_the_mount():
+    # Counted independently of the generator: the `pub` fields of MountConfig in its source.
+    source = (ROOT / "src" / "model" / "mount" / "config.rs").read_text()
+    struct = source.split("pub struct MountConfig {", 1)[1].split("\n}", 1)[0]
+    fields = re.findall(r"^\s*pub (\w+):", struct, re.M)
+    assert {"bracket", "body_node", "preload", "active"} <= set(fields)
+    text = (BOOK_SRC / "reference" / "vehicle.md").read_text()
+    section = text.split("### MountConfig\n", 1)[1].split("\n### ", 1)[0]
+    assert re.findall(r"^\| `(\w+)` \|", section, re.M) == fields
+    for name in ("VehicleConfig", "BodyConfig", "BodyDamping", "DampingTable", "ChassisConfig",
+                 "EngineConfig", "MountCurve"):
+        assert f"### {name}\n" in text, name
+    assert '`"kind": "nastran"`' in text and "| `include_root` |" in text
