@@ -22,9 +22,7 @@ def register(sub):
                    help="stationary: constant --rpm-point; runup: linear --runup FROM TO over "
                         "--duration (repeatable; default both)")
     options.add_speed_point(p, 2000.0, "speed of the stationary scenario, rpm")
-    p.add_argument("--load-torque", type=options.number, default=0.0,
-                   help="the drivetrain's reaction torque on the engine, N·m, in both scenarios "
-                        "(default 0)")
+    options.add_load_torque(p)
     p.add_argument("--runup", type=options.number, nargs=2, default=[800.0, 2500.0],
                    metavar=("FROM", "TO"), help="speeds of the run-up, rpm (default 800 2500)")
     p.add_argument("--duration", type=options.number, default=0.5,
