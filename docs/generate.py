@@ -1,13 +1,20 @@
 """Writes the guide's generated sections from where their truth is: the variable tables from the
 model descriptions that build.rs writes from modelDescription/variables.json (with the family
 names and descriptions of variables.json itself), the FMI 3.0 terminals from the 3.0 FMUs'
-terminalsAndIcons.xml, the supported bulk-data cards from the deck reader's dispatch table.
+terminalsAndIcons.xml, the supported bulk-data cards from the deck reader's dispatch table, the
+measured figures and their tables from docs/figures.toml, and the reference pages from the code
+(docs/reference.py: the emc command line, the vehicle configuration, the result files).
 
-A generated section sits in a page between two markers:
+A generated section sits in a page (or the README) between two markers:
 
     <!-- generated: NAME -->
     ...
     <!-- end generated: NAME -->
+
+and a measured figure quoted in running text between two short ones, filled from
+docs/figures.toml:
+
+    <!--f:ID-->11.8–14×<!--/f-->
 
 Usage (after `bash packaging/package.sh`, which writes the FMUs this reads):
 
@@ -28,6 +35,10 @@ import sys
 import xml.etree.ElementTree as ET
 import zipfile
 
+sys.path.insert(0, str(pathlib.Path(__file__).resolve().parent))
+import figures  # noqa: E402  (beside this script, not a package)
+import reference  # noqa: E402
+
 ROOT = pathlib.Path(__file__).resolve().parent.parent
 PAGES = ROOT / "docs" / "src"
 DIST = ROOT / "dist"
@@ -37,6 +48,15 @@ COMMAND = ".venv/bin/python docs/generate.py"
 BEGIN = re.compile(r"<!-- generated: ([\w-]+) -->\n")
 END = "<!-- end generated: {} -->"
 INDICES = ["i", "j", "k"]
+_SOURCES: dict = {}
+
+
+def SOURCES() -> dict:  # noqa: N802 - read once, like a constant
+    if not _SOURCES:
+        _SOURCES.update(figures.load())
+    return _SOURCES
+
+
 CAUSALITY_ORDER = ["input", "output", "parameter", "calculatedParameter", "structuralParameter",
                    "local", "independent"]
 
@@ -283,53 +303,93 @@ def supported_cards() -> str:
 # Pages
 
 SECTIONS = {
+    "machines": lambda: figures.machines_markdown(SOURCES()),
     "engine-variables": engine_variables,
     "body-variables": body_variables,
     "fmi3-terminals": fmi3_terminals,
     "supported-cards": supported_cards,
+    "cli-reference": reference.cli_reference,
+    "vehicle-fields": reference.vehicle_fields,
+    "result-files": reference.result_files_reference,
 }
 
 
-def regenerate(text: str, page: pathlib.Path, cache: dict[str, str]) -> str:
+LIGHT = {"machines", "figure-list", "cli-reference", "vehicle-fields", "result-files"}
+
+
+def section(name: str, page: pathlib.Path, cache: dict[str, str]) -> str:
+    """A generated section's text; the figure tables and the list of figures depend on the page
+    (their links are relative to it)."""
+    if name.startswith("table-"):
+        if name[len("table-"):] not in SOURCES()["tables"]:
+            sys.exit(f"generate: {page.relative_to(ROOT)} asks for '{name}', which "
+                     f"{figures.SOURCE.relative_to(ROOT)} does not hold")
+        return figures.table_markdown(name[len("table-"):], SOURCES(), page)
+    if name == "figure-list":
+        return figures.figure_list_markdown(SOURCES(), pages(), page)
+    if name not in SECTIONS:
+        sys.exit(f"generate: {page.relative_to(ROOT)} asks for an unknown section '{name}'")
+    if name not in cache:
+        cache[name] = SECTIONS[name]().rstrip("\n")
+    return cache[name]
+
+
+# The sections written from docs/figures.toml and the code alone: no packaged FMU, no cargo.
+def light(name: str) -> bool:
+    return name.startswith("table-") or name in LIGHT
+
+
+def regenerate(text: str, page: pathlib.Path, cache: dict[str, str], only=None) -> str:
+    """The page with its generated sections and figures as their sources say; with ``only`` (a
+    test of section names), the other sections are left as they are."""
     out, pos = [], 0
     for m in BEGIN.finditer(text):
         name = m.group(1)
-        if name not in SECTIONS:
-            sys.exit(f"generate: {page.relative_to(ROOT)} asks for an unknown section '{name}'")
         end = text.find(END.format(name), m.end())
         if end < 0:
             sys.exit(f"generate: {page.relative_to(ROOT)}: '{END.format(name)}' is missing")
-        if name not in cache:
-            cache[name] = SECTIONS[name]().rstrip("\n")
-        out += [text[pos:m.end()], "\n", cache[name], "\n\n"]
+        if only is not None and not only(name):
+            out.append(text[pos:end])
+        else:
+            out += [text[pos:m.end()], "\n", section(name, page, cache).rstrip("\n"), "\n\n"]
         pos = end
     out.append(text[pos:])
-    return "".join(out)
+    try:
+        return figures.fill("".join(out), SOURCES(), page.relative_to(ROOT).as_posix())
+    except KeyError as missing:
+        sys.exit(f"generate: {missing.args[0]}")
 
 
 def pages() -> list[pathlib.Path]:
-    return sorted(p for p in PAGES.rglob("*.md") if BEGIN.search(p.read_text()))
+    """The README and the guide's pages that hold a generated section or a marked figure."""
+    return [p for p in [ROOT / "README.md"] + sorted(PAGES.rglob("*.md"))
+            if BEGIN.search(p.read_text()) or figures.MARKER.search(p.read_text())]
 
 
-def stale_pages() -> list[pathlib.Path]:
-    """The pages whose generated sections differ from what this script writes now."""
+def stale_pages(only=None) -> list[pathlib.Path]:
+    """The pages whose generated sections (with ``only``, those it accepts) or figures differ
+    from what this script writes now."""
     cache: dict[str, str] = {}
-    return [p for p in pages() if regenerate(p.read_text(), p, cache) != p.read_text()]
+    return [p for p in pages() if regenerate(p.read_text(), p, cache, only) != p.read_text()]
 
 
 def main(argv: list[str] | None = None) -> None:
     parser = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     parser.add_argument("--check", action="store_true", help="only list stale pages; exit 1 if any")
+    parser.add_argument("--light", action="store_true",
+                        help="only the figures and the sections that need no packaged FMU and no "
+                             "cargo (figure tables, machines, reference pages)")
     args = parser.parse_args(argv)
+    only = light if args.light else None
     if args.check:
-        stale = stale_pages()
+        stale = stale_pages(only)
         for p in stale:
             print(f"stale: {p.relative_to(ROOT)} (regenerate with `{COMMAND}`)")
         sys.exit(1 if stale else 0)
     cache: dict[str, str] = {}
     for p in pages():
         text = p.read_text()
-        new = regenerate(text, p, cache)
+        new = regenerate(text, p, cache, only)
         if new != text:
             p.write_text(new)
             print(f"wrote {p.relative_to(ROOT)}")

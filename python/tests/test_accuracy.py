@@ -4,7 +4,9 @@ against a tight reference follows the tolerance passed through fmi2SetupExperime
 absolute tolerance the user sets still wins; and ``emc accuracy`` reports it for any
 configuration."""
 
+import json
 import math
+import pathlib
 
 import numpy as np
 import pandas as pd
@@ -139,3 +141,50 @@ def test_emc_accuracy_refuses_what_it_cannot_measure(fmu_path, tmp_path, capsys,
     code = cli.main(["accuracy", "--fmu", str(fmu_path), "--out", str(tmp_path), *args])
     assert code == 2
     assert message in capsys.readouterr().err
+
+
+def roll_moment(forces: np.ndarray, brackets: list) -> np.ndarray:
+    """Moment about the crank axis (y) of the mount forces on their attachments, per sample:
+    ``Σ z_i F_x,i − x_i F_z,i`` (columns of ``forces``: mount[1].F[1..3], mount[2].F[1..3], …).
+    A pure couple, so the point about which it is taken does not matter for its change."""
+    return sum(b[2] * forces[:, 3 * i] - b[0] * forces[:, 3 * i + 2]
+               for i, b in enumerate(brackets))
+
+
+def test_the_load_torque_reaches_the_runs_of_emc_accuracy(fmu_path):
+    # Statics, not the code's own output: on average the mounts carry the drivetrain's reaction
+    # and nothing else of the mean torque (the engine's own torque closes inside the
+    # powertrain), so a load torque L changes the mounts' mean roll moment by L.
+    brackets = [m["bracket"] for m in json.loads(
+        (pathlib.Path(__file__).resolve().parents[2] / "resources" / "vehicle.json")
+        .read_text())["mounts"]]
+    signals = [f"mount[{i}].F[{j}]" for i in range(1, 5) for j in range(1, 4)]
+    moments = {}
+    with Runner(str(fmu_path)) as runner:
+        for load in (0.0, 150.0):
+            scenario = accuracy.Scenario("1500 rpm", 1500.0, 1500.0, duration=0.08, step=1e-3,
+                                         load_torque=load)
+            samples = accuracy.run(runner, scenario, {"scene": 1}, signals, 1e-7)["samples"]
+            moments[load] = roll_moment(samples, brackets).mean()
+    assert abs(abs(moments[150.0] - moments[0.0]) - 150.0) < 1.5, moments
+
+
+def test_emc_accuracy_takes_the_operating_point(fmu_path, tmp_path, monkeypatch):
+    seen = {}
+
+    def capture(fmu, cases, scenarios, *args, **kwargs):
+        seen["scenarios"] = scenarios
+        return pd.DataFrame([{"case": "", "scenario": s.name, "rtol": 1e-5, "steps": 1,
+                              "cpu_s_per_s": 1.0, "x_realtime": 1.0, "l2 mount": 1e-4,
+                              "orders mount": 1e-4, "reference_steps": 1} for s in scenarios])
+
+    monkeypatch.setattr(accuracy, "work_precision", capture)
+    monkeypatch.setattr(accuracy, "plot", lambda *a, **k: None)
+    code = cli.main(["accuracy", "--fmu", str(fmu_path), "--rpm-point", "1500",
+                     "--load-torque", "150", "--out", str(tmp_path), "--quiet"])
+    assert code == 0
+    stationary, runup = seen["scenarios"]
+    assert (stationary.rpm_from, stationary.rpm_to, stationary.load_torque) == (1500, 1500, 150)
+    assert runup.load_torque == 150 and stationary.name == "1500 rpm, 150 N·m"
+    meta = json.loads((tmp_path / "metadata.json").read_text())
+    assert [s["load_torque"] for s in meta["scenarios"]] == [150.0, 150.0]

@@ -254,6 +254,10 @@ HISTORY = re.compile(r"|".join([
     r"\bthe former\b", r"\bformerly\b", r"\bof that day\b", r"\buntil now\b",
     r"\bprevious(ly)? (version|release|code|solver)\b", r"\bearlier (runs|measurements|version|code)\b",
     r"\b(has|have) not been re-?(run|measured)\b",
+    # What a default or a version was, and targets met or missed: the page says what holds and
+    # what was measured with which setting.
+    r"\b(previous|old|former|earlier) defaults?\b", r"\bversion \d+(\.\d+)+ (used|had|was)\b",
+    r"\bgoals?\b", r"\b(is|are|was|were) (met|missed|not met)\b",
 ]), re.I)
 
 
@@ -272,3 +276,179 @@ def test_the_history_check_finds_history():
     text = "Fast.\n607.9 s the day before (issue 27, first sitting); measured before the fix.\n"
     assert len(history_phrases(text)) == 4
     assert history_phrases("The solver holds the order down for a while.") == []
+    text = ("The previous default, 1 %, gave more. Version 0.1.0 used 1e-8. Against the goals\n"
+            "(150×) it is short; the goal of 1.8× is met.\n")
+    assert len(history_phrases(text)) == 5, history_phrases(text)
+    assert history_phrases("The default is 5 %; the Adams table gives 6.2 m/s² there.") == []
+
+
+# ---------------------------------------------------------------------------------------------
+# Measured figures: one source (docs/figures.toml), quoted between markers
+
+
+def _figures():
+    sys.path.insert(0, str(ROOT / "docs"))
+    try:
+        import figures
+    finally:
+        sys.path.pop(0)
+    return figures
+
+
+def test_every_figure_says_when_where_and_how_it_was_measured():
+    figures = _figures()
+    sources = figures.load()
+    assert not figures.problems(sources), figures.problems(sources)
+    assert len(sources["figures"]) >= 30 and len(sources["tables"]) >= 5
+    broken = dict(sources, figures={"x": {"value": "about 3", "what": "w", "date": "4 Dec",
+                                          "machine": "Z", "command": "c", "damping": "1 %"}})
+    assert len(figures.problems(broken)) == 4, figures.problems(broken)
+
+
+def quoted_figures_that_differ(text: str, sources: dict) -> list[str]:
+    figures = _figures()
+    wrong = []
+    for m in figures.MARKER.finditer(text):
+        if m.group(1) not in sources["figures"]:
+            wrong.append(f"{m.group(1)}: not in docs/figures.toml")
+        elif m.group(2) != figures.text(m.group(1), sources):
+            wrong.append(f"{m.group(1)}: '{m.group(2)}', the source says "
+                         f"'{figures.text(m.group(1), sources)}'")
+    return wrong
+
+
+def test_every_quoted_figure_and_figure_table_equals_its_source():
+    figures = _figures()
+    sources = figures.load()
+    wrong = {p.relative_to(ROOT).as_posix(): quoted_figures_that_differ(p.read_text(), sources)
+             for p in pages()}
+    wrong = {page: hits for page, hits in wrong.items() if hits}
+    assert not wrong, wrong
+    # Every figure and every table of the source is on a page.
+    text = "\n".join(p.read_text() for p in pages())
+    quoted = {m.group(1) for m in figures.MARKER.finditer(text)}
+    assert not set(sources["figures"]) - quoted, set(sources["figures"]) - quoted
+    tables = set(re.findall(r"<!-- generated: table-([\w-]+) -->", text))
+    assert tables == set(sources["tables"]), set(sources["tables"]) ^ tables
+    # The figure tables, the machines and the list of figures as docs/generate.py writes them.
+    generate = _generator()
+    stale = [p.relative_to(ROOT).as_posix() for p in generate.stale_pages(generate.light)]
+    assert not stale, f"stale figures in {stale}: run `{generate.COMMAND} --light`"
+
+
+def test_a_figure_that_differs_from_its_source_is_found():
+    figures = _figures()
+    sources = figures.load()
+    readme = (ROOT / "README.md").read_text()
+    marked = "<!--f:realtime.scene2.2000-->" + figures.text("realtime.scene2.2000", sources)
+    assert marked in readme
+    edited = readme.replace(marked, "<!--f:realtime.scene2.2000-->12–14×", 1)
+    assert quoted_figures_that_differ(edited, sources) == [
+        "realtime.scene2.2000: '12–14×', the source says '11.8–14×'"]
+    assert figures.fill(edited, sources) == readme
+    # A new measurement in the source makes every page that quotes it stale.
+    remeasured = dict(sources, tables={**sources["tables"], "realtime": dict(
+        sources["tables"]["realtime"],
+        rows=[sources["tables"]["realtime"]["rows"][0],
+              ["2", "211", "16–19×", "13–15×", "7.2–8.2×"]])})
+    assert quoted_figures_that_differ(readme, remeasured) == [
+        "realtime.scene2.2000: '11.8–14×', the source says '13–15×'"]
+
+
+def test_a_figure_measured_with_the_adams_table_says_so():
+    figures = _figures()
+    sources = figures.load()
+    unsaid = {p.relative_to(ROOT).as_posix(): figures.unsaid_damping(p.read_text(), sources)
+              for p in pages()}
+    unsaid = {page: hits for page, hits in unsaid.items() if hits}
+    assert not unsaid, unsaid
+    assert sources["figures"]["comfort.wheel.1100.adams"]["damping"] == "adams"
+    page = "Fast.\n\nThe wheel: <!--f:comfort.wheel.1100.adams-->6.2 m/s²<!--/f-->.\n"
+    assert len(figures.unsaid_damping(page, sources)) == 1
+    assert figures.unsaid_damping(page.replace("The wheel", "With the Adams table"), sources) == []
+
+
+def unmarked_copies(text: str, sources: dict) -> list[str]:
+    """Ranges with a unit (distinctive enough not to be another quantity that happens to read
+    alike) written out on a page without their marker: a copy that would not follow its source."""
+    figures = _figures()
+    bare = figures.MARKER.sub("", text)
+    bare = re.sub(r"<!-- generated: ([\w-]+) -->.*?<!-- end generated: \1 -->", "", bare,
+                  flags=re.S)
+    found = []
+    for figure_id in sources["figures"]:
+        shown = figures.text(figure_id, sources)
+        if not sources["figures"][figure_id].get("unit") and not shown.endswith("×"):
+            continue
+        if "–" not in shown:
+            continue
+        if re.search(r"(?<![\w.–-])" + re.escape(shown) + r"(?![\w–])", bare):
+            found.append(f"{figure_id}: '{shown}' without its marker")
+    return found
+
+
+def test_a_quoted_figure_carries_its_marker():
+    figures = _figures()
+    sources = figures.load()
+    found = {p.relative_to(ROOT).as_posix(): unmarked_copies(p.read_text(), sources)
+             for p in pages()}
+    found = {page: hits for page, hits in found.items() if hits}
+    assert not found, found
+    assert unmarked_copies("scene 2 at 11.8–14× real time", sources) == [
+        "realtime.scene2.2000: '11.8–14×' without its marker"]
+
+
+# ---------------------------------------------------------------------------------------------
+# Reference pages generated from the code
+
+
+REFERENCE_PAGES = {"reference/cli.md": "cli-reference", "reference/vehicle.md": "vehicle-fields",
+                   "reference/results.md": "result-files"}
+
+
+@pytest.mark.parametrize("page", REFERENCE_PAGES)
+def test_a_reference_page_is_what_the_code_says(page):
+    generate = _generator()
+    path = BOOK_SRC / page
+    text = path.read_text()
+    assert f"<!-- generated: {REFERENCE_PAGES[page]} -->" in text
+    assert generate.regenerate(text, path, {}, generate.light) == text, (
+        f"{page} is stale: run `{generate.COMMAND} --light`")
+    assert f"]({page})" in (BOOK_SRC / "SUMMARY.md").read_text()
+
+
+def test_the_cli_reference_names_every_command_and_option():
+    generate = _generator()
+    text = (BOOK_SRC / "reference" / "cli.md").read_text()
+    from emc.cli import build_parser
+
+    emc_parser = build_parser()
+    commands = generate.reference.commands(emc_parser)
+    assert len(commands) >= 20
+    for name, command in commands.items():
+        assert f"### emc {name}\n" in text, name
+        section = text.split(f"### emc {name}\n", 1)[1].split("\n### ", 1)[0]
+        for action in command._actions:
+            for option in action.option_strings:
+                if option not in ("-h", "--help"):
+                    assert f"`{option}" in section, f"emc {name} {option}"
+    # A new option is on the page at once.
+    accuracy = commands["accuracy"]
+    accuracy.add_argument("--brand-new", type=float, default=3.5, help="an option")
+    assert "| `--brand-new BRAND_NEW` | 3.5 | an option |" in generate.reference.cli_reference(emc_parser)
+    assert "--brand-new" not in generate.reference.cli_reference()
+
+
+def test_the_vehicle_reference_has_every_field_of_the_mount():
+    # Counted independently of the generator: the `pub` fields of MountConfig in its source.
+    source = (ROOT / "src" / "model" / "mount" / "config.rs").read_text()
+    struct = source.split("pub struct MountConfig {", 1)[1].split("\n}", 1)[0]
+    fields = re.findall(r"^\s*pub (\w+):", struct, re.M)
+    assert {"bracket", "body_node", "preload", "active"} <= set(fields)
+    text = (BOOK_SRC / "reference" / "vehicle.md").read_text()
+    section = text.split("### MountConfig\n", 1)[1].split("\n### ", 1)[0]
+    assert re.findall(r"^\| `(\w+)` \|", section, re.M) == fields
+    for name in ("VehicleConfig", "BodyConfig", "BodyDamping", "DampingTable", "ChassisConfig",
+                 "EngineConfig", "MountCurve"):
+        assert f"### {name}\n" in text, name
+    assert '`"kind": "nastran"`' in text and "| `include_root` |" in text

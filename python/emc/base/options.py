@@ -103,7 +103,9 @@ def add_order(p, default: float = 1.5, help: str = "order of the plots"):
 
 
 def add_load_torque(p):
-    p.add_argument("--load-torque", type=number, default=0.0, help="N·m, every point")
+    p.add_argument("--load-torque", type=number, default=0.0,
+                   help="the drivetrain's reaction torque on the engine, N·m, every run "
+                        "(default 0)")
 
 
 def add_window(p, revolutions: int | None, steps: int = 72, load: bool = True):

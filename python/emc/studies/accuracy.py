@@ -48,7 +48,7 @@ from .defaults import COMPARED_ORDERS, DEFAULT_TOLERANCES, REFERENCE_TOLERANCE
 class Scenario:
     """``settle`` seconds at ``rpm_from`` (not compared), then the compared window of
     ``duration`` seconds: at constant speed (``rpm_from == rpm_to``) or a linear run-up to
-    ``rpm_to``."""
+    ``rpm_to``, under the drivetrain's reaction ``load_torque`` (N·m) throughout."""
 
     name: str
     rpm_from: float
@@ -57,6 +57,7 @@ class Scenario:
     step: float = 1e-3
     periodic: bool = False
     settle: float = 0.0
+    load_torque: float = 0.0
 
     @property
     def stationary(self) -> bool:
@@ -86,7 +87,7 @@ def run(runner: Runner, scenario: Scenario, parameters: dict, signals: list[str]
     runner.log.clear()
     try:
         slave.setupExperiment(tolerance=tolerance, startTime=0.0)
-        start = {"rpm": scenario.rpm_from, **parameters}
+        start = {"rpm": scenario.rpm_from, "loadTorque": scenario.load_torque, **parameters}
         if scenario.periodic:
             start["initialization.periodic"] = True
         for name, value in start.items():
@@ -259,21 +260,23 @@ def cmd_accuracy(args) -> int:
     check_range("--step", args.step, 0.0, args.duration, strict_low=True)
     highest = highest_speed(variables)
     check_range("--rpm-point", args.rpm_point, 0.0, highest, strict_low=True)
+    check_range("--load-torque", args.load_torque)
+    load = f", {args.load_torque:g} N·m" if args.load_torque else ""
     kinds = list(dict.fromkeys(args.scenario or ["stationary", "runup"]))
     scenarios = []
     for kind in kinds:
         if kind == "stationary":
-            scenarios.append(Scenario(f"{args.rpm_point:g} rpm", args.rpm_point, args.rpm_point,
-                                      args.duration, args.step, args.start == "periodic",
-                                      args.settle))
+            scenarios.append(Scenario(f"{args.rpm_point:g} rpm{load}", args.rpm_point,
+                                      args.rpm_point, args.duration, args.step,
+                                      args.start == "periodic", args.settle, args.load_torque))
         else:
             check_speeds(args.runup, increasing=True, highest=highest)
             if args.start == "periodic":
                 raise UsageError("--start periodic needs a constant speed; use "
                                      "--scenario stationary")
-            scenarios.append(Scenario(f"run-up {args.runup[0]:g}-{args.runup[1]:g} rpm",
+            scenarios.append(Scenario(f"run-up {args.runup[0]:g}-{args.runup[1]:g} rpm{load}",
                                       args.runup[0], args.runup[1], args.duration, args.step,
-                                      settle=args.settle))
+                                      settle=args.settle, load_torque=args.load_torque))
     signals = list(dict.fromkeys(args.signal or []))
     check_outputs("--signal", signals, variables)
     signals = signals or default_accuracy_signals(variables)

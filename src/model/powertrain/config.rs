@@ -90,9 +90,9 @@ pub struct EccentricWeight {
 }
 
 /// Residual unbalance of a rotating part after balancing, by its balance grade (ISO 21940-11,
-/// formerly ISO 1940-1): the permissible specific unbalance `e = G / Ω` at the maximum service
-/// speed `Ω`, so `U = m G / Ω` for a part of mass `m`. It acts as a point mass `U / r` at radius
-/// [`UNBALANCE_RADIUS`] on the part, turning with it.
+/// which replaced ISO 1940-1): the permissible specific unbalance `e = G / Ω` at the maximum
+/// service speed `Ω`, so `U = m G / Ω` for a part of mass `m`. It acts as a point mass `U / r`
+/// at radius [`UNBALANCE_RADIUS`] on the part, turning with it.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct ResidualUnbalance {
