@@ -59,19 +59,16 @@ impl BodySimulation {
                 vehicle.mounts.len()
             )));
         }
-        let (mut model, note) = build_body_alone(&vehicle, &settings.chassis)?;
+        let (mut model, mut notes) = build_body_alone(&vehicle, &settings.chassis)?;
         let inputs = apply(&mut model, inputs)?;
         let comfort = ComfortPoints::resolve(model.output_points().iter().map(|p| p.name.as_str()));
         let state = model.static_equilibrium(t0);
-        let notes = vec![
-            note,
-            format!(
-                "the body alone: {} modes on its suspension, forces at {} mount points, \
-                 propagated exactly (ramp inputs); static equilibrium under the forces at t = {t0} s",
-                model.modes(),
-                model.mount_points().iter().flatten().count()
-            ),
-        ];
+        notes.push(format!(
+            "the body alone: {} modes on its suspension, forces at {} mount points, propagated \
+             exactly (ramp inputs); static equilibrium under the forces at t = {t0} s",
+            model.modes(),
+            model.mount_points().iter().flatten().count()
+        ));
         Ok(Self {
             model,
             notes,

@@ -375,7 +375,10 @@ impl Instance {
             self.event(&parameters::replaced_note(r));
         }
         for line in simulation.describe() {
-            self.event(&line);
+            match line.strip_prefix("warning: ") {
+                Some(warning) => self.log_warning(warning),
+                None => self.event(&line),
+            }
         }
         let outputs = simulation.outputs().map_err(|e| parameters::message(&e))?;
         self.write_outputs(&outputs, &simulation.counters());

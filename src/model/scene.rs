@@ -261,10 +261,7 @@ pub fn build(
                 notes: Vec::new(),
             });
         }
-        SceneKind::Body => {
-            let (body, note) = body(vehicle, options)?;
-            (body, vec![note])
-        }
+        SceneKind::Body => body(vehicle, options)?,
     };
     let model = CoupledModel::with_body(vehicle, body).map_err(|e| e.to_string())?;
     Ok(Built { model, notes })
@@ -299,13 +296,13 @@ fn mode_selection(vehicle: &VehicleConfig, options: &BodyOptions) -> (ModeSelect
 }
 
 /// The vehicle's reduced body alone, driven by forces at its mount points (the body FMU), with
-/// a log line on how the body was obtained.
+/// the log lines of [`body`].
 pub fn build_body_alone(
     vehicle: &VehicleConfig,
     options: &BodyOptions,
-) -> Result<(BodyAlone, String), SceneError> {
+) -> Result<(BodyAlone, Vec<String>), SceneError> {
     vehicle.validate().map_err(|e| e.to_string())?;
-    let (reduced, note) = body(vehicle, options)?;
+    let (reduced, notes) = body(vehicle, options)?;
     let weight = crate::model::powertrain::Powertrain::new(
         vehicle.engine.clone(),
         vehicle.effects,
@@ -317,7 +314,7 @@ pub fn build_body_alone(
     let force_limit = crate::model::inputs::BODY_FORCE_LIMIT_WEIGHTS * weight;
     let model = BodyAlone::new(reduced, &vehicle.mounts, &vehicle.outputs, force_limit)
         .map_err(|e| e.to_string())?;
-    Ok((model, note))
+    Ok((model, notes))
 }
 
 /// What the reduction of the vehicle's body depends on for these options (procedural chassis,
@@ -423,19 +420,71 @@ fn file_digest(
 /// Sets the modal damping of `body`: the vehicle configuration's body damping, else the body's
 /// own (a deck's `TABDMP1` named by `SDAMPING`; a reduced body read from a file keeps its
 /// ratios), else the default; the physical part scaled by `scale`. Returns what was applied,
-/// for the log.
+/// for the log, and a warning for every mode damped above critical.
 fn apply_damping(
     body: &mut ReducedChassis,
     vehicle: &VehicleConfig,
     scale: f64,
-) -> Result<String, SceneError> {
+) -> Result<(String, Vec<String>), SceneError> {
+    let (applied, origin) = set_damping(body, vehicle, scale)?;
+    Ok((applied, overdamped(body, &origin, scale)))
+}
+
+/// Overdamped modes are legal (a joint or a damping layer may damp a local mode beyond critical),
+/// but a damping table or override that puts a mode there is more often a unit mistake (a G or
+/// Q value given as CRIT, a percentage as a ratio): each is named, with its value and origin. The
+/// interface modes above the cut-off are damped numerically (at most critical) and not named.
+fn overdamped(body: &ReducedChassis, origin: &str, scale: f64) -> Vec<String> {
+    let hz = |k: usize| body.omega[k] / (2.0 * std::f64::consts::PI);
+    let physical = |k: usize| body.cutoff_hz.is_none_or(|c| hz(k) <= c);
+    let over: Vec<usize> = (0..body.zeta.len())
+        .filter(|&k| body.zeta[k] > 1.0 && physical(k))
+        .collect();
+    let scaled = if scale == 1.0 {
+        String::new()
+    } else {
+        format!(", chassis.modalDampingScale = {scale}")
+    };
+    let mut lines: Vec<String> = over
+        .iter()
+        .take(5)
+        .map(|&k| {
+            format!(
+                "warning: body mode {} ({:.1} Hz) is damped at {:.3} of critical, above critical \
+                 (overdamped), by {origin}{scaled}: accepted; check the table's unit (CRIT is a \
+                 fraction of critical, G = 2 CRIT, Q = 1 / (2 CRIT)) and whether a percentage \
+                 was meant",
+                k + 1,
+                hz(k),
+                body.zeta[k]
+            )
+        })
+        .collect();
+    if over.len() > 5 {
+        lines.push(format!(
+            "warning: {} more body modes are damped above critical",
+            over.len() - 5
+        ));
+    }
+    lines
+}
+
+/// [`apply_damping`] without the warnings: what was applied, and where the damping came from.
+fn set_damping(
+    body: &mut ReducedChassis,
+    vehicle: &VehicleConfig,
+    scale: f64,
+) -> Result<(String, String), SceneError> {
     let given = vehicle.body.damping();
     if given.is_none() {
         if let BodyConfig::Reduced { .. } = vehicle.body {
             for z in &mut body.zeta {
                 *z *= scale;
             }
-            return Ok(format!("modal damping x{scale} (the file's ratios)"));
+            return Ok((
+                format!("modal damping x{scale} (the file's ratios)"),
+                "the reduced body file's ratios".to_owned(),
+            ));
         }
     }
     let (damping, origin) = match (given, &body.own_damping) {
@@ -461,14 +510,23 @@ fn apply_damping(
         }
         None => String::new(),
     };
-    Ok(format!("modal damping x{scale} ({origin}){interface}"))
+    let source = match (given, &body.own_damping) {
+        (Some(_), _) => "the vehicle configuration's body.damping".to_owned(),
+        (None, Some(own)) => format!("the body's {}", own.source),
+        (None, None) => "the default damping".to_owned(),
+    };
+    Ok((
+        format!("modal damping x{scale} ({origin}){interface}"),
+        source,
+    ))
 }
 
-/// The reduced body the scene asks for, from the cache or freshly reduced (timed for the log).
+/// The reduced body the scene asks for, from the cache or freshly reduced (timed for the log),
+/// with the log lines: how it was obtained, then its warnings (each starting with "warning: ").
 pub fn body(
     vehicle: &VehicleConfig,
     options: &BodyOptions,
-) -> Result<(ReducedChassis, String), SceneError> {
+) -> Result<(ReducedChassis, Vec<String>), SceneError> {
     options.validate()?;
     let flexible = vehicle.effects.chassis_flexibility;
     let started = std::time::Instant::now();
@@ -533,12 +591,15 @@ pub fn body(
         rigid.cutoff_hz = rigid.cutoff_hz.map(|_| RIGID_BODY_HZ);
         rigid
     };
-    let damping_origin = apply_damping(&mut body, vehicle, options.modal_damping_scale)?;
+    let (damping_origin, warnings) =
+        apply_damping(&mut body, vehicle, options.modal_damping_scale)?;
     let note = format!(
         "{origin}, {damping_origin}: {} modes, {:.1}..{:.1} Hz, in {seconds:.2} s",
         body.n_modes(),
         body.omega.first().copied().unwrap_or(0.0) / (2.0 * std::f64::consts::PI),
         body.omega.last().copied().unwrap_or(0.0) / (2.0 * std::f64::consts::PI),
     );
-    Ok((body, note))
+    let mut lines = vec![note];
+    lines.extend(warnings);
+    Ok((body, lines))
 }

@@ -248,6 +248,22 @@ fn merge_patch(target: &mut serde_json::Value, patch: &serde_json::Value) {
     }
 }
 
+/// Where in `body` an error lies, which serde reports for the whole of `body`: the kinds are an
+/// internally tagged enum, whose content serde buffers, so the path inside is lost. The fields
+/// shared by the kinds that carry nested data (`damping`) are read again on their own to find it.
+fn body_error_path(body: &serde_json::Value) -> Option<(String, String)> {
+    let damping = body.get("damping")?;
+    let e =
+        serde_path_to_error::deserialize::<_, crate::cms::BodyDamping>(damping.clone()).err()?;
+    let inner = e.path().to_string();
+    let path = if inner == "." || inner.is_empty() {
+        "body.damping".to_owned()
+    } else {
+        format!("body.damping.{inner}")
+    };
+    Some((path, format!("{}", e.into_inner())))
+}
+
 impl VehicleConfig {
     /// Parses a vehicle configuration (see the module doc for `extends`) and validates it.
     pub fn from_json(text: &str) -> Result<Self, ConfigError> {
@@ -265,9 +281,17 @@ impl VehicleConfig {
             merge_patch(&mut merged, &value);
             value = merged;
         }
-        let config: Self = serde_path_to_error::deserialize(value).map_err(|e| {
+        let config: Self = serde_path_to_error::deserialize(value.clone()).map_err(|e| {
             let path = e.path().to_string();
-            err(path, format!("{}", e.into_inner()))
+            let inner = if path == "body" {
+                body_error_path(&value["body"])
+            } else {
+                None
+            };
+            match inner {
+                Some((path, message)) => err(path, message),
+                None => err(path, format!("{}", e.into_inner())),
+            }
         })?;
         config.validate()?;
         Ok(config)

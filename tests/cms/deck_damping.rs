@@ -78,7 +78,7 @@ fn the_tabdmp1_sdamping_names_reaches_every_mode_and_the_cache() {
 fn bad_damping_input_is_refused_naming_card_id_and_line() {
     // The deck: SOL, CEND, the control line(s), then BEGIN BULK at line 4 (or 5), the plate's
     // 2 + 28 + 18 cards and 12 springs; the extra cards start at line 65.
-    let cases: [(&str, &str, &[&str]); 8] = [
+    let cases: [(&str, &str, &[&str]); 9] = [
         (
             "SDAMPING = 9\n",
             TABLE,
@@ -129,6 +129,16 @@ fn bad_damping_input_is_refused_naming_card_id_and_line() {
             "SDAMPING = 5\n",
             "TABDMP1,5,CRIT\n,0.,.04,ENDT,,7.\n",
             &["line 66", "TABDMP1 5", "after the end of the table"],
+        ),
+        (
+            // A frequency without its value: the 100 Hz point must not vanish silently.
+            "SDAMPING = 5\n",
+            "TABDMP1,10,CRIT\n,0.,.04,100.,ENDT\n",
+            &[
+                "line 66",
+                "TABDMP1 10",
+                "the frequency 100 has no damping value before ENDT",
+            ],
         ),
     ];
     for (k, (control, cards, says)) in cases.iter().enumerate() {

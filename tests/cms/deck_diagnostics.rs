@@ -138,7 +138,8 @@ fn the_deck_notes_reach_the_body_log_line() {
         cache: CacheSetting::Disabled,
         ..BodyOptions::default()
     };
-    let (_, note) = body(&vehicle, &options).unwrap();
+    let (_, notes) = body(&vehicle, &options).unwrap();
+    let note = &notes[0];
     assert!(
         note.contains("bulk data deck") && note.contains("1 GRID(s)") && note.contains("999999"),
         "{note}"

@@ -236,3 +236,71 @@ fn bad_tables_in_the_configuration_are_refused_naming_the_field_and_point() {
         );
     }
 }
+
+#[test]
+fn damping_above_critical_is_accepted_with_a_warning_naming_mode_and_value() {
+    let dir = temp_dir("overdamped");
+    // Each a likely unit mistake: CRIT 1.5, G 10 (ζ = 5), Q 0.01 (ζ = 50), an override of 50.
+    let cases = [
+        (
+            "crit",
+            r#"{"table": {"type": "crit", "points": [[0, 1.5]]}}"#,
+            "1.500",
+        ),
+        (
+            "g",
+            r#"{"table": {"type": "g", "points": [[0, 10.0]]}}"#,
+            "5.000",
+        ),
+        (
+            "q",
+            r#"{"table": {"type": "q", "points": [[0, 0.01]]}}"#,
+            "50.000",
+        ),
+        (
+            "override",
+            r#"{"table": {"type": "crit", "points": [[0, 0.05]]}, "modes": [[3, 50.0]]}"#,
+            "50.000",
+        ),
+    ];
+    for (name, damping, value) in cases {
+        let settings = scene_with_damping(&dir, name, damping);
+        let sim = Simulation::new(&settings, 0.0, &inputs(1500.0)).expect("accepted");
+        let warnings: Vec<String> = sim
+            .describe()
+            .into_iter()
+            .filter(|l| l.starts_with("warning: "))
+            .collect();
+        assert!(!warnings.is_empty(), "{name}: no warning");
+        let first = &warnings[0];
+        assert!(
+            first.contains(&format!("is damped at {value} of critical, above critical"))
+                && first.contains("body mode")
+                && first.contains("the vehicle configuration's body.damping"),
+            "{name}: {first}"
+        );
+        if name == "override" {
+            assert!(first.contains("body mode 3 ("), "{first}");
+            assert_eq!(warnings.len(), 1, "{warnings:?}");
+        }
+    }
+    // The default 5 % warns of nothing.
+    let settings = Settings {
+        scene: SceneKind::Body,
+        ..Settings::default()
+    };
+    let sim = Simulation::new(&settings, 0.0, &inputs(1500.0)).expect("scene 2");
+    assert!(!sim.describe().iter().any(|l| l.starts_with("warning: ")));
+    let _ = std::fs::remove_dir_all(&dir);
+}
+
+#[test]
+fn a_damping_type_error_in_the_json_names_its_path() {
+    let e = VehicleConfig::from_json(
+        r#"{"extends": "default", "body": {"kind": "procedural", "damping": {"table": {"type": "crit", "points": [[10.0, 0.05]]}, "modes": [[2.5, 0.02]]}}}"#,
+    )
+    .unwrap_err()
+    .to_string();
+    assert!(e.contains("body.damping.modes"), "{e}");
+    assert!(e.contains("expected usize"), "{e}");
+}

@@ -70,6 +70,23 @@ pub(crate) fn tabdmp1(r: &Reader) -> Result<DampingTableCard, FeError> {
     let mut i = 8;
     loop {
         let (f, g) = (r.value(i, "fi")?, r.value(i + 1, "gi")?);
+        // A frequency whose value field holds ENDT: the table ends with a point half given.
+        if is(&g, "ENDT") && !matches!(f, Value::Blank) && !is(&f, "SKIP") {
+            return Err(r.error(
+                i,
+                "fi",
+                format!(
+                    "TABDMP1 {id}: the frequency {} has no damping value before ENDT (each \
+                     point is a frequency and its value)",
+                    match &f {
+                        Value::Real(v) => v.to_string(),
+                        Value::Int(v) => v.to_string(),
+                        Value::Text(t) => t.clone(),
+                        Value::Blank => String::new(),
+                    }
+                ),
+            ));
+        }
         if is(&f, "ENDT") || is(&g, "ENDT") {
             let after = if is(&f, "ENDT") { i + 1 } else { i + 2 };
             return match (after..r.len())
