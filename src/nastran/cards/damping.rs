@@ -33,16 +33,13 @@ pub(crate) fn tabdmp1(r: &Reader) -> Result<DampingTableCard, FeError> {
         Value::Text(t) if t == "CRIT" => "CRIT",
         Value::Text(t) if t == "Q" => "Q",
         other => {
-            let shown = match other {
-                Value::Text(t) => t,
-                Value::Int(v) => v.to_string(),
-                Value::Real(v) => v.to_string(),
-                Value::Blank => String::new(),
-            };
             return Err(r.error(
                 1,
                 "TYPE",
-                format!("TABDMP1 {id}: damping type '{shown}' is not handled (G, CRIT or Q)"),
+                format!(
+                    "TABDMP1 {id}: damping type '{}' is not handled (G, CRIT or Q)",
+                    shown(&other)
+                ),
             ));
         }
     };
@@ -65,6 +62,29 @@ pub(crate) fn tabdmp1(r: &Reader) -> Result<DampingTableCard, FeError> {
             return Err(r.error(i, "blank", format!("TABDMP1 {id}: the field must be blank")));
         }
     }
+    let (points, point_lines) = table_points(r, id)?;
+    Ok(DampingTableCard {
+        id,
+        kind,
+        points,
+        point_lines,
+        loc: r.card().loc(),
+    })
+}
+
+/// A field's value as the deck shows it, for messages.
+fn shown(value: &Value) -> String {
+    match value {
+        Value::Text(t) => t.clone(),
+        Value::Int(v) => v.to_string(),
+        Value::Real(v) => v.to_string(),
+        Value::Blank => String::new(),
+    }
+}
+
+/// The pairs `f1 g1 f2 g2 …` of a `TABDMP1` from its field 9 up to `ENDT`, with the place of each
+/// point's frequency; a pair with `SKIP` in either field left out.
+fn table_points(r: &Reader, id: u32) -> Result<(Vec<[f64; 2]>, Vec<Loc>), FeError> {
     let is = |v: &Value, word: &str| matches!(v, Value::Text(t) if t == word);
     let (mut points, mut point_lines) = (Vec::new(), Vec::new());
     let mut i = 8;
@@ -78,12 +98,7 @@ pub(crate) fn tabdmp1(r: &Reader) -> Result<DampingTableCard, FeError> {
                 format!(
                     "TABDMP1 {id}: the frequency {} has no damping value before ENDT (each \
                      point is a frequency and its value)",
-                    match &f {
-                        Value::Real(v) => v.to_string(),
-                        Value::Int(v) => v.to_string(),
-                        Value::Text(t) => t.clone(),
-                        Value::Blank => String::new(),
-                    }
+                    shown(&f)
                 ),
             ));
         }
@@ -101,13 +116,7 @@ pub(crate) fn tabdmp1(r: &Reader) -> Result<DampingTableCard, FeError> {
                     "TABDMP1 {id}: the table has no point (at least one frequency and value \
                      before ENDT)"
                 ))),
-                None => Ok(DampingTableCard {
-                    id,
-                    kind,
-                    points,
-                    point_lines,
-                    loc: r.card().loc(),
-                }),
+                None => Ok((points, point_lines)),
             };
         }
         if i >= r.len() {
