@@ -273,13 +273,28 @@ fn inputs(table: &Value, families: &[super::Family]) -> String {
 /// `is_interface_input`: the Real inputs some output responds to at once (named in a row's
 /// `feedthrough`).
 fn interface_inputs(families: &[super::Family]) -> String {
-    let ranges: Vec<String> = families
+    let mut spans: Vec<(usize, usize)> = families
         .iter()
         .filter(|f| families.iter().any(|g| g.feedthrough.contains(&f.rust)))
         .map(|f| {
-            let count: usize = f.dims.iter().product();
-            format!("{}..={}", f.first_vr, f.first_vr + count - 1)
+            (
+                f.first_vr,
+                f.first_vr + f.dims.iter().product::<usize>() - 1,
+            )
         })
+        .collect();
+    spans.sort_unstable();
+    // Adjacent families make one range (as clippy wants the pattern written).
+    let mut merged: Vec<(usize, usize)> = Vec::new();
+    for (first, last) in spans {
+        match merged.last_mut() {
+            Some(previous) if previous.1 + 1 >= first => previous.1 = previous.1.max(last),
+            _ => merged.push((first, last)),
+        }
+    }
+    let ranges: Vec<String> = merged
+        .iter()
+        .map(|(first, last)| format!("{first}..={last}"))
         .collect();
     let test = if ranges.is_empty() {
         "{ let _ = index; false }".to_owned()

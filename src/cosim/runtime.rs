@@ -150,14 +150,6 @@ impl Runtime {
         }
     }
 
-    /// Whether the model accepts `inputs` (the model's one check), changing nothing.
-    pub fn check_inputs(&self, inputs: &Inputs) -> Result<(), Error> {
-        match self {
-            Runtime::Engine(s) => s.check_inputs(inputs),
-            Runtime::Body(s) => s.check_inputs(inputs),
-        }
-    }
-
     /// The model's rule for one input ([`crate::model::Input::check`]), changing nothing: the
     /// check of an input when it is set. An input the model does not have passes.
     pub fn check_input(&self, input: Input, ramp: &RampInput) -> Result<(), Error> {

@@ -17,3 +17,90 @@ include!(concat!(env!("OUT_DIR"), "/bindings.rs"));
 fn saturated(count: u64) -> i32 {
     i32::try_from(count).unwrap_or(i32::MAX)
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::cosim::{Inputs, FMU_MOUNTS};
+    use crate::variables::{Causality, REALS};
+
+    /// Every Real input, and nothing else, is bound to a runtime input that has a slot in the
+    /// runtime's inputs, no two to the same, and `input_variable` leads back to it with the
+    /// inverse factor.
+    #[test]
+    fn every_real_input_is_bound_both_ways() {
+        let mut slots = Inputs::nominal(FMU_MOUNTS);
+        let mut seen = Vec::new();
+        for v in REALS {
+            let bound = input_of(v.index);
+            assert_eq!(
+                bound.is_some(),
+                v.causality == Causality::Input,
+                "{}",
+                v.name
+            );
+            let Some((input, to_si)) = bound else {
+                continue;
+            };
+            assert!(!seen.contains(&input), "{}: {input:?} bound twice", v.name);
+            seen.push(input);
+            assert!(slots.ramp_mut(input).is_some(), "{}: {input:?}", v.name);
+            let (back, from_si) = input_variable(input).expect("the way back");
+            assert_eq!(back, v.index, "{}", v.name);
+            assert!((to_si * from_si - 1.0).abs() < 1e-15, "{}", v.name);
+        }
+        assert_eq!(
+            seen.len(),
+            2 + 2 * 4 + 3 * 4 * 3,
+            "rpm, loadTorque, 8 scales, 36 axes"
+        );
+        assert_eq!(input_variable(Input::StiffnessScale(FMU_MOUNTS)), None);
+    }
+
+    /// The speed is bound in rpm: 60 rpm is one revolution per second, 2π rad/s.
+    #[test]
+    fn the_speed_binds_in_rpm() {
+        assert_eq!(input_of(real::RPM).map(|(i, _)| i), Some(Input::CrankSpeed));
+        let (_, to_si) = input_of(real::RPM).unwrap();
+        assert!((60.0 * to_si - std::f64::consts::TAU).abs() < 1e-14);
+        let (index, from_si) = input_variable(Input::CrankSpeed).unwrap();
+        assert_eq!(index, real::RPM);
+        assert!((std::f64::consts::TAU * from_si - 60.0).abs() < 1e-12);
+        let (index, _) = input_variable(Input::BodyVelocity(2, 1)).unwrap();
+        assert_eq!(index, real::MOUNT_BODY_V[2][1]);
+    }
+
+    /// The inputs outputs answer at once are the external body's motion and the forces on the
+    /// body, and no other.
+    #[test]
+    fn the_interface_inputs_are_the_body_motion_and_forces() {
+        for v in REALS {
+            let interface = matches!(
+                input_of(v.index),
+                Some((
+                    Input::BodyDisplacement(..) | Input::BodyVelocity(..) | Input::BodyForce(..),
+                    _
+                ))
+            );
+            assert_eq!(is_interface_input(v.index), interface, "{}", v.name);
+        }
+    }
+
+    /// Counters beyond an FMI Integer's range read as its largest value, not wrapped.
+    #[test]
+    fn counters_are_bound_and_saturate() {
+        let mut n = Store::<i32>::start();
+        let c = Counters {
+            steps: 7,
+            rhs_evaluations: u64::MAX,
+            jacobian_evaluations: 1 << 31,
+            factorizations: (1 << 31) - 1,
+            ..Counters::default()
+        };
+        put_counters(&mut n, &c);
+        assert_eq!(*n.get(integer::SOLVER_STEPS), 7);
+        assert_eq!(*n.get(integer::SOLVER_RHS_EVALUATIONS), i32::MAX);
+        assert_eq!(*n.get(integer::SOLVER_JACOBIAN_EVALUATIONS), i32::MAX);
+        assert_eq!(*n.get(integer::SOLVER_FACTORIZATIONS), i32::MAX);
+    }
+}

@@ -678,11 +678,7 @@ impl Instance {
     /// units, refused naming the variable). A model not built yet checks every input when it is
     /// built; a step checks only the signals that continued without being set
     /// ([`super::step`]).
-    pub(super) fn check_inputs(
-        &self,
-        tracks: &[InputTrack],
-        indices: &[usize],
-    ) -> Result<(), String> {
+    fn check_inputs(&self, tracks: &[InputTrack], indices: &[usize]) -> Result<(), String> {
         let Some(runtime) = &self.core.simulation else {
             return Ok(());
         };

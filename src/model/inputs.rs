@@ -455,6 +455,34 @@ mod tests {
         assert!(bad.validate(3).is_err());
     }
 
+    /// Each rule is on its own input's ramp: an external body's point may be anywhere but not
+    /// move faster than 100 m/s; its velocity up to 100 m/s, changing by up to 1e4 m/s².
+    #[test]
+    fn each_input_has_its_own_rule() {
+        let ramp = |value, rate| RampInput {
+            value,
+            rate,
+            since: 0.0,
+        };
+        let r = Input::BodyDisplacement(0, 0);
+        assert!(r.check(&ramp(1e3, 99.0), f64::INFINITY).is_ok());
+        assert!(r.check(&ramp(0.0, 101.0), f64::INFINITY).is_err());
+        let v = Input::BodyVelocity(3, 2);
+        assert!(v.check(&ramp(-99.0, 9e3), f64::INFINITY).is_ok());
+        assert!(v.check(&ramp(-101.0, 0.0), f64::INFINITY).is_err());
+        assert!(v.check(&ramp(0.0, -1.1e4), f64::INFINITY).is_err());
+        // A speed set-point must be >= 0; a load torque may have either sign.
+        assert!(Input::CrankSpeed.check(&ramp(-1.0, 0.0), 0.0).is_err());
+        assert!(Input::LoadTorque.check(&ramp(-1e3, -1e3), 0.0).is_ok());
+        // Forces are bounded by the limit given, their rate by the limit per rise time.
+        let f = Input::BodyForce(0, 2);
+        assert!(f.check(&ramp(-999.0, 0.0), 1e3).is_ok());
+        assert!(f.check(&ramp(1001.0, 0.0), 1e3).is_err());
+        assert!(f
+            .check(&ramp(0.0, 1.01e3 / BODY_FORCE_RISE_TIME), 1e3)
+            .is_err());
+    }
+
     #[test]
     fn body_forces_beyond_the_bound_are_refused() {
         let limit = 1e5;
