@@ -3,7 +3,8 @@
 //! [.., "body"]`, the body FMU; one library, told apart by the GUID at instantiation):
 //! - `modelDescription.xml` and `body.modelDescription.xml` (packaged into the FMUs),
 //! - `variables.rs` (the value-reference table the FMI layer includes, with the unit factors)
-//!   and `bindings.rs` (each Real output bound to its accessor; `build/bindings.rs`),
+//!   and `bindings.rs` (each output and input bound to what it is in the runtime;
+//!   `build/bindings.rs`),
 //! - `index.html` and `body.index.html` (the FMUs' documentation pages),
 //! - `exports.map`, a linker version script that exports exactly the fmi2 and fmi3 functions;
 //! - the FMI 3.0 files of both FMUs (`build/fmi3_description.rs`).
@@ -174,7 +175,10 @@ fn main() {
             + &fmi3_description::rust_map(&table, &families)
             + &bindings::rust_units(&table)),
     );
-    write(&out.join("bindings.rs"), &bindings::rust_bindings(&table));
+    write(
+        &out.join("bindings.rs"),
+        &bindings::rust_bindings(&table, &families),
+    );
     fmi3_description::write_files(&out, &table, &families, &fmus);
 
     let mut map = String::from("{\n  global:\n");

@@ -6,7 +6,9 @@
 
 use super::scene::{vehicle_config_with_replacements, ComfortPoints};
 use super::settings::Replaced;
-use super::{Counters, Error, Inputs, Outputs, Settings, StepFailure, FMU_MOUNTS};
+use super::{
+    Counters, Error, Input, Inputs, Outputs, RampInput, Settings, StepFailure, FMU_MOUNTS,
+};
 use crate::model::body_alone::BodyAlone;
 use crate::model::scene::build_body_alone;
 use crate::model::{Mode, ModeKind};
@@ -45,6 +47,14 @@ pub struct BodyState {
 fn apply(model: &mut BodyAlone, inputs: &Inputs) -> Result<Inputs, Error> {
     let sized = inputs.sized(model.mount_points().len());
     model.set_forces(&sized.body_force)?;
+    Ok(sized)
+}
+
+/// Applies the forces of `inputs`, sized to the model's mounts, each of which passed its rule
+/// where it was set ([`BodyAlone::check_input`]), and returns the inputs as applied.
+fn apply_checked(model: &mut BodyAlone, inputs: &Inputs) -> Result<Inputs, Error> {
+    let sized = inputs.sized(model.mount_points().len());
+    model.set_checked_forces(&sized.body_force)?;
     Ok(sized)
 }
 
@@ -114,10 +124,22 @@ impl BodySimulation {
         Ok(self.model.check_forces(&sized.body_force)?)
     }
 
+    /// The body's rule for one input, changing nothing; an input the body does not have passes.
+    pub fn check_input(&self, input: Input, ramp: &RampInput) -> Result<(), Error> {
+        Ok(self.model.check_input(input, ramp)?)
+    }
+
     /// Applies the forces of `inputs` from the current time on. The exact propagation needs no
     /// restart, so nothing "jumps" for the integrator: returns `false`.
     pub fn set_inputs(&mut self, inputs: &Inputs) -> Result<bool, Error> {
         self.inputs = apply(&mut self.model, inputs)?;
+        Ok(false)
+    }
+
+    /// [`Self::set_inputs`] for forces each of which passed its rule where it was set
+    /// ([`Self::check_input`]): the rules do not run again.
+    pub fn set_checked_inputs(&mut self, inputs: &Inputs) -> Result<bool, Error> {
+        self.inputs = apply_checked(&mut self.model, inputs)?;
         Ok(false)
     }
 
@@ -155,11 +177,11 @@ impl BodySimulation {
         out
     }
 
-    /// Outputs at the communication time with the forces of `interface` (the state held): the
-    /// accelerations respond at once to the forces.
+    /// Outputs at the communication time with the forces of `interface` (the state held; each
+    /// force checked where it was set): the accelerations respond at once to the forces.
     pub fn outputs_with(&self, interface: &Inputs) -> Result<Outputs, Error> {
         let mut model = self.model.clone();
-        apply(&mut model, &self.inputs.with_interface(interface))?;
+        apply_checked(&mut model, &self.inputs.with_interface(interface))?;
         Ok(Self::outputs_of(
             &model,
             self.comfort,

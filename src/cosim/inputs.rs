@@ -4,7 +4,7 @@
 //! ([`ModelInputs::validate`], [`crate::model::inputs::validate_body_forces`]).
 
 use crate::model::inputs::AttachmentMotion;
-use crate::model::{ModelInputs, RampInput};
+use crate::model::{Input, ModelInputs, RampInput};
 
 /// All inputs of the runtime, in SI units. Per mount, in configuration order: a list shorter
 /// than the configuration's mounts leaves the others at their nominal value (scale 1, body at
@@ -27,6 +27,23 @@ impl Inputs {
         Inputs {
             model,
             body_force: Vec::new(),
+        }
+    }
+
+    /// Every input at its nominal value for `mounts` mounts: speed and load torque zero, every
+    /// scale 1, the body at rest and without forces.
+    pub fn nominal(mounts: usize) -> Inputs {
+        Inputs {
+            model: ModelInputs::new(mounts),
+            body_force: vec![[RampInput::ZERO; 3]; mounts],
+        }
+    }
+
+    /// The ramp of `input`, to change (`None` for a mount these inputs do not have).
+    pub fn ramp_mut(&mut self, input: Input) -> Option<&mut RampInput> {
+        match input {
+            Input::BodyForce(i, j) => self.body_force.get_mut(i).and_then(|f| f.get_mut(j)),
+            _ => self.model.ramp_mut(input),
         }
     }
 

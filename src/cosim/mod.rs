@@ -226,7 +226,7 @@ impl Simulation {
     /// [`Self::natural_modes`] and the analysis export linearise at [`Self::equilibrium`].
     fn linearisation_model(&self) -> Result<CoupledModel, Error> {
         let mut model = self.scene.clone();
-        scene::apply_inputs(&mut model, &self.initial_inputs)?;
+        scene::apply_checked_inputs(&mut model, &self.initial_inputs)?;
         model
             .set_fade_start(self.initial_time)
             .map_err(|e| e.to_string())?;
@@ -260,14 +260,29 @@ impl Simulation {
         Ok(inputs.sized(mounts).model.validate(mounts)?)
     }
 
-    /// Applies inputs valid from the current time on. Returns whether an input jumped, in which
-    /// case the integrator restarted at order 1 from the state at the communication time (its
-    /// history, and any step it took past that time, describe the old inputs).
+    /// The model's rule for one input ([`crate::model::Input::check`]), changing nothing; an
+    /// input this model does not have passes.
+    pub fn check_input(&self, input: Input, ramp: &RampInput) -> Result<(), Error> {
+        Ok(self.scene.check_input(input, ramp)?)
+    }
+
+    /// Applies inputs valid from the current time on (checked by the model first; on refusal
+    /// nothing changed). Returns whether an input jumped ([`Self::set_checked_inputs`]).
     pub fn set_inputs(&mut self, inputs: &Inputs) -> Result<bool, Error> {
+        self.check_inputs(inputs)?;
+        self.set_checked_inputs(inputs)
+    }
+
+    /// Applies inputs valid from the current time on, each of which passed its rule where it
+    /// was set ([`Self::check_input`]): the rules do not run again. Returns whether an input
+    /// jumped, in which case the integrator restarted at order 1 from the state at the
+    /// communication time (its history, and any step it took past that time, describe the old
+    /// inputs).
+    pub fn set_checked_inputs(&mut self, inputs: &Inputs) -> Result<bool, Error> {
         let t = self.time;
         let previous = self.inputs.clone();
-        // Sized to the mounts and checked by the model; on refusal nothing changed.
-        let inputs = scene::apply_inputs(&mut self.scene, inputs)?;
+        // Sized to the mounts; on refusal nothing changed.
+        let inputs = scene::apply_checked_inputs(&mut self.scene, inputs)?;
         // With the speed follower the crank speed is a state: a set-point jump bends its
         // trajectory but does not break it. It only needs a restart when the kink it puts into
         // the crank acceleration would fail the error test of the next step anyway.
@@ -282,7 +297,7 @@ impl Simulation {
         // An external body may move a mount beyond its characteristic: refuse the inputs
         // (naming the mount) rather than extrapolate a curve the mount does not have.
         if let Err(e) = self.interface_in_range() {
-            scene::apply_inputs(&mut self.scene, &previous)?;
+            scene::apply_checked_inputs(&mut self.scene, &previous)?;
             return Err(e);
         }
         self.inputs = inputs;
@@ -290,7 +305,7 @@ impl Simulation {
         if jumped {
             if let Err(e) = self.integrator.restart_at(&mut self.scene, t, &self.state) {
                 // Leave everything as it was: the old inputs still describe the integrator.
-                scene::apply_inputs(&mut self.scene, &previous)?;
+                scene::apply_checked_inputs(&mut self.scene, &previous)?;
                 self.inputs = previous;
                 return Err(Error::Model(e.to_string()));
             }
@@ -366,14 +381,15 @@ impl Simulation {
 
     /// Outputs at the communication time, the state held, with the interface signals of
     /// `interface`: the mount forces and the powertrain acceleration respond at once to the
-    /// external body's motion (scene 3).
+    /// external body's motion (scene 3). Each signal passed its rule where it was set
+    /// ([`Self::check_input`]); the mounts' range is checked here, for the state held.
     pub fn outputs_with(&mut self, interface: &Inputs) -> Result<Outputs, Error> {
         let trial = self.inputs.with_interface(interface);
-        scene::apply_inputs(&mut self.scene, &trial)?;
+        scene::apply_checked_inputs(&mut self.scene, &trial)?;
         let outputs = self
             .interface_in_range()
             .and_then(|()| scene::outputs(&self.scene, self.comfort, self.time, &self.state));
-        scene::apply_inputs(&mut self.scene, &self.inputs)?;
+        scene::apply_checked_inputs(&mut self.scene, &self.inputs)?;
         outputs
     }
 
@@ -394,16 +410,17 @@ impl Simulation {
     }
 
     /// The response of the mount forces and the powertrain acceleration to the attachment
-    /// increments in `seed` (values only), the state held, at the interface signals of `at`:
-    /// the exact derivatives of [`Self::outputs_with`] (zero outside scene 3).
+    /// increments in `seed` (values only), the state held, at the interface signals of `at`
+    /// (checked where they were set): the exact derivatives of [`Self::outputs_with`] (zero
+    /// outside scene 3).
     pub fn input_sensitivities(&mut self, at: &Inputs, seed: &Inputs) -> Result<Outputs, Error> {
         let trial = self.inputs.with_interface(at);
-        scene::apply_inputs(&mut self.scene, &trial)?;
+        scene::apply_checked_inputs(&mut self.scene, &trial)?;
         let sensitivities = self
             .scene
             .interface_sensitivities(self.time, &self.state)
             .map_err(|e| Error::Model(format!("{e:?}")));
-        scene::apply_inputs(&mut self.scene, &self.inputs)?;
+        scene::apply_checked_inputs(&mut self.scene, &self.inputs)?;
         let mut out = Outputs::default();
         let seed = seed.sized(self.inputs.model.body_motion.len());
         for (i, s) in sensitivities?.iter().enumerate().take(FMU_MOUNTS) {

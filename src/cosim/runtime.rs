@@ -4,7 +4,10 @@
 
 use super::body::{BodySimulation, BodyState};
 use super::settings::Replaced;
-use super::{Counters, Error, Inputs, Outputs, Settings, Simulation, SimulationState, StepFailure};
+use super::{
+    Counters, Error, Input, Inputs, Outputs, RampInput, Settings, Simulation, SimulationState,
+    StepFailure,
+};
 use crate::model::Mode;
 
 /// Which FMU an instance is.
@@ -147,11 +150,12 @@ impl Runtime {
         }
     }
 
-    /// Whether the model accepts `inputs` (the model's one check), changing nothing.
-    pub fn check_inputs(&self, inputs: &Inputs) -> Result<(), Error> {
+    /// The model's rule for one input ([`crate::model::Input::check`]), changing nothing: the
+    /// check of an input when it is set. An input the model does not have passes.
+    pub fn check_input(&self, input: Input, ramp: &RampInput) -> Result<(), Error> {
         match self {
-            Runtime::Engine(s) => s.check_inputs(inputs),
-            Runtime::Body(s) => s.check_inputs(inputs),
+            Runtime::Engine(s) => s.check_input(input, ramp),
+            Runtime::Body(s) => s.check_input(input, ramp),
         }
     }
 
@@ -160,6 +164,15 @@ impl Runtime {
         match self {
             Runtime::Engine(s) => s.set_inputs(inputs),
             Runtime::Body(s) => s.set_inputs(inputs),
+        }
+    }
+
+    /// Applies inputs each of which passed its rule ([`Self::check_input`]) where it was set:
+    /// the rules do not run again. Whether the integrator restarted.
+    pub fn set_checked_inputs(&mut self, inputs: &Inputs) -> Result<bool, Error> {
+        match self {
+            Runtime::Engine(s) => s.set_checked_inputs(inputs),
+            Runtime::Body(s) => s.set_checked_inputs(inputs),
         }
     }
 

@@ -79,6 +79,14 @@ pub fn apply_inputs(model: &mut CoupledModel, inputs: &Inputs) -> Result<Inputs,
     Ok(sized)
 }
 
+/// Applies inputs, sized to the model's mounts, each of which passed its rule where it was set
+/// ([`CoupledModel::check_input`]): the rules do not run again. Returns them as applied.
+pub fn apply_checked_inputs(model: &mut CoupledModel, inputs: &Inputs) -> Result<Inputs, Error> {
+    let sized = inputs.sized(model.mounts().len());
+    model.set_checked_inputs(&sized.model)?;
+    Ok(sized)
+}
+
 /// Where the FMU's comfort outputs (`steeringWheel.a`, `seat.a`) are among a model's output
 /// points: resolved once when the model is built, not looked up by name at every output.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]

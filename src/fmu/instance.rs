@@ -11,7 +11,7 @@ use std::collections::BTreeMap;
 use std::path::PathBuf;
 
 use super::abi::{self, Abi};
-use super::bindings;
+use super::bindings::{self, is_interface_input};
 use super::input_track::InputTrack;
 use super::logger::{Level, Logger};
 use super::parameters::{self, Calculated};
@@ -522,7 +522,7 @@ impl Instance {
             let tracks = self.core.inputs.clone();
             let refreshed = self.follow_real_inputs(indices).and_then(|()| {
                 if phase == Phase::StepComplete
-                    && indices.iter().any(|&i| parameters::is_interface_input(i))
+                    && indices.iter().any(|&i| is_interface_input(i as u32))
                 {
                     self.refresh_feedthrough()
                 } else {
@@ -663,7 +663,7 @@ impl Instance {
     }
 
     /// The input signals after the Reals at `indices` were set: each input set continues from
-    /// its new value. Refused, changing nothing, if the inputs would be inadmissible.
+    /// its new value. Refused, changing nothing, if an input set would be inadmissible.
     fn follow_real_inputs(&mut self, indices: &[usize]) -> Result<(), String> {
         let mut tracks = self.core.inputs.clone();
         for &i in indices {
@@ -671,20 +671,29 @@ impl Instance {
                 tracks[i].set_value(self.core.values.reals.as_slice()[i]);
             }
         }
-        self.check_inputs(&tracks)?;
+        self.check_inputs(&tracks, indices)?;
         self.core.inputs = tracks;
         Ok(())
     }
 
-    /// Whether the model accepts the inputs the signals `tracks` give from now on (a model not
-    /// built yet checks them when it is built).
-    fn check_inputs(&self, tracks: &[InputTrack]) -> Result<(), String> {
+    /// The one check of an input, when the master sets it: whether the model accepts, for each
+    /// Real input at `indices`, the signal `tracks` give it from now on (the model's rule, in SI
+    /// units, refused naming the variable). A model not built yet checks every input when it is
+    /// built; a step checks only the signals that continued without being set
+    /// ([`super::step`]).
+    fn check_inputs(&self, tracks: &[InputTrack], indices: &[usize]) -> Result<(), String> {
         let Some(runtime) = &self.core.simulation else {
             return Ok(());
         };
-        runtime
-            .check_inputs(&parameters::inputs_from(tracks, self.core.time))
-            .map_err(|e| parameters::message(&e))
+        for &i in indices {
+            let Some((input, ramp)) = parameters::input_at(tracks, i as u32, self.core.time) else {
+                continue;
+            };
+            runtime
+                .check_input(input, &ramp)
+                .map_err(|e| parameters::message(&e))?;
+        }
+        Ok(())
     }
 
     /// First time derivatives of the Real inputs at `indices` (fmi2SetRealInputDerivatives).
@@ -712,7 +721,7 @@ impl Instance {
             }
             candidate[i].set_slope(*value);
         }
-        self.check_inputs(&candidate)?;
+        self.check_inputs(&candidate, indices)?;
         self.core.inputs = candidate;
         self.core.setup_failure = None;
         Ok(Status::Ok)

@@ -1,11 +1,13 @@
 //! The one mapping between the FMU's variables and the runtime's typed world: parameters onto
-//! [`Settings`], Real inputs onto [`cosim::Inputs`], the model's effective values back onto
-//! parameters, and the runtime's typed errors and notes into messages that name the FMU's
-//! variables. No other module names an FMU variable: they use the generated constants, and
-//! the names come from the generated table.
+//! [`Settings`], the Real input signals onto [`cosim::Inputs`] (through the bindings the variable
+//! table generates, [`bindings::input_of`]), the model's effective values back onto parameters,
+//! and the runtime's typed errors and notes into messages that name the FMU's variables. No
+//! other module names an FMU variable: they use the generated constants, and the names come from
+//! the generated table.
 
 use std::path::{Path, PathBuf};
 
+use super::bindings;
 use super::input_track::InputTrack;
 use super::values::Values;
 use crate::cms::CacheSetting;
@@ -13,10 +15,9 @@ use crate::cosim::{
     self, BodyOption, BodyOptions, EffectSwitch, Input, Replaced, SceneKind, Settings,
     VehicleOverrides, VehicleSetting,
 };
-use crate::model::inputs::AttachmentMotion;
-use crate::model::{ModelInputs, RampInput};
+use crate::model::RampInput;
 use crate::variables::{
-    boolean, integer, real, string, units, Parameters, BOOLEANS, INTEGERS, REALS, STRINGS,
+    boolean, integer, real, string, Causality, Parameters, BOOLEANS, INTEGERS, REALS, STRINGS,
 };
 
 /// The Boolean parameter of an effect switch.
@@ -242,64 +243,57 @@ pub fn calculated(vr: u32) -> Calculated {
 /// The runtime's inputs from the Real input signals, from `time` on (SI units), one entry per
 /// mount of the FMU's variables (the runtime sizes them to the configuration).
 pub fn inputs_from(tracks: &[InputTrack], time: f64) -> cosim::Inputs {
-    inputs_by(|index, scale| {
-        let (value, derivative) = tracks[index as usize].preview(time);
-        RampInput {
-            value: value * scale,
-            rate: derivative * scale,
-            since: time,
-        }
-    })
+    inputs_by(|index, to_si| signal(&tracks[index as usize], time, to_si))
+}
+
+/// The runtime input Real `index` is, with the signal `tracks` give it from `time` on (SI
+/// units): what a value or derivative the master sets is checked as. `None` for a Real that is
+/// not an input.
+pub fn input_at(tracks: &[InputTrack], index: u32, time: f64) -> Option<(Input, RampInput)> {
+    let (input, to_si) = bindings::input_of(index)?;
+    Some((input, signal(&tracks[index as usize], time, to_si)))
+}
+
+/// The signal of `track` from `time` on, converted to SI units by `to_si`: the one conversion
+/// of an input's value and derivative.
+fn signal(track: &InputTrack, time: f64, to_si: f64) -> RampInput {
+    let (value, derivative) = track.preview(time);
+    RampInput {
+        value: value * to_si,
+        rate: derivative * to_si,
+        since: time,
+    }
 }
 
 /// Input increments as runtime inputs (SI units, values only), from increments `seeds` of the
 /// Reals indexed like [`REALS`]: the seed of a directional derivative.
 pub fn input_increments(seeds: &[f64]) -> cosim::Inputs {
-    inputs_by(|index, scale| RampInput::constant(seeds[index as usize] * scale))
+    inputs_by(|index, to_si| RampInput::constant(seeds[index as usize] * to_si))
 }
 
-/// The runtime's inputs with each ramp from `ramp(real index, factor to SI)`: the one place
-/// that knows which Real input feeds which runtime input (and [`input_variable`] the way back).
+/// The runtime's inputs with each ramp from `ramp(real index, factor to SI)`, each Real input
+/// in the slot its row of the variable table binds it to ([`bindings::input_of`]); the slots no
+/// variable has stay nominal.
 fn inputs_by(ramp: impl Fn(u32, f64) -> RampInput) -> cosim::Inputs {
-    let per_mount = |indices: &[u32]| indices.iter().map(|&i| ramp(i, 1.0)).collect();
-    let axes = |indices: &[u32; 3]| indices.map(|i| ramp(i, 1.0));
-    let mut model = ModelInputs::new(0);
-    model.crank_speed = ramp(real::RPM, units::RPM);
-    model.load_torque = ramp(real::LOAD_TORQUE, 1.0);
-    model.stiffness_scale = per_mount(&real::MOUNT_STIFFNESS_SCALE);
-    model.damping_scale = per_mount(&real::MOUNT_DAMPING_SCALE);
-    model.body_motion = real::MOUNT_BODY_R
-        .iter()
-        .zip(&real::MOUNT_BODY_V)
-        .map(|(r, v)| AttachmentMotion {
-            displacement: axes(r),
-            velocity: axes(v),
-        })
-        .collect();
-    cosim::Inputs {
-        model,
-        body_force: real::BODY_MOUNT_F.iter().map(axes).collect(),
+    let mut inputs = cosim::Inputs::nominal(cosim::FMU_MOUNTS);
+    for v in REALS.iter().filter(|v| v.causality == Causality::Input) {
+        let Some((input, to_si)) = bindings::input_of(v.index) else {
+            continue;
+        };
+        if let Some(slot) = inputs.ramp_mut(input) {
+            *slot = ramp(v.index, to_si);
+        }
     }
-}
-
-/// Whether Real `index` is an input through which outputs respond at once (the interface to an
-/// external body: attachment motion, forces on the body).
-pub fn is_interface_input(index: usize) -> bool {
-    [real::MOUNT_BODY_R, real::MOUNT_BODY_V, real::BODY_MOUNT_F]
-        .iter()
-        .flatten()
-        .flatten()
-        .any(|&i| i as usize == index)
+    inputs
 }
 
 /// Whether Real `index` is the motion of an external body's point at a mount (`mount[i].body.*`),
 /// which only scene 3 uses.
 pub fn is_body_point_input(index: usize) -> bool {
-    [real::MOUNT_BODY_R, real::MOUNT_BODY_V]
-        .iter()
-        .flatten()
-        .flatten()
-        .any(|&i| i as usize == index)
+    u32::try_from(index)
+        .ok()
+        .and_then(bindings::input_of)
+        .is_some_and(|(input, _)| input.is_external_body_motion())
 }
 
 /// The warning for body-point inputs set while `scene` is not the one with an external body,
@@ -317,24 +311,6 @@ pub fn unused_body_point_input(values: &Values, index: usize) -> Option<String> 
         SceneKind::ExternalBody.number(),
         INTEGERS[integer::SCENE as usize].name,
     ))
-}
-
-/// The Real input behind a runtime input, and the factor from SI units to the input's unit
-/// (`None` for a mount the FMU's variables do not have).
-fn input_variable(input: Input) -> Option<(u32, f64)> {
-    let mount = |family: &[u32], i: usize| family.get(i).map(|&k| (k, 1.0));
-    let axis = |family: &[[u32; 3]], i: usize, j: usize| {
-        family.get(i).and_then(|m| m.get(j)).map(|&k| (k, 1.0))
-    };
-    match input {
-        Input::CrankSpeed => Some((real::RPM, 1.0 / units::RPM)),
-        Input::LoadTorque => Some((real::LOAD_TORQUE, 1.0)),
-        Input::StiffnessScale(i) => mount(&real::MOUNT_STIFFNESS_SCALE, i),
-        Input::DampingScale(i) => mount(&real::MOUNT_DAMPING_SCALE, i),
-        Input::BodyDisplacement(i, j) => axis(&real::MOUNT_BODY_R, i, j),
-        Input::BodyVelocity(i, j) => axis(&real::MOUNT_BODY_V, i, j),
-        Input::BodyForce(i, j) => axis(&real::BODY_MOUNT_F, i, j),
-    }
 }
 
 /// The FMU parameter behind a body option.
@@ -375,7 +351,7 @@ pub fn message(error: &cosim::Error) -> String {
             value,
             rule,
         } => format!("{} = {value} {rule}", body_option_name(*option)),
-        cosim::Error::Input { input, value, rule } => match input_variable(*input) {
+        cosim::Error::Input { input, value, rule } => match bindings::input_variable(*input) {
             Some((index, scale)) => format!(
                 "{} = {} {rule}",
                 REALS[index as usize].name,
@@ -401,6 +377,7 @@ pub fn replaced_note(r: &Replaced) -> String {
 mod tests {
     use super::*;
     use crate::model::{Effects, SpeedFollower, VehicleConfig};
+    use crate::variables::units;
 
     /// The model's own defaults are the variable table's start values: one set of defaults.
     #[test]

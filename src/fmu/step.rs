@@ -8,7 +8,7 @@ use super::parameters;
 use super::state::Phase;
 use super::values::Num;
 use crate::cosim;
-use crate::variables::{integer, Causality, LogCategory, Variability, REALS};
+use crate::variables::{Causality, LogCategory, Variability, REALS};
 
 /// Relative tolerance on communication points: masters compute them as `t0 + n h`.
 const TIME_JITTER: f64 = 1e-9;
@@ -23,6 +23,15 @@ fn on_grid(t: f64) -> f64 {
     } else {
         t
     }
+}
+
+/// What committing the inputs for a step found ([`Instance::commit_inputs`]).
+pub(super) struct Committed {
+    /// A ramp was bent onto a declared bound (logged as a warning).
+    pub clipped: bool,
+    /// The Real inputs (indices like [`REALS`]) whose signal continued a ramp the master did not
+    /// set since the last step: the values they reach are new.
+    pub continued: Vec<u32>,
 }
 
 fn same_time(a: f64, b: f64) -> bool {
@@ -75,20 +84,34 @@ impl Instance {
     fn commit_step_inputs(&mut self, step: f64) -> Result<bool, String> {
         let tracks_before = self.core.inputs.clone();
         let reals_before = self.core.values.reals.clone();
-        let clipped = self.commit_inputs(step);
-        let inputs = parameters::inputs_from(&self.core.inputs, self.core.time);
+        let committed = self.commit_inputs(step);
         let time = self.core.time;
+        let inputs = parameters::inputs_from(&self.core.inputs, time);
+        // An input the master set since the last step was checked when it was set (or, before
+        // the model was built, when it was built), and committing it only bends its ramp toward
+        // its declared range, which no rule refuses. A signal nobody set continues its ramp and
+        // reaches values nobody checked (a body velocity ramping past what a car body does, a
+        // force past its bound): those, and only those, are checked here.
+        let continued = committed
+            .continued
+            .iter()
+            .filter_map(|&i| parameters::input_at(&self.core.inputs, i, time))
+            .collect::<Vec<_>>();
         let Some(simulation) = self.core.simulation.as_mut() else {
             return Err("the model was not initialised".into());
         };
-        match simulation.set_inputs(&inputs) {
+        let applied = continued
+            .iter()
+            .try_for_each(|(input, ramp)| simulation.check_input(*input, ramp))
+            .and_then(|()| simulation.set_checked_inputs(&inputs));
+        match applied {
             Ok(restarted) => {
                 if restarted {
                     self.event(&format!(
                         "input discontinuity at t = {time} s: integrator restarted at order 1"
                     ));
                 }
-                Ok(clipped)
+                Ok(committed.clipped)
             }
             Err(e) => {
                 self.core.inputs = tracks_before;
@@ -172,14 +195,21 @@ impl Instance {
 
     /// Starts the step `[t, t + step]` for every input ([`super::input_track::InputTrack::commit`]):
     /// the signals in force from now on. The input values the master reads back are the signals'
-    /// values at `t`. Returns whether a ramp had to be bent onto a declared bound (logged as a
-    /// warning).
-    pub(super) fn commit_inputs(&mut self, step: f64) -> bool {
+    /// values at `t`. Says whether a ramp had to be bent onto a declared bound (logged as a
+    /// warning) and which signals continued a ramp without being set.
+    pub(super) fn commit_inputs(&mut self, step: f64) -> Committed {
         let t = self.core.time;
-        let mut clipped = false;
+        let mut committed = Committed {
+            clipped: false,
+            continued: Vec::new(),
+        };
         for v in REALS.iter().filter(|v| v.causality == Causality::Input) {
             let i = v.index as usize;
             let track = &mut self.core.inputs[i];
+            if track.pending_value.is_none() && track.pending_slope.is_none() && track.slope != 0.0
+            {
+                committed.continued.push(v.index);
+            }
             let commit = track.commit(
                 t,
                 step,
@@ -189,7 +219,7 @@ impl Instance {
             let (value, lo, hi) = (track.value, track.lo, track.hi);
             self.core.values.reals.put(v.index, value);
             if let Some(bound) = commit.clipped {
-                clipped = true;
+                committed.clipped = true;
                 self.log_warning(&format!(
                     "{}: the ramp from {} with slope {} per s would leave the declared range [{}, {}] within the step from {t} s; it ends on {} at {} s and stays there until a new value or derivative is set",
                     v.name,
@@ -202,7 +232,7 @@ impl Instance {
                 ));
             }
         }
-        clipped
+        committed
     }
 
     /// The first time derivatives of the Real outputs at `indices` at the current communication
@@ -230,17 +260,10 @@ impl Instance {
         Ok(indices.iter().map(|&i| reals.as_slice()[i]).collect())
     }
 
-    /// Writes the outputs and the solver counters.
+    /// Writes the outputs and the solver counters, each where its row of the variable table
+    /// binds it.
     pub(super) fn write_outputs(&mut self, o: &cosim::Outputs, c: &cosim::Counters) {
         bindings::put_outputs(&mut self.core.values.reals, o);
-        let n = &mut self.core.values.integers;
-        let clamp = |x: u64| x.min(i32::MAX as u64) as i32;
-        n.put(integer::SOLVER_STEPS, clamp(c.steps));
-        n.put(integer::SOLVER_RHS_EVALUATIONS, clamp(c.rhs_evaluations));
-        n.put(
-            integer::SOLVER_JACOBIAN_EVALUATIONS,
-            clamp(c.jacobian_evaluations),
-        );
-        n.put(integer::SOLVER_FACTORIZATIONS, clamp(c.factorizations));
+        bindings::put_counters(&mut self.core.values.integers, c);
     }
 }

@@ -13,7 +13,7 @@
 use nalgebra::{Matrix2, Vector2, Vector3};
 
 use super::coupled::{output_points, point_index, ModelError, OutputPoint, MOUNT_MATCH_TOLERANCE};
-use super::inputs::{validate_body_forces, InputError, RampInput};
+use super::inputs::{validate_body_forces, Input, InputError, RampInput};
 use super::mount::MountConfig;
 use crate::cms::ReducedChassis;
 
@@ -134,6 +134,12 @@ impl BodyAlone {
 
     /// Whether `forces` (one per configured mount) are admissible ([`validate_body_forces`]).
     pub fn check_forces(&self, forces: &[[RampInput; 3]]) -> Result<(), InputError> {
+        self.check_force_count(forces)?;
+        validate_body_forces(forces, self.force_limit)
+    }
+
+    /// Whether there is one force per configured mount.
+    fn check_force_count(&self, forces: &[[RampInput; 3]]) -> Result<(), InputError> {
         if forces.len() != self.forces.len() {
             return Err(InputError::Other(format!(
                 "{} mount forces for {} mounts",
@@ -141,13 +147,30 @@ impl BodyAlone {
                 self.forces.len()
             )));
         }
-        validate_body_forces(forces, self.force_limit)
+        Ok(())
     }
 
     /// Sets the force on the body at each mount (configuration order), as ramps; validated as a
     /// whole ([`Self::check_forces`]), on error nothing changes.
     pub fn set_forces(&mut self, forces: &[[RampInput; 3]]) -> Result<(), InputError> {
         self.check_forces(forces)?;
+        self.forces.copy_from_slice(forces);
+        Ok(())
+    }
+
+    /// The body's rule for one input ([`Input::check`] with its force bound); an input the body
+    /// does not have (the engine's, a mount beyond the configuration) is none of its business.
+    pub fn check_input(&self, input: Input, ramp: &RampInput) -> Result<(), InputError> {
+        match input {
+            Input::BodyForce(i, _) if i < self.forces.len() => input.check(ramp, self.force_limit),
+            _ => Ok(()),
+        }
+    }
+
+    /// The forces at each mount, each of which passed its rule where it was set
+    /// ([`Self::check_input`]): only their number is checked, the rules do not run again.
+    pub fn set_checked_forces(&mut self, forces: &[[RampInput; 3]]) -> Result<(), InputError> {
+        self.check_force_count(forces)?;
         self.forces.copy_from_slice(forces);
         Ok(())
     }

@@ -129,6 +129,68 @@ impl std::fmt::Display for Input {
     }
 }
 
+impl Input {
+    /// The model's one rule for this input, on its ramp in SI units: finite; a crank speed and
+    /// mount scales >= 0; an external body's point within [`ATTACHMENT_SPEED_LIMIT`] and
+    /// [`ATTACHMENT_ACCELERATION_LIMIT`]; a force on the body within `force_limit` (N, the body
+    /// alone's bound) and changing at most by it within [`BODY_FORCE_RISE_TIME`].
+    pub fn check(self, ramp: &RampInput, force_limit: f64) -> Result<(), InputError> {
+        let refuse = |rule: String| Err(InputError::value(self, ramp, rule));
+        let (value, rate) = (ramp.value, ramp.rate);
+        match self {
+            Input::CrankSpeed
+            | Input::LoadTorque
+            | Input::StiffnessScale(_)
+            | Input::DampingScale(_)
+                if !ramp.is_finite() =>
+            {
+                refuse(format!("(rate {rate}) must be finite"))
+            }
+            _ if !ramp.is_finite() => refuse(format!("(rate {rate}) is not finite")),
+            Input::CrankSpeed if value < 0.0 => refuse("is negative".into()),
+            Input::StiffnessScale(_) if value < 0.0 => {
+                refuse("must be >= 0 (0: no stiffness; the mount keeps its preload)".into())
+            }
+            Input::DampingScale(_) if value < 0.0 => refuse("must be >= 0".into()),
+            Input::BodyDisplacement(..) if rate.abs() > ATTACHMENT_SPEED_LIMIT => refuse(format!(
+                "changes at {rate} m/s, beyond the {ATTACHMENT_SPEED_LIMIT} m/s a point of a car \
+                 body can move"
+            )),
+            Input::BodyVelocity(..) if value.abs() > ATTACHMENT_SPEED_LIMIT => refuse(format!(
+                "is beyond the {ATTACHMENT_SPEED_LIMIT} m/s a point of a car body can move"
+            )),
+            Input::BodyVelocity(..) if rate.abs() > ATTACHMENT_ACCELERATION_LIMIT => {
+                refuse(format!(
+                    "changes at {rate} m/s², beyond the {ATTACHMENT_ACCELERATION_LIMIT} m/s² a \
+                     point of a car body can accelerate"
+                ))
+            }
+            Input::BodyForce(..) => {
+                let bound = format!(
+                    "{force_limit:.4e} N ({BODY_FORCE_LIMIT_WEIGHTS} times the powertrain's weight)"
+                );
+                if value.abs() > force_limit {
+                    refuse(format!("is beyond the plausible bound {bound}"))
+                } else if rate.abs() > force_limit / BODY_FORCE_RISE_TIME {
+                    refuse(format!(
+                        "changes at {rate} N/s: beyond the plausible bound {bound} within \
+                         {BODY_FORCE_RISE_TIME} s"
+                    ))
+                } else {
+                    Ok(())
+                }
+            }
+            _ => Ok(()),
+        }
+    }
+
+    /// Whether this is the motion of an external body's point at a mount, which only a scene
+    /// with an external body uses.
+    pub fn is_external_body_motion(self) -> bool {
+        matches!(self, Input::BodyDisplacement(..) | Input::BodyVelocity(..))
+    }
+}
+
 /// An input the model refuses.
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]
 pub enum InputError {
@@ -199,55 +261,6 @@ impl AttachmentMotion {
             self.velocity.map(|r| r.at(t)),
         )
     }
-
-    /// Finite ramps within [`ATTACHMENT_SPEED_LIMIT`] and [`ATTACHMENT_ACCELERATION_LIMIT`];
-    /// the error names mount `i`'s input.
-    fn validate(&self, i: usize) -> Result<(), InputError> {
-        for j in 0..3 {
-            let (r, v) = (&self.displacement[j], &self.velocity[j]);
-            let (r_input, v_input) = (Input::BodyDisplacement(i, j), Input::BodyVelocity(i, j));
-            for (input, ramp) in [(r_input, r), (v_input, v)] {
-                if !ramp.is_finite() {
-                    return Err(InputError::value(
-                        input,
-                        ramp,
-                        format!("(rate {}) is not finite", ramp.rate),
-                    ));
-                }
-            }
-            let speed = ATTACHMENT_SPEED_LIMIT;
-            if r.rate.abs() > speed {
-                return Err(InputError::value(
-                    r_input,
-                    r,
-                    format!(
-                        "changes at {} m/s, beyond the {speed} m/s a point of a car body can move",
-                        r.rate
-                    ),
-                ));
-            }
-            if v.value.abs() > speed {
-                return Err(InputError::value(
-                    v_input,
-                    v,
-                    format!("is beyond the {speed} m/s a point of a car body can move"),
-                ));
-            }
-            let acceleration = ATTACHMENT_ACCELERATION_LIMIT;
-            if v.rate.abs() > acceleration {
-                return Err(InputError::value(
-                    v_input,
-                    v,
-                    format!(
-                        "changes at {} m/s², beyond the {acceleration} m/s² a point of a car body \
-                         can accelerate",
-                        v.rate
-                    ),
-                ));
-            }
-        }
-        Ok(())
-    }
 }
 
 impl ModelInputs {
@@ -270,10 +283,64 @@ impl ModelInputs {
         )
     }
 
-    /// The one check of the model's inputs: one entry per configured mount, finite ramps, a
-    /// crank speed and mount scales >= 0, an external body's motion within what a car body can
-    /// do.
+    /// The model's inputs with their names, in the order they are checked: crank speed, load
+    /// torque, per mount the stiffness and damping scales, per mount and axis the external
+    /// body's displacement and velocity.
+    pub fn ramps(&self) -> Vec<(Input, &RampInput)> {
+        let mut all = vec![
+            (Input::CrankSpeed, &self.crank_speed),
+            (Input::LoadTorque, &self.load_torque),
+        ];
+        for (i, (k, c)) in self
+            .stiffness_scale
+            .iter()
+            .zip(&self.damping_scale)
+            .enumerate()
+        {
+            all.extend([(Input::StiffnessScale(i), k), (Input::DampingScale(i), c)]);
+        }
+        for (i, m) in self.body_motion.iter().enumerate() {
+            for j in 0..3 {
+                all.extend([
+                    (Input::BodyDisplacement(i, j), &m.displacement[j]),
+                    (Input::BodyVelocity(i, j), &m.velocity[j]),
+                ]);
+            }
+        }
+        all
+    }
+
+    /// The ramp of `input`, to change (`None` for a mount these inputs do not have, and for the
+    /// body alone's forces, which are not the coupled model's).
+    pub fn ramp_mut(&mut self, input: Input) -> Option<&mut RampInput> {
+        match input {
+            Input::CrankSpeed => Some(&mut self.crank_speed),
+            Input::LoadTorque => Some(&mut self.load_torque),
+            Input::StiffnessScale(i) => self.stiffness_scale.get_mut(i),
+            Input::DampingScale(i) => self.damping_scale.get_mut(i),
+            Input::BodyDisplacement(i, j) => self
+                .body_motion
+                .get_mut(i)
+                .and_then(|m| m.displacement.get_mut(j)),
+            Input::BodyVelocity(i, j) => self
+                .body_motion
+                .get_mut(i)
+                .and_then(|m| m.velocity.get_mut(j)),
+            Input::BodyForce(..) => None,
+        }
+    }
+
+    /// Whether these are inputs for `mounts` configured mounts and each passes its rule
+    /// ([`Input::check`]).
     pub fn validate(&self, mounts: usize) -> Result<(), InputError> {
+        self.check_lengths(mounts)?;
+        self.ramps()
+            .into_iter()
+            .try_for_each(|(input, ramp)| input.check(ramp, f64::INFINITY))
+    }
+
+    /// Whether these are inputs for `mounts` configured mounts: one entry per mount.
+    pub fn check_lengths(&self, mounts: usize) -> Result<(), InputError> {
         let lengths = [
             self.stiffness_scale.len(),
             self.damping_scale.len(),
@@ -285,49 +352,6 @@ impl ModelInputs {
                  mounts",
                 lengths[0], lengths[1], lengths[2]
             )));
-        }
-        for (input, r) in [
-            (Input::CrankSpeed, &self.crank_speed),
-            (Input::LoadTorque, &self.load_torque),
-        ] {
-            if !r.is_finite() {
-                let rule = format!("(rate {}) must be finite", r.rate);
-                return Err(InputError::value(input, r, rule));
-            }
-        }
-        if self.crank_speed.value < 0.0 {
-            return Err(InputError::value(
-                Input::CrankSpeed,
-                &self.crank_speed,
-                "is negative",
-            ));
-        }
-        for (i, (k, c)) in self
-            .stiffness_scale
-            .iter()
-            .zip(&self.damping_scale)
-            .enumerate()
-        {
-            let rules = [
-                (
-                    Input::StiffnessScale(i),
-                    k,
-                    "must be >= 0 (0: no stiffness; the mount keeps its preload)",
-                ),
-                (Input::DampingScale(i), c, "must be >= 0"),
-            ];
-            for (input, r, rule) in rules {
-                if !r.is_finite() {
-                    let rule = format!("(rate {}) must be finite", r.rate);
-                    return Err(InputError::value(input, r, rule));
-                }
-                if r.value < 0.0 {
-                    return Err(InputError::value(input, r, rule));
-                }
-            }
-        }
-        for (i, m) in self.body_motion.iter().enumerate() {
-            m.validate(i)?;
         }
         Ok(())
     }
@@ -362,37 +386,12 @@ impl ModelInputs {
     }
 }
 
-/// The one check of the body alone's mount forces: finite ramps, each force within `limit` (N)
-/// and changing at most by `limit` within [`BODY_FORCE_RISE_TIME`].
+/// The one check of the body alone's mount forces: each passes its rule ([`Input::check`]) with
+/// the bound `limit` (N).
 pub fn validate_body_forces(forces: &[[RampInput; 3]], limit: f64) -> Result<(), InputError> {
     for (i, f) in forces.iter().enumerate() {
         for (j, r) in f.iter().enumerate() {
-            let input = Input::BodyForce(i, j);
-            if !r.is_finite() {
-                let rule = format!("(rate {}) is not finite", r.rate);
-                return Err(InputError::value(input, r, rule));
-            }
-            let bound =
-                format!("{limit:.4e} N ({BODY_FORCE_LIMIT_WEIGHTS} times the powertrain's weight)");
-            if r.value.abs() > limit {
-                return Err(InputError::value(
-                    input,
-                    r,
-                    format!("is beyond the plausible bound {bound}"),
-                ));
-            }
-            let rate_limit = limit / BODY_FORCE_RISE_TIME;
-            if r.rate.abs() > rate_limit {
-                return Err(InputError::value(
-                    input,
-                    r,
-                    format!(
-                        "changes at {} N/s: beyond the plausible bound {bound} within \
-                         {BODY_FORCE_RISE_TIME} s",
-                        r.rate
-                    ),
-                ));
-            }
+            Input::BodyForce(i, j).check(r, limit)?;
         }
     }
     Ok(())
@@ -454,6 +453,34 @@ mod tests {
         let mut bad = good;
         bad.body_motion[0].velocity[0].rate = 2.0 * ATTACHMENT_ACCELERATION_LIMIT;
         assert!(bad.validate(3).is_err());
+    }
+
+    /// Each rule is on its own input's ramp: an external body's point may be anywhere but not
+    /// move faster than 100 m/s; its velocity up to 100 m/s, changing by up to 1e4 m/s².
+    #[test]
+    fn each_input_has_its_own_rule() {
+        let ramp = |value, rate| RampInput {
+            value,
+            rate,
+            since: 0.0,
+        };
+        let r = Input::BodyDisplacement(0, 0);
+        assert!(r.check(&ramp(1e3, 99.0), f64::INFINITY).is_ok());
+        assert!(r.check(&ramp(0.0, 101.0), f64::INFINITY).is_err());
+        let v = Input::BodyVelocity(3, 2);
+        assert!(v.check(&ramp(-99.0, 9e3), f64::INFINITY).is_ok());
+        assert!(v.check(&ramp(-101.0, 0.0), f64::INFINITY).is_err());
+        assert!(v.check(&ramp(0.0, -1.1e4), f64::INFINITY).is_err());
+        // A speed set-point must be >= 0; a load torque may have either sign.
+        assert!(Input::CrankSpeed.check(&ramp(-1.0, 0.0), 0.0).is_err());
+        assert!(Input::LoadTorque.check(&ramp(-1e3, -1e3), 0.0).is_ok());
+        // Forces are bounded by the limit given, their rate by the limit per rise time.
+        let f = Input::BodyForce(0, 2);
+        assert!(f.check(&ramp(-999.0, 0.0), 1e3).is_ok());
+        assert!(f.check(&ramp(1001.0, 0.0), 1e3).is_err());
+        assert!(f
+            .check(&ramp(0.0, 1.01e3 / BODY_FORCE_RISE_TIME), 1e3)
+            .is_err());
     }
 
     #[test]

@@ -318,6 +318,44 @@ fn body_forces_beyond_the_plausible_bound_are_refused_naming_the_input() {
     assert!(s.reals(&watched).iter().all(|x| x.is_finite()));
 }
 
+/// Inputs are checked when they are set; a step checks only the signals that continue a ramp
+/// nobody set, which reach values nobody checked: a force ramp crossing the plausible bound
+/// (176.6 kN) between steps is refused at the step that would start beyond it, naming the input,
+/// and nothing changes.
+#[test]
+fn a_force_ramp_continued_past_the_bound_is_refused_at_the_step() {
+    let fmu = Fmu::load();
+    let s = body(&fmu, "continued-force");
+    let input = [real::BODY_MOUNT_F[1][2]];
+    // 1.76e5 N is within the bound, and 1e6 N/s (1 kN per ms) within the bound's rate.
+    assert_eq!(s.set_real(&input, &[1.76e5]), OK, "{:?}", s.logs());
+    assert_eq!(
+        s.set_input_derivatives(&input, &[1e6]),
+        OK,
+        "{:?}",
+        s.logs()
+    );
+    assert_eq!(s.do_step(0.02, 1e-3), OK, "{:?}", s.logs());
+    let reached = s.reals(&input)[0];
+    assert!((reached - 1.77e5).abs() < 1e-6, "{reached}");
+    let watched = reals_of(Causality::Output, 2);
+    let before = s.reals(&watched);
+    assert_eq!(s.do_step(0.021, 1e-3), ERROR);
+    assert!(
+        s.logs()
+            .iter()
+            .any(|l| l.contains("mount[2].F[3] = 177000") && l.contains("plausible bound")),
+        "{:?}",
+        s.logs()
+    );
+    assert_eq!(s.reals(&watched), before);
+    assert_eq!(s.reals(&input), [reached]);
+    // A value set brings the signal back; the run goes on from where it was.
+    assert_eq!(s.set_real(&input, &[-1e4]), OK);
+    assert_eq!(s.set_input_derivatives(&input, &[0.0]), OK);
+    assert_eq!(s.do_step(0.021, 1e-3), OK, "{:?}", s.logs());
+}
+
 /// The trial: a derivative of 1e300 m/s on a body-point input failed the next step with "Newton
 /// convergence failures"; it is refused when set, naming the input, as is any speed beyond
 /// what a point of a car body does (100 m/s) and any acceleration beyond 1e4 m/s².

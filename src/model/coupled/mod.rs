@@ -50,7 +50,7 @@ use nalgebra::Vector3;
 
 use super::effects::Effects;
 use super::follower::SpeedFollower;
-use super::inputs::{InputError, ModelInputs, RampInput};
+use super::inputs::{Input, InputError, ModelInputs, RampInput};
 use super::mount::{Mount, MountConfig};
 use super::powertrain::assembly::v3;
 use super::powertrain::Powertrain;
@@ -487,6 +487,32 @@ impl CoupledModel {
     /// All inputs at once (validated as a whole; on error nothing changes).
     pub fn set_inputs(&mut self, inputs: &ModelInputs) -> Result<(), InputError> {
         inputs.validate(self.mounts.len())?;
+        self.inputs = inputs.clone();
+        Ok(())
+    }
+
+    /// The model's rule for one input ([`Input::check`]); an input this model does not have (a
+    /// mount beyond its configuration, a force on the body alone) is none of its business.
+    pub fn check_input(&self, input: Input, ramp: &RampInput) -> Result<(), InputError> {
+        let mount = match input {
+            Input::BodyForce(..) => return Ok(()),
+            Input::CrankSpeed | Input::LoadTorque => None,
+            Input::StiffnessScale(i)
+            | Input::DampingScale(i)
+            | Input::BodyDisplacement(i, _)
+            | Input::BodyVelocity(i, _) => Some(i),
+        };
+        if mount.is_some_and(|i| i >= self.mounts.len()) {
+            return Ok(());
+        }
+        input.check(ramp, f64::INFINITY)
+    }
+
+    /// All inputs at once, each of which passed its rule where it was set
+    /// ([`Self::check_input`]): only their number per mount is checked, the rules do not run
+    /// again.
+    pub fn set_checked_inputs(&mut self, inputs: &ModelInputs) -> Result<(), InputError> {
+        inputs.check_lengths(self.mounts.len())?;
         self.inputs = inputs.clone();
         Ok(())
     }
