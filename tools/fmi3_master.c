@@ -106,6 +106,8 @@ static void step(DoStep do_step, fmi3Instance c, double t, double h) {
 }
 
 int main(int argc, char **argv) {
+  /* Rows unbuffered: a run that dies leaves what it wrote, so a test can tell how far it got. */
+  setvbuf(stdout, NULL, _IONBF, 0);
   if (argc != 7) {
     fprintf(stderr, "usage: fmi3_master <library> <resource-path> <cache-dir> <value-references> "
                     "<relative-tolerance> <gas-forces 0|1>\n");

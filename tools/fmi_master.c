@@ -101,6 +101,8 @@ static void *need(void *lib, const char *name) {
   } while (0)
 
 int main(int argc, char **argv) {
+  /* Rows unbuffered: a run that dies leaves what it wrote, so a test can tell how far it got. */
+  setvbuf(stdout, NULL, _IONBF, 0);
   if (argc != 7) {
     fprintf(stderr, "usage: fmi_master <library> <resources-uri> <cache-dir> <value-references> "
                     "<relative-tolerance> <gas-forces 0|1>\n");

@@ -42,39 +42,119 @@ def unpacked(fmu_path, tmp_path_factory):
     return work, root.get("guid"), ",".join(vr[n] for n in names)
 
 
-def _wine_failed_to_start(proc) -> bool:
-    """Whether a wine run failed before the master ran: the masters report every failure of
-    their own on stderr, so a failure with nothing on either stream is wine's (exit 1, seen once
-    in CI), as is "could not load kernel32.dll" (exit 53, seen twice in about ten suites)."""
+class WinePrefix:
+    """A wine prefix of the test's own, served by one persistent wineserver from creation to teardown.
+
+    A wine program exits 1 with nothing on either stream when its wineserver goes away under it
+    (reproduced here by `wineserver -k` during a run), and CI saw exactly that three times in about
+    fifteen suites, twice in one run. A server that shuts down on its own a few seconds after each
+    program is one that a new program can meet while it exits; a persistent one cannot be. Should
+    the server still go away, the run is repeated with a fresh one, and a final failure is reported
+    with wine's own error channel switched on."""
+
+    def __init__(self, path: pathlib.Path):
+        self.path = path
+        self.env = {"WINEDEBUG": "-all", "WINEPREFIX": str(path)}
+        self.server = shutil.which("wineserver")
+        if not (path / "system.reg").exists():
+            for _ in range(2):
+                boot = subprocess.run([_wine(), "wineboot", "--init"], capture_output=True, text=True,
+                                      env=self._full_env(), timeout=600)
+                self._server("-w")
+                if boot.returncode == 0:
+                    break
+        self._server("-p")
+
+    def _full_env(self, **extra) -> dict:
+        return {**os.environ, **self.env, **extra}
+
+    def _server(self, *args):
+        if self.server is not None:
+            # -p forks a daemon that keeps the standard streams: they go nowhere, so nothing waits on them.
+            subprocess.run([self.server, *args], env=self._full_env(), timeout=600,
+                           stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
+
+    def run(self, cmd, token):
+        for _ in range(3):
+            proc = self._run_once(cmd, token, "-all")
+            if not _server_went_away(proc):
+                return proc
+            self._server("-k")
+            self._server("-w")
+            self._server("-p")
+        # Once more with wine's error channel on, so that the report says what wine saw.
+        return self._run_once(cmd, token, "err+all")
+
+    def _run_once(self, cmd, token, debug):
+        """The streams go to files, not pipes: wine's service processes, started by the first
+        program a server sees, inherit them and live as long as the server, so a pipe would never
+        reach its end."""
+        out, err = self.path.parent / "wine.out", self.path.parent / "wine.err"
+        with open(out, "w") as stdout, open(err, "w") as stderr:
+            returncode = subprocess.run(cmd, stdout=stdout, stderr=stderr, timeout=600,
+                                        env=self._full_env(FMU_GUID=token, WINEDEBUG=debug)).returncode
+        return subprocess.CompletedProcess(cmd, returncode, out.read_text(), err.read_text())
+
+    def close(self):
+        self._server("-k")
+
+
+def _server_went_away(proc) -> bool:
+    """Whether a wine run failed outside the master: the masters report every failure of their own
+    on stderr, so a failure with nothing there is wine's (exit 1; the rows written before it show
+    how far the master got), as is "could not load kernel32.dll" (exit 53) in a new prefix."""
     return ((proc.returncode == 53 and "could not load kernel32.dll" in proc.stderr)
-            or (proc.returncode != 0 and not proc.stdout.strip() and not proc.stderr.strip()))
+            or (proc.returncode != 0 and not proc.stderr.strip()))
 
 
-def _wine_env(prefix) -> dict:
-    """A wine prefix of the test's own, created and settled before the first master runs in it:
-    wine sometimes fails the very run that creates a new prefix on a loaded machine."""
-    env = {"WINEDEBUG": "-all", "WINEPREFIX": str(prefix)}
-    if not (prefix / "system.reg").exists():
-        full = dict(os.environ, **env)
-        for _ in range(2):
-            boot = subprocess.run([_wine(), "wineboot", "--init"], capture_output=True, text=True,
-                                  env=full, timeout=600)
-            server = shutil.which("wineserver")
-            if server is not None:
-                subprocess.run([server, "-w"], env=full, timeout=600)
-            if boot.returncode == 0:
-                break
-    return env
-
-
-def _run(cmd, guid, env_extra=None):
-    env = dict(os.environ, FMU_GUID=guid, **(env_extra or {}))
-    proc = subprocess.run(cmd, capture_output=True, text=True, env=env, timeout=600)
-    if "WINEPREFIX" in env and _wine_failed_to_start(proc):
-        # The prefix is complete afterwards: the same command runs once more in it.
-        proc = subprocess.run(cmd, capture_output=True, text=True, env=env, timeout=600)
-    assert proc.returncode == 0, f"{cmd[0]} failed ({proc.returncode}):\n{proc.stderr[-3000:]}"
+def _rows(proc, program):
+    assert proc.returncode == 0, (f"{program} failed ({proc.returncode}) after "
+                                  f"{len(proc.stdout.splitlines())} rows:\n{proc.stderr[-3000:]}")
     return np.array([[float(x) for x in line.split(",")] for line in proc.stdout.splitlines()])
+
+
+def _run(cmd, token):
+    proc = subprocess.run(cmd, capture_output=True, text=True, timeout=600,
+                          env=dict(os.environ, FMU_GUID=token))
+    return _rows(proc, cmd[0])
+
+
+def _windows_master(work, master_source, library, resources, args, token):
+    """Builds the master with mingw-w64 once and runs it on the win64 library under wine."""
+    wine = _wine()
+    mingw = shutil.which("x86_64-w64-mingw32-gcc")
+    if wine is None or mingw is None:
+        pytest.skip("wine or mingw-w64 is not installed (scripts/setup.sh installs both); "
+                    "the win64 binary was not run")
+    exe = work / (master_source.stem + ".exe")
+    if not exe.exists():
+        subprocess.run([mingw, "-O2", "-o", str(exe), str(master_source)], check=True)
+        # Windows 10+ ships bcryptprimitives.dll (ProcessPrng, used by Rust's std); Wine 8 does
+        # not: a stand-in next to the master, for the test only.
+        subprocess.run([mingw, "-shared", "-O2", "-o", str(work / "bcryptprimitives.dll"), str(SHIM),
+                        "-lbcrypt"], check=True)
+    to_windows = lambda p: "Z:" + str(p).replace("/", "\\")  # noqa: E731  wine maps / to Z:
+    cmd = [wine, str(exe), to_windows(library), resources(to_windows), to_windows(work / "cache-win"), *args]
+    try:
+        return _rows(_prefix(work).run(cmd, token), "wine " + exe.name)
+    except subprocess.TimeoutExpired:
+        pytest.skip("wine did not finish within 10 minutes on this machine; the win64 binary was not checked")
+
+
+_PREFIXES: dict = {}
+
+
+def _prefix(work) -> WinePrefix:
+    if work not in _PREFIXES:
+        _PREFIXES[work] = WinePrefix(work / "wineprefix")
+    return _PREFIXES[work]
+
+
+@pytest.fixture(scope="module", autouse=True)
+def _wine_servers_stopped():
+    yield
+    while _PREFIXES:
+        _PREFIXES.popitem()[1].close()
 
 
 def _linux(work, guid, vrs, rel_tol, gas):
@@ -88,28 +168,9 @@ def _linux(work, guid, vrs, rel_tol, gas):
 
 
 def _windows(work, guid, vrs, rel_tol, gas):
-    wine = _wine()
-    mingw = shutil.which("x86_64-w64-mingw32-gcc")
-    if wine is None or mingw is None:
-        pytest.skip("wine or mingw-w64 is not installed (scripts/setup.sh installs both); "
-                    "the win64 binary was not run")
-    exe = work / "master.exe"
-    if not exe.exists():
-        subprocess.run([mingw, "-O2", "-o", str(exe), str(MASTER)], check=True)
-        # Windows 10+ ships bcryptprimitives.dll (ProcessPrng, used by Rust's std); Wine 8 does
-        # not: a stand-in next to the master, for the test only.
-        subprocess.run([mingw, "-shared", "-O2", "-o", str(work / "bcryptprimitives.dll"), str(SHIM),
-                        "-lbcrypt"], check=True)
-    to_windows = lambda p: "Z:" + str(p).replace("/", "\\")  # noqa: E731  wine maps / to Z:
-    lib = to_windows(work / "fmu" / "binaries" / "win64" / "EngineMountChassis.dll")
-    uri = "file:///Z:" + str(work / "fmu" / "resources")
-    cache = to_windows(work / "cache-win")
-    prefix = work / "wineprefix"
-    try:
-        return _run([wine, str(exe), lib, uri, cache, vrs, str(rel_tol), str(int(gas))], guid,
-                    _wine_env(prefix))
-    except subprocess.TimeoutExpired:
-        pytest.skip("wine did not finish within 10 minutes on this machine; the win64 binary was not checked")
+    return _windows_master(work, MASTER, work / "fmu" / "binaries" / "win64" / "EngineMountChassis.dll",
+                           lambda _: "file:///Z:" + str(work / "fmu" / "resources"),
+                           [vrs, str(rel_tol), str(int(gas))], guid)
 
 
 def _difference(a, b):
@@ -177,25 +238,9 @@ def _linux3(work, token, vrs, rel_tol, gas):
 
 
 def _windows3(work, token, vrs, rel_tol, gas):
-    wine = _wine()
-    mingw = shutil.which("x86_64-w64-mingw32-gcc")
-    if wine is None or mingw is None:
-        pytest.skip("wine or mingw-w64 is not installed (scripts/setup.sh installs both); "
-                    "the win64 binary was not run")
-    exe = work / "master3.exe"
-    if not exe.exists():
-        subprocess.run([mingw, "-O2", "-o", str(exe), str(MASTER3)], check=True)
-        subprocess.run([mingw, "-shared", "-O2", "-o", str(work / "bcryptprimitives.dll"), str(SHIM),
-                        "-lbcrypt"], check=True)
-    to_windows = lambda p: "Z:" + str(p).replace("/", "\\")  # noqa: E731  wine maps / to Z:
-    lib = to_windows(work / "fmu" / "binaries" / "x86_64-windows" / "EngineMountChassis.dll")
-    resources = to_windows(work / "fmu" / "resources") + "\\"
-    cache = to_windows(work / "cache-win")
-    try:
-        return _run([wine, str(exe), lib, resources, cache, vrs, str(rel_tol), str(int(gas))], token,
-                    _wine_env(work / "wineprefix"))
-    except subprocess.TimeoutExpired:
-        pytest.skip("wine did not finish within 10 minutes on this machine; the win64 binary was not checked")
+    return _windows_master(work, MASTER3, work / "fmu" / "binaries" / "x86_64-windows" / "EngineMountChassis.dll",
+                           lambda to_windows: to_windows(work / "fmu" / "resources") + "\\",
+                           [vrs, str(rel_tol), str(int(gas))], token)
 
 
 def test_fmi3_master_repeats_the_fmi2_master_run_exactly(unpacked, unpacked3):
