@@ -18,7 +18,9 @@ description before anything runs.
 from __future__ import annotations
 
 import argparse
+import atexit
 import importlib
+import os
 import re
 import sys
 
@@ -81,5 +83,22 @@ def main(argv: list[str] | None = None) -> int:
             args.out_claim.release()
 
 
+def run() -> None:
+    """The ``emc`` command (and ``python -m emc``): :func:`main`, then the process ends without
+    Python's own teardown. The exit handlers run (temporary folders, logging, a Dask cluster's
+    finalisers) and the standard streams are flushed; skipped is only the clearing of the
+    modules, 0.12-0.13 s of every command that loaded pandas, matplotlib and fmpy (a process that
+    imports them and ends: 0.74-0.75 s against 0.61-0.62 s). Every file emc writes is closed
+    where it is written, so nothing waits for the teardown."""
+    code = main()
+    atexit._run_exitfuncs()
+    for stream in (sys.stdout, sys.stderr):
+        try:
+            stream.flush()
+        except (OSError, ValueError):  # a closed pipe: nothing more can reach it
+            pass
+    os._exit(0 if code is None else code if isinstance(code, int) else 1)
+
+
 if __name__ == "__main__":
-    sys.exit(main())
+    run()

@@ -15,7 +15,7 @@ import numpy as np
 import pandas as pd
 
 from ..figures.plots import draw_band, plt
-from ..running.band import wide
+from ..running.band import nominal_rows, wide
 from ..running.modal import Export, body_point_of
 from ..running.runner import Runner, set_value
 from ..signals.spectra import dft_at
@@ -147,7 +147,7 @@ def plot(table: pd.DataFrame, path: str, unit: str, title: str, top: int | None 
     around the nominal line, the nominal phase); ``checks`` (frequency, input, amplitude, phase_deg) from the sine
     excitation as points; ``marks`` {label: Hz} as vertical lines (e.g. an order at a speed)."""
     banded = "bound" in table
-    full, table = table, table[table.bound == "nominal"] if banded else table
+    full, table = table, nominal_rows(table)
     inputs = list(dict.fromkeys(table.input))
     if top is not None:
         peaks = table.groupby("input").amplitude.max().sort_values(ascending=False)

@@ -277,7 +277,7 @@ def cmd_tpa(args) -> int:
         tables.append(table)
     table = pd.concat(tables, ignore_index=True)
     save(table, str(out / "tpa.csv"))
-    nominal = table if band is None else table[table.bound == "nominal"]
+    nominal = bands.nominal_rows(table)
     names = _mount_names(exports[cases[0][0]])
     labels = [label for label, _ in cases]
     summary = report_paths(nominal, names, responses, labels, lambda label: at, args.order,
@@ -290,7 +290,7 @@ def cmd_tpa(args) -> int:
                                 "responses": responses, "revolutions": args.revolutions,
                                 "steps_per_revolution": args.steps_per_rev, **summary},
                         "export": exports[cases[0][0]].manifest, **band_metadata(band)})
-    runs = len(cases) * len(speeds) * (1 if band is None else len(bands.BOUNDS))
+    runs = bands.run_count(band, len(cases) * len(speeds))
     print(f"{runs} points in {time.perf_counter() - started:.1f} s -> {out}")
     return 0
 
@@ -363,7 +363,7 @@ def cmd_tpa_runup(args) -> int:
     fmu_warnings_summary(warnings)
     save(table, str(out / "tpa_runup.csv"))
     labels = [label for label, _ in cases]
-    nominal = table if band is None else table[table.bound == "nominal"]
+    nominal = bands.nominal_rows(table)
     speeds = {label: np.sort(nominal[nominal.case == label].rpm.unique()) for label in labels}
     at_of = {label: float(v[np.argmin(np.abs(v - at))]) for label, v in speeds.items()}
     names = _mount_names(exports[labels[0]])
@@ -468,9 +468,10 @@ def cmd_frf(args) -> int:
     if export.body is None:
         raise UsageError("transfer functions need the elastic body: --set scene=2")
     # At the band's bounds: the body and the linearised model exported with their damping.
-    exports = ({"nominal": export} if band is None else
-               {bound: export if bound == "nominal" else
-                export_for(args, band.applied(parameters, bound)) for bound in bands.BOUNDS})
+    exports = {}
+    for bound in bands.bounds_of(band):
+        settings = bands.settings_at(band, parameters, bound)
+        exports[bound] = export if settings == parameters else export_for(args, settings)
 
     def at_bounds(table_of) -> pd.DataFrame:
         if band is None:

@@ -43,7 +43,6 @@ from ..base.errors import UsageError
 from ..base.options import BAND_BODY_SCALE, BAND_MOUNT_SCALE
 from ..base.orders import MAIN_ORDERS
 from ..base.outputs import safe_name, save
-from ..figures import plots
 from ..signals.comfort import comfort_table as per_case
 
 BOUNDS = ("low", "nominal", "high")
@@ -148,6 +147,27 @@ def run_band(run: Callable[[dict, str], object], band: Band,
     return BandResult(band, results)
 
 
+def bounds_of(band: Band | None) -> tuple[str, ...]:
+    """The bounds a study runs at: the band's three, or the nominal alone where there is none."""
+    return ("nominal",) if band is None else BOUNDS
+
+
+def settings_at(band: Band | None, parameters: dict, bound: str) -> dict:
+    """A case's settings at one bound (its own settings where there is no band)."""
+    return dict(parameters) if band is None else band.applied(parameters, bound)
+
+
+def run_count(band: Band | None, per_bound: int) -> int:
+    """The runs of a study of ``per_bound`` runs at each of its bounds."""
+    return per_bound * len(bounds_of(band))
+
+
+def nominal_rows(table: pd.DataFrame) -> pd.DataFrame:
+    """A study's nominal results: the nominal bound's rows of a table with a ``bound`` column,
+    else the whole table."""
+    return table[table.bound == "nominal"] if "bound" in table else table
+
+
 def with_bound(table: pd.DataFrame, bound: str) -> pd.DataFrame:
     out = table.copy()
     out["bound"] = bound
@@ -230,13 +250,14 @@ def report_sweep(out, band: Band, orders: pd.DataFrame, spectra: pd.DataFrame, s
                  plot_signals, units: dict, suffix: str) -> pd.DataFrame:
     """Writes the band's tables (all three bounds side by side) and plots of a sweep; returns
     the comfort table (with its ``bound`` column)."""
+    from ..figures import plots  # deferred: matplotlib only where a band is drawn (start-up time)
+
     keys = ["case", "signal", "order", "rpm"]
     main = orders[orders.order.isin(MAIN_ORDERS)]
     save(wide(main, keys, ["amplitude"]), str(out / f"order_band{suffix}"))
     for signal in plot_signals:
         name = safe_name(signal)
-        nominal = spectra[(spectra.bound == "nominal")]
-        plots.waterfall(nominal, signal, str(out / f"waterfall_{name}.png"),
+        plots.waterfall(nominal_rows(spectra), signal, str(out / f"waterfall_{name}.png"),
                         unit=units.get(signal),
                         title=f"{signal}: waterfall at the nominal damping")
         plots.order_cuts(orders, signal, str(out / f"order_cuts_{name}.png"),
@@ -253,12 +274,14 @@ def report_sweep(out, band: Band, orders: pd.DataFrame, spectra: pd.DataFrame, s
 def report_runup(out, band: Band, orders: pd.DataFrame, plot_signals, units: dict, what: str,
                  suffix: str):
     """Writes the band's table and plots of a run-up's tracked orders."""
+    from ..figures import plots  # deferred: matplotlib only where a band is drawn (start-up time)
+
     main = orders[orders.order.isin(MAIN_ORDERS)]
     save(wide(main, ["case", "signal", "order", "rpm"], ["amplitude"]),
          str(out / f"runup_order_band{suffix}"))
     for signal in plot_signals:
         name = safe_name(signal)
-        plots.order_map(orders[orders.bound == "nominal"], signal,
+        plots.order_map(nominal_rows(orders), signal,
                         str(out / f"runup_order_map_{name}.png"), unit=units.get(signal),
                         title=f"{signal}: order map at the nominal damping, {what}")
         plots.order_cuts(orders, signal, str(out / f"runup_order_cuts_{name}.png"),

@@ -52,7 +52,7 @@ from typing import Callable, Iterable
 import dask
 import fmpy
 import numpy
-from dask.distributed import Client, LocalCluster, as_completed
+from dask.distributed import Client, LocalCluster, as_completed, get_worker
 from distributed.diagnostics.plugin import WorkerPlugin
 
 from ..base.errors import ClusterMismatch
@@ -262,6 +262,11 @@ def file_mismatches(local: dict[str, str | None], workers: dict[str, dict]) -> l
 def _warm_up(sha256: str, evaluate: Callable | None, item, dask_worker=None):
     """Run on each worker by :meth:`FmuPool.warm`: as many idle instances as the worker has
     threads, each through ``evaluate(runner, item)`` once."""
+    if dask_worker is None:
+        try:
+            dask_worker = get_worker()  # as a task (warm_soon) rather than through client.run
+        except ValueError:
+            dask_worker = None
     threads = dask_worker.state.nthreads if dask_worker is not None else 1
     with _RUNNERS_LOCK:
         runners = _IDLE_RUNNERS.pop(sha256, [])
@@ -387,6 +392,7 @@ class FmuPool:
         # The last map's timings (see MapRecord.anatomy).
         self.last_map: MapRecord | None = None
         self.cluster = None
+        self._warming: list = []
         if scheduler:
             self.client = Client(scheduler)
         else:
@@ -445,6 +451,18 @@ class FmuPool:
         timed study that follows pays for neither."""
         self.client.run(_warm_up, self.sha256, evaluate, item)
 
+    def warm_soon(self):
+        """Has every worker make its instances in the background, as a task pinned to it, while
+        the caller goes on (its own checks, its questions to the FMU): a map that follows finds
+        them made, or queues behind their making on that worker. A failure there is the first
+        map's to report: its points make an instance again and fail with the FMU's message."""
+        # A worker of several threads is left to make its instances as its tasks come: a task
+        # beside the warming one would make one more than the worker has threads.
+        self._warming = [self.client.submit(_warm_up, self.sha256, None, None, pure=False,
+                                            workers=[address], allow_other_workers=False)
+                         for address, worker in self.client.scheduler_info()["workers"].items()
+                         if worker.get("nthreads", 1) == 1]
+
     def map(self, evaluate: Callable, items: Iterable, progress: Callable[[int], None] | None = None,
             batches: int | None = None) -> list:
         """``evaluate(runner, item)`` for every item on the workers; the results in the order of
@@ -480,6 +498,7 @@ class FmuPool:
         return results
 
     def close(self):
+        self._warming = []
         if self.cluster is not None:
             # A worker whose heartbeat meets the closing scheduler logs the closed connection as
             # an error with its traceback (seen with 16 workers on 2 cores): noise after the

@@ -374,13 +374,25 @@ def extracted(path: str, sha256: str) -> str:
     return target
 
 
-def cutoffs_in_use(fmu: str, cases: list[tuple[str, dict]]) -> list[float | None]:
+def cutoffs_in_use(fmu: str, cases: list[tuple[str, dict]],
+                   runner: Runner | None = None) -> list[float | None]:
     """The chassis mode cut-off (Hz) each case's body keeps, as the FMU reports it
-    (``chassis.modeCutoffInUse``; None for an FMU without it)."""
-    with Runner(fmu) as runner:
+    (``chassis.modeCutoffInUse``; None for an FMU without it); asked of ``runner`` if given (the
+    instance the command's points run on next), else of an instance of its own."""
+    own = runner is None
+    runner = Runner(fmu) if own else runner
+    try:
         if CUTOFF_IN_USE not in runner.vr:
             return [None for _ in cases]
         return [runner.initial_values(parameters, [CUTOFF_IN_USE])[0] for _, parameters in cases]
+    finally:
+        if own:
+            runner.close()
+
+
+def cutoffs_on(runner: Runner, cases: list[tuple[str, dict]]) -> list[float | None]:
+    """:func:`cutoffs_in_use` of ``runner``'s FMU, as an evaluation on a pool's worker."""
+    return cutoffs_in_use("", cases, runner)
 
 
 def serial_map(fmu_path: str, evaluate: Callable, items: Iterable,

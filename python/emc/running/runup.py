@@ -47,9 +47,8 @@ def cmd_runup(args) -> int:
     out = claim(args)
     started = time.perf_counter()
     records, tracked, fmu_warnings = [], [], []
-    runs = ([(label, None, parameters) for label, parameters in cases] if band is None else
-            [(label, bound, band.applied(parameters, bound))
-             for bound in bands.BOUNDS for label, parameters in cases])
+    runs = [(label, bound if band is not None else None, bands.settings_at(band, parameters, bound))
+            for bound in bands.bounds_of(band) for label, parameters in cases]
     for label, bound, parameters in runs:
         start_values = {**parameters, "loadTorque": args.load_torque}
         if periodic:

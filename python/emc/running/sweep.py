@@ -83,11 +83,12 @@ def run_sweep(fmu_path: str, points: list[OperatingPoint], signals: list[str] | 
               case: str = "", parallel: bool = True, scheduler: str | None = None,
               workers: int = 2, progress: bool = True,
               warnings: list | None = None,
-              pool=None) -> tuple[pd.DataFrame, pd.DataFrame]:
+              pool=None, runner: Runner | None = None) -> tuple[pd.DataFrame, pd.DataFrame]:
     """Runs the points; returns (order table, spectrum table). A failed point raises
     :class:`PointFailed` (with its rpm, case and FMU log); the FMU's warnings of the points that
     succeeded are appended to ``warnings`` if given. ``pool``: a running :class:`FmuPool` of
-    this FMU (a study keeps one for all its sweeps); else, if ``parallel``, one is started for
+    this FMU (a study keeps one for all its sweeps); else ``runner``: an instance in this
+    process to run them on, one after the other; else, if ``parallel``, a pool is started for
     this sweep (on ``scheduler``, or ``workers`` local processes) and closed after it."""
     bar = progress_bar(len(points), case or "sweep", progress, unit="point")
     evaluate = functools.partial(sweep_point, signals=signals, case=case)
@@ -95,6 +96,8 @@ def run_sweep(fmu_path: str, points: list[OperatingPoint], signals: list[str] | 
     try:
         if pool is not None:
             done = pool.map(evaluate, points, update)
+        elif runner is not None:
+            done = serial_map(fmu_path, evaluate, points, update, runner=runner)
         elif parallel:
             # Deferred: dask is imported only where a sweep runs on a pool (start-up time).
             from .distributed import FmuPool

@@ -3,6 +3,9 @@ band's bounds), into order and spectrum tables, waterfalls, order cuts and comfo
 
 from __future__ import annotations
 
+import contextlib
+import dataclasses
+import functools
 import pathlib
 import time
 
@@ -13,31 +16,60 @@ from ..base.checks import (analysed_signals, check_count, check_pool, check_rang
 from ..base.fmu import default_signals, highest_speed, units_of
 from ..base.outputs import (claim, fmu_warnings_summary, reduction_notice, safe_name, save,
                             warn_cases, write_metadata)
-from ..figures import plots
+from ..figures import draw_all, preload_figures
 from ..signals.comfort import comfort_table
 from . import band as bands
-from .runner import cutoffs_in_use
+from .runner import Runner, cutoffs_in_use, cutoffs_on
 from .sweep import run_sweep, speed_points
 
 
-def sweep_cases(args, cases: list[tuple[str, dict]], signals: list[str], out: pathlib.Path,
-                point_options: dict, band: bands.Band | None = None
-                ) -> tuple[pd.DataFrame, pd.DataFrame, list[str]]:
-    """Every case's speed points (serial or on Dask), at the band's three bounds if a band is
-    given (a ``bound`` column then), the FMU's warnings summarised, the order and spectrum tables
-    of all cases written; returns (orders, spectra, FMU warnings)."""
-    fmu_warnings = []
-    # One pool for every case and bound: its workers start and load the FMU once.
-    runs = len(cases) * args.count * (1 if band is None else len(bands.BOUNDS))
-    workers = pool_workers(args, runs)
-    parallel = workers is not None or args.scheduler is not None
-    pool = None
-    if parallel:
-        # Deferred: dask is imported only where the points run on a pool (start-up time).
-        from .distributed import FmuPool, settings_files
+@dataclasses.dataclass
+class PointEngine:
+    """Where a command's points run: a pool of workers, or one instance in this process."""
 
-        files = sorted({f for _, parameters in cases for f in settings_files(parameters)})
-        pool = FmuPool(args.fmu, workers, args.scheduler, files=files)
+    runner: Runner | None = None
+    pool: object | None = None  # an emc.running.distributed.FmuPool (dask imported on demand)
+
+    def cutoffs(self, fmu: str, cases: list[tuple[str, dict]]) -> list[float | None]:
+        """:func:`cutoffs_in_use`, asked of the instance the points run on next (a worker's
+        warm one on a pool): no instance is made for the question alone."""
+        if self.pool is not None:
+            return self.pool.map(cutoffs_on, [cases])[0]
+        return cutoffs_in_use(fmu, cases, self.runner)
+
+
+@contextlib.contextmanager
+def point_engine(args, cases: list[tuple[str, dict]], runs: int):
+    """The :class:`PointEngine` for a command's ``runs`` points: a pool of local workers (or the
+    given scheduler's), whose instances are made in the background while this process checks and
+    prepares, or one instance in this process (few points, or --serial)."""
+    workers = pool_workers(args, runs)
+    engine = PointEngine()
+    try:
+        if workers is not None or args.scheduler is not None:
+            # Deferred: dask is imported only where the points run on a pool (start-up time).
+            from .distributed import FmuPool, settings_files
+
+            files = sorted({f for _, parameters in cases for f in settings_files(parameters)})
+            engine.pool = FmuPool(args.fmu, workers, args.scheduler, files=files)
+            engine.pool.warm_soon()
+        else:
+            engine.runner = Runner(args.fmu)
+        yield engine
+    finally:
+        if engine.pool is not None:
+            engine.pool.close()
+        if engine.runner is not None:
+            engine.runner.close()
+
+
+def sweep_cases(args, cases: list[tuple[str, dict]], signals: list[str], out: pathlib.Path,
+                point_options: dict, engine: PointEngine, band: bands.Band | None = None
+                ) -> tuple[pd.DataFrame, pd.DataFrame, list[str]]:
+    """Every case's speed points on the ``engine``, at the band's three
+    bounds if a band is given (a ``bound`` column then), the FMU's warnings summarised, the order
+    and spectrum tables of all cases written; returns (orders, spectra, FMU warnings)."""
+    fmu_warnings: list[str] = []
 
     def run(_settings: dict, bound: str | None = None):
         tables = []
@@ -47,20 +79,16 @@ def sweep_cases(args, cases: list[tuple[str, dict]], signals: list[str], out: pa
             points = speed_points(args.rpm[0], args.rpm[1], args.count,
                                   parameters=tuple(parameters.items()), **point_options)
             tables.append(run_sweep(args.fmu, points, signals=signals, case=label,
-                                    parallel=parallel, progress=not args.quiet,
-                                    warnings=fmu_warnings, pool=pool))
+                                    progress=not args.quiet, warnings=fmu_warnings, pool=engine.pool,
+                                    runner=engine.runner))
         return (pd.concat([t[0] for t in tables], ignore_index=True),
                 pd.concat([t[1] for t in tables], ignore_index=True))
 
-    try:
-        if band is None:
-            orders, spectra = run({})
-        else:
-            result = bands.run_band(run, band)
-            orders, spectra = result.stack(0), result.stack(1)
-    finally:
-        if pool is not None:
-            pool.close()
+    if band is None:
+        orders, spectra = run({})
+    else:
+        result = bands.run_band(run, band)
+        orders, spectra = result.stack(0), result.stack(1)
     fmu_warnings_summary(fmu_warnings)
     suffix = ".parquet" if args.parquet else ".csv"
     save(orders, str(out / f"orders{suffix}"))
@@ -78,41 +106,52 @@ def cmd_sweep(args) -> int:
     band = bands.band_of(args, variables, cases)
     check_speeds(args.rpm, increasing=args.count > 1, highest=highest_speed(variables))
     signals = analysed_signals(args, variables, default_signals(variables))
-    warn_cases([(label, sampling_warnings(variables, parameters, args.rpm[0], args.rpm[1],
-                                          args.steps_per_rev, cutoff=cutoff))
-                for (label, parameters), cutoff in zip(cases, cutoffs_in_use(args.fmu, cases))])
-    reduction_notice(cases[0][1], variables)
-    out = claim(args)
-    started = time.perf_counter()
-    orders, spectra, fmu_warnings = sweep_cases(
-        args, cases, signals, out, {**options, "steps_per_revolution": args.steps_per_rev,
-                                    "load_torque": args.load_torque}, band)
-    elapsed = time.perf_counter() - started
+    runs = bands.run_count(band, len(cases) * args.count)
+    with point_engine(args, cases, runs) as engine:
+        # After the pool's workers are forked: none inherits a half-done import.
+        preload_figures()
+        cutoffs = engine.cutoffs(args.fmu, cases)
+        warn_cases([(label, sampling_warnings(variables, parameters, args.rpm[0], args.rpm[1],
+                                              args.steps_per_rev, cutoff=cutoff))
+                    for (label, parameters), cutoff in zip(cases, cutoffs)])
+        reduction_notice(cases[0][1], variables)
+        out = claim(args)
+        started = time.perf_counter()
+        orders, spectra, fmu_warnings = sweep_cases(
+            args, cases, signals, out, {**options, "steps_per_revolution": args.steps_per_rev,
+                                        "load_torque": args.load_torque}, engine, band)
+        elapsed = time.perf_counter() - started
+    from ..figures import plots  # deferred: loaded in the background meanwhile (start-up time)
+
     suffix = ".parquet" if args.parquet else ".csv"
     units = units_of(variables)
     labels = [label for label, _ in cases]
     if band is not None:
         bands.report_sweep(out, band, orders, spectra, signals, args.plot or signals[:1], units,
                            suffix)
+    jobs = []
     for signal in [] if band is not None else args.plot or signals[:1]:
-        name = safe_name(signal)
+        name, unit = safe_name(signal), units.get(signal)
         if len(cases) == 1:
-            plots.waterfall(spectra, signal, str(out / f"waterfall_{name}.png"), unit=units.get(signal))
-            plots.order_cuts(orders, signal, str(out / f"order_cuts_{name}.png"),
-                             unit=units.get(signal))
+            jobs += [functools.partial(plots.waterfall, spectra, signal,
+                                       str(out / f"waterfall_{name}.png"), unit=unit),
+                     functools.partial(plots.order_cuts, orders, signal,
+                                       str(out / f"order_cuts_{name}.png"), unit=unit)]
         else:
-            plots.side_by_side(spectra, orders, signal, labels, str(out / f"waterfall_{name}.png"),
-                               str(out / f"order_cuts_{name}.png"), unit=units.get(signal))
+            jobs.append(functools.partial(plots.side_by_side, spectra, orders, signal, labels,
+                                          str(out / f"waterfall_{name}.png"),
+                                          str(out / f"order_cuts_{name}.png"), unit=unit))
     exposure = comfort_table(spectra) if band is None else pd.DataFrame()
     if not exposure.empty:
         save(exposure, str(out / f"comfort{suffix}"))
-        plots.comfort(exposure, str(out / "comfort.png"), cases=labels)
+        jobs.append(functools.partial(plots.comfort, exposure, str(out / "comfort.png"),
+                                      cases=labels))
+    draw_all(jobs)
     write_metadata(out, args, variables, cases,
                    {"speeds": {"from": args.rpm[0], "to": args.rpm[1], "count": args.count},
                     "start": options, "steps_per_revolution": args.steps_per_rev,
                     "load_torque": args.load_torque, "signals": signals,
                     **bands.band_metadata(band)},
                    fmu_warnings)
-    runs = len(cases) * args.count * (1 if band is None else len(bands.BOUNDS))
     print(f"{runs} points in {elapsed:.1f} s -> {out}")
     return 0

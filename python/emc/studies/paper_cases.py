@@ -3,6 +3,7 @@ each case swept and drawn side by side on common scales."""
 
 from __future__ import annotations
 
+import functools
 import time
 
 from ..base.checks import (analysed_signals, case_parameters, check_count, check_pool, check_speeds,
@@ -10,9 +11,8 @@ from ..base.checks import (analysed_signals, case_parameters, check_count, check
 from ..base.errors import UsageError
 from ..base.fmu import highest_speed, model_variables, units_of
 from ..base.outputs import claim, reduction_notice, safe_name, save, warn_cases, write_metadata
-from ..figures import plots
-from ..running.runner import cutoffs_in_use
-from ..running.sweep_cases import sweep_cases
+from ..figures import draw_all, preload_figures
+from ..running.sweep_cases import point_engine, sweep_cases
 from ..signals.comfort import comfort_table
 
 STUDY_CASES = {
@@ -67,24 +67,33 @@ def run_study(args, cases: dict) -> int:
                 raise UsageError(f"this FMU lacks {key}, which case {name!r} needs")
     signals = analysed_signals(args, variables, STUDY_SIGNALS)
     study = [(name, case_parameters(common, params)) for name, params in cases.items()]
-    warn_cases([(label, sampling_warnings(variables, parameters, args.rpm[0], args.rpm[1], 72,
-                                          cutoff=cutoff))
-                for (label, parameters), cutoff in zip(study, cutoffs_in_use(args.fmu, study))])
-    reduction_notice(study[0][1], variables)
-    out = claim(args)
-    started = time.perf_counter()
-    orders, spectra, fmu_warnings = sweep_cases(args, study, signals, out, options)
+    with point_engine(args, study, len(study) * args.count) as engine:
+        # After the pool's workers are forked: none inherits a half-done import.
+        preload_figures()
+        cutoffs = engine.cutoffs(args.fmu, study)
+        warn_cases([(label, sampling_warnings(variables, parameters, args.rpm[0], args.rpm[1],
+                                              72, cutoff=cutoff))
+                    for (label, parameters), cutoff in zip(study, cutoffs)])
+        reduction_notice(study[0][1], variables)
+        out = claim(args)
+        started = time.perf_counter()
+        orders, spectra, fmu_warnings = sweep_cases(args, study, signals, out, options, engine)
+    from ..figures import plots  # deferred: loaded in the background meanwhile (start-up time)
+
     suffix = ".parquet" if args.parquet else ".csv"
     units = units_of(variables)
-    for signal in args.signal or STUDY_PLOTS:
-        name = safe_name(signal)
-        plots.side_by_side(spectra, orders, signal, list(cases),
-                           str(out / f"study_waterfall_{name}.png"),
-                           str(out / f"study_order_cuts_{name}.png"), unit=units.get(signal))
+    jobs = [functools.partial(plots.side_by_side, spectra, orders, signal, list(cases),
+                              str(out / f"study_waterfall_{safe_name(signal)}.png"),
+                              str(out / f"study_order_cuts_{safe_name(signal)}.png"),
+                              unit=units.get(signal))
+            for signal in args.signal or STUDY_PLOTS]
     exposure = comfort_table(spectra)
     if not exposure.empty:
         save(exposure, str(out / f"comfort{suffix}"))
-        plots.comfort(exposure, str(out / "comfort.png"), cases=list(cases))
+        jobs.append(functools.partial(plots.comfort, exposure, str(out / "comfort.png"),
+                                      cases=list(cases)))
+    draw_all(jobs)
+    if not exposure.empty:
         comfort_summary = exposure.groupby("case", sort=False)[["wheel_ahv", "seat_av_comfort"]]
         print("weighted steering-wheel a_hv and seat a_v [m/s²], mean and maximum over the speeds:")
         print(comfort_summary.agg(["mean", "max"]).to_string(float_format=lambda v: f"{v:.3g}"))

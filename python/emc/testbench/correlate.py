@@ -309,9 +309,8 @@ def cmd_correlate(args) -> int:
     seconds = {}
     table = pd.DataFrame()
     if setup.grid is not None:
-        bounds = ["nominal"] + ([] if band is None else ["low", "high"])
-        sets = [(setup.parameters if b == "nominal" else band.applied(setup.parameters, b), None)
-                for b in bounds]
+        bounds = bands.bounds_of(band)
+        sets = [(bands.settings_at(band, setup.parameters, b), None) for b in bounds]
         pool = open_pool(args)
         simulator = Simulator(args.fmu, pool)
         seconds["start"] = time.perf_counter() - started
