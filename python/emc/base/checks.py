@@ -101,6 +101,20 @@ def case_parameters(common: dict, own: dict) -> dict:
     return {**DEFAULT_PARAMETERS, **common, **own}
 
 
+def name_and_bounds(text: str, option: str, error: type[Exception] = UsageError
+                    ) -> tuple[str, tuple[float, float] | None]:
+    """``NAME`` or ``NAME=LOW:HIGH`` (a design variable, a calibration parameter): the name and
+    the bounds if given (``error`` names ``option`` and the text when they are not two numbers)."""
+    name, _, bounds = text.partition("=")
+    if not bounds:
+        return name.strip(), None
+    try:
+        low, high = (float(v) for v in bounds.split(":"))
+    except ValueError:
+        raise error(f"{option} {text}: bounds are LOW:HIGH") from None
+    return name.strip(), (low, high)
+
+
 def check_pool(args):
     """--workers, if given, at least one."""
     if args.workers is not None:

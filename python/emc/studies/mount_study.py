@@ -48,7 +48,7 @@ import numpy as np
 import pandas as pd
 
 from ..base.checks import (check_count, check_pool, check_range, check_revolutions, check_speeds,
-                           parse_settings, pool_workers)
+                           name_and_bounds, parse_settings, pool_workers)
 from ..base.errors import UsageError
 from ..base.fmu import check_config_file, highest_speed, model_variables, mount_count
 from ..base.options import POOL_FROM
@@ -93,8 +93,7 @@ class Variable:
 
 def parse_variable(text: str, mounts: int) -> Variable:
     """``NAME`` or ``NAME=LOW:HIGH``, e.g. ``mount[2].stiffnessScale=0.5:2``."""
-    name, _, bounds = text.partition("=")
-    name = name.strip()
+    name, bounds = name_and_bounds(text, "--var", StudyError)
     match = VARIABLE.match(name)
     if not match:
         raise StudyError(f"--var {text}: not a design variable (mount[i].stiffnessScale, "
@@ -104,12 +103,7 @@ def parse_variable(text: str, mounts: int) -> Variable:
         raise StudyError(f"--var {text}: the FMU has mounts 1 to {mounts}")
     kind = match.group(2).split("[")[0]
     axis = match.group(3)
-    low, high = DEFAULT_BOUNDS[kind]
-    if bounds:
-        try:
-            low, high = (float(v) for v in bounds.split(":"))
-        except ValueError:
-            raise StudyError(f"--var {text}: bounds are LOW:HIGH") from None
+    low, high = bounds or DEFAULT_BOUNDS[kind]
     if not (math.isfinite(low) and math.isfinite(high) and low < high):
         raise StudyError(f"--var {text}: need finite bounds LOW < HIGH")
     if low < 0.0:

@@ -28,6 +28,8 @@ import json
 import math
 import re
 
+from ..base.checks import name_and_bounds
+
 PATTERN = re.compile(r"^(?:mount\[(\d+|\*)\]\.(stiffnessScale|dampingScale|rate\[([123])\])"
                      r"|(chassis\.modalDampingScale)|body\.damping\.table\[(\d+)\])$")
 DEFAULT_BOUNDS = {"stiffnessScale": (0.5, 2.0), "rate": (0.5, 2.0), "dampingScale": (0.25, 4.0),
@@ -67,8 +69,7 @@ class Parameter:
 
 def parse(text: str, mounts: int) -> Parameter:
     """``NAME`` or ``NAME=LOW:HIGH`` (factors; the bounds must enclose 1, the nominal)."""
-    name, _, bounds = text.partition("=")
-    name = name.strip()
+    name, bounds = name_and_bounds(text, "--param", ParameterError)
     match = PATTERN.match(name)
     if not match:
         raise ParameterError(f"--param {text}: not a calibration parameter (mount[i]."
@@ -94,12 +95,7 @@ def parse(text: str, mounts: int) -> Parameter:
             if not 1 <= mount <= mounts:
                 raise ParameterError(f"--param {text}: the FMU has mounts 1 to {mounts}")
             chosen = (mount,)
-    low, high = DEFAULT_BOUNDS[kind]
-    if bounds:
-        try:
-            low, high = (float(v) for v in bounds.split(":"))
-        except ValueError:
-            raise ParameterError(f"--param {text}: bounds are LOW:HIGH") from None
+    low, high = bounds or DEFAULT_BOUNDS[kind]
     if not (math.isfinite(low) and math.isfinite(high) and 0.0 < low < 1.0 < high):
         raise ParameterError(f"--param {text}: the bounds must be finite factors with 0 < LOW "
                              "< 1 < HIGH (the nominal is 1)")
