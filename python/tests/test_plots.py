@@ -155,3 +155,27 @@ def test_comfort_lines_follow_the_case_order():
         assert list(fig.axes[1].lines[0].get_ydata()) == [1, 2]
     finally:
         plt.close(fig)
+
+
+def _write(path, text):
+    path.write_text(text)
+
+
+def _fail(message):
+    raise ValueError(message)
+
+
+def test_figures_drawn_side_by_side_write_every_file_and_report_a_failure(tmp_path):
+    """draw_all forks a process per figure beyond the first: every job's file is written, and a
+    job that fails in a child process comes back as an error naming its cause."""
+    import functools
+
+    from emc.figures import draw_all
+
+    jobs = [functools.partial(_write, tmp_path / f"{k}.txt", str(k)) for k in range(3)]
+    draw_all(jobs)
+    assert [(tmp_path / f"{k}.txt").read_text() for k in range(3)] == ["0", "1", "2"]
+    with pytest.raises(RuntimeError, match="ValueError: the third figure"):
+        draw_all([jobs[0], jobs[1], functools.partial(_fail, "the third figure")])
+    with pytest.raises(ValueError, match="the first figure"):  # this process's own share
+        draw_all([functools.partial(_fail, "the first figure"), jobs[1]])
