@@ -299,8 +299,7 @@ impl Element for Beam {
 
     fn matrices(&self, index: usize, mesh: &Mesh) -> Result<ElementMatrices, FeError> {
         let what = format!("beam {index}");
-        let p1 = mesh.position(&what, self.nodes[0])?;
-        let p2 = mesh.position(&what, self.nodes[1])?;
+        let [p1, p2] = mesh.positions(&what, &self.nodes)?;
         let ends = mesh.beam_ends.get(&index).copied().unwrap_or_default();
         Ok(ElementMatrices::stiffness_and_mass(
             &stiffness_with_ends(index, self, &ends, &p1, &p2)?,

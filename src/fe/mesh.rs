@@ -284,6 +284,19 @@ impl Mesh {
         self.nodes.len() - 1
     }
 
+    /// Positions of an element's corner `nodes`, each checked as by [`Mesh::position`].
+    pub fn positions<const N: usize>(
+        &self,
+        what: &str,
+        nodes: &[usize; N],
+    ) -> Result<[Vector3<f64>; N], super::FeError> {
+        let mut points = [Vector3::zeros(); N];
+        for (point, &node) in points.iter_mut().zip(nodes) {
+            *point = self.position(what, node)?;
+        }
+        Ok(points)
+    }
+
     /// Position of `node`, which `what` (an element, a link) refers to: an error if the node
     /// does not exist or its coordinates are not finite.
     pub fn position(&self, what: &str, node: usize) -> Result<Vector3<f64>, super::FeError> {

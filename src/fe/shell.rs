@@ -424,12 +424,7 @@ impl Element for Shell {
 
     fn matrices(&self, index: usize, mesh: &Mesh) -> Result<ElementMatrices, FeError> {
         let what = format!("shell {index}");
-        let p = [
-            mesh.position(&what, self.nodes[0])?,
-            mesh.position(&what, self.nodes[1])?,
-            mesh.position(&what, self.nodes[2])?,
-            mesh.position(&what, self.nodes[3])?,
-        ];
+        let p = mesh.positions(&what, &self.nodes)?;
         Ok(ElementMatrices::stiffness_and_mass(
             &stiffness(index, self, &p)?,
             &lumped_mass(index, self, &p)?,

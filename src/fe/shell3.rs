@@ -309,11 +309,7 @@ impl Element for TriShell {
 
     fn matrices(&self, index: usize, mesh: &Mesh) -> Result<ElementMatrices, FeError> {
         let what = format!("triangle {index}");
-        let p = [
-            mesh.position(&what, self.nodes[0])?,
-            mesh.position(&what, self.nodes[1])?,
-            mesh.position(&what, self.nodes[2])?,
-        ];
+        let p = mesh.positions(&what, &self.nodes)?;
         Ok(ElementMatrices::stiffness_and_mass(
             &stiffness(index, self, &p)?,
             &lumped_mass(index, self, &p)?,

@@ -51,8 +51,7 @@ impl Element for Spring {
     /// scattering through the DOF map gives them back on the components.
     fn matrices(&self, index: usize, mesh: &Mesh) -> Result<ElementMatrices, FeError> {
         let what = format!("spring {index}");
-        mesh.position(&what, self.nodes[0])?;
-        mesh.position(&what, self.nodes[1])?;
+        mesh.positions(&what, &self.nodes)?;
         let (ks, cs) = two_node_matrices(index, self)?;
         let frames = &mesh.displacement_frames;
         Ok(ElementMatrices::stiffness_and_damping(
