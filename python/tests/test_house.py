@@ -20,7 +20,7 @@ FLOORS = {"base": 0, "signals": 1, "figures": 2, "running": 3, "diagnosis": 4, "
 # time, each with a comment saying so where it stands.
 DEFERRED = {("base/fmu.py", "fmpy"), ("base/outputs.py", "fmpy"), ("base/outputs.py", "fcntl"),
             ("cli.py", ".running.runner"), ("running/sweep.py", ".distributed"),
-            ("running/sweep_cases.py", ".distributed"), ("running/sweep_cases.py", "..figures"),
+            ("running/engine.py", ".distributed"), ("running/sweep_cases.py", "..figures"),
             ("running/band.py", "..figures"), ("studies/paper_cases.py", "..figures"),
             ("running/split.py", "libcosimpy.CosimExecution"),
             ("running/split.py", "libcosimpy.CosimLogging"),

@@ -3,8 +3,6 @@ band's bounds), into order and spectrum tables, waterfalls, order cuts and comfo
 
 from __future__ import annotations
 
-import contextlib
-import dataclasses
 import functools
 import pathlib
 import time
@@ -12,55 +10,15 @@ import time
 import pandas as pd
 
 from ..base.checks import (analysed_signals, check_count, check_pool, check_range, check_speeds,
-                           pool_workers, prepare, sampling_warnings, start_options)
+                           prepare, sampling_warnings, start_options)
 from ..base.fmu import default_signals, highest_speed, units_of
 from ..base.outputs import (claim, fmu_warnings_summary, reduction_notice, safe_name, save,
                             warn_cases, write_metadata)
 from ..figures import draw_all, preload_figures
 from ..signals.comfort import comfort_table
 from . import band as bands
-from .runner import Runner, cutoffs_in_use, cutoffs_on
+from .engine import PointEngine, point_engine
 from .sweep import run_sweep, speed_points
-
-
-@dataclasses.dataclass
-class PointEngine:
-    """Where a command's points run: a pool of workers, or one instance in this process."""
-
-    runner: Runner | None = None
-    pool: object | None = None  # an emc.running.distributed.FmuPool (dask imported on demand)
-
-    def cutoffs(self, fmu: str, cases: list[tuple[str, dict]]) -> list[float | None]:
-        """:func:`cutoffs_in_use`, asked of the instance the points run on next (a worker's
-        warm one on a pool): no instance is made for the question alone."""
-        if self.pool is not None:
-            return self.pool.map(cutoffs_on, [cases])[0]
-        return cutoffs_in_use(fmu, cases, self.runner)
-
-
-@contextlib.contextmanager
-def point_engine(args, cases: list[tuple[str, dict]], runs: int):
-    """The :class:`PointEngine` for a command's ``runs`` points: a pool of local workers (or the
-    given scheduler's), whose instances are made in the background while this process checks and
-    prepares, or one instance in this process (few points, or --serial)."""
-    workers = pool_workers(args, runs)
-    engine = PointEngine()
-    try:
-        if workers is not None or args.scheduler is not None:
-            # Deferred: dask is imported only where the points run on a pool (start-up time).
-            from .distributed import FmuPool, settings_files
-
-            files = sorted({f for _, parameters in cases for f in settings_files(parameters)})
-            engine.pool = FmuPool(args.fmu, workers, args.scheduler, files=files)
-            engine.pool.warm_soon()
-        else:
-            engine.runner = Runner(args.fmu)
-        yield engine
-    finally:
-        if engine.pool is not None:
-            engine.pool.close()
-        if engine.runner is not None:
-            engine.runner.close()
 
 
 def sweep_cases(args, cases: list[tuple[str, dict]], signals: list[str], out: pathlib.Path,

@@ -48,12 +48,12 @@ import numpy as np
 import pandas as pd
 
 from ..base.checks import (check_count, check_pool, check_range, check_revolutions, check_speeds,
-                           name_and_bounds, parse_settings, pool_workers)
+                           name_and_bounds, parse_settings)
 from ..base.errors import UsageError
 from ..base.fmu import check_config_file, highest_speed, model_variables, mount_count
 from ..base.options import POOL_FROM
 from ..base.outputs import claim
-from ..running.distributed import FmuPool, settings_files
+from ..running.engine import open_pool
 from ..running.runner import OperatingPoint, PointFailed, Runner
 from ..running.sweep import analyse, speed_points, tables
 from ..signals.comfort import SEAT, WHEEL, comfort_table
@@ -465,9 +465,7 @@ def open_study(args, problem: Problem, mounts: int):
     if store.records:
         print(f"note: {len(store.records)} evaluations found in {store.path}: the study "
               "continues from them", file=sys.stderr)
-    workers = pool_workers(args, POOL_FROM)  # a study runs many designs
-    pool = None if workers is None else FmuPool(args.fmu, workers, args.scheduler,
-                                            files=settings_files(dict(problem.parameters)))
+    pool = open_pool(args, POOL_FROM, [dict(problem.parameters)])  # a study runs many designs
     evaluator = Evaluator(problem, args.fmu, store, mounts, pool)
     return store, evaluator, pool
 

@@ -12,7 +12,8 @@ from ..base.errors import UsageError
 from ..base.fmu import highest_speed, model_variables, units_of
 from ..base.outputs import claim, reduction_notice, safe_name, save, warn_cases, write_metadata
 from ..figures import draw_all, preload_figures
-from ..running.sweep_cases import point_engine, sweep_cases
+from ..running.engine import point_engine
+from ..running.sweep_cases import sweep_cases
 from ..signals.comfort import comfort_table
 
 STUDY_CASES = {

@@ -360,7 +360,7 @@ def cmd_calibrate(args) -> int:
         print(f"note: {len(store.records)} evaluations found in {store.path}: the calibration "
               "continues from them", file=sys.stderr)
     started = time.perf_counter()
-    pool = open_pool(args)
+    pool = open_pool(args, setup.parameters)
     simulator = Simulator(args.fmu, pool)
     evaluations = Evaluations(problem, simulator, store, not args.quiet)
     try:

@@ -28,7 +28,7 @@ import pandas as pd
 from matplotlib import ticker
 
 from ..base.checks import (case_parameters, check_pool, check_range, check_revolutions,
-                           parse_settings, pool_workers)
+                           parse_settings)
 from ..base.errors import UsageError
 from ..base.fmu import check_config_file, highest_speed, model_variables, units_of
 from ..base.options import POOL_FROM
@@ -36,7 +36,7 @@ from ..base.outputs import claim, reduction_notice, safe_name, write_metadata
 from ..figures import plots
 from ..running import band as bands
 from ..running.band import band_metadata
-from ..running.distributed import FmuPool
+from ..running import engine
 from ..running.modal import body_point_of, export_from_fmu
 from ..running.runner import progress_bar
 from . import metrics
@@ -93,10 +93,9 @@ class Setup:
         return out
 
 
-def open_pool(args):
+def open_pool(args, parameters: dict):
     """The pool of a correlation or calibration (a study of many points), or None: serial."""
-    workers = pool_workers(args, POOL_FROM)
-    return None if workers is None else FmuPool(args.fmu, workers, args.scheduler)
+    return engine.open_pool(args, POOL_FROM, [parameters])
 
 
 def run_sets(simulator: Simulator, grid: Grid, sets: list[tuple[dict, str | None]],
@@ -311,7 +310,7 @@ def cmd_correlate(args) -> int:
     if setup.grid is not None:
         bounds = bands.bounds_of(band)
         sets = [(bands.settings_at(band, setup.parameters, b), None) for b in bounds]
-        pool = open_pool(args)
+        pool = open_pool(args, setup.parameters)
         simulator = Simulator(args.fmu, pool)
         seconds["start"] = time.perf_counter() - started
         try:

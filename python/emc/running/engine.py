@@ -1,0 +1,60 @@
+"""Where a command's points run: a Dask pool (:mod:`.distributed`, imported only when one is
+used) or one FMU instance in this process, chosen from the command's options and its number of
+runs (:func:`emc.base.checks.pool_workers`)."""
+
+from __future__ import annotations
+
+import contextlib
+import dataclasses
+
+from ..base.checks import pool_workers
+from .runner import Runner, cutoffs_in_use, cutoffs_on
+
+
+def open_pool(args, runs: int, settings: list[dict]):
+    """The pool for a command's ``runs`` runs, or None where they run in this process. Every
+    worker must see the files the ``settings`` (each run's start values) make the FMU read, with
+    the content this process sees (checked before anything runs)."""
+    workers = pool_workers(args, runs)
+    if workers is None:
+        return None
+    # Deferred: dask is imported only where the points run on a pool (start-up time).
+    from .distributed import FmuPool, settings_files
+
+    files = sorted({f for parameters in settings for f in settings_files(parameters)})
+    return FmuPool(args.fmu, workers, args.scheduler, files=files)
+
+
+@dataclasses.dataclass
+class PointEngine:
+    """Where a command's points run: a pool of workers, or one instance in this process."""
+
+    runner: Runner | None = None
+    pool: object | None = None  # an emc.running.distributed.FmuPool (dask imported on demand)
+
+    def cutoffs(self, fmu: str, cases: list[tuple[str, dict]]) -> list[float | None]:
+        """:func:`cutoffs_in_use`, asked of the instance the points run on next (a worker's
+        warm one on a pool): no instance is made for the question alone."""
+        if self.pool is not None:
+            return self.pool.map(cutoffs_on, [cases])[0]
+        return cutoffs_in_use(fmu, cases, self.runner)
+
+
+@contextlib.contextmanager
+def point_engine(args, cases: list[tuple[str, dict]], runs: int):
+    """The :class:`PointEngine` for a command's ``runs`` points: a pool of local workers (or the
+    given scheduler's), whose instances are made in the background while this process checks and
+    prepares, or one instance in this process (few points, or --serial)."""
+    engine = PointEngine()
+    try:
+        engine.pool = open_pool(args, runs, [parameters for _, parameters in cases])
+        if engine.pool is not None:
+            engine.pool.warm_soon()
+        else:
+            engine.runner = Runner(args.fmu)
+        yield engine
+    finally:
+        if engine.pool is not None:
+            engine.pool.close()
+        if engine.runner is not None:
+            engine.runner.close()
