@@ -49,21 +49,33 @@ class WinePrefix:
     (reproduced here by `wineserver -k` during a run), and CI saw exactly that three times in about
     fifteen suites, twice in one run. A server that shuts down on its own a few seconds after each
     program is one that a new program can meet while it exits; a persistent one cannot be. Should
-    the server still go away, the run is repeated with a fresh one, and a final failure is reported
-    with wine's own error channel switched on."""
+    the server still go away, the run is repeated with a fresh one (in a prefix made anew where
+    kernel32.dll could not be loaded), and a final failure is reported with wine's own error
+    channel switched on."""
 
     def __init__(self, path: pathlib.Path):
         self.path = path
         self.env = {"WINEDEBUG": "-all", "WINEPREFIX": str(path)}
         self.server = shutil.which("wineserver")
         if not (path / "system.reg").exists():
-            for _ in range(2):
-                boot = subprocess.run([_wine(), "wineboot", "--init"], capture_output=True, text=True,
-                                      env=self._full_env(), timeout=600)
-                self._server("-w")
-                if boot.returncode == 0:
-                    break
+            self._create()
         self._server("-p")
+
+    def _create(self):
+        for _ in range(2):
+            boot = subprocess.run([_wine(), "wineboot", "--init"], capture_output=True, text=True,
+                                  env=self._full_env(), timeout=600)
+            self._server("-w")
+            if boot.returncode == 0:
+                break
+
+    def _recreate(self):
+        """A prefix in which kernel32.dll cannot be loaded (exit 53; CI saw it once with every
+        retry in the same prefix, at stop 51) is made anew."""
+        self._server("-k")
+        self._server("-w")
+        shutil.rmtree(self.path, ignore_errors=True)
+        self._create()
 
     def _full_env(self, **extra) -> dict:
         return {**os.environ, **self.env, **extra}
@@ -79,8 +91,11 @@ class WinePrefix:
             proc = self._run_once(cmd, token, "-all")
             if not _server_went_away(proc):
                 return proc
-            self._server("-k")
-            self._server("-w")
+            if proc.returncode == 53:
+                self._recreate()
+            else:
+                self._server("-k")
+                self._server("-w")
             self._server("-p")
         # Once more with wine's error channel on, so that the report says what wine saw.
         return self._run_once(cmd, token, "err+all")
