@@ -31,6 +31,7 @@ from .base.checks import DEFAULT_PARAMETERS, check_range
 from .base.fmu import check_outputs, highest_speed, model_variables
 from .base.outputs import save
 from .running.distributed import FmuPool
+from .running.local_pool import LocalPool
 from .running.runner import OperatingPoint, Runner
 from .running.sweep import speed_points, sweep_point
 
@@ -148,21 +149,34 @@ def same_results(a: list, b: list) -> bool:
     return len(a) == len(b) and all(same(x, y) and wx == wy for (x, wx), (y, wy) in zip(a, b))
 
 
-def timed_pool_runs(fmu_path: str, workers: int, batching: str, evaluate, items: list,
-                    repeat: int, warm_with=None, threads: int = 1) -> dict:
-    """A pool of ``workers`` processes of ``threads`` threads each (``batching``: "guided" or
-    "equal") started, its instances warmed
-    (and ``evaluate(runner, warm_with)`` run once on each, if given), then ``repeat`` timed maps
-    of ``evaluate`` over ``items``: the start and warm-up times, each run's wall and CPU time
-    (every process), the last run's results, the evaluations' least CPU time and the fastest
-    run's anatomy (:meth:`emc.running.distributed.MapRecord.anatomy`)."""
+POOL_KINDS = ("local", "dask")
 
+
+def timed_pool_runs(fmu_path: str, workers: int, batching: str, evaluate, items: list,
+                    repeat: int, warm_with=None, threads: int = 1, kind: str = "dask") -> dict:
+    """A pool of ``workers`` processes of ``threads`` threads each (``kind``: ``"local"``, the
+    process pool of ``--workers``, one thread each, or ``"dask"``, a local Dask cluster;
+    ``batching``: "guided" or "equal") started, its instances warmed (and ``evaluate(runner,
+    warm_with)`` run once on each, if given), then ``repeat`` timed maps of ``evaluate`` over
+    ``items``: the start and warm-up times, each run's wall and CPU time (every process), the
+    last run's results, the evaluations' least CPU time and the fastest run's anatomy
+    (:meth:`emc.running.batches.MapRecord.anatomy`)."""
+
+    batches = 4 if batching == "equal" else None
     started = time.perf_counter()
-    with FmuPool(fmu_path, workers=workers, threads_per_worker=threads,
-                 batches_per_worker=4 if batching == "equal" else None) as pool:
+    if kind == "local":
+        pool = LocalPool(fmu_path, workers, batches_per_worker=batches,
+                         warm_with=None if warm_with is None else (evaluate, warm_with))
+    else:
+        pool = FmuPool(fmu_path, workers=workers, threads_per_worker=threads,
+                       batches_per_worker=batches)
+    with pool:
         start = time.perf_counter() - started
         started = time.perf_counter()
-        pool.warm(evaluate if warm_with is not None else None, warm_with)
+        if kind == "local":
+            pool.warm()
+        else:
+            pool.warm(evaluate if warm_with is not None else None, warm_with)
         warm = time.perf_counter() - started
         anatomies = []
 
@@ -194,18 +208,20 @@ def _tree_cpu() -> float:
 
 
 def scaling_table(fmu_path: str, points: list, workers=(1, 2), repeat: int = 2,
-                  batchings=("guided",), out=sys.stdout, threads=(1,)) -> pd.DataFrame:
-    """Serial against Dask pools of each worker count, threads per worker and batching
-    (``"guided"``: shrinking batches; ``"equal"``: four equal batches per worker), on warm
-    instances: the serial loop runs
+                  batchings=("guided",), out=sys.stdout, threads=(1,),
+                  pools=POOL_KINDS) -> pd.DataFrame:
+    """Serial against pools of each kind (``pools``: ``"local"``, the process pool of
+    ``--workers``, whose workers have one thread each; ``"dask"``, a local Dask cluster), worker
+    count, threads per worker and batching (``"guided"``: shrinking batches; ``"equal"``: four
+    equal batches per worker), on warm instances: the serial loop runs
     on an instance that has already run a point; each pool is started and its workers' instances
     warmed (one point each, the reduced body read from the cache) before the timed runs. The
     start and warm-up of each pool are reported beside, and the CPU time of each run: the serial
     process's, or that of this process and all its children (scheduler, nannies, workers),
     which load does not change. Of the pool runs also the CPU time of the evaluations alone
     (the worker threads that ran them) and where the workers' time went
-    (:meth:`emc.running.distributed.MapRecord.anatomy`, the run with the shortest wall time). Every run's
-    results are compared with the serial ones to the bit."""
+    (:meth:`emc.running.batches.MapRecord.anatomy`, the run with the shortest wall time). Every
+    run's results are compared with the serial ones to the bit."""
 
     evaluate = functools.partial(sweep_point, signals=None, case="")
     rows = []
@@ -217,22 +233,26 @@ def scaling_table(fmu_path: str, points: list, workers=(1, 2), repeat: int = 2,
               file=out, flush=True)
         times, cpus, serial = _timed(lambda: [evaluate(runner, p) for p in points], repeat,
                                      time.process_time)
-    rows.append({"workers": "serial", "threads": "", "batching": "", "start_s": 0.0,
+    rows.append({"pool": "", "workers": "serial", "threads": "", "batching": "", "start_s": 0.0,
                  "warm_s": 0.0,
                  "run_min_s": min(times), "run_max_s": max(times), "cpu_s": min(cpus),
                  "task_cpu_s": min(cpus), "identical": True})
     print(f"serial: {min(times):.2f}-{max(times):.2f} s", file=out, flush=True)
-    for w, t, batching in itertools.product(workers, threads, batchings):
+    for kind, w, t, batching in itertools.product(pools, workers, threads, batchings):
+        if kind == "local" and t != 1:
+            continue  # a local pool's workers have one thread each
         run = timed_pool_runs(fmu_path, w, batching, evaluate, points, repeat,
-                              warm_with=points[0], threads=t)
-        rows.append({"workers": w, "threads": t, "batching": batching, "start_s": run["start_s"],
+                              warm_with=points[0], threads=t, kind=kind)
+        rows.append({"pool": kind, "workers": w, "threads": t, "batching": batching,
+                     "start_s": run["start_s"],
                      "warm_s": run["warm_s"], "run_min_s": min(run["times"]),
                      "run_max_s": max(run["times"]), "cpu_s": min(run["cpus"]),
                      "task_cpu_s": run["task_cpu_s"], "batches": run["batches"],
                      "busy": run["busy"], "first_s": run["first_s"], "tail_s": run["tail_s"],
                      "identical": same_results(run["results"], serial)})
         times = run["times"]
-        print(f"{w} workers x {t} threads, {batching} batches: start {run['start_s']:.1f} s, "
+        print(f"{kind} pool, {w} workers x {t} threads, {batching} batches: start "
+              f"{run['start_s']:.2f} s, "
               f"warm-up {run['warm_s']:.1f} s, "
               f"{min(times):.2f}-{max(times):.2f} s", file=out, flush=True)
     table = pd.DataFrame(rows)
@@ -271,7 +291,8 @@ def point_costs(fmu_path: str, points: list) -> list[float]:
 
 
 def scheduling_table(fmu_path: str, costs: list[float], workers=(16,), repeat: int = 2,
-                     batchings=("guided", "equal"), out=sys.stdout) -> pd.DataFrame:
+                     batchings=("guided", "equal"), out=sys.stdout,
+                     pools=POOL_KINDS) -> pd.DataFrame:
     """What distribution alone costs at any worker count, on a machine with fewer cores: each
     point is replaced by a wait of its measured time (:func:`wait_point`), so the workers hold
     no core while they "compute" and only the pool's own work (scheduling, batching, the
@@ -281,20 +302,21 @@ def scheduling_table(fmu_path: str, costs: list[float], workers=(16,), repeat: i
     table's task_cpu_ratio)."""
     total = sum(costs)
     rows = []
-    for w in workers:
-        for batching in batchings:
-            run = timed_pool_runs(fmu_path, w, batching, wait_point, costs, repeat)
-            if run["results"] != costs:
-                raise RuntimeError("the pool returned the items out of order")
-            times = run["times"]
-            rows.append({"workers": w, "batching": batching, "start_s": run["start_s"],
-                         "run_min_s": min(times), "run_max_s": max(times),
-                         "ideal_s": total / w, "speedup": total / min(times),
-                         "speedup_low": total / max(times), "efficiency": total / w / min(times),
-                         "pool_cpu_s": min(run["cpus"]), "batches": run["batches"],
-                         "busy": run["busy"], "first_s": run["first_s"], "tail_s": run["tail_s"]})
-            print(f"{w} workers, {batching} batches: {min(times):.2f}-{max(times):.2f} s "
-                  f"(ideal {total / w:.2f} s)", file=out, flush=True)
+    for kind, w, batching in itertools.product(pools, workers, batchings):
+        run = timed_pool_runs(fmu_path, w, batching, wait_point, costs, repeat, kind=kind)
+        if run["results"] != costs:
+            raise RuntimeError("the pool returned the items out of order")
+        times = run["times"]
+        rows.append({"pool": kind, "workers": w, "batching": batching,
+                     "start_s": run["start_s"],
+                     "run_min_s": min(times), "run_max_s": max(times),
+                     "ideal_s": total / w, "speedup": total / min(times),
+                     "speedup_low": total / max(times), "efficiency": total / w / min(times),
+                     "pool_cpu_s": min(run["cpus"]), "batches": run["batches"],
+                     "busy": run["busy"], "first_s": run["first_s"], "tail_s": run["tail_s"]})
+        print(f"{kind} pool, {w} workers, {batching} batches: "
+              f"{min(times):.2f}-{max(times):.2f} s "
+              f"(ideal {total / w:.2f} s)", file=out, flush=True)
     return pd.DataFrame(rows)
 
 
@@ -327,11 +349,11 @@ def cmd_scaling(args) -> int:
     print(f"{len(points)} points, {args.rpm[0]:g}-{args.rpm[1]:g} rpm, scene 2, periodic start, "
           f"8 revolutions at 72 steps each; {args.repeat} timed runs per row", flush=True)
     table = scaling_table(args.fmu, points, args.workers, args.repeat, args.batching,
-                          threads=args.threads)
+                          threads=args.threads, pools=args.pool)
     load = os.getloadavg()
     print(f"load average after: {load[0]:.2f} / {load[1]:.2f} / {load[2]:.2f}")
-    show_table(table, ["workers", "threads", "batching", "start_s", "warm_s", "run s (min-max)",
-                       "speed-up", "points_per_s", "cpu_s", "cpu_ratio", "task_cpu_ratio",
+    show_table(table, ["pool", "workers", "threads", "batching", "start_s", "warm_s",
+                       "run s (min-max)", "speed-up", "points_per_s", "cpu_s", "cpu_ratio", "task_cpu_ratio",
                        "batches", "busy", "first_s", "tail_s", "identical"],
                "speed-up: against the serial loop (best; worst); cpu_ratio: the CPU time of every "
                "process against the serial loop's; task_cpu_ratio: that of the evaluations alone "
@@ -350,9 +372,10 @@ def cmd_scheduling(args) -> int:
           f"measured serially {sum(costs):.2f} s ({min(costs) * 1e3:.0f}-{max(costs) * 1e3:.0f} "
           f"ms a point); waits of {args.scale:g} x that, {sum(scaled):.2f} s in all; "
           f"{args.repeat} timed runs per row", flush=True)
-    table = scheduling_table(args.fmu, scaled, args.workers, args.repeat, args.batching)
-    show_table(table, ["workers", "batching", "start_s", "run s (min-max)", "ideal_s", "speed-up",
-                       "efficiency", "pool_cpu_s", "batches", "busy", "first_s", "tail_s"],
+    table = scheduling_table(args.fmu, scaled, args.workers, args.repeat, args.batching,
+                             pools=args.pool)
+    show_table(table, ["pool", "workers", "batching", "start_s", "run s (min-max)", "ideal_s",
+                       "speed-up", "efficiency", "pool_cpu_s", "batches", "busy", "first_s", "tail_s"],
                "speed-up: the sum of the waits over the run's wall time (best; worst); "
                "efficiency: of the ideal sum / workers; pool_cpu_s: CPU time of every process "
                "during the run (the pool's own work, the waits use none)", args.csv, len(points))

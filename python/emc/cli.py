@@ -25,7 +25,7 @@ import re
 import sys
 
 from .base import outputs
-from .base.errors import UsageError
+from .base.errors import UsageError, WorkerLost
 from .commands import MODULES
 
 
@@ -74,6 +74,9 @@ def main(argv: list[str] | None = None) -> int:
         return 2
     except PointFailed as failure:
         print(failure.report(), file=sys.stderr)
+        return 1
+    except WorkerLost as lost:
+        print(f"error: {lost}", file=sys.stderr)
         return 1
     except KeyboardInterrupt:
         print("error: interrupted", file=sys.stderr)

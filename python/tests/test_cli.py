@@ -137,7 +137,7 @@ def error_lines(err: str) -> list[str]:
             and "?point" not in line]
 
 
-@pytest.mark.parametrize("mode", [["--serial"], ["--workers", "1"]], ids=["serial", "dask"])
+@pytest.mark.parametrize("mode", [["--serial"], ["--workers", "1"]], ids=["serial", "pool"])
 def test_a_failing_point_reports_the_fmus_cause_first(fmu_path, tmp_path, capsys, mode):
     # A configuration the FMU rejects: an unknown field in the engine section.
     bad = tmp_path / "bad_vehicle.json"
@@ -307,7 +307,8 @@ def test_fmu_content_is_written_once_under_its_checksum(fmu_path, tmp_path):
     first = os.stat(path).st_mtime_ns
     assert fmu_from_content(content, digest) == path and os.stat(path).st_mtime_ns == first
     # A worker runs from the bytes its plugin got alone: the caller's copy is gone.
-    from emc.running.distributed import FmuPlugin, evaluate_batch
+    from emc.running.batches import evaluate_batch
+    from emc.running.distributed import FmuPlugin
 
     copy = tmp_path / "gone.fmu"
     shutil.copy(fmu_path, copy)

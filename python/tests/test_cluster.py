@@ -124,11 +124,9 @@ def test_the_pool_counts_every_thread_of_every_worker_and_warms_an_instance_for_
         assert pool.workers == 4
         pool.warm()
 
-        def idle(sha256):
-            from emc.running.distributed import _IDLE_RUNNERS
-            return len(_IDLE_RUNNERS.get(sha256, []))
+        from emc.running.batches import idle_count
 
-        assert list(pool.client.run(idle, pool.sha256).values()) == [4]
+        assert list(pool.client.run(idle_count, pool.sha256).values()) == [4]
 
 
 def test_a_worker_with_other_software_is_refused_naming_both_versions(fmu_path, tmp_path,

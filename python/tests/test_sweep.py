@@ -1,10 +1,15 @@
-"""The sweep tool: exact order analysis, and Dask sweeps equal to serial ones."""
+"""The sweep tool: exact order analysis, and sweeps on pools equal to serial ones."""
+
+import os
+import time
 
 import numpy as np
 import pandas as pd
 import pytest
 
-from emc.running.runner import OperatingPoint, Runner
+from emc.base.errors import WorkerLost
+from emc.running.local_pool import LocalPool
+from emc.running.runner import OperatingPoint, PointFailed, Runner
 from emc.running.sweep import run_sweep, speed_points
 from emc.signals.spectra import ORDERS, amplitude_spectrum, order_amplitudes
 
@@ -31,16 +36,15 @@ def test_operating_points_reject_windows_without_half_orders():
         raise AssertionError(f"{bad} accepted")
 
 
-def test_dask_sweeps_equal_the_serial_sweep_for_any_worker_count(fmu_path):
+def test_pool_sweeps_equal_the_serial_sweep_for_any_worker_count(fmu_path):
     """Workers keep their instance from batch to batch: whatever the worker count and batching,
-    the tables are the serial sweep's to the bit (scene 2, five points)."""
-    from emc.running.distributed import FmuPool
-
+    the tables are the serial sweep's to the bit (scene 2, five points). The Dask cluster's
+    pool is compared in the same way in test_cluster.py and by the scaling benchmark's test."""
     points = speed_points(900, 2100, 5, revolutions=4)
     signals = ["mount[1].F[3]", "mount[3].F[1]", "steeringWheel.a[3]"]
     serial = run_sweep(str(fmu_path), points, signals, parallel=False, progress=False)
     for workers in (1, 2, 3):
-        with FmuPool(str(fmu_path), workers=workers, batches_per_worker=2) as pool:
+        with LocalPool(str(fmu_path), workers=workers, batches_per_worker=2) as pool:
             assert pool.workers == workers
             # Twice on the same pool: the second sweep runs on instances already used.
             for _ in range(2):
@@ -55,8 +59,54 @@ def test_dask_sweeps_equal_the_serial_sweep_for_any_worker_count(fmu_path):
     assert main.min() > 10 * other.max()
 
 
+def _where(runner, item):
+    return os.getpid(), id(runner)
+
+
+def _exit(runner, item):
+    os._exit(7)
+
+
+def _fail_first_sleep_after(runner, item):
+    if item == 0:
+        raise PointFailed("item 0 refused", ("[error] logStatusError: item 0 refused",))
+    time.sleep(60)
+    return item
+
+
+def test_a_local_pools_workers_each_keep_the_instance_they_made_at_start(fmu_path):
+    with LocalPool(str(fmu_path), workers=2) as pool:
+        first = pool.map(_where, range(8), batches=4)
+        second = pool.map(_where, range(8), batches=4)
+    instances = {}
+    for pid, runner in first + second:
+        instances.setdefault(pid, set()).add(runner)
+    assert os.getpid() not in instances and len(instances) <= 2
+    assert all(len(runners) == 1 for runners in instances.values()), instances
+
+
+def test_a_failure_on_a_local_pool_cancels_the_rest_and_stops_its_busy_worker(fmu_path):
+    pool = LocalPool(str(fmu_path), workers=2)
+    processes = list(pool.executor._processes.values())
+    started = time.monotonic()
+    try:
+        with pytest.raises(PointFailed, match="item 0 refused"):
+            pool.map(_fail_first_sleep_after, [0, 1], batches=2)
+    finally:
+        pool.close()
+    # The other worker sleeps in its batch: it is terminated, not waited for.
+    assert time.monotonic() - started < 20
+    assert len(processes) == 2 and not any(p.is_alive() for p in processes)
+
+
+def test_a_worker_that_dies_is_reported_with_how_it_ended(fmu_path):
+    with LocalPool(str(fmu_path), workers=2) as pool:
+        with pytest.raises(WorkerLost, match="exit code 7"):
+            pool.map(_exit, [0, 1, 2])
+
+
 def test_batches_interleave_the_items_and_cover_each_once():
-    from emc.running.distributed import interleaved_batches
+    from emc.running.batches import interleaved_batches
 
     assert interleaved_batches(7, 3) == [[0, 3, 6], [1, 4], [2, 5]]
     assert interleaved_batches(2, 8) == [[0], [1]]
@@ -65,7 +115,7 @@ def test_batches_interleave_the_items_and_cover_each_once():
 
 
 def test_guided_batches_shrink_to_single_items_and_spread_over_the_items():
-    from emc.running.distributed import guided_batches, guided_sizes
+    from emc.running.batches import guided_batches, guided_sizes
 
     assert guided_sizes(48, 2) == [12, 12, 6, 6, 3, 3, 2, 2, 1, 1]
     sizes = guided_sizes(192, 16)
@@ -84,7 +134,7 @@ def test_guided_batches_shrink_to_single_items_and_spread_over_the_items():
 
 
 def test_a_maps_anatomy_splits_the_workers_time():
-    from emc.running.distributed import BatchRecord, MapRecord
+    from emc.running.batches import BatchRecord, MapRecord
 
     # Two workers over 10 s: one busy 1-9 s in two batches, the other 2-6 s; a third never used.
     record = MapRecord(100.0, 110.0, [BatchRecord(1, 7, 2, 101.0, 105.0, 3.5),
@@ -194,7 +244,8 @@ def test_the_scaling_benchmark_checks_each_pool_run_and_splits_its_time(fmu_path
     points = scaling_points(3)
     table = scaling_table(str(fmu_path), points, workers=(2,), repeat=1,
                           batchings=("guided", "equal"), out=io.StringIO())
-    assert list(table.workers) == ["serial", 2, 2] and table.identical.all()
+    assert list(table.workers) == ["serial", 2, 2, 2, 2] and table.identical.all()
+    assert list(table.pool) == ["", "local", "local", "dask", "dask"]
     pools = table.iloc[1:]
     assert (pools.batches == 3).all() and ((pools.busy > 0) & (pools.busy <= 1)).all()
     assert (pools.task_cpu_s > 0).all() and (pools.tail_s >= 0).all()
@@ -202,7 +253,9 @@ def test_the_scaling_benchmark_checks_each_pool_run_and_splits_its_time(fmu_path
     waits = [0.05] * 8
     scheduled = scheduling_table(str(fmu_path), waits, workers=(2,), repeat=1,
                                  batchings=("guided",), out=io.StringIO())
-    assert 0 < scheduled.speedup.iloc[0] <= 2.0 and scheduled.ideal_s.iloc[0] == sum(waits) / 2
+    assert list(scheduled.pool) == ["local", "dask"]
+    assert ((0 < scheduled.speedup) & (scheduled.speedup <= 2.0)).all()
+    assert (scheduled.ideal_s == sum(waits) / 2).all()
 
 
 def test_the_command_line_keeps_freed_memory_for_reuse(monkeypatch):

@@ -8,3 +8,8 @@ class UsageError(Exception):
 class ClusterMismatch(UsageError):
     """A Dask worker cannot give the numbers this process would: another emc, fmpy or numpy,
     or another copy (or none) of a file the settings name."""
+
+
+class WorkerLost(RuntimeError):
+    """A worker process of a local pool ended in the middle of its work (killed, or a crash):
+    reported as one line, with how it ended."""

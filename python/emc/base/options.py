@@ -174,14 +174,15 @@ def add_band_from(p):
 
 
 def add_pool(p):
-    """Where the points run: local Dask workers, a running cluster, or this process."""
+    """Where the points run: worker processes of this machine, a running Dask cluster, or this
+    process."""
     p.add_argument("--workers", type=int, default=None,
-                   help=f"local Dask workers (default {DEFAULT_WORKERS}; fewer than "
+                   help=f"worker processes on this machine (default {DEFAULT_WORKERS}; fewer than "
                         f"{POOL_FROM} runs go in this process, where a pool's start would cost "
                         "more than it saves)")
     p.add_argument("--scheduler", help="address of a running Dask scheduler (the FMU is sent to "
                                        "the workers by content)")
-    p.add_argument("--serial", action="store_true", help="no Dask")
+    p.add_argument("--serial", action="store_true", help="every point in this process")
 
 
 def add_quiet(p, help: str = "no progress bars"):

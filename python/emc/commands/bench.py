@@ -25,7 +25,7 @@ def register(sub):
                    help="windows per case (the range is reported; default 3)")
     r.set_defaults(func=options.runs("emc.bench:cmd_bench_realtime"))
 
-    s = sub.add_parser("bench-scaling", help="a sweep serial and on Dask pools of several worker "
+    s = sub.add_parser("bench-scaling", help="a sweep serial and on pools of several worker "
                                              "counts (warm instances), with speed-ups and a "
                                              "bit-for-bit check")
     options.add_fmu(s)
@@ -57,7 +57,8 @@ def register(sub):
                                                  "correlate against a twin measurement of 4 "
                                                  "channels x 4 orders x 35 speeds, timed")
     options.add_fmu(c)
-    c.add_argument("--workers", type=int, default=2, help="local Dask workers (default 2)")
+    c.add_argument("--workers", type=int, default=2,
+                   help="worker processes on this machine (default 2)")
     c.add_argument("--speeds", type=int, default=35, help="measured speeds (default 35)")
     c.add_argument("--revolutions", type=int, default=4,
                    help="analysed window per speed (even; default 4)")
@@ -99,6 +100,9 @@ def _worker_counts(p, default: list[int]):
 
 def _timed_runs(p, batchings: list[str], help: str):
     _repeat(p, 2, "timed runs per row")
+    p.add_argument("--pool", nargs="+", choices=("local", "dask"), default=["local", "dask"],
+                   help="pools to compare: the process pool of --workers (local; its workers "
+                        "have one thread each) and/or a local Dask cluster (dask); default both")
     p.add_argument("--batching", nargs="+", choices=("guided", "equal"), default=batchings,
                    help=help)
     _csv(p)

@@ -1,51 +1,28 @@
-"""Many FMU evaluations on Dask, with one warm FMU instance per worker.
+"""Many FMU evaluations on a Dask cluster (``--scheduler``; :mod:`.batches` says how any pool
+keeps its instances and batches its items).
 
-A study (a sweep, a design of experiments, an optimisation) evaluates the same FMU hundreds or
-thousands of times. What each evaluation may cost besides its own simulation is kept small:
+A cluster's workers need not share this machine's file system or software:
 
 - **The FMU's bytes reach each worker once**, in a worker plugin (workers that join the cluster
   later get it too); the worker writes them to its temporary directory under their checksum.
-- **Each worker keeps one instance per task it runs at once** (:class:`emc.running.runner.Runner`) for its
-  life and reuses it from evaluation to evaluation: ``fmi2Reset`` brings it back to the
-  instantiated state. A worker started with several threads (Dask's default: one per core) runs
-  that many tasks at once; each task takes an instance no other task holds (FMI allows one call
-  at a time per instance), so the threads compute in parallel (the FMU releases the GIL). Restoring an
-  FMU state saved right after instantiation does the same and gives the same numbers to the bit;
-  both cost well under a millisecond against 100–400 ms for a point (most of it the periodic
-  start), so the plain reset is kept: there is no state to hold.
-- **Evaluations go in batches**, several per task, so that scheduling is a small part of each
-  task. By default the batches shrink as the study goes (guided self-scheduling): the first
-  round gives each worker a batch of a ``2 × workers``-th of the items, each later round a
-  ``2 × workers``-th of what is left, down to single items. Big batches at the start keep the
-  scheduling cost small; single items at the end leave a worker idle for at most about one
-  evaluation while the others finish. Each batch spreads over the items (a sweep's slow
-  low-speed points over all batches). ``batches_per_worker=B`` gives the older scheme instead:
-  ``B × workers`` equal interleaved batches.
-- **Results come back in the order of the items**, and every evaluation starts from the reset
-  instance: a study gives the same numbers to the bit, serially or on any number of workers.
+- **Every worker is checked before anything runs**: the same emc, fmpy and numpy as this process,
+  and the same content of every file the settings make the FMU read (:class:`ClusterMismatch`).
+- **A worker may have any number of threads**: each running task has an instance of its own.
 
-    with FmuPool("dist/EngineMountChassis.fmu", workers=4) as pool:
+    with FmuPool("dist/EngineMountChassis.fmu", scheduler="tcp://host:8786") as pool:
         results = pool.map(evaluate, items)      # evaluate(runner, item) on the workers
 
-``evaluate`` must be picklable (a module-level function, or a ``functools.partial`` of one) and
-may raise :class:`emc.running.runner.PointFailed`; the first failure cancels the rest and is raised with
-the FMU's log.
+Without a scheduler it starts a local Dask cluster (the scaling benchmark compares its threads
+and processes); the commands' local pools are :class:`emc.running.local_pool.LocalPool`.
 """
 
 from __future__ import annotations
 
-import contextlib
 import functools
 import hashlib
 import json
 import logging
-import math
 import os
-import signal
-import sys
-import threading
-import time
-from dataclasses import dataclass, field
 from importlib import metadata
 from typing import Callable, Iterable
 
@@ -56,8 +33,9 @@ from dask.distributed import Client, LocalCluster, as_completed, get_worker
 from distributed.diagnostics.plugin import WorkerPlugin
 
 from ..base.errors import ClusterMismatch
-from .runner import (MALLOC_SETTINGS, PointFailed, Runner, extracted, fmu_from_content,
-                     keep_freed_memory)
+from .batches import (START_METHOD, BatchPool, forget_idle, serve_fmu, sigint_ignored,
+                      warm_instances)
+from .runner import MALLOC_SETTINGS, fmu_from_content, keep_freed_memory
 
 # Local workers: Dask's nanny starts them with MALLOC_TRIM_THRESHOLD_=65536 so that they hand
 # memory back to the system; glibc then trims the FMU's short-lived allocations at every free, and
@@ -69,12 +47,8 @@ from .runner import (MALLOC_SETTINGS, PointFailed, Runner, extracted, fmu_from_c
 # 0.5 s and 0.1 s, work stealing every 0.1 s) cost the caller 4 % and each worker 2 % of a core
 # while a study runs; at 1-5 s they cost a tenth of that (2 workers, 48 scene-2 points: all
 # processes together within 1-4 % of the serial loop's CPU time instead of 22 % above it).
-# Local workers are forked from the calling process where the system allows it (Linux): they
-# start with its modules imported, a pool of 2 in 0.27-0.35 s against 1.8-2.4 s spawned (each
-# worker importing dask, fmpy and emc anew; /tmp/poolstart-like timing of FmuPool and warm(),
-# machine F under load, 2026-12-04). The fork happens on Dask's event-loop thread while the
-# calling thread waits for the cluster, holding no lock a worker needs.
-START_METHOD = "fork" if sys.platform.startswith("linux") else "spawn"
+# Local workers are forked where the system allows it (batches.START_METHOD), on Dask's event-loop
+# thread while the calling thread waits for the cluster.
 WORKER_CONFIG = {
     "distributed.worker.multiprocessing-method": START_METHOD,
     "distributed.nanny.pre-spawn-environ": {
@@ -86,16 +60,6 @@ WORKER_CONFIG = {
     "distributed.scheduler.work-stealing-interval": "1s",
 }
 
-# The warm instances of this worker process that no task holds now, by the FMU's checksum. A
-# worker with several threads runs several tasks at once: each takes an idle instance (or makes
-# one) and gives it back when done, so no instance is ever called from two threads at once and a
-# worker holds as many instances as it ran tasks at once. Every evaluation starts from a reset, so
-# which instance runs which item does not change a number.
-_IDLE_RUNNERS: dict[str, list[Runner]] = {}
-_RUNNERS_LOCK = threading.Lock()
-# The FMU files the plugin wrote on this worker, by checksum.
-_FMU_FILES: dict[str, str] = {}
-
 
 class FmuPlugin(WorkerPlugin):
     """Puts the FMU's bytes on every worker once (also on workers that join later)."""
@@ -106,73 +70,13 @@ class FmuPlugin(WorkerPlugin):
         self.name = f"emc-fmu-{sha256[:16]}"
 
     def setup(self, worker):
-        _FMU_FILES[self.sha256] = fmu_from_content(self.content, self.sha256)
+        serve_fmu(self.sha256, fmu_from_content(self.content, self.sha256))
         # The FMU's short-lived workspaces stay with the worker (as in emc's own process).
         keep_freed_memory()
 
     def teardown(self, worker):
-        # Idle instances are dropped, not freed: freeing is cheap to skip, the worker process
-        # ends next and takes them along; an instance a task still holds (a study interrupted)
-        # must not be freed under its step. The files stay extracted for the next pool here.
-        with _RUNNERS_LOCK:
-            _IDLE_RUNNERS.pop(self.sha256, None)
-
-
-def _new_runner(sha256: str) -> Runner:
-    path = _FMU_FILES.get(sha256)
-    if path is None:
-        raise RuntimeError(f"the FMU {sha256[:12]}… never reached this worker")
-    name = f"emc-worker-{os.getpid()}-{threading.get_ident()}"
-    return Runner(path, instance_name=name, unzipdir=extracted(path, sha256))
-
-
-@contextlib.contextmanager
-def worker_runner(sha256: str):
-    """An instance of the FMU with this checksum that no other task of this worker holds, for
-    the length of the ``with`` block: an idle one, else a new one."""
-    with _RUNNERS_LOCK:
-        idle = _IDLE_RUNNERS.get(sha256)
-        runner = idle.pop() if idle else None
-    if runner is None:
-        runner = _new_runner(sha256)
-    try:
-        yield runner
-    finally:
-        with _RUNNERS_LOCK:
-            _IDLE_RUNNERS.setdefault(sha256, []).append(runner)
-
-
-@dataclass(frozen=True)
-class BatchRecord:
-    """Where and when a batch ran: the worker's process and thread, its wall-clock start and end
-    (``time.time()``, comparable between the processes of one machine) and the CPU time of the
-    worker thread that ran it (the evaluations alone, without the worker's housekeeping)."""
-    pid: int
-    thread: int
-    items: int
-    start: float
-    end: float
-    cpu: float
-
-
-def evaluate_batch(sha256: str, evaluate: Callable,
-                   items: list) -> tuple[list, PointFailed | None, BatchRecord]:
-    """A task: ``evaluate(runner, item)`` for each item on this worker's warm instance. A failure
-    comes back as a value with the results before it, so the worker logs nothing of its own and
-    the caller reports the FMU's cause."""
-    start, cpu = time.time(), time.thread_time()
-    results: list = []
-    failure = None
-    with worker_runner(sha256) as runner:
-        for item in items:
-            try:
-                results.append(evaluate(runner, item))
-            except PointFailed as failed:
-                failure = failed
-                break
-    record = BatchRecord(os.getpid(), threading.get_ident(), len(items), start, time.time(),
-                         time.thread_time() - cpu)
-    return results, failure, record
+        # The files stay extracted for the next pool here.
+        forget_idle(self.sha256)
 
 
 @functools.cache
@@ -268,27 +172,7 @@ def _warm_up(sha256: str, evaluate: Callable | None, item, dask_worker=None):
         except ValueError:
             dask_worker = None
     threads = dask_worker.state.nthreads if dask_worker is not None else 1
-    with _RUNNERS_LOCK:
-        runners = _IDLE_RUNNERS.pop(sha256, [])
-    runners += [_new_runner(sha256) for _ in range(threads - len(runners))]
-    if evaluate is not None:
-        for runner in runners:
-            evaluate(runner, item)
-    with _RUNNERS_LOCK:
-        _IDLE_RUNNERS.setdefault(sha256, []).extend(runners)
-
-
-@contextlib.contextmanager
-def _sigint_ignored():
-    """SIGINT ignored while child processes are started from this (main) thread."""
-    if threading.current_thread() is not threading.main_thread():
-        yield
-        return
-    previous = signal.signal(signal.SIGINT, signal.SIG_IGN)
-    try:
-        yield
-    finally:
-        signal.signal(signal.SIGINT, previous)
+    warm_instances(sha256, threads, evaluate, item)
 
 
 def _quiet_teardown():
@@ -296,84 +180,14 @@ def _quiet_teardown():
     logging.getLogger("distributed").setLevel(logging.CRITICAL)
 
 
-def interleaved_batches(count: int, batches: int) -> list[list[int]]:
-    """Item indices ``0 … count-1`` in ``batches`` equal interleaved batches (none empty):
-    batch ``b`` holds items ``b, b + B, b + 2B, …``."""
-    batches = max(1, min(batches, count))
-    return spread_batches([count // batches + (b < count % batches) for b in range(batches)])
-
-
-def spread_batches(sizes: list[int]) -> list[list[int]]:
-    """Item indices ``0 … sum(sizes)-1`` in batches of these sizes, each spread evenly over the
-    index range: the ``j``-th of a batch's ``k`` slots belongs at the middle of the ``j``-th
-    ``k``-th of the range, and the slots of all batches, sorted by that place (the first batch on
-    a tie), take the items in order. Equal sizes give :func:`interleaved_batches`."""
-    slots = sorted(((2 * j + 1) / (2 * size), b) for b, size in enumerate(sizes)
-                   for j in range(size))
-    batches: list[list[int]] = [[] for _ in sizes]
-    for i, (_, b) in enumerate(slots):
-        batches[b].append(i)
-    return batches
-
-
-def guided_sizes(count: int, workers: int) -> list[int]:
-    """Batch sizes of guided self-scheduling: rounds of ``workers`` batches, each of a
-    ``2 × workers``-th of the items still left (rounded up), the last rounds single items."""
-    sizes: list[int] = []
-    left = count
-    while left > 0:
-        size = max(1, math.ceil(left / (2 * workers)))
-        for _ in range(workers):
-            take = min(size, left)
-            if take == 0:
-                break
-            sizes.append(take)
-            left -= take
-    return sizes
-
-
-def guided_batches(count: int, workers: int) -> list[list[int]]:
-    """Item indices ``0 … count-1`` in shrinking batches (:func:`guided_sizes`), each spread over
-    the items, the largest first."""
-    return spread_batches(guided_sizes(count, workers))
-
-
-@dataclass
-class MapRecord:
-    """A :meth:`FmuPool.map`: its wall-clock start and end (``time.time()``) and every batch."""
-    start: float
-    end: float = 0.0
-    batches: list[BatchRecord] = field(default_factory=list)
-
-    def anatomy(self, workers: int) -> dict:
-        """Where the workers' time went (``workers``: the task slots, the threads of all
-        workers): ``busy``, the share of ``workers × wall time`` spent in batches; ``first_s``,
-        how long a slot waited for its first batch (mean); ``tail_s``, how long a slot sat idle
-        between its last batch and the map's end (mean); ``cpu_s``, the CPU time of the
-        evaluations alone (the worker threads that ran them)."""
-        wall = self.end - self.start
-        by_worker: dict[tuple[int, int], list[BatchRecord]] = {}
-        for batch in self.batches:
-            by_worker.setdefault((batch.pid, batch.thread), []).append(batch)
-        # Workers that got no batch wait the whole map.
-        idle = max(0, workers - len(by_worker))
-        first = [min(b.start for b in runs) - self.start for runs in by_worker.values()]
-        tail = [self.end - max(b.end for b in runs) for runs in by_worker.values()]
-        return {"busy": sum(b.end - b.start for b in self.batches) / (workers * wall),
-                "first_s": (sum(first) + idle * wall) / workers,
-                "tail_s": (sum(tail) + idle * wall) / workers,
-                "cpu_s": sum(b.cpu for b in self.batches),
-                "batches": len(self.batches)}
-
-
-class FmuPool:
+class FmuPool(BatchPool):
     """A Dask cluster whose workers each hold a warm instance of one FMU.
 
     ``scheduler``: the address of a running Dask scheduler (its workers get the FMU by content:
     they need not share the caller's file system, and may have any number of threads: each
-    running task has an instance of its own); else a local cluster of ``workers`` processes with
-    one thread each (the FMU runs single-threaded; processes keep the instances' memory apart). ``batches_per_worker``: ``None`` for
-    shrinking (guided) batches, a number for that many equal batches per worker.
+    running task has an instance of its own); else a local Dask cluster of ``workers`` processes
+    with ``threads_per_worker`` threads each. ``batches_per_worker``: ``None`` for shrinking
+    (guided) batches, a number for that many equal batches per worker.
     """
 
     def __init__(self, fmu_path: str, workers: int = 2, scheduler: str | None = None,
@@ -389,19 +203,13 @@ class FmuPool:
             self.content = f.read()
         self.sha256 = hashlib.sha256(self.content).hexdigest()
         self.batches_per_worker = batches_per_worker
-        # The last map's timings (see MapRecord.anatomy).
-        self.last_map: MapRecord | None = None
         self.cluster = None
         self._warming: list = []
         if scheduler:
             self.client = Client(scheduler)
         else:
             # Worker logs below ERROR (cancelled tasks after a failure, …) would bury the cause.
-            # The worker processes start with Ctrl-C ignored (a Python process keeps an
-            # ignored SIGINT): the terminal's interrupt reaches them too, and each would print
-            # its own KeyboardInterrupt traceback before the command's one-line message; the
-            # command stops them itself.
-            with dask.config.set(WORKER_CONFIG), _sigint_ignored():
+            with dask.config.set(WORKER_CONFIG), sigint_ignored():
                 self.cluster = LocalCluster(n_workers=workers,
                                             threads_per_worker=threads_per_worker,
                                             processes=True, dashboard_address=None,
@@ -463,39 +271,14 @@ class FmuPool:
                          for address, worker in self.client.scheduler_info()["workers"].items()
                          if worker.get("nthreads", 1) == 1]
 
-    def map(self, evaluate: Callable, items: Iterable, progress: Callable[[int], None] | None = None,
-            batches: int | None = None) -> list:
-        """``evaluate(runner, item)`` for every item on the workers; the results in the order of
-        ``items``. ``progress(n)`` is called with the number of items each finished batch held.
-        ``batches``: that many equal batches for this map (else as the pool was made)."""
+    def _submit(self, function: Callable, *args):
+        return self.client.submit(function, *args, pure=False)
 
-        items = list(items)
-        if not items:
-            return []
-        record = MapRecord(time.time())
-        workers = self.workers
-        if batches or self.batches_per_worker:
-            groups = interleaved_batches(len(items), batches or self.batches_per_worker * workers)
-        else:
-            groups = guided_batches(len(items), workers)
-        # Submitted largest first: the scheduler hands out tasks in the order they came.
-        futures = {self.client.submit(evaluate_batch, self.sha256, evaluate,
-                                      [items[i] for i in group], pure=False): group
-                   for group in groups}
-        results: list = [None] * len(items)
-        for future in as_completed(futures):
-            values, failure, batch = future.result()
-            record.batches.append(batch)
-            if failure is not None:
-                self.client.cancel(list(futures))
-                raise failure
-            for i, value in zip(futures[future], values):
-                results[i] = value
-            if progress is not None:
-                progress(len(values))
-        record.end = time.time()
-        self.last_map = record
-        return results
+    def _completed(self, futures: Iterable):
+        return as_completed(futures)
+
+    def _cancel(self, futures: list):
+        self.client.cancel(futures)
 
     def close(self):
         self._warming = []
@@ -510,9 +293,3 @@ class FmuPool:
         self.client.close()
         if self.cluster is not None:
             self.cluster.close()
-
-    def __enter__(self):
-        return self
-
-    def __exit__(self, *exc):
-        self.close()

@@ -1,6 +1,7 @@
-"""Where a command's points run: a Dask pool (:mod:`.distributed`, imported only when one is
-used) or one FMU instance in this process, chosen from the command's options and its number of
-runs (:func:`emc.base.checks.pool_workers`)."""
+"""Where a command's points run: a pool of worker processes of this machine (:mod:`.local_pool`),
+the workers of a Dask cluster (:mod:`.distributed`, imported only when one is used) or one FMU
+instance in this process, chosen from the command's options and its number of runs
+(:func:`emc.base.checks.pool_workers`)."""
 
 from __future__ import annotations
 
@@ -8,21 +9,33 @@ import contextlib
 import dataclasses
 
 from ..base.checks import pool_workers
+from .batches import BatchPool
+from .local_pool import LocalPool
 from .runner import Runner, cutoffs_in_use, cutoffs_on
 
 
-def open_pool(args, runs: int, settings: list[dict]):
-    """The pool for a command's ``runs`` runs, or None where they run in this process. Every
-    worker must see the files the ``settings`` (each run's start values) make the FMU read, with
-    the content this process sees (checked before anything runs)."""
-    workers = pool_workers(args, runs)
-    if workers is None:
-        return None
-    # Deferred: dask is imported only where the points run on a pool (start-up time).
+def start_pool(fmu: str, workers: int, scheduler: str | None = None,
+               settings: list[dict] = ()) -> BatchPool:
+    """A pool of ``workers`` processes of this machine (:class:`LocalPool`), or the workers of the
+    Dask cluster at ``scheduler`` (:class:`emc.running.distributed.FmuPool`), each of which must
+    see the files the ``settings`` (each run's start values) make the FMU read, with the content
+    this process sees (checked before anything runs)."""
+    if not scheduler:
+        return LocalPool(fmu, workers)
+    # Deferred: Dask is imported only where the points run on a cluster (start-up time).
     from .distributed import FmuPool, settings_files
 
     files = sorted({f for parameters in settings for f in settings_files(parameters)})
-    return FmuPool(args.fmu, workers, args.scheduler, files=files)
+    return FmuPool(fmu, workers, scheduler, files=files)
+
+
+def open_pool(args, runs: int, settings: list[dict]) -> BatchPool | None:
+    """The pool for a command's ``runs`` runs (:func:`start_pool`), or None where they run in
+    this process."""
+    workers = pool_workers(args, runs)
+    if workers is None:
+        return None
+    return start_pool(args.fmu, workers, args.scheduler, settings)
 
 
 @dataclasses.dataclass
@@ -30,7 +43,7 @@ class PointEngine:
     """Where a command's points run: a pool of workers, or one instance in this process."""
 
     runner: Runner | None = None
-    pool: object | None = None  # an emc.running.distributed.FmuPool (dask imported on demand)
+    pool: BatchPool | None = None
 
     def cutoffs(self, fmu: str, cases: list[tuple[str, dict]]) -> list[float | None]:
         """:func:`cutoffs_in_use`, asked of the instance the points run on next (a worker's

@@ -414,7 +414,7 @@ def serial_map(fmu_path: str, evaluate: Callable, items: Iterable,
 
 
 def progress_bar(total: int, description: str, enabled: bool = True, unit: str = "eval"):
-    """A tqdm bar on stderr if wanted (else None); ``bar.update`` fits :meth:`FmuPool.map`'s
+    """A tqdm bar on stderr if wanted (else None); ``bar.update`` fits :meth:`emc.running.batches.BatchPool.map`'s
     ``progress``."""
     if not enabled:
         return None

@@ -1,7 +1,7 @@
 """Constant-speed sweeps, serial or in parallel with Dask, into tidy tables.
 
-Parallel runs go through :class:`emc.running.distributed.FmuPool`: every worker keeps one FMU instance,
-reset between points, and takes the points in batches. The FMU is deterministic, so a parallel
+Parallel runs go through a pool (:func:`emc.running.engine.start_pool`): every worker keeps one FMU
+instance, reset between points, and takes the points in batches. The FMU is deterministic, so a parallel
 sweep gives exactly the numbers of a serial one.
 """
 
@@ -16,6 +16,7 @@ import pandas as pd
 from ..base.fmu import default_signals
 from ..base.orders import HIGHEST_ORDER, ORDERS
 from ..signals.spectra import amplitude_spectrum, order_amplitudes
+from .engine import start_pool
 from .runner import OperatingPoint, Runner, progress_bar, serial_map
 
 
@@ -86,7 +87,7 @@ def run_sweep(fmu_path: str, points: list[OperatingPoint], signals: list[str] | 
               pool=None, runner: Runner | None = None) -> tuple[pd.DataFrame, pd.DataFrame]:
     """Runs the points; returns (order table, spectrum table). A failed point raises
     :class:`PointFailed` (with its rpm, case and FMU log); the FMU's warnings of the points that
-    succeeded are appended to ``warnings`` if given. ``pool``: a running :class:`FmuPool` of
+    succeeded are appended to ``warnings`` if given. ``pool``: a running pool (:class:`emc.running.batches.BatchPool`) of
     this FMU (a study keeps one for all its sweeps); else ``runner``: an instance in this
     process to run them on, one after the other; else, if ``parallel``, a pool is started for
     this sweep (on ``scheduler``, or ``workers`` local processes) and closed after it."""
@@ -99,10 +100,7 @@ def run_sweep(fmu_path: str, points: list[OperatingPoint], signals: list[str] | 
         elif runner is not None:
             done = serial_map(fmu_path, evaluate, points, update, runner=runner)
         elif parallel:
-            # Deferred: dask is imported only where a sweep runs on a pool (start-up time).
-            from .distributed import FmuPool
-
-            with FmuPool(fmu_path, workers, scheduler) as own_pool:
+            with start_pool(fmu_path, workers, scheduler) as own_pool:
                 done = own_pool.map(evaluate, points, update)
         else:
             done = serial_map(fmu_path, evaluate, points, update)

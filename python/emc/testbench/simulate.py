@@ -96,7 +96,7 @@ def points(grid: Grid, parameters: dict, configuration: str | None,
 
 
 class Simulator:
-    """Runs sets of points on a pool (``FmuPool``) or on one instance here; counts the points
+    """Runs sets of points on a pool (:class:`emc.running.batches.BatchPool`) or on one instance here; counts the points
     and the CPU time of the evaluations."""
 
     def __init__(self, fmu: str, pool=None):
