@@ -1,7 +1,7 @@
 #!/usr/bin/env bash
 # Builds everything, packages the FMU and runs the demo speed sweep of the engine in the elastic
 # chassis (scene 2): 800–2500 rpm, 18 points, each started on its periodic steady state and
-# analysed over 8 revolutions (4 working cycles: every half order on a bin), in parallel with Dask,
+# analysed over 8 revolutions (4 working cycles: every half order on a bin), on two local workers,
 # at the nominal damping and at the two bounds of the damping band (--band). Tables and the
 # waterfall, order-cut and comfort plots (with the band) go to out/demo/.
 set -euo pipefail

@@ -166,8 +166,8 @@ def _fail(message):
 
 
 def test_figures_drawn_side_by_side_write_every_file_and_report_a_failure(tmp_path):
-    """draw_all forks a process per figure beyond the first: every job's file is written, and a
-    job that fails in a child process comes back as an error naming its cause."""
+    """draw_all forks processes for the jobs beyond the first: every job's file is written, and
+    a job that fails, here or in a child process, comes back as an error naming its cause."""
     import functools
 
     from emc.figures import draw_all
@@ -177,5 +177,14 @@ def test_figures_drawn_side_by_side_write_every_file_and_report_a_failure(tmp_pa
     assert [(tmp_path / f"{k}.txt").read_text() for k in range(3)] == ["0", "1", "2"]
     with pytest.raises(RuntimeError, match="ValueError: the third figure"):
         draw_all([jobs[0], jobs[1], functools.partial(_fail, "the third figure")])
-    with pytest.raises(ValueError, match="the first figure"):  # this process's own share
+    with pytest.raises(RuntimeError, match="ValueError: the first figure"):  # this process's
         draw_all([functools.partial(_fail, "the first figure"), jobs[1]])
+    # More jobs than processes: a failed job does not keep the others of its process from
+    # writing, and every failure is named.
+    many = [functools.partial(_write, tmp_path / f"m{k}.txt", str(k)) for k in range(8)]
+    many[1] = functools.partial(_fail, "job one")
+    many[0] = functools.partial(_fail, "job zero")
+    with pytest.raises(RuntimeError) as failed:
+        draw_all(many)
+    assert "ValueError: job zero" in str(failed.value) and "ValueError: job one" in str(failed.value)
+    assert all((tmp_path / f"m{k}.txt").read_text() == str(k) for k in range(2, 8))

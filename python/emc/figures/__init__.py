@@ -34,53 +34,62 @@ def preload_figures() -> None:
 
 
 def _draw(jobs, report=None):
-    try:
-        for job in jobs:
+    """Runs every job of a group, also after one failed (each writes files of its own); the
+    failures go to ``report`` (a child's pipe) or are raised here."""
+    errors = []
+    for job in jobs:
+        try:
             job()
-    except BaseException as error:  # noqa: BLE001 - reported to the parent, which raises it
-        if report is None:
-            raise
-        report.send(f"{type(error).__name__}: {error}")
-    else:
-        if report is not None:
-            report.send(None)
+        except BaseException as error:  # noqa: BLE001 - reported to the parent, which raises it
+            if report is None and not isinstance(error, Exception):
+                raise
+            errors.append(f"{type(error).__name__}: {error}")
+    if report is not None:
+        report.send("; ".join(errors) or None)
+    elif errors:
+        raise RuntimeError("writing the results failed: " + "; ".join(errors))
 
 
 def draw_all(jobs: list[Callable[[], None]]) -> None:
-    """Runs figure-drawing ``jobs`` (each draws and writes its own files) side by side: a
-    figure costs 0.15–0.5 s of one core (laying out and rasterising), so on Linux all but one
-    are drawn in forked processes while this one draws the first; serially where there is one
-    core, one job, or no fork. A failed job is raised here with its message."""
+    """Runs ``jobs`` that write a command's results (figures, tables; each writes files of its
+    own) side by side: a figure costs 0.15–0.5 s of one core (laying out and rasterising), a
+    48-point sweep's spectrum table 0.15 s, so on Linux this process runs the first job (give
+    it the costliest) while forked processes run the others; serially where there is one core,
+    one job, or no fork. Every job runs even where another fails; a failure is raised here with
+    its message."""
     while _PRELOAD:
         _PRELOAD.pop().join()
     cores = len(os.sched_getaffinity(0)) if hasattr(os, "sched_getaffinity") else 1
     if cores == 1 or len(jobs) < 2 or not sys.platform.startswith("linux"):
         _draw(jobs)
         return
-    # A process per figure, up to two per core: figures differ in cost, and more processes than
-    # cores share the cores out among them. A sweep's three figures on two cores, five runs each:
-    # 0.35-0.51 s in three processes, 0.35-0.54 s in two, 0.54-0.67 s in this one alone.
-    shares = min(len(jobs), 2 * cores)
+    # The other jobs in processes of their own, up to two per core: jobs differ in cost, and
+    # more processes than cores share the cores out among them. A sweep's three figures on two
+    # cores, five runs each: 0.35-0.51 s in three processes, 0.35-0.54 s in two, 0.54-0.67 s in
+    # this one alone.
+    others = jobs[1:]
+    shares = min(len(others), 2 * cores - 1)
     fork = multiprocessing.get_context("fork")
-    groups = [jobs[k::shares] for k in range(shares)]
     children = []
-    for group in groups[1:]:
+    for group in (others[k::shares] for k in range(shares)):
         reader, writer = fork.Pipe(duplex=False)
         child = fork.Process(target=_draw, args=(group, writer), daemon=True)
         child.start()
         writer.close()
         children.append((child, reader))
+    errors = []
     try:
-        _draw(groups[0])
+        _draw(jobs[:1])
+    except Exception as error:  # noqa: BLE001 - reported with the children's, once they end
+        errors.append(str(error).removeprefix("writing the results failed: "))
     finally:
-        errors = []
         for child, reader in children:
             try:
                 error = reader.recv()
             except EOFError:
-                error = "a figure process ended without a word"
+                error = "a process writing results ended without a word"
             child.join()
             if error is not None:
                 errors.append(error)
     if errors:
-        raise RuntimeError("drawing the figures failed: " + "; ".join(errors))
+        raise RuntimeError("writing the results failed: " + "; ".join(errors))

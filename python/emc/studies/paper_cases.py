@@ -13,7 +13,7 @@ from ..base.fmu import highest_speed, model_variables, units_of
 from ..base.outputs import claim, reduction_notice, safe_name, save, warn_cases, write_metadata
 from ..figures import draw_all, preload_figures
 from ..running.engine import point_engine
-from ..running.sweep_cases import sweep_cases
+from ..running.sweep_cases import sweep_cases, table_jobs
 from ..signals.comfort import comfort_table
 
 STUDY_CASES = {
@@ -93,7 +93,7 @@ def run_study(args, cases: dict) -> int:
         save(exposure, str(out / f"comfort{suffix}"))
         jobs.append(functools.partial(plots.comfort, exposure, str(out / "comfort.png"),
                                       cases=list(cases)))
-    draw_all(jobs)
+    draw_all(jobs[:1] + table_jobs(args, out, orders, spectra) + jobs[1:])
     if not exposure.empty:
         comfort_summary = exposure.groupby("case", sort=False)[["wheel_ahv", "seat_av_comfort"]]
         print("weighted steering-wheel a_hv and seat a_v [m/s²], mean and maximum over the speeds:")
