@@ -99,6 +99,31 @@ def test_a_failure_on_a_local_pool_cancels_the_rest_and_stops_its_busy_worker(fm
     assert len(processes) == 2 and not any(p.is_alive() for p in processes)
 
 
+def test_an_engine_gives_the_same_points_here_and_on_a_pool_and_counts_them(fmu_path):
+    import functools
+
+    from emc.running.engine import PointEngine
+    from emc.running.sweep import sweep_point
+
+    points = speed_points(1000, 2000, 3, revolutions=2, parameters=(("scene", 1),))
+    evaluate = functools.partial(sweep_point, signals=["mount[1].F[3]"], case="")
+    here = PointEngine.on(str(fmu_path))
+    try:
+        serial = here.map(evaluate, points)
+    finally:
+        here.close()
+    with LocalPool(str(fmu_path), workers=2) as pool:
+        on_pool = PointEngine.on(str(fmu_path), pool)
+        parallel = on_pool.map(evaluate, points) + on_pool.map(evaluate, points[:1])
+        on_pool.close()
+        assert pool.map(_where, [0])  # the engine leaves the pool open
+    assert here.runner is None and here.points == 3 and here.cpu_s > 0
+    assert on_pool.points == 4 and on_pool.cpu_s > 0
+    for (a, _), (b, _) in zip(serial + serial[:1], parallel):
+        assert np.array_equal(a.order_amplitude, b.order_amplitude)
+        assert np.array_equal(a.amplitude, b.amplitude)
+
+
 def test_a_worker_that_dies_is_reported_with_how_it_ended(fmu_path):
     with LocalPool(str(fmu_path), workers=2) as pool:
         with pytest.raises(WorkerLost, match="exit code 7"):

@@ -28,7 +28,8 @@ from emc.studies.mount_study import base_configuration
 from emc.testbench import metrics, parameters
 from emc.testbench.mapping import load
 from emc.testbench.measurement import MeasurementError, read_csv, read_modes, read_uff_functions
-from emc.testbench.simulate import Grid, Simulator, points
+from emc.running.engine import PointEngine
+from emc.testbench.simulate import Grid, evaluate, points
 from emc.testbench.synthetic import twin_measurement
 
 OUTPUTS = {"steeringWheel.a[3]": "m/s2", "seat.a[3]": "m/s2", "mount[1].F[3]": "N",
@@ -348,13 +349,14 @@ def test_the_folded_configuration_gives_the_fmus_own_scales(tmp_path, fmu_path):
     folded = parameters.configuration_text(parameters.apply(base, chosen, theta, True))
     grid = Grid((1100.0,), ("steeringWheel.a[3]", "mount[1].F[3]", "mount[3].F[1]"),
                 (1.0, 1.5, 3.0))
-    simulator = Simulator(str(fmu_path))
+    engine = PointEngine.on(str(fmu_path))
     try:
-        by_inputs, by_file = simulator.run(
+        by_inputs, by_file = engine.map(
+            evaluate,
             points(grid, {"scene": 2, **parameters.fmu_values(chosen, theta)}, None, 2)
             + points(grid, {"scene": 2}, folded, 2))
     finally:
-        simulator.close()
+        engine.close()
     assert np.max(np.abs(by_inputs)) > 0
     np.testing.assert_allclose(by_file, by_inputs, rtol=1e-4, atol=1e-6 * np.abs(by_inputs).max())
 
@@ -368,14 +370,15 @@ def test_rates_and_table_ordinates_are_the_fmus_own_scales(fmu_path):
                                    + ["body.damping.table[1]"], 4)
     config = parameters.apply(base, in_file, [0.8, 0.8, 0.8, 1.5], fold_inputs=False)
     grid = Grid((1100.0,), ("steeringWheel.a[3]", "mount[2].F[3]"), (1.5, 3.0))
-    simulator = Simulator(str(fmu_path))
+    engine = PointEngine.on(str(fmu_path))
     try:
-        by_inputs, by_file = simulator.run(
+        by_inputs, by_file = engine.map(
+            evaluate,
             points(grid, {"scene": 2, "mount[2].stiffnessScale": 0.8,
                           "chassis.modalDampingScale": 1.5}, None, 2)
             + points(grid, {"scene": 2}, parameters.configuration_text(config), 2))
     finally:
-        simulator.close()
+        engine.close()
     np.testing.assert_allclose(by_file, by_inputs, rtol=1e-4, atol=1e-6 * np.abs(by_inputs).max())
     with pytest.raises(parameters.ParameterError, match=r"table\[2\].*has 1 point"):
         parameters.apply(base, parameters.parse_all(["body.damping.table[2]"], 4), [1.2], False)

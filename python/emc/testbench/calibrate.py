@@ -61,10 +61,11 @@ from ..base.outputs import claim, write_metadata
 from ..figures import plots
 from ..running import band as bands
 from ..running.band import band_metadata
+from ..running.engine import PointEngine
 from ..studies.mount_study import Store, StudyError, base_configuration
 from . import parameters as params
 from .correlate import Setup, cuts_table, metrics_table, open_pool, overlay_figure, run_sets, safe
-from .simulate import Grid, Simulator
+from .simulate import Grid
 
 STEP = 0.005              # forward-difference step of the log factors
 NOT_TOLD_APART = 0.95     # |correlation| above which two parameters trade off
@@ -144,9 +145,9 @@ class Evaluations:
     """The simulated order components of parameter sets, from the store or run (all missing
     sets of a call together on the pool) and stored."""
 
-    def __init__(self, problem: Problem, simulator: Simulator, store: Store,
+    def __init__(self, problem: Problem, engine: PointEngine, store: Store,
                  progress: bool = True):
-        self.problem, self.simulator, self.store = problem, simulator, store
+        self.problem, self.engine, self.store = problem, engine, store
         self.progress = progress
         self.run_now = 0      # parameter sets simulated by this process
         self.calls = 0        # parameter sets asked for (the store's included)
@@ -160,7 +161,7 @@ class Evaluations:
         if missing:
             began = time.perf_counter()
             sets = [self.problem.start(theta) for theta in missing]
-            done = run_sets(self.simulator, self.problem.grid, sets, self.problem.revolutions,
+            done = run_sets(self.engine, self.problem.grid, sets, self.problem.revolutions,
                             True, "calibrate")
             seconds = (time.perf_counter() - began) / len(missing)
             for theta, sim in zip(missing, done):
@@ -361,8 +362,8 @@ def cmd_calibrate(args) -> int:
               "continues from them", file=sys.stderr)
     started = time.perf_counter()
     pool = open_pool(args, setup.parameters)
-    simulator = Simulator(args.fmu, pool)
-    evaluations = Evaluations(problem, simulator, store, not args.quiet)
+    engine = PointEngine.on(args.fmu, pool)
+    evaluations = Evaluations(problem, engine, store, not args.quiet)
     try:
         result = fit(problem, evaluations, args.max_evaluations)
         fitted = time.perf_counter() - started
@@ -370,12 +371,12 @@ def cmd_calibrate(args) -> int:
         theta = result["theta"]
         nominal, calibrated = evaluations([np.ones(len(chosen)), theta])
         start, config = problem.start(theta)
-        low, high = run_sets(simulator, setup.grid,
+        low, high = run_sets(engine, setup.grid,
                              [(band.applied(start, "low"), config),
                               (band.applied(start, "high"), config)],
                              args.revolutions, True, "band")
     finally:
-        simulator.close()
+        engine.close()
         if pool is not None:
             pool.close()
     elapsed = time.perf_counter() - started
@@ -383,7 +384,7 @@ def cmd_calibrate(args) -> int:
     write_results(args, setup, problem, result, band, sims, base, out,
                   {"seconds_fit": fitted, "seconds_total": elapsed,
                    "parameter_sets_run_now": evaluations.run_now,
-                   "points_run_now": simulator.points, "cpu_seconds_points": simulator.cpu})
+                   "points_run_now": engine.points, "cpu_seconds_points": engine.cpu_s})
     return 0
 
 

@@ -36,12 +36,13 @@ from ..base.outputs import claim, reduction_notice, safe_name, write_metadata
 from ..figures import plots
 from ..running import band as bands
 from ..running.band import band_metadata
-from ..running import engine
+from ..running.engine import PointEngine
+from ..running.engine import open_pool as open_command_pool
 from ..running.modal import body_point_of, export_from_fmu
 from ..running.runner import progress_bar
 from . import metrics
 from .mapping import Mapping, MeasurementError, load
-from .simulate import Grid, Simulator, grid_of, points
+from .simulate import Grid, evaluate, grid_of, points
 
 # The most speeds simulated without --speeds (each costs one point per parameter set).
 MAX_SPEEDS = 120
@@ -95,10 +96,10 @@ class Setup:
 
 def open_pool(args, parameters: dict):
     """The pool of a correlation or calibration (a study of many points), or None: serial."""
-    return engine.open_pool(args, POOL_FROM, [parameters])
+    return open_command_pool(args, POOL_FROM, [parameters])
 
 
-def run_sets(simulator: Simulator, grid: Grid, sets: list[tuple[dict, str | None]],
+def run_sets(engine: PointEngine, grid: Grid, sets: list[tuple[dict, str | None]],
              revolutions: int, quiet: bool, what: str) -> list[np.ndarray]:
     """Each (start values, configuration) over the grid's speeds, every point of every set in
     one map; per set an array (speeds, orders, signals)."""
@@ -106,7 +107,7 @@ def run_sets(simulator: Simulator, grid: Grid, sets: list[tuple[dict, str | None
                                                                revolutions)]
     bar = progress_bar(len(items), what, not quiet, unit="point")
     try:
-        done = simulator.run(items, None if bar is None else bar.update)
+        done = engine.map(evaluate, items, None if bar is None else bar.update)
     finally:
         if bar is not None:
             bar.close()
@@ -311,13 +312,13 @@ def cmd_correlate(args) -> int:
         bounds = bands.bounds_of(band)
         sets = [(bands.settings_at(band, setup.parameters, b), None) for b in bounds]
         pool = open_pool(args, setup.parameters)
-        simulator = Simulator(args.fmu, pool)
+        engine = PointEngine.on(args.fmu, pool)
         seconds["start"] = time.perf_counter() - started
         try:
-            sims = dict(zip(bounds, run_sets(simulator, setup.grid, sets, args.revolutions,
+            sims = dict(zip(bounds, run_sets(engine, setup.grid, sets, args.revolutions,
                                              args.quiet, "correlate")))
         finally:
-            simulator.close()
+            engine.close()
             if pool is not None:
                 pool.close()
         seconds["simulation"] = time.perf_counter() - started - seconds["start"]

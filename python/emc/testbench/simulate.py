@@ -1,6 +1,6 @@
 """The simulated counterpart of a measurement: the complex order components of the mapped
-outputs at the measured speeds, for given FMU start values (and vehicle configuration), on the
-Dask pool or here.
+outputs at the measured speeds, for given FMU start values (and vehicle configuration), on a
+:class:`emc.running.engine.PointEngine` (a pool, or one instance here).
 
 Each speed is one constant-speed point on its periodic steady state (``initialization.periodic``):
 the window of whole working cycles that follows gives every half order on a DFT bin
@@ -11,7 +11,6 @@ the run, crank angle ``crank.startAngle``).
 from __future__ import annotations
 
 import dataclasses
-import time
 
 import numpy as np
 
@@ -93,35 +92,3 @@ def points(grid: Grid, parameters: dict, configuration: str | None,
            revolutions: int) -> list[Point]:
     return [Point(rpm, tuple(parameters.items()), configuration, grid.signals, grid.orders,
                   revolutions) for rpm in grid.speeds]
-
-
-class Simulator:
-    """Runs sets of points on a pool (:class:`emc.running.batches.BatchPool`) or on one instance here; counts the points
-    and the CPU time of the evaluations."""
-
-    def __init__(self, fmu: str, pool=None):
-        self.fmu, self.pool = fmu, pool
-        self.runner = None if pool is not None else Runner(fmu)
-        self.points = 0
-        self.cpu = 0.0
-
-    def run(self, items: list[Point], progress=None) -> list[np.ndarray]:
-        if not items:
-            return []
-        if self.pool is not None:
-            results = self.pool.map(evaluate, items, progress)
-            self.cpu += self.pool.last_map.anatomy(self.pool.workers)["cpu_s"]
-        else:
-            start = time.process_time()
-            results = []
-            for item in items:
-                results.append(evaluate(self.runner, item))
-                if progress is not None:
-                    progress(1)
-            self.cpu += time.process_time() - start
-        self.points += len(items)
-        return results
-
-    def close(self):
-        if self.runner is not None:
-            self.runner.close()

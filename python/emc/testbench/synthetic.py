@@ -14,8 +14,9 @@ import pathlib
 import numpy as np
 import pyuff
 
+from ..running.engine import PointEngine
 from . import units
-from .simulate import Grid, Simulator, points
+from .simulate import Grid, evaluate, points
 
 # The response nodes the synthetic files give each output (a test rig's numbering).
 NODES = {"steeringWheel": 101, "seat": 201}
@@ -127,11 +128,11 @@ def twin_measurement(fmu: str, folder, truth: dict, outputs: list[str], orders: 
     folder.mkdir(parents=True, exist_ok=True)
     grid = Grid(tuple(float(s) for s in speeds), tuple(outputs), tuple(orders))
     start = {"scene": 2, **(parameters or {}), **truth}
-    simulator = Simulator(fmu, pool)
+    engine = PointEngine.on(fmu, pool)
     try:
-        simulated = np.array(simulator.run(points(grid, start, None, revolutions)))
+        simulated = np.array(engine.map(evaluate, points(grid, start, None, revolutions)))
     finally:
-        simulator.close()
+        engine.close()
     rng = np.random.default_rng(seed)
     cuts = []
     for j, output in enumerate(outputs):
