@@ -6,19 +6,32 @@
 set -euo pipefail
 root=$(cd "$(dirname "$0")/.." && pwd)
 cd "$root"
+# Each phase says how long it took (CI time is a budget: where it goes is in every log).
+phase_start=$SECONDS
+phase() {
+  echo "== test.sh: $1 took $((SECONDS - phase_start)) s (total $SECONDS s)"
+  phase_start=$SECONDS
+}
 bash scripts/setup.sh --tests
+phase "setup"
 
 cargo fmt --all -- --check
 cargo clippy --release --all-targets -- -D warnings
+phase "fmt and clippy"
 # The ABI tests dlopen the cdylib, which `cargo test` does not build.
 cargo build --release
 cargo test --release
+phase "cargo build and test"
 # The API documentation must build without broken intra-doc links.
 RUSTDOCFLAGS="-D rustdoc::broken_intra_doc_links" cargo doc --release --no-deps
 # The user guide (docs/book/); test_docs.py builds it again into a temporary folder to check it.
 mdbook build docs
+phase "cargo doc and the guide"
 
 if [ -d python/tests ] && ls python/tests/test_*.py >/dev/null 2>&1; then
   bash packaging/package.sh
-  .venv/bin/python -m pytest -q python/tests
+  phase "packaging"
+  # The slowest tests are listed: the place to look when the suite grows.
+  .venv/bin/python -m pytest -q --durations=15 python/tests
+  phase "pytest"
 fi

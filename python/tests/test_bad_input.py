@@ -264,8 +264,12 @@ def test_ctrl_c_during_a_study_on_local_workers_prints_one_line(tmp_path, fmu_pa
                "--var", "mount[1].stiffnessScale", "--method", "sobol", "--samples", "64",
                "--rpm", "1000", "1600", "--count", "3", "--revolutions", "2", "--quiet",
                "--workers", "2", "--out", str(tmp_path / "doe")]
+    # As a terminal runs a command in the foreground: with SIGINT at its default. A runner that
+    # starts the tests as a background job hands them SIGINT ignored, which a child inherits
+    # and Python then keeps (such a command is not meant to stop on the terminal's Ctrl-C).
     process = subprocess.Popen(command, stdout=subprocess.PIPE, stderr=subprocess.PIPE,
-                               text=True, start_new_session=True)
+                               text=True, start_new_session=True,
+                               preexec_fn=lambda: signal.signal(signal.SIGINT, signal.SIG_DFL))
     deadline = time.monotonic() + 120
     store = tmp_path / "doe" / "evaluations.jsonl"
     # Interrupted once designs are being evaluated on the pool.

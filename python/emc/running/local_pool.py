@@ -16,8 +16,10 @@ import hashlib
 import multiprocessing
 import os
 import signal
+import time
 from concurrent.futures import FIRST_COMPLETED, ProcessPoolExecutor, wait
 from concurrent.futures.process import BrokenProcessPool
+from multiprocessing import connection
 from typing import Callable, Iterable
 
 from ..base.errors import WorkerLost
@@ -74,10 +76,12 @@ class LocalPool(BatchPool):
             self.count, mp_context=context, initializer=_start_worker,
             initargs=(self.sha256, path, warm_with, self._started))
         self._futures: list = []
+        self._workers: dict = {}
         # The first task starts every worker now, from this thread (a forked pool starts them
         # all at once); each makes its instance while this process goes on.
         with sigint_ignored():
             self._futures.append(self.executor.submit(os.getpid))
+        self._know_workers()
 
     @property
     def workers(self) -> int:
@@ -98,7 +102,15 @@ class LocalPool(BatchPool):
     def _submit(self, function: Callable, *args):
         future = self.executor.submit(function, *args)
         self._futures = [f for f in self._futures if not f.done()] + [future]
+        self._know_workers()
         return future
+
+    def _know_workers(self):
+        """Keeps a hand on every worker process the executor started: it forgets them when a
+        worker dies (the pool is then broken), and they say how it ended. The executor's own
+        record (Python 3.11 has no public one; 3.14's terminate_workers stops them)."""
+        for pid, process in (getattr(self.executor, "_processes", None) or {}).items():
+            self._workers.setdefault(pid, process)
 
     def _completed(self, futures: Iterable):
         """The futures as they finish; those found finished together in the order they were
@@ -120,8 +132,10 @@ class LocalPool(BatchPool):
             future.cancel()
 
     def _exit_codes(self) -> str:
-        processes = getattr(self.executor, "_processes", None) or {}
-        codes = [p.exitcode for p in processes.values() if p.exitcode is not None]
+        """How the lost worker ended. Once one is lost the executor terminates the others
+        (SIGTERM): those are named only where nothing else is known."""
+        codes = [code for code in map(_exit_code, self._workers.values()) if code is not None]
+        codes = sorted(set(c for c in codes if c != -signal.SIGTERM) or set(codes))
         return ", ".join(f"exit code {c}" if c >= 0 else f"signal {-c}" for c in codes) or \
             "exit code unknown"
 
@@ -131,12 +145,26 @@ class LocalPool(BatchPool):
         if all(future.done() for future in self._futures):
             self.executor.shutdown(wait=True)
             return
-        # The executor's own processes: Python 3.11 has no public way to stop a busy worker
-        # (3.14's terminate_workers does this).
-        processes = list((getattr(self.executor, "_processes", None) or {}).values())
+        processes = list(self._workers.values())
         self.executor.shutdown(wait=False, cancel_futures=True)
         for process in processes:
-            if process.is_alive():
-                process.terminate()
-        for process in processes:
-            process.join(timeout=5)
+            process.terminate()  # nothing where it has ended
+        # Ended once their sentinels say so (the executor's thread reaps them).
+        running = [process.sentinel for process in processes]
+        deadline = time.monotonic() + 5
+        while running and time.monotonic() < deadline:
+            ended = connection.wait(running, timeout=deadline - time.monotonic())
+            running = [sentinel for sentinel in running if sentinel not in ended]
+
+
+def _exit_code(process) -> int | None:
+    """A worker's exit code (negative: the signal that ended it), None while it runs. The
+    executor's own thread reaps its workers too: a poll between its reaping and its recording
+    the code finds none, so a process that has ended is asked again for a while."""
+    if not connection.wait([process.sentinel], timeout=1):
+        return None
+    for _ in range(100):
+        if process.exitcode is not None:
+            return process.exitcode
+        time.sleep(0.01)
+    return None
