@@ -53,7 +53,7 @@ from ..base.errors import UsageError
 from ..base.fmu import check_config_file, highest_speed, model_variables, mount_count
 from ..base.options import POOL_FROM
 from ..base.outputs import claim
-from ..running.engine import open_pool
+from ..running.engine import PointEngine, open_pool
 from ..running.runner import OperatingPoint, PointFailed, Runner
 from ..running.sweep import analyse, speed_points, tables
 from ..signals.comfort import SEAT, WHEEL, comfort_table
@@ -358,24 +358,15 @@ class Evaluator:
                  progress=None):
         self.problem, self.fmu_path, self.store = problem, fmu_path, store
         self.mounts, self.pool, self.progress = mounts, pool, progress
-        self.runner = None if pool is not None else Runner(fmu_path)
+        self.engine = PointEngine.on(fmu_path, pool)
         self.evaluated = 0  # designs run by this evaluator (not read from the store)
 
     def close(self):
-        if self.runner is not None:
-            self.runner.close()
+        self.engine.close()
 
     def run_all(self, items: list, progress=None) -> list:
         """The results of FMU runs (:class:`Run`), on the pool or here, in order."""
-        evaluate = functools.partial(run, mounts=self.mounts)
-        if self.pool is not None:
-            return self.pool.map(evaluate, items, progress)
-        results = []
-        for item in items:
-            results.append(evaluate(self.runner, item))
-            if progress is not None:
-                progress(1)
-        return results
+        return self.engine.map(functools.partial(run, mounts=self.mounts), items, progress)
 
     def __call__(self, designs, chunk: int | None = None) -> list[dict]:
         """The records of ``designs`` (rows of the variables' values), stored ones read, the
