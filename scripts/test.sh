@@ -20,17 +20,25 @@ cargo clippy --release --all-targets -- -D warnings
 phase "fmt and clippy"
 # The ABI tests dlopen the cdylib, which `cargo test` does not build.
 cargo build --release
+has_python_tests=false
+if [ -d python/tests ] && ls python/tests/test_*.py >/dev/null 2>&1; then
+  has_python_tests=true
+  # Packaged before `cargo test`, from the build just made: the crate's rlib has one file name
+  # whatever the features of its dependencies, and a build with the dev-dependencies' features
+  # (tests, examples) and one without (the package) each rebuild the crate over the other
+  # (80-90 s each time: the test of the DMIG writer runs an example after packaging).
+  bash packaging/package.sh
+fi
+phase "cargo build and packaging"
 cargo test --release
-phase "cargo build and test"
+phase "cargo test"
 # The API documentation must build without broken intra-doc links.
 RUSTDOCFLAGS="-D rustdoc::broken_intra_doc_links" cargo doc --release --no-deps
 # The user guide (docs/book/); test_docs.py builds it again into a temporary folder to check it.
 mdbook build docs
 phase "cargo doc and the guide"
 
-if [ -d python/tests ] && ls python/tests/test_*.py >/dev/null 2>&1; then
-  bash packaging/package.sh
-  phase "packaging"
+if $has_python_tests; then
   # The slowest tests are listed: the place to look when the suite grows.
   .venv/bin/python -m pytest -q --durations=15 python/tests
   phase "pytest"
