@@ -353,7 +353,8 @@ def cmd_scaling(args) -> int:
     load = os.getloadavg()
     print(f"load average after: {load[0]:.2f} / {load[1]:.2f} / {load[2]:.2f}")
     show_table(table, ["pool", "workers", "threads", "batching", "start_s", "warm_s",
-                       "run s (min-max)", "speed-up", "points_per_s", "cpu_s", "cpu_ratio", "task_cpu_ratio",
+                       "run s (min-max)", "speed-up", "points_per_s", "cpu_s", "cpu_ratio",
+                       "task_cpu_ratio",
                        "batches", "busy", "first_s", "tail_s", "identical"],
                "speed-up: against the serial loop (best; worst); cpu_ratio: the CPU time of every "
                "process against the serial loop's; task_cpu_ratio: that of the evaluations alone "
@@ -375,7 +376,8 @@ def cmd_scheduling(args) -> int:
     table = scheduling_table(args.fmu, scaled, args.workers, args.repeat, args.batching,
                              pools=args.pool)
     show_table(table, ["pool", "workers", "batching", "start_s", "run s (min-max)", "ideal_s",
-                       "speed-up", "efficiency", "pool_cpu_s", "batches", "busy", "first_s", "tail_s"],
+                       "speed-up", "efficiency", "pool_cpu_s", "batches", "busy", "first_s",
+                       "tail_s"],
                "speed-up: the sum of the waits over the run's wall time (best; worst); "
                "efficiency: of the ideal sum / workers; pool_cpu_s: CPU time of every process "
                "during the run (the pool's own work, the waits use none)", args.csv, len(points))

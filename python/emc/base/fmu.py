@@ -5,6 +5,7 @@ outputs, how many mounts it has, the signals a sweep records, and which configur
 from __future__ import annotations
 
 import difflib
+import hashlib
 import pathlib
 import platform
 import re
@@ -22,6 +23,15 @@ CUTOFF_IN_USE = "chassis.modeCutoffInUse"
 ENGINE = "EngineMountChassis"
 BODY = "EngineMountBody"
 KIND = {ENGINE: "the engine FMU", BODY: "the body FMU"}
+
+
+def file_sha256(path) -> str:
+    """The SHA-256 of a file's content (an FMU, a configuration), read in blocks."""
+    digest = hashlib.sha256()
+    with open(path, "rb") as f:
+        for block in iter(lambda: f.read(1 << 20), b""):
+            digest.update(block)
+    return digest.hexdigest()
 
 
 def binaries_folder() -> str:

@@ -18,7 +18,6 @@ anything runs, and :func:`claim`, where the command starts writing):
 from __future__ import annotations
 
 import datetime
-import hashlib
 import json
 import os
 import pathlib
@@ -29,7 +28,7 @@ import time
 from importlib import metadata as importlib_metadata
 
 from .errors import UsageError
-from .fmu import start_value
+from .fmu import file_sha256, start_value
 
 # Options that change where or how fast results are made, not what they are.
 NOT_SETTINGS = {"out", "quiet", "workers", "scheduler", "serial", "overwrite", "func",
@@ -251,8 +250,7 @@ def write_metadata(out: pathlib.Path, args, variables: dict, cases: list[tuple[s
     from fmpy import read_model_description
 
     fmu = args.fmu
-    with open(fmu, "rb") as f:
-        digest = hashlib.sha256(f.read()).hexdigest()
+    digest = file_sha256(fmu)
     md = read_model_description(fmu)
 
     def non_default(parameters: dict) -> dict:

@@ -33,21 +33,21 @@ def preload_figures() -> None:
     _PRELOAD.append(thread)
 
 
-def _draw(jobs, report=None):
-    """Runs every job of a group, also after one failed (each writes files of its own); the
-    failures go to ``report`` (a child's pipe) or are raised here."""
+def _run(jobs, catch=Exception) -> list[str]:
+    """Runs every job of a group, also after one failed (each writes files of its own); returns
+    the failures (``catch``: what counts as one; anything else is raised)."""
     errors = []
     for job in jobs:
         try:
             job()
-        except BaseException as error:  # noqa: BLE001 - reported to the parent, which raises it
-            if report is None and not isinstance(error, Exception):
-                raise
+        except catch as error:  # noqa: BLE001 - reported with the others' failures
             errors.append(f"{type(error).__name__}: {error}")
-    if report is not None:
-        report.send("; ".join(errors) or None)
-    elif errors:
-        raise RuntimeError("writing the results failed: " + "; ".join(errors))
+    return errors
+
+
+def _run_in_child(jobs, report):
+    """A forked process's group: every failure, an interrupt included, goes to the parent."""
+    report.send("; ".join(_run(jobs, BaseException)) or None)
 
 
 def draw_all(jobs: list[Callable[[], None]]) -> None:
@@ -55,41 +55,39 @@ def draw_all(jobs: list[Callable[[], None]]) -> None:
     own) side by side: a figure costs 0.15–0.5 s of one core (laying out and rasterising), a
     48-point sweep's spectrum table 0.15 s, so on Linux this process runs the first job (give
     it the costliest) while forked processes run the others; serially where there is one core,
-    one job, or no fork. Every job runs even where another fails; a failure is raised here with
-    its message."""
+    one job, or no fork. Every job runs even where another fails; the failures are raised here
+    with their messages."""
     while _PRELOAD:
         _PRELOAD.pop().join()
     cores = len(os.sched_getaffinity(0)) if hasattr(os, "sched_getaffinity") else 1
-    if cores == 1 or len(jobs) < 2 or not sys.platform.startswith("linux"):
-        _draw(jobs)
-        return
-    # The other jobs in processes of their own, up to two per core: jobs differ in cost, and
-    # more processes than cores share the cores out among them. A sweep's three figures on two
-    # cores, five runs each: 0.35-0.51 s in three processes, 0.35-0.54 s in two, 0.54-0.67 s in
-    # this one alone.
-    others = jobs[1:]
-    shares = min(len(others), 2 * cores - 1)
-    fork = multiprocessing.get_context("fork")
-    children = []
-    for group in (others[k::shares] for k in range(shares)):
-        reader, writer = fork.Pipe(duplex=False)
-        child = fork.Process(target=_draw, args=(group, writer), daemon=True)
-        child.start()
-        writer.close()
-        children.append((child, reader))
     errors = []
-    try:
-        _draw(jobs[:1])
-    except Exception as error:  # noqa: BLE001 - reported with the children's, once they end
-        errors.append(str(error).removeprefix("writing the results failed: "))
-    finally:
-        for child, reader in children:
-            try:
-                error = reader.recv()
-            except EOFError:
-                error = "a process writing results ended without a word"
-            child.join()
-            if error is not None:
-                errors.append(error)
+    if cores == 1 or len(jobs) < 2 or not sys.platform.startswith("linux"):
+        errors = _run(jobs)
+    else:
+        # The other jobs in processes of their own, up to two per core: jobs differ in cost,
+        # and more processes than cores share the cores out among them. A sweep's three
+        # figures on two cores, five runs each: 0.35-0.51 s in three processes, 0.35-0.54 s in
+        # two, 0.54-0.67 s in this one alone.
+        others = jobs[1:]
+        shares = min(len(others), 2 * cores - 1)
+        fork = multiprocessing.get_context("fork")
+        children = []
+        for group in (others[k::shares] for k in range(shares)):
+            reader, writer = fork.Pipe(duplex=False)
+            child = fork.Process(target=_run_in_child, args=(group, writer), daemon=True)
+            child.start()
+            writer.close()
+            children.append((child, reader))
+        try:
+            errors = _run(jobs[:1])
+        finally:
+            for child, reader in children:
+                try:
+                    error = reader.recv()
+                except EOFError:
+                    error = "a process writing results ended without a word"
+                child.join()
+                if error is not None:
+                    errors.append(error)
     if errors:
         raise RuntimeError("writing the results failed: " + "; ".join(errors))

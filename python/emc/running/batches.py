@@ -265,8 +265,8 @@ class BatchPool:
     def _cancel(self, futures: list):
         raise NotImplementedError
 
-    def map(self, evaluate: Callable, items: Iterable, progress: Callable[[int], None] | None = None,
-            batches: int | None = None) -> list:
+    def map(self, evaluate: Callable, items: Iterable,
+            progress: Callable[[int], None] | None = None, batches: int | None = None) -> list:
         """``evaluate(runner, item)`` for every item on the workers; the results in the order of
         ``items``. ``progress(n)`` is called with the number of items each finished batch held.
         ``batches``: that many equal batches for this map (else as the pool was made)."""

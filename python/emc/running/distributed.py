@@ -33,6 +33,7 @@ from dask.distributed import Client, LocalCluster, as_completed, get_worker
 from distributed.diagnostics.plugin import WorkerPlugin
 
 from ..base.errors import ClusterMismatch
+from ..base.fmu import file_sha256
 from .batches import (START_METHOD, BatchPool, forget_idle, serve_fmu, sigint_ignored,
                       warm_instances)
 from .runner import MALLOC_SETTINGS, fmu_from_content, keep_freed_memory
@@ -116,8 +117,7 @@ def identity_mismatches(local: dict, workers: dict[str, dict]) -> list[str]:
 def file_digest(path: str) -> str | None:
     """The SHA-256 of the file at ``path``, None if there is none."""
     try:
-        with open(path, "rb") as f:
-            return hashlib.sha256(f.read()).hexdigest()
+        return file_sha256(path)
     except OSError:
         return None
 

@@ -69,7 +69,7 @@ class PointEngine:
             self.cpu_s += self.pool.last_map.anatomy(self.pool.workers)["cpu_s"]
         else:
             started = time.process_time()
-            results = serial_map("", evaluate, items, progress, runner=self.runner)
+            results = serial_map(None, evaluate, items, progress, runner=self.runner)
             self.cpu_s += time.process_time() - started
         self.points += len(items)
         return results

@@ -12,7 +12,6 @@ kept as in every pool (:mod:`.batches`), so the numbers equal the serial ones to
 
 from __future__ import annotations
 
-import hashlib
 import multiprocessing
 import os
 import signal
@@ -23,8 +22,9 @@ from multiprocessing import connection
 from typing import Callable, Iterable
 
 from ..base.errors import WorkerLost
+from ..base.fmu import file_sha256
 from .batches import START_METHOD, BatchPool, serve_fmu, sigint_ignored, warm_instances
-from .runner import MALLOC_SETTINGS, extracted, keep_freed_memory
+from .runner import extracted, keep_freed_memory
 
 
 def _start_worker(sha256: str, path: str, warm_with: tuple | None, started):
@@ -34,7 +34,6 @@ def _start_worker(sha256: str, path: str, warm_with: tuple | None, started):
     which makes one again and reports the FMU's own message (a failure here would break the
     pool)."""
     signal.signal(signal.SIGINT, signal.SIG_IGN)
-    os.environ.update({name: str(value) for name, value in MALLOC_SETTINGS.items()})
     keep_freed_memory()
     serve_fmu(sha256, path)
     try:
@@ -43,14 +42,6 @@ def _start_worker(sha256: str, path: str, warm_with: tuple | None, started):
         pass
     finally:
         started.release()
-
-
-def file_sha256(path: str) -> str:
-    digest = hashlib.sha256()
-    with open(path, "rb") as f:
-        for block in iter(lambda: f.read(1 << 20), b""):
-            digest.update(block)
-    return digest.hexdigest()
 
 
 class LocalPool(BatchPool):

@@ -395,7 +395,7 @@ def cutoffs_on(runner: Runner, cases: list[tuple[str, dict]]) -> list[float | No
     return cutoffs_in_use("", cases, runner)
 
 
-def serial_map(fmu_path: str, evaluate: Callable, items: Iterable,
+def serial_map(fmu_path: str | None, evaluate: Callable, items: Iterable,
                progress: Callable[[int], None] | None = None,
                runner: Runner | None = None) -> list:
     """The same evaluations in this process, one instance reused (``runner`` if given)."""

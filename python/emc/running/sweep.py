@@ -1,12 +1,13 @@
-"""Constant-speed sweeps, serial or in parallel with Dask, into tidy tables.
+"""Constant-speed sweeps, serial or in parallel, into tidy tables.
 
-Parallel runs go through a pool (:func:`emc.running.engine.start_pool`): every worker keeps one FMU
-instance, reset between points, and takes the points in batches. The FMU is deterministic, so a parallel
-sweep gives exactly the numbers of a serial one.
+Parallel runs go through a pool (:func:`emc.running.engine.start_pool`): every worker keeps one
+FMU instance, reset between points, and takes the points in batches. The FMU is deterministic,
+so a parallel sweep gives exactly the numbers of a serial one.
 """
 
 from __future__ import annotations
 
+import contextlib
 import dataclasses
 import functools
 
@@ -16,8 +17,8 @@ import pandas as pd
 from ..base.fmu import default_signals
 from ..base.orders import HIGHEST_ORDER, ORDERS
 from ..signals.spectra import amplitude_spectrum, order_amplitudes
-from .engine import start_pool
-from .runner import OperatingPoint, Runner, progress_bar, serial_map
+from .engine import PointEngine, start_pool
+from .runner import OperatingPoint, Runner, progress_bar
 
 
 @dataclasses.dataclass
@@ -87,23 +88,22 @@ def run_sweep(fmu_path: str, points: list[OperatingPoint], signals: list[str] | 
               pool=None, runner: Runner | None = None) -> tuple[pd.DataFrame, pd.DataFrame]:
     """Runs the points; returns (order table, spectrum table). A failed point raises
     :class:`PointFailed` (with its rpm, case and FMU log); the FMU's warnings of the points that
-    succeeded are appended to ``warnings`` if given. ``pool``: a running pool (:class:`emc.running.batches.BatchPool`) of
-    this FMU (a study keeps one for all its sweeps); else ``runner``: an instance in this
-    process to run them on, one after the other; else, if ``parallel``, a pool is started for
-    this sweep (on ``scheduler``, or ``workers`` local processes) and closed after it."""
+    succeeded are appended to ``warnings`` if given. ``pool``: a running pool
+    (:class:`emc.running.batches.BatchPool`) of this FMU (a study keeps one for all its
+    sweeps); else ``runner``: an instance in this process to run them on, one after the other;
+    else, if ``parallel``, a pool is started for this sweep (on ``scheduler``, or ``workers``
+    local processes) and closed after it; else an instance of its own."""
     bar = progress_bar(len(points), case or "sweep", progress, unit="point")
     evaluate = functools.partial(sweep_point, signals=signals, case=case)
     update = None if bar is None else bar.update
     try:
-        if pool is not None:
-            done = pool.map(evaluate, points, update)
-        elif runner is not None:
-            done = serial_map(fmu_path, evaluate, points, update, runner=runner)
-        elif parallel:
-            with start_pool(fmu_path, workers, scheduler) as own_pool:
-                done = own_pool.map(evaluate, points, update)
-        else:
-            done = serial_map(fmu_path, evaluate, points, update)
+        with contextlib.ExitStack() as own:
+            if pool is None and runner is None:
+                if parallel:
+                    pool = own.enter_context(start_pool(fmu_path, workers, scheduler))
+                else:
+                    runner = own.enter_context(Runner(fmu_path))
+            done = PointEngine(runner=runner, pool=pool).map(evaluate, points, update)
     finally:
         if bar is not None:
             bar.close()

@@ -50,7 +50,8 @@ import pandas as pd
 from ..base.checks import (check_count, check_pool, check_range, check_revolutions, check_speeds,
                            name_and_bounds, parse_settings)
 from ..base.errors import UsageError
-from ..base.fmu import check_config_file, highest_speed, model_variables, mount_count
+from ..base.fmu import (check_config_file, file_sha256, highest_speed, model_variables,
+                        mount_count)
 from ..base.options import POOL_FROM
 from ..base.outputs import claim
 from ..running.engine import PointEngine, open_pool
@@ -447,8 +448,7 @@ def open_study(args, problem: Problem, mounts: int):
     """(store, evaluator, pool or None, progress bar or None) for the command's options; the
     caller closes the evaluator and the pool."""
 
-    with open(args.fmu, "rb") as f:
-        digest = hashlib.sha256(f.read()).hexdigest()
+    digest = file_sha256(args.fmu)
     try:
         store = Store(claim(args), digest, problem.settings())
     except StudyError as error:

@@ -56,7 +56,7 @@ from scipy.stats import t as student_t
 
 from ..base.checks import check_range
 from ..base.errors import UsageError
-from ..base.fmu import mount_count, units_of
+from ..base.fmu import file_sha256, mount_count, units_of
 from ..base.outputs import claim, write_metadata
 from ..figures import plots
 from ..running import band as bands
@@ -345,8 +345,7 @@ def cmd_calibrate(args) -> int:
     problem = Problem(grid=setup.grid, channels=setup.channels, parameters=chosen, fixed=fixed,
                       base=base, revolutions=args.revolutions, uncertainty=args.uncertainty,
                       phase=not args.no_phase)
-    with open(args.fmu, "rb") as f:
-        digest = hashlib.sha256(f.read()).hexdigest()
+    digest = file_sha256(args.fmu)
     used = sum(int(np.sum(np.abs(c.values) > c.floor)) for c in problem.channels)
     if used <= len(chosen):
         raise UsageError(f"{args.mapping}: {used} measured points above the noise floors "
